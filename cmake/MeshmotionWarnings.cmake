@@ -1,0 +1,7 @@
+# Warnings (as errors) for the project's own targets only; never pushed onto consumers.
+add_library(meshmotion_warnings INTERFACE)
+if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
+  target_compile_options(meshmotion_warnings INTERFACE
+    -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Werror)
+  # Eigen and nanoflann are system headers (-isystem), so these flags judge our code only.
+endif()

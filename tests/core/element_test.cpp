@@ -1,0 +1,80 @@
+#include "meshmotion/core/element.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <set>
+
+using namespace meshmotion;
+
+namespace {
+std::vector<ElementType> all_types() {
+  std::vector<ElementType> t;
+  for (int i = 0; i < num_element_types; ++i) t.push_back(static_cast<ElementType>(i));
+  return t;
+}
+}  // namespace
+
+TEST_CASE("element catalogue is consistent", "[core]") {
+  for (ElementType t : all_types()) {
+    INFO(name(t));
+    const auto& info = element_info(t);
+    CHECK(info.type == t);
+    CHECK(element_type_from_gmsh(info.gmsh_id) == t);
+    CHECK(element_type_from_name(info.name) == t);
+    const int ne = static_cast<int>(edges(t).size());
+    if (order(t) == 2) {
+      // Vertices + one node per edge (+ face and volume nodes for complete types).
+      CHECK(num_nodes(t) >= num_vertices(t) + ne);
+      CHECK(linear_type(t) == element_type(shape(t), 1));
+      CHECK(quadratic_type(linear_type(t), info.complete) == t);
+    }
+    if (const auto perm = vtk_order(t); !perm.empty()) {
+      // A permutation of the nodes that VTK writes.
+      std::set<int> seen(perm.begin(), perm.end());
+      CHECK(static_cast<int>(seen.size()) == static_cast<int>(perm.size()));
+      CHECK(*seen.rbegin() < num_nodes(t));
+    }
+  }
+}
+
+TEST_CASE("every edge lies on exactly two facets of a 3D shape, one of a 2D shape's", "[core]") {
+  for (ElementType t : {ElementType::tri3, ElementType::quad4, ElementType::tet4, ElementType::hex8,
+                        ElementType::prism6, ElementType::pyramid5}) {
+    INFO(name(t));
+    for (const auto& e : edges(t)) {
+      int count = 0;
+      for (const auto& f : facets(t))
+        for (int k = 0; k < (f.shape == Shape::line ? 1 : f.num_vertices); ++k) {
+          const int a = f.vertices[static_cast<std::size_t>(k)];
+          const int b = f.vertices[static_cast<std::size_t>((k + 1) % f.num_vertices)];
+          if ((a == e[0] && b == e[1]) || (a == e[1] && b == e[0])) ++count;
+        }
+      CHECK(count == (dimension(t) == 3 ? 2 : 1));
+    }
+  }
+}
+
+TEST_CASE("facet nodes of quadratic elements follow Gmsh's face node numbering", "[core]") {
+  std::array<int, 9> nodes{};
+  // hex27 face k carries node 20 + k; its edge nodes are the element's.
+  for (int f = 0; f < 6; ++f) {
+    REQUIRE(facet_nodes(ElementType::hex27, f, nodes) == 9);
+    CHECK(nodes[8] == 20 + f);
+  }
+  REQUIRE(facet_nodes(ElementType::tet10, 0, nodes) == 6);  // facet (0,2,1)
+  CHECK(std::vector<int>(nodes.begin(), nodes.begin() + 6) == std::vector<int>{0, 2, 1, 6, 5, 4});
+  CHECK(facet_type(ElementType::prism18, 2) == ElementType::quad9);
+  CHECK(facet_type(ElementType::prism15, 2) == ElementType::quad8);
+  CHECK(facet_type(ElementType::prism18, 0) == ElementType::tri6);
+  REQUIRE(facet_nodes(ElementType::pyramid14, 0, nodes) == 9);
+  CHECK(nodes[8] == 13);
+  REQUIRE(facet_nodes(ElementType::tri6, 2, nodes) == 3);
+  CHECK(std::vector<int>(nodes.begin(), nodes.begin() + 3) == std::vector<int>{2, 0, 5});
+}
+
+TEST_CASE("unknown type numbers and names are errors", "[core]") {
+  CHECK_THROWS_AS(element_type_from_gmsh(42), InputError);
+  CHECK_THROWS_AS(element_type_from_vtk(99), InputError);
+  CHECK_THROWS_WITH(element_type_from_name("tri7"), Catch::Contains("tri7"));
+}
