@@ -1,0 +1,238 @@
+#pragma once
+/// \file
+/// LinearSolver: one of Eigen's sparse solvers chosen at run time by SolverOptions, with the
+/// symbolic analysis kept apart from the numeric factorization (a mover re-based on a moved
+/// mesh whose matrix keeps its sparsity pattern re-uses the analysis), solves for several
+/// right-hand sides at once, and a SolverReport of iterations, residual, time and
+/// factorizations. Failure or non-convergence raises SolverError.
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/solvers/detail/stopwatch.hpp"
+#include "meshmotion/solvers/solver_options.hpp"
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+
+#include <cmath>
+#include <memory>
+#include <string>
+
+namespace meshmotion {
+
+/// Column-major sparse matrix used by the solvers and movers.
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+namespace detail {
+
+/// Run-time choice among Eigen solver types sharing analyzePattern/factorize/solve.
+class SparseBackend {
+ public:
+  virtual ~SparseBackend() = default;
+  virtual void analyze(const SparseMatrix& a) = 0;
+  /// Returns false when the factorization failed (matrix not SPD, structurally singular).
+  virtual bool factorize(const SparseMatrix& a) = 0;
+  /// Solves for one column; returns false when the solver reports failure.
+  virtual bool solve(const Eigen::VectorXd& b, Eigen::VectorXd& x, Index& iterations) = 0;
+};
+
+template <class EigenSolver>
+class DirectBackend final : public SparseBackend {
+ public:
+  void analyze(const SparseMatrix& a) override { solver_.analyzePattern(a); }
+  bool factorize(const SparseMatrix& a) override {
+    solver_.factorize(a);
+    return solver_.info() == Eigen::Success;
+  }
+  bool solve(const Eigen::VectorXd& b, Eigen::VectorXd& x, Index& iterations) override {
+    x = solver_.solve(b);
+    iterations = 0;
+    return solver_.info() == Eigen::Success;
+  }
+
+ private:
+  EigenSolver solver_;
+};
+
+template <class EigenSolver>
+class IterativeBackend final : public SparseBackend {
+ public:
+  IterativeBackend(double tolerance, Index max_iterations) {
+    solver_.setTolerance(tolerance);
+    if (max_iterations > 0) solver_.setMaxIterations(max_iterations);
+  }
+  void analyze(const SparseMatrix& a) override { solver_.analyzePattern(a); }
+  bool factorize(const SparseMatrix& a) override {
+    solver_.factorize(a);
+    return solver_.info() == Eigen::Success;
+  }
+  bool solve(const Eigen::VectorXd& b, Eigen::VectorXd& x, Index& iterations) override {
+    // Warm start from the caller's x when it has the right size (repeated moves are close).
+    if (x.size() != b.size()) x.setZero(b.size());
+    x = solver_.solveWithGuess(b, x);
+    iterations = solver_.iterations();
+    return solver_.info() == Eigen::Success;
+  }
+
+ private:
+  EigenSolver solver_;
+};
+
+inline std::unique_ptr<SparseBackend> make_backend(const SolverOptions& o) {
+  constexpr int Lower = Eigen::Lower;
+  constexpr int LowerUpper = Eigen::Lower | Eigen::Upper;
+  switch (o.kind) {
+    case SolverKind::simplicial_ldlt:
+      return std::make_unique<DirectBackend<Eigen::SimplicialLDLT<SparseMatrix, Lower>>>();
+    case SolverKind::simplicial_llt:
+      return std::make_unique<DirectBackend<Eigen::SimplicialLLT<SparseMatrix, Lower>>>();
+    case SolverKind::sparse_lu:
+      return std::make_unique<DirectBackend<Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>>>>();
+    case SolverKind::cg_jacobi:
+      return std::make_unique<IterativeBackend<Eigen::ConjugateGradient<SparseMatrix, LowerUpper>>>(
+          o.tolerance, o.max_iterations);
+    case SolverKind::cg_incomplete_cholesky:
+      return std::make_unique<IterativeBackend<Eigen::ConjugateGradient<
+          SparseMatrix, LowerUpper, Eigen::IncompleteCholesky<double, Eigen::Lower>>>>(o.tolerance,
+                                                                                           o.max_iterations);
+    case SolverKind::bicgstab:
+      return std::make_unique<IterativeBackend<Eigen::BiCGSTAB<SparseMatrix>>>(o.tolerance, o.max_iterations);
+  }
+  throw InputError("LinearSolver: unknown solver kind");
+}
+
+}  // namespace detail
+
+/// A sparse linear solver over one square matrix A (n × n), factorized once and applied to
+/// many right-hand sides.
+///
+/// Usage: `compute(A)` (analysis when the pattern is new, then factorization), then
+/// `solve(B)` as often as needed. A later `compute(A2)` with the same sparsity pattern skips
+/// the symbolic analysis. The solver keeps a copy of A (iterative solvers and residual
+/// checks need it).
+class LinearSolver {
+ public:
+  explicit LinearSolver(SolverOptions options = {}) : options_(options) {}
+
+  [[nodiscard]] const SolverOptions& options() const noexcept { return options_; }
+  [[nodiscard]] const SolverReport& report() const noexcept { return report_; }
+  /// Number of rows of the factorized matrix (0 before compute).
+  [[nodiscard]] Index size() const noexcept { return matrix_.rows(); }
+
+  /// Analyses (if the pattern differs from the last one) and factorizes A.
+  /// Throws InputError when A is not square or holds a non-finite value, SolverError when the
+  /// factorization fails (e.g. SimplicialLLT on a matrix that is not positive definite).
+  void compute(const SparseMatrix& a) {
+    const detail::Stopwatch watch;
+    if (a.rows() != a.cols())
+      throw InputError("LinearSolver::compute: matrix is not square (got " + std::to_string(a.rows()) + " × " +
+                       std::to_string(a.cols()) + ")");
+    for (Index k = 0; k < a.nonZeros(); ++k)
+      if (!std::isfinite(a.valuePtr()[k]))
+        throw InputError("LinearSolver::compute: matrix holds a non-finite value");
+    const bool same_pattern = backend_ && same_pattern_as(a);
+    matrix_ = a;
+    matrix_.makeCompressed();
+    if (!same_pattern) {
+      backend_ = detail::make_backend(options_);
+      fallback_.reset();
+      backend_->analyze(matrix_);
+      ++report_.analyses;
+    }
+    const bool ok = backend_->factorize(matrix_);
+    ++report_.factorizations;
+    if (fallback_) fallback_factorize();
+    report_.seconds += watch.seconds();
+    if (!ok)
+      throw SolverError(std::string(name(options_.kind)) + ": factorization of a " + std::to_string(a.rows()) +
+                        " × " + std::to_string(a.rows()) +
+                        " matrix failed (matrix singular or not positive definite)");
+  }
+
+  /// Solves A X = B for every column of B (n × m); X is resized to n × m. Iterative solvers
+  /// start from X when it already has that shape. Throws SolverError naming the solver, the
+  /// iterations and the residual when a solve fails or does not converge (unless
+  /// fallback_to_direct, which the report then records), InputError on a size mismatch or a
+  /// non-finite right-hand side.
+  void solve(const Eigen::Ref<const Eigen::MatrixXd>& b, Eigen::MatrixXd& x) {
+    const detail::Stopwatch watch;
+    if (!backend_) throw InputError("LinearSolver::solve: compute() was not called");
+    if (b.rows() != size())
+      throw InputError("LinearSolver::solve: right-hand side has " + std::to_string(b.rows()) +
+                       " rows (expected " + std::to_string(size()) + ")");
+    if (!b.allFinite()) throw InputError("LinearSolver::solve: right-hand side holds a non-finite value");
+    if (x.rows() != b.rows() || x.cols() != b.cols()) x.setZero(b.rows(), b.cols());
+    report_.iterations = 0;
+    report_.residual = 0.0;
+    for (Index c = 0; c < b.cols(); ++c) {
+      rhs_ = b.col(c);
+      column_ = x.col(c);
+      Index iterations = 0;
+      bool ok = backend_->solve(rhs_, column_, iterations);
+      double residual = relative_residual();
+      report_.iterations = std::max(report_.iterations, iterations);
+      const double limit = is_iterative(options_.kind) ? 10.0 * options_.tolerance : 1e-6;
+      if (!ok || !(residual <= std::max(limit, 1e-13))) {
+        if (!options_.fallback_to_direct || !is_iterative(options_.kind))
+          throw SolverError(std::string(name(options_.kind)) + ": solve did not converge (iterations " +
+                            std::to_string(iterations) + ", relative residual " + std::to_string(residual) +
+                            ", expected <= " + std::to_string(limit) + ")");
+        if (!fallback_) fallback_factorize();
+        ok = fallback_->solve(rhs_, column_, iterations);
+        residual = relative_residual();
+        report_.fell_back = true;
+        if (!ok || !(residual <= 1e-6))
+          throw SolverError(std::string(name(options_.kind)) + " and its sparse_lu fallback failed (relative residual " +
+                            std::to_string(residual) + ")");
+      }
+      report_.residual = std::max(report_.residual, residual);
+      x.col(c) = column_;
+    }
+    report_.seconds += watch.seconds();
+  }
+
+  /// Allocating form of solve: returns X (n × m).
+  [[nodiscard]] Eigen::MatrixXd solve(const Eigen::Ref<const Eigen::MatrixXd>& b) {
+    Eigen::MatrixXd x;
+    solve(b, x);
+    return x;
+  }
+
+ private:
+  [[nodiscard]] bool same_pattern_as(const SparseMatrix& a) const {
+    if (a.rows() != matrix_.rows() || a.nonZeros() != matrix_.nonZeros() || !a.isCompressed()) return false;
+    for (Index j = 0; j <= a.cols(); ++j)
+      if (a.outerIndexPtr()[j] != matrix_.outerIndexPtr()[j]) return false;
+    for (Index k = 0; k < a.nonZeros(); ++k)
+      if (a.innerIndexPtr()[k] != matrix_.innerIndexPtr()[k]) return false;
+    return true;
+  }
+
+  [[nodiscard]] double relative_residual() const {
+    const double norm_b = rhs_.norm();
+    const double r = (matrix_ * column_ - rhs_).norm();
+    return norm_b > 0.0 ? r / norm_b : r;
+  }
+
+  void fallback_factorize() {
+    if (!fallback_) {
+      fallback_ = detail::make_backend(SolverOptions{SolverKind::sparse_lu});
+      fallback_->analyze(matrix_);
+    }
+    if (!fallback_->factorize(matrix_))
+      throw SolverError("sparse_lu fallback: factorization failed (matrix singular)");
+    ++report_.factorizations;
+  }
+
+  SolverOptions options_;
+  SolverReport report_;
+  SparseMatrix matrix_;
+  std::unique_ptr<detail::SparseBackend> backend_;
+  std::unique_ptr<detail::SparseBackend> fallback_;
+  Eigen::VectorXd rhs_;
+  Eigen::VectorXd column_;
+};
+
+}  // namespace meshmotion

@@ -1,0 +1,64 @@
+#pragma once
+/// \file
+/// SolverOptions: which of Eigen's sparse solvers a LinearSolver uses, with its tolerances,
+/// and SolverReport: what the solver did.
+
+#include "meshmotion/core/types.hpp"
+
+#include <string_view>
+
+namespace meshmotion {
+
+/// Eigen sparse solvers the library chooses among.
+enum class SolverKind {
+  simplicial_ldlt,         ///< Eigen::SimplicialLDLT: sparse symmetric (SPD or quasi-definite), direct
+  simplicial_llt,          ///< Eigen::SimplicialLLT: sparse SPD Cholesky, direct
+  sparse_lu,               ///< Eigen::SparseLU (SuperLU's algorithm): any square matrix, direct
+  cg_jacobi,               ///< Eigen::ConjugateGradient with a diagonal preconditioner: SPD, iterative
+  cg_incomplete_cholesky,  ///< Eigen::ConjugateGradient with IncompleteCholesky: SPD, iterative
+  bicgstab,                ///< Eigen::BiCGSTAB with a diagonal preconditioner: any square, iterative
+};
+
+/// Name of a solver kind as used in messages and on command lines ("simplicial_ldlt", ...).
+[[nodiscard]] constexpr std::string_view name(SolverKind kind) {
+  switch (kind) {
+    case SolverKind::simplicial_ldlt: return "simplicial_ldlt";
+    case SolverKind::simplicial_llt: return "simplicial_llt";
+    case SolverKind::sparse_lu: return "sparse_lu";
+    case SolverKind::cg_jacobi: return "cg_jacobi";
+    case SolverKind::cg_incomplete_cholesky: return "cg_incomplete_cholesky";
+    case SolverKind::bicgstab: return "bicgstab";
+  }
+  return "unknown";
+}
+
+/// True for the Krylov solvers (tolerance and max_iterations apply to them only).
+[[nodiscard]] constexpr bool is_iterative(SolverKind kind) {
+  return kind == SolverKind::cg_jacobi || kind == SolverKind::cg_incomplete_cholesky ||
+         kind == SolverKind::bicgstab;
+}
+
+/// Options of a LinearSolver.
+struct SolverOptions {
+  SolverKind kind = SolverKind::simplicial_ldlt;
+  /// Relative residual ||A x - b|| / ||b|| an iterative solver must reach.
+  double tolerance = 1e-12;
+  /// Iteration cap of an iterative solver; 0 means Eigen's default (2 × matrix size).
+  Index max_iterations = 0;
+  /// When an iterative solver does not converge, solve again with SparseLU instead of
+  /// throwing (the report's fell_back says so).
+  bool fallback_to_direct = false;
+};
+
+/// What a solver did, accumulated since it was created (seconds, factorizations) or for the
+/// latest solve (iterations, residual).
+struct SolverReport {
+  Index iterations = 0;      ///< largest iteration count over the right-hand sides of the last solve
+  double residual = 0.0;     ///< largest relative residual ||A x - b|| / ||b|| of the last solve
+  double seconds = 0.0;      ///< total time in analysis, factorization and solves
+  Index analyses = 0;        ///< symbolic analyses (sparsity pattern) performed
+  Index factorizations = 0;  ///< numeric factorizations (or preconditioner builds) performed
+  bool fell_back = false;    ///< an iterative solve failed and the direct fallback answered
+};
+
+}  // namespace meshmotion

@@ -1,0 +1,106 @@
+#include "meshmotion/solvers.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <vector>
+
+using namespace meshmotion;
+
+namespace {
+
+/// 2D Poisson 5-point matrix on an m × m grid: SPD, well known.
+SparseMatrix poisson(int m, double shift = 0.0) {
+  std::vector<Eigen::Triplet<double>> t;
+  const auto id = [m](int i, int j) { return i * m + j; };
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      t.emplace_back(id(i, j), id(i, j), 4.0 + shift);
+      if (i > 0) t.emplace_back(id(i, j), id(i - 1, j), -1.0);
+      if (i + 1 < m) t.emplace_back(id(i, j), id(i + 1, j), -1.0);
+      if (j > 0) t.emplace_back(id(i, j), id(i, j - 1), -1.0);
+      if (j + 1 < m) t.emplace_back(id(i, j), id(i, j + 1), -1.0);
+    }
+  SparseMatrix a(m * m, m * m);
+  a.setFromTriplets(t.begin(), t.end());
+  return a;
+}
+
+}  // namespace
+
+TEST_CASE("every sparse solver kind solves an SPD system with several right-hand sides", "[solvers]") {
+  const SparseMatrix a = poisson(12);
+  Eigen::MatrixXd x_true = Eigen::MatrixXd::Random(a.rows(), 3);
+  const Eigen::MatrixXd b = a * x_true;
+  for (auto kind : {SolverKind::simplicial_ldlt, SolverKind::simplicial_llt, SolverKind::sparse_lu,
+                    SolverKind::cg_jacobi, SolverKind::cg_incomplete_cholesky, SolverKind::bicgstab}) {
+    CAPTURE(name(kind));
+    LinearSolver solver(SolverOptions{kind, 1e-12, 0, false});
+    solver.compute(a);
+    const Eigen::MatrixXd x = solver.solve(b);
+    CHECK((x - x_true).norm() / x_true.norm() < 1e-9);
+    CHECK(solver.report().residual < 1e-10);
+    CHECK(solver.report().factorizations == 1);
+    CHECK(solver.report().fell_back == false);
+    if (is_iterative(kind)) CHECK(solver.report().iterations > 0);
+  }
+}
+
+TEST_CASE("a second compute with the same pattern re-uses the symbolic analysis", "[solvers]") {
+  LinearSolver solver;
+  solver.compute(poisson(8));
+  solver.compute(poisson(8, 1.0));
+  CHECK(solver.report().analyses == 1);
+  CHECK(solver.report().factorizations == 2);
+  const Eigen::VectorXd b = Eigen::VectorXd::Ones(64);
+  const Eigen::MatrixXd x = solver.solve(b);
+  CHECK((poisson(8, 1.0) * x - b).norm() < 1e-10);
+  solver.compute(poisson(9));
+  CHECK(solver.report().analyses == 2);
+}
+
+TEST_CASE("solver failures raise SolverError naming solver, iterations and residual", "[solvers]") {
+  SECTION("LLT of an indefinite matrix") {
+    LinearSolver solver(SolverOptions{SolverKind::simplicial_llt});
+    CHECK_THROWS_AS(solver.compute(poisson(6, -6.0)), SolverError);
+  }
+  SECTION("CG capped at 2 iterations") {
+    LinearSolver solver(SolverOptions{SolverKind::cg_jacobi, 1e-12, 2, false});
+    solver.compute(poisson(10));
+    const Eigen::VectorXd b = Eigen::VectorXd::Ones(100);
+    CHECK_THROWS_WITH(solver.solve(b), Catch::Contains("cg_jacobi") && Catch::Contains("iterations 2") &&
+                                           Catch::Contains("residual"));
+  }
+  SECTION("CG capped at 2 iterations falls back to a direct solve when asked") {
+    LinearSolver solver(SolverOptions{SolverKind::cg_jacobi, 1e-12, 2, true});
+    solver.compute(poisson(10));
+    const Eigen::VectorXd b = Eigen::VectorXd::Ones(100);
+    const Eigen::MatrixXd x = solver.solve(b);
+    CHECK((poisson(10) * x - b).norm() < 1e-10);
+    CHECK(solver.report().fell_back);
+  }
+  SECTION("bad inputs") {
+    LinearSolver solver;
+    CHECK_THROWS_AS(solver.solve(Eigen::VectorXd::Ones(3)), InputError);
+    CHECK_THROWS_AS(solver.compute(SparseMatrix(3, 4)), InputError);
+    solver.compute(poisson(3));
+    CHECK_THROWS_AS(solver.solve(Eigen::VectorXd::Ones(4)), InputError);
+    Eigen::VectorXd nan_rhs = Eigen::VectorXd::Ones(9);
+    nan_rhs[2] = std::numeric_limits<double>::quiet_NaN();
+    CHECK_THROWS_AS(solver.solve(nan_rhs), InputError);
+  }
+}
+
+TEST_CASE("dense solvers agree and detect failures", "[solvers]") {
+  const Eigen::MatrixXd a = Eigen::MatrixXd(poisson(5));
+  const Eigen::MatrixXd b = Eigen::MatrixXd::Random(25, 2);
+  for (auto kind : {DenseSolverKind::llt, DenseSolverKind::ldlt, DenseSolverKind::partial_piv_lu}) {
+    DenseSolver solver(kind);
+    solver.compute(a);
+    CHECK((a * solver.solve(b) - b).norm() < 1e-10);
+  }
+  DenseSolver llt(DenseSolverKind::llt);
+  CHECK_THROWS_AS(llt.compute(-a), SolverError);
+  DenseSolver lu;
+  lu.compute(Eigen::MatrixXd::Zero(3, 3));
+  CHECK_THROWS_AS(lu.solve(Eigen::VectorXd::Ones(3)), SolverError);
+}
