@@ -1,0 +1,68 @@
+#include "meshmotion/spatial.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <random>
+
+using namespace meshmotion;
+
+namespace {
+
+template <int Dim>
+void check_against_brute_force(Index n) {
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Points<Dim> points(Dim, n);
+  for (Index i = 0; i < n; ++i)
+    for (int d = 0; d < Dim; ++d) points(d, i) = u(rng);
+  const KdTree<Dim> tree(points);
+  REQUIRE(tree.size() == n);
+  std::vector<Neighbor> found;
+  for (int q = 0; q < 50; ++q) {
+    Vec<Dim> query;
+    for (int d = 0; d < Dim; ++d) query[d] = 1.2 * u(rng);
+    const double radius = 0.05 + 0.5 * (q % 5) / 4.0;
+    tree.radius_search(query, radius, found);
+    std::vector<std::size_t> got;
+    for (const auto& [i, d2] : found) {
+      got.push_back(i);
+      CHECK(d2 == Approx((points.col(static_cast<Index>(i)) - query).squaredNorm()));
+    }
+    std::sort(got.begin(), got.end());
+    std::vector<std::size_t> expected;
+    std::vector<std::pair<double, std::size_t>> all;
+    for (Index i = 0; i < n; ++i) {
+      const double d2 = (points.col(i) - query).squaredNorm();
+      if (d2 < radius * radius) expected.push_back(static_cast<std::size_t>(i));
+      all.emplace_back(d2, static_cast<std::size_t>(i));
+    }
+    CHECK(got == expected);
+    std::sort(all.begin(), all.end());
+    const auto knn = tree.nearest(query, 7);
+    REQUIRE(knn.size() == 7);
+    for (std::size_t k = 0; k < 7; ++k) CHECK(knn[k].second == Approx(all[k].first));
+    CHECK(tree.nearest(query).first == all[0].second);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("k-d tree radius and k-nearest queries match brute force", "[spatial]") {
+  check_against_brute_force<2>(500);
+  check_against_brute_force<3>(800);
+}
+
+TEST_CASE("k-d tree reads the matrix in place and handles edge cases", "[spatial]") {
+  Points<2> points(2, 3);
+  points << 0, 1, 2, 0, 0, 0;
+  const KdTree<2> tree(points);
+  CHECK(tree.radius_search(Vec<2>(0.9, 0.0), 0.2).size() == 1);
+  const KdTree<2> empty(Points<2>(2, 0));
+  CHECK(empty.radius_search(Vec<2>(0.0, 0.0), 1.0).empty());
+  CHECK(empty.nearest(Vec<2>(0.0, 0.0), 3).empty());
+  CHECK_THROWS_AS(empty.nearest(Vec<2>(0.0, 0.0)), InputError);
+  CHECK(tree.nearest(Vec<2>(5.0, 0.0), 10).size() == 3);
+  points(0, 1) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(KdTree<2>(points), InputError);
+}
