@@ -1,0 +1,11 @@
+#pragma once
+/// \file
+/// The io layer: Gmsh .msh and SU2 .su2 reading and writing, VTK .vtu writing, mesh summaries.
+
+#include "meshmotion/io/any_mesh.hpp"
+#include "meshmotion/io/gmsh_reader.hpp"
+#include "meshmotion/io/gmsh_writer.hpp"
+#include "meshmotion/io/mesh_io.hpp"
+#include "meshmotion/io/su2_reader.hpp"
+#include "meshmotion/io/su2_writer.hpp"
+#include "meshmotion/io/vtu_writer.hpp"

@@ -1,0 +1,52 @@
+#pragma once
+/// \file
+/// Atomic writing: a temporary file in the same folder, then a rename, so a failed write never
+/// leaves a partial output nor touches an existing file.
+
+#include "meshmotion/core/error.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+#include <system_error>
+
+namespace meshmotion::detail {
+
+/// A name for the temporary file beside `file` (same folder, so rename is atomic).
+[[nodiscard]] inline std::filesystem::path temporary_path_for(const std::filesystem::path& file) {
+  static std::atomic<unsigned> counter{0};
+  const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
+  std::filesystem::path tmp = file;
+  tmp += ".tmp" + std::to_string(stamp % 1000000007) + "_" + std::to_string(counter++);
+  return tmp;
+}
+
+/// Writes `contents` to `file` through a temporary file in the same folder and a rename.
+/// Throws IoError (leaving neither `file` changed nor the temporary behind) on failure.
+inline void write_file_atomically(const std::filesystem::path& file, std::string_view contents) {
+  const std::filesystem::path tmp = temporary_path_for(file);
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw IoError(file.string() + ": cannot create the temporary file " + tmp.string());
+    out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
+    out.close();
+    if (!out) {
+      std::error_code ignored;
+      std::filesystem::remove(tmp, ignored);
+      throw IoError(file.string() + ": write failed (disk full?)");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, file, ec);
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw IoError(file.string() + ": cannot rename the temporary file into place (" + ec.message() + ")");
+  }
+}
+
+}  // namespace meshmotion::detail
