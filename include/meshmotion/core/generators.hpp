@@ -1,0 +1,319 @@
+#pragma once
+/// \file
+/// Built-in meshes: structured rectangles and boxes of every linear element type (and mixed
+/// ones), and a boundary-layer O-mesh around an ellipse (a cylinder) or a square inside a
+/// circular farfield. Every generator returns positively oriented cells and the boundary
+/// facets tagged with named groups.
+
+#include "meshmotion/core/element.hpp"
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/topology.hpp"
+#include "meshmotion/core/types.hpp"
+
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace meshmotion {
+
+/// Cell types of rectangle_mesh().
+enum class RectangleCells {
+  quad4,     ///< one quadrilateral per grid cell
+  tri3,      ///< each grid cell split into two triangles
+  tri_quad,  ///< triangles in the left half (i < nx/2), quadrilaterals elsewhere
+};
+
+/// Options of rectangle_mesh(): an nx × ny grid on [x_min, x_max] × [y_min, y_max].
+struct RectangleOptions {
+  Index nx = 10;
+  Index ny = 10;
+  double x_min = 0.0, x_max = 1.0;
+  double y_min = 0.0, y_max = 1.0;
+  RectangleCells cells = RectangleCells::quad4;
+};
+
+/// Cell types of box_mesh().
+enum class BoxCells {
+  hex8,               ///< one hexahedron per grid cell
+  tet4,               ///< 6 tetrahedra per grid cell (Kuhn split along the main diagonal, conforming)
+  prism6,             ///< 2 prisms per grid cell (triangles in x-y, extruded in z)
+  pyramid5,           ///< 6 pyramids per grid cell around a new centre node
+  hex_prism,          ///< prisms for i < nx/2, hexahedra elsewhere
+  tet_pyramid_prism,  ///< prisms, then pyramids, then tetrahedra along x (thirds of nx); the
+                      ///< pyramid cells next to the tetrahedra split their base into 2 tetrahedra
+};
+
+/// Options of box_mesh(): an nx × ny × nz grid on [x_min, x_max] × [y_min, y_max] × [z_min, z_max].
+struct BoxOptions {
+  Index nx = 4;
+  Index ny = 4;
+  Index nz = 4;
+  double x_min = 0.0, x_max = 1.0;
+  double y_min = 0.0, y_max = 1.0;
+  double z_min = 0.0, z_max = 1.0;
+  BoxCells cells = BoxCells::hex8;
+};
+
+/// The body of o_mesh().
+enum class OMeshBody { ellipse, square };
+
+/// Options of o_mesh(): a boundary-layer mesh around a body inside a circular farfield
+/// (the README's demo case and the rotating-object benchmark, thesis fig. 4.11).
+struct OMeshOptions {
+  OMeshBody body = OMeshBody::ellipse;
+  double semi_axis_x = 0.5;     ///< ellipse semi-axis along x, or half the square's side
+  double semi_axis_y = 0.5;     ///< ellipse semi-axis along y (ignored for a square)
+  Index n_around = 128;         ///< nodes around the body (a multiple of 4 for a square)
+  Index n_radial = 64;          ///< cell layers from the wall to the farfield
+  double first_height = 1e-5;   ///< height of the wall cells (1e-5 of the default diameter)
+  double growth = 0.0;          ///< ratio of successive layer heights; 0: solved per ray so
+                                ///< that the last layer reaches the farfield circle exactly
+  double farfield_radius = 20.0;
+  bool triangles = false;       ///< split each quadrilateral into two triangles
+};
+
+namespace detail {
+
+/// Sets mesh.facets to the boundary facets, each tagged by classify(facet nodes) in
+/// 1 .. names.size(), and names the groups.
+template <int Dim, class Classify>
+void add_boundary_groups(Mesh<Dim>& mesh, const std::vector<std::string>& names, Classify&& classify) {
+  mesh.facets = boundary_facets(mesh);
+  for (auto& block : mesh.facets)
+    for (Index e = 0; e < block.size(); ++e) block.tags[static_cast<std::size_t>(e)] = classify(block.element(e));
+  for (std::size_t g = 0; g < names.size(); ++g) mesh.groups.push_back({Dim - 1, static_cast<int>(g) + 1, names[g]});
+}
+
+/// Tags grid boundary facets by the box side all their nodes lie on: 2d + 1 for the minimum
+/// of axis d, 2d + 2 for its maximum.
+template <int Dim>
+void add_box_groups(Mesh<Dim>& mesh, const std::array<double, Dim>& lo, const std::array<double, Dim>& hi) {
+  const std::vector<std::string> names =
+      Dim == 2 ? std::vector<std::string>{"left", "right", "bottom", "top"}
+               : std::vector<std::string>{"left", "right", "front", "back", "bottom", "top"};
+  add_boundary_groups(mesh, names, [&](std::span<const Index> nodes) {
+    for (int d = 0; d < Dim; ++d) {
+      const double tol = 1e-12 * (hi[static_cast<std::size_t>(d)] - lo[static_cast<std::size_t>(d)]);
+      const auto on = [&](double value) {
+        for (Index v : nodes)
+          if (std::abs(mesh.points(d, v) - value) > tol) return false;
+        return true;
+      };
+      if (on(lo[static_cast<std::size_t>(d)])) return 2 * d + 1;
+      if (on(hi[static_cast<std::size_t>(d)])) return 2 * d + 2;
+    }
+    throw InvalidMeshError("box generator: a boundary facet lies on no side of the box");
+  });
+}
+
+inline void require_cells(const char* where, std::initializer_list<Index> counts) {
+  for (Index n : counts)
+    if (n < 1) throw InputError(std::string(where) + ": cell counts must be positive (got " + std::to_string(n) + ")");
+}
+
+/// Appends a tetrahedron, swapping two nodes if needed so that it is positively oriented.
+inline void add_positive_tet(ElementBlock& block, const Points<3>& p, std::array<Index, 4> t) {
+  const Vec<3> a = p.col(t[1]) - p.col(t[0]);
+  const Vec<3> b = p.col(t[2]) - p.col(t[0]);
+  const Vec<3> c = p.col(t[3]) - p.col(t[0]);
+  if (a.cross(b).dot(c) < 0) std::swap(t[1], t[2]);
+  block.add(t);
+}
+
+}  // namespace detail
+
+/// A structured rectangle mesh with groups "left", "right", "bottom", "top" (tags 1–4).
+/// Nodes are numbered i + (nx + 1) j. Throws InputError for non-positive counts.
+[[nodiscard]] inline Mesh<2> rectangle_mesh(const RectangleOptions& options = {}) {
+  const Index nx = options.nx, ny = options.ny;
+  detail::require_cells("rectangle_mesh", {nx, ny});
+  Mesh<2> mesh;
+  mesh.points.resize(2, (nx + 1) * (ny + 1));
+  const auto node = [&](Index i, Index j) { return i + (nx + 1) * j; };
+  for (Index j = 0; j <= ny; ++j)
+    for (Index i = 0; i <= nx; ++i)
+      mesh.points.col(node(i, j)) << options.x_min + (options.x_max - options.x_min) * static_cast<double>(i) / static_cast<double>(nx),
+          options.y_min + (options.y_max - options.y_min) * static_cast<double>(j) / static_cast<double>(ny);
+  for (Index j = 0; j < ny; ++j)
+    for (Index i = 0; i < nx; ++i) {
+      const std::array<Index, 4> q{node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)};
+      const bool split = options.cells == RectangleCells::tri3 || (options.cells == RectangleCells::tri_quad && 2 * i < nx);
+      if (split) {
+        mesh.block(ElementType::tri3).add({q[0], q[1], q[2]});
+        mesh.block(ElementType::tri3).add({q[0], q[2], q[3]});
+      } else {
+        mesh.block(ElementType::quad4).add(q);
+      }
+    }
+  detail::add_box_groups<2>(mesh, {options.x_min, options.y_min}, {options.x_max, options.y_max});
+  return mesh;
+}
+
+/// A structured box mesh with groups "left", "right" (x), "front", "back" (y), "bottom",
+/// "top" (z) (tags 1–6). Grid nodes are numbered i + (nx + 1)(j + (ny + 1) k); pyramid
+/// centre nodes follow them. Throws InputError for non-positive counts.
+[[nodiscard]] inline Mesh<3> box_mesh(const BoxOptions& options = {}) {
+  const Index nx = options.nx, ny = options.ny, nz = options.nz;
+  detail::require_cells("box_mesh", {nx, ny, nz});
+  enum class Kind { hex, tet, prism, pyramid };
+  const auto kind_of = [&](Index i) {
+    switch (options.cells) {
+      case BoxCells::hex8: return Kind::hex;
+      case BoxCells::tet4: return Kind::tet;
+      case BoxCells::prism6: return Kind::prism;
+      case BoxCells::pyramid5: return Kind::pyramid;
+      case BoxCells::hex_prism: return 2 * i < nx ? Kind::prism : Kind::hex;
+      case BoxCells::tet_pyramid_prism: return 3 * i < nx ? Kind::prism : 3 * i < 2 * nx ? Kind::pyramid : Kind::tet;
+    }
+    return Kind::hex;
+  };
+  Index num_centres = 0;
+  for (Index i = 0; i < nx; ++i)
+    if (kind_of(i) == Kind::pyramid) num_centres += ny * nz;
+  const Index num_grid = (nx + 1) * (ny + 1) * (nz + 1);
+  Mesh<3> mesh;
+  mesh.points.resize(3, num_grid + num_centres);
+  const auto node = [&](Index i, Index j, Index k) { return i + (nx + 1) * (j + (ny + 1) * k); };
+  const auto lerp = [](double a, double b, Index i, Index n) {
+    return a + (b - a) * static_cast<double>(i) / static_cast<double>(n);
+  };
+  for (Index k = 0; k <= nz; ++k)
+    for (Index j = 0; j <= ny; ++j)
+      for (Index i = 0; i <= nx; ++i)
+        mesh.points.col(node(i, j, k)) << lerp(options.x_min, options.x_max, i, nx),
+            lerp(options.y_min, options.y_max, j, ny), lerp(options.z_min, options.z_max, k, nz);
+
+  // Kuhn's 6 tetrahedra share the diagonal 0–6 and split every face along the diagonal from
+  // its lowest to its highest corner, so neighbouring grid cells conform.
+  static constexpr std::array<std::array<int, 4>, 6> kuhn{
+      {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6}, {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}}};
+  Index next_centre = num_grid;
+  for (Index k = 0; k < nz; ++k)
+    for (Index j = 0; j < ny; ++j)
+      for (Index i = 0; i < nx; ++i) {
+        const std::array<Index, 8> h{node(i, j, k),         node(i + 1, j, k),         node(i + 1, j + 1, k),
+                                     node(i, j + 1, k),     node(i, j, k + 1),         node(i + 1, j, k + 1),
+                                     node(i + 1, j + 1, k + 1), node(i, j + 1, k + 1)};
+        switch (kind_of(i)) {
+          case Kind::hex: mesh.block(ElementType::hex8).add(h); break;
+          case Kind::tet:
+            for (const auto& t : kuhn) detail::add_positive_tet(mesh.block(ElementType::tet4), mesh.points, {h[t[0]], h[t[1]], h[t[2]], h[t[3]]});
+            break;
+          case Kind::prism:
+            mesh.block(ElementType::prism6).add({h[0], h[1], h[2], h[4], h[5], h[6]});
+            mesh.block(ElementType::prism6).add({h[0], h[2], h[3], h[4], h[6], h[7]});
+            break;
+          case Kind::pyramid: {
+            const Index c = next_centre++;
+            mesh.points.col(c) = Vec<3>::Zero();
+            for (Index v : h) mesh.points.col(c) += mesh.points.col(v) / 8.0;
+            const bool tets_beyond = i + 1 < nx && kind_of(i + 1) == Kind::tet;
+            for (int f = 0; f < 6; ++f) {
+              const auto& out = facets(ElementType::hex8)[static_cast<std::size_t>(f)].vertices;
+              // hexahedron facet 3 is the x-max side, which the tetrahedra split along 1–6.
+              if (f == 3 && tets_beyond) {
+                detail::add_positive_tet(mesh.block(ElementType::tet4), mesh.points, {h[1], h[2], h[6], c});
+                detail::add_positive_tet(mesh.block(ElementType::tet4), mesh.points, {h[1], h[6], h[5], c});
+                continue;
+              }
+              // The base's normal must point at the apex: the outward facet reversed.
+              mesh.block(ElementType::pyramid5).add({h[out[0]], h[out[3]], h[out[2]], h[out[1]], c});
+            }
+            break;
+          }
+        }
+      }
+  detail::add_box_groups<3>(mesh, {options.x_min, options.y_min, options.z_min},
+                            {options.x_max, options.y_max, options.z_max});
+  return mesh;
+}
+
+/// A boundary-layer O-mesh: n_around radial lines from the body to the farfield circle,
+/// wall-normal spacing growing geometrically from first_height. Groups "wall" (tag 1) and
+/// "farfield" (tag 2). Ring j (0 at the wall) holds nodes j n_around .. (j+1) n_around - 1,
+/// counter-clockwise; wall nodes lie exactly on the ellipse (a cos t, b sin t), t = 2πi/n,
+/// or on the square. Throws InputError for sizes that cannot make a valid mesh (a farfield
+/// not enclosing the body, first_height × n_radial beyond the farfield).
+[[nodiscard]] inline Mesh<2> o_mesh(const OMeshOptions& options = {}) {
+  const Index n = options.n_around, layers = options.n_radial;
+  if (n < 3 || layers < 1)
+    throw InputError("o_mesh: need n_around >= 3 and n_radial >= 1 (got " + std::to_string(n) + ", " +
+                     std::to_string(layers) + ")");
+  if (options.body == OMeshBody::square && n % 4 != 0)
+    throw InputError("o_mesh: n_around must be a multiple of 4 for a square (got " + std::to_string(n) + ")");
+  const double a = options.semi_axis_x, b = options.body == OMeshBody::square ? a : options.semi_axis_y;
+  if (!(a > 0 && b > 0 && options.first_height > 0 && options.growth >= 0))
+    throw InputError("o_mesh: semi-axes and first_height must be positive and growth non-negative");
+  const double body_radius = options.body == OMeshBody::square ? a * std::numbers::sqrt2 : std::max(a, b);
+  if (!(options.farfield_radius > body_radius))
+    throw InputError("o_mesh: farfield_radius " + std::to_string(options.farfield_radius) +
+                     " does not enclose the body (expected > " + std::to_string(body_radius) + ")");
+
+  Mesh<2> mesh;
+  mesh.points.resize(2, n * (layers + 1));
+  const double h1 = options.first_height;
+  // Sum of the first m layer heights for growth g.
+  const auto distance = [&](double g, Index m) {
+    return std::abs(g - 1.0) < 1e-12 ? h1 * static_cast<double>(m)
+                                     : h1 * (std::pow(g, static_cast<double>(m)) - 1.0) / (g - 1.0);
+  };
+  for (Index i = 0; i < n; ++i) {
+    Vec<2> wall;
+    if (options.body == OMeshBody::ellipse) {
+      const double t = 2.0 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(n);
+      wall << a * std::cos(t), b * std::sin(t);
+    } else {
+      // Uniform along the perimeter, counter-clockwise from the corner (a, -a).
+      const Index per_side = n / 4;
+      const Index side = i / per_side;
+      const double u = 2.0 * a * static_cast<double>(i % per_side) / static_cast<double>(per_side);
+      const std::array<Vec<2>, 4> start{Vec<2>(a, -a), Vec<2>(a, a), Vec<2>(-a, a), Vec<2>(-a, -a)};
+      const std::array<Vec<2>, 4> along{Vec<2>(0, 1), Vec<2>(-1, 0), Vec<2>(0, -1), Vec<2>(1, 0)};
+      wall = start[static_cast<std::size_t>(side)] + u * along[static_cast<std::size_t>(side)];
+    }
+    const Vec<2> far = options.farfield_radius * wall.normalized();
+    const double length = (far - wall).norm();
+    const Vec<2> dir = (far - wall) / length;
+    double g = options.growth;
+    if (g == 0.0) {
+      if (h1 * static_cast<double>(layers) >= length)
+        throw InputError("o_mesh: first_height × n_radial = " + std::to_string(h1 * static_cast<double>(layers)) +
+                         " reaches past the farfield (expected < " + std::to_string(length) + ")");
+      double lo = 1.0, hi = 2.0;
+      while (distance(hi, layers) < length) hi *= 2.0;
+      for (int it = 0; it < 200; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (distance(mid, layers) < length ? lo : hi) = mid;
+      }
+      g = 0.5 * (lo + hi);
+    }
+    for (Index j = 0; j <= layers; ++j) {
+      // The farfield ring is placed exactly when the growth was solved for it.
+      const double s = (options.growth == 0.0 && j == layers) ? length : distance(g, j);
+      mesh.points.col(j * n + i) = j == 0 ? wall : Vec<2>(wall + s * dir);
+    }
+  }
+  for (Index j = 0; j < layers; ++j)
+    for (Index i = 0; i < n; ++i) {
+      const Index i1 = (i + 1) % n;
+      const std::array<Index, 4> q{j * n + i, (j + 1) * n + i, (j + 1) * n + i1, j * n + i1};
+      if (options.triangles) {
+        mesh.block(ElementType::tri3).add({q[0], q[1], q[2]});
+        mesh.block(ElementType::tri3).add({q[0], q[2], q[3]});
+      } else {
+        mesh.block(ElementType::quad4).add(q);
+      }
+    }
+  detail::add_boundary_groups(mesh, {"wall", "farfield"}, [&](std::span<const Index> nodes) {
+    return nodes[0] < n ? 1 : 2;
+  });
+  return mesh;
+}
+
+}  // namespace meshmotion
