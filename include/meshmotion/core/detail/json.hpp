@@ -1,0 +1,127 @@
+#pragma once
+/// \file
+/// A minimal streaming JSON writer for reports and the example programs' --json output.
+///
+/// \code
+/// JsonWriter w(std::cout);
+/// w.begin_object().key("elements").value(n).key("min").value(0.3).end_object();
+/// \endcode
+/// Non-finite numbers are written as null (JSON has no NaN or infinity). Separators are
+/// inserted automatically; the writer does not check that keys and values alternate.
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+namespace meshmotion::detail {
+
+class JsonWriter {
+ public:
+  explicit JsonWriter(std::ostream& out) : out_(out) {}
+
+  JsonWriter& begin_object() { return open('{'); }
+  JsonWriter& end_object() { return close('}'); }
+  JsonWriter& begin_array() { return open('['); }
+  JsonWriter& end_array() { return close(']'); }
+
+  JsonWriter& key(std::string_view k) {
+    separate();
+    write_string(k);
+    out_ << ':';
+    after_key_ = true;
+    return *this;
+  }
+
+  JsonWriter& value(std::string_view s) {
+    separate();
+    write_string(s);
+    return *this;
+  }
+  JsonWriter& value(const char* s) { return value(std::string_view(s)); }
+  JsonWriter& value(const std::string& s) { return value(std::string_view(s)); }
+  JsonWriter& value(bool b) {
+    separate();
+    out_ << (b ? "true" : "false");
+    return *this;
+  }
+  JsonWriter& value(double x) {
+    separate();
+    if (!std::isfinite(x)) {
+      out_ << "null";
+    } else {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.17g", x);
+      out_ << buf;
+    }
+    return *this;
+  }
+  template <class Int>
+    requires std::is_integral_v<Int> && (!std::is_same_v<Int, bool>)
+  JsonWriter& value(Int i) {
+    separate();
+    out_ << static_cast<std::int64_t>(i);
+    return *this;
+  }
+  /// A whole array of numbers or strings.
+  template <class T>
+  JsonWriter& array(const std::vector<T>& items) {
+    begin_array();
+    for (const auto& x : items) value(x);
+    return end_array();
+  }
+
+ private:
+  JsonWriter& open(char c) {
+    separate();
+    out_ << c;
+    first_.push_back(true);
+    return *this;
+  }
+  JsonWriter& close(char c) {
+    out_ << c;
+    if (!first_.empty()) first_.pop_back();
+    return *this;
+  }
+  void separate() {
+    if (after_key_) {
+      after_key_ = false;
+      return;
+    }
+    if (first_.empty()) return;
+    if (!first_.back()) out_ << ',';
+    first_.back() = false;
+  }
+  void write_string(std::string_view s) {
+    out_ << '"';
+    for (const char ch : s) {
+      const auto c = static_cast<unsigned char>(ch);
+      switch (ch) {
+        case '"': out_ << "\\\""; break;
+        case '\\': out_ << "\\\\"; break;
+        case '\n': out_ << "\\n"; break;
+        case '\r': out_ << "\\r"; break;
+        case '\t': out_ << "\\t"; break;
+        default:
+          if (c < 0x20) {
+            char buf[8];
+            std::snprintf(buf, sizeof buf, "\\u%04x", c);
+            out_ << buf;
+          } else {
+            out_ << ch;
+          }
+      }
+    }
+    out_ << '"';
+  }
+
+  std::ostream& out_;
+  std::vector<bool> first_;
+  bool after_key_ = false;
+};
+
+}  // namespace meshmotion::detail

@@ -1,0 +1,236 @@
+#pragma once
+/// \file
+/// The polynomial space of det J of each element type, in Bernstein (Bézier) form, with the
+/// tables the scaled-Jacobian check needs (Johnen, Remacle & Geuzaine, "Geometrical validity
+/// of curvilinear finite elements", J. Comput. Phys. 233, 2013).
+///
+/// det J of a P-order element lies in: simplices of dimension d, degree d(p-1); quads and
+/// hexes, degree dp-1 in each direction; prisms, degree 3p-2 on the triangle times 3p-1 along
+/// the axis (serendipity types lie in the space of their complete sibling). A function of
+/// that space is sampled at the uniform lattice of the space, converted to Bézier
+/// coefficients (lag2bez), which bound it from below and above; subdividing the domain into
+/// 2^d similar children tightens the bounds (child values = child_values[c] × parent
+/// coefficients, exactly, since children are affine images of the reference element).
+/// Pyramids are rational: they get a sampling lattice only (no Bézier bound).
+
+#include "meshmotion/core/element.hpp"
+#include "meshmotion/core/shape_functions.hpp"
+#include "meshmotion/core/types.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+#include <array>
+#include <cmath>
+#include <vector>
+
+namespace meshmotion::detail {
+
+struct JacobianSpace {
+  int dim = 0;            // reference dimension
+  int simplex_dim = 0;    // 0 (none), 2 (triangle) or 3 (tetrahedron) leading coordinates
+  int simplex_degree = 0;
+  int line_dims = 0;      // trailing coordinates in [-1, 1] with a 1D Bernstein factor each
+  int line_degree = 0;
+  bool bezier = false;    // false for pyramids: sampled only
+  int num_points = 0;
+  int num_nodes = 0;      // nodes of the element type
+  std::vector<RefPoint> points;                // sampling lattice
+  std::vector<std::array<int, 4>> simplex_index;  // barycentric multi-index per point
+  std::vector<std::array<int, 3>> line_index;     // 1D index per line dimension per point
+  std::vector<double> gradients;               // [(point * num_nodes + node) * dim + d]
+  std::vector<double> linear_gradients;        // vertex shape gradients at the centroid: [vertex * dim + d]
+  Eigen::MatrixXd lag2bez;                     // Bézier coefficients = lag2bez × lattice values
+  std::vector<Eigen::MatrixXd> child_values;   // lattice values of child c = child_values[c] × coefficients
+};
+
+inline double factorial(int n) {
+  double f = 1.0;
+  for (int k = 2; k <= n; ++k) f *= k;
+  return f;
+}
+
+// Value of the Bernstein function with lattice index k of `space` at reference point x.
+inline double bernstein(const JacobianSpace& s, std::size_t k, const RefPoint& x) {
+  double b = 1.0;
+  if (s.simplex_dim > 0) {
+    std::array<double, 4> lambda{1.0, 0.0, 0.0, 0.0};
+    for (int d = 0; d < s.simplex_dim; ++d) {
+      lambda[static_cast<std::size_t>(d + 1)] = x[static_cast<std::size_t>(d)];
+      lambda[0] -= x[static_cast<std::size_t>(d)];
+    }
+    const auto& alpha = s.simplex_index[k];
+    b *= factorial(s.simplex_degree);
+    for (int i = 0; i <= s.simplex_dim; ++i) {
+      const auto ii = static_cast<std::size_t>(i);
+      b *= int_pow(lambda[ii], alpha[ii]) / factorial(alpha[ii]);
+    }
+  }
+  for (int l = 0; l < s.line_dims; ++l) {
+    const double t = 0.5 * (x[static_cast<std::size_t>(s.simplex_dim + l)] + 1.0);
+    const int i = s.line_index[k][static_cast<std::size_t>(l)], n = s.line_degree;
+    b *= factorial(n) / (factorial(i) * factorial(n - i)) * int_pow(t, i) * int_pow(1.0 - t, n - i);
+  }
+  return b;
+}
+
+struct AffineChild {
+  RefPoint origin{0, 0, 0};
+  std::array<RefPoint, 3> axes{};  // image of the reference unit vector of each coordinate
+};
+
+inline RefPoint map_child(const AffineChild& c, const RefPoint& x) {
+  RefPoint y = c.origin;
+  for (std::size_t i = 0; i < 3; ++i)
+    for (std::size_t d = 0; d < 3; ++d) y[d] += c.axes[i][d] * x[i];
+  return y;
+}
+
+// The 4 (triangle) or 8 (tetrahedron) similar children of the unit simplex, as vertex lists.
+inline std::vector<std::vector<RefPoint>> simplex_children(int sd) {
+  std::vector<RefPoint> v(static_cast<std::size_t>(sd + 1), RefPoint{0, 0, 0});
+  for (int d = 0; d < sd; ++d) v[static_cast<std::size_t>(d + 1)][static_cast<std::size_t>(d)] = 1.0;
+  const auto mid = [&v](int a, int b) {
+    RefPoint m{};
+    for (std::size_t d = 0; d < 3; ++d) m[d] = 0.5 * (v[static_cast<std::size_t>(a)][d] + v[static_cast<std::size_t>(b)][d]);
+    return m;
+  };
+  if (sd == 2) {
+    const auto m01 = mid(0, 1), m12 = mid(1, 2), m20 = mid(2, 0);
+    return {{v[0], m01, m20}, {m01, v[1], m12}, {m20, m12, v[2]}, {m12, m20, m01}};
+  }
+  const auto m01 = mid(0, 1), m02 = mid(0, 2), m03 = mid(0, 3), m12 = mid(1, 2), m13 = mid(1, 3), m23 = mid(2, 3);
+  // Corner tetrahedra, then the inner octahedron cut along its diagonal m02-m13.
+  return {{v[0], m01, m02, m03}, {m01, v[1], m12, m13}, {m02, m12, v[2], m23}, {m03, m13, m23, v[3]},
+          {m02, m13, m01, m12},  {m02, m13, m12, m23}, {m02, m13, m23, m03}, {m02, m13, m03, m01}};
+}
+
+inline std::vector<AffineChild> make_children(const JacobianSpace& s) {
+  std::vector<AffineChild> simplex;
+  if (s.simplex_dim > 0) {
+    for (const auto& verts : simplex_children(s.simplex_dim)) {
+      AffineChild c;
+      c.origin = verts[0];
+      for (int d = 0; d < s.simplex_dim; ++d)
+        for (std::size_t e = 0; e < 3; ++e)
+          c.axes[static_cast<std::size_t>(d)][e] = verts[static_cast<std::size_t>(d + 1)][e] - verts[0][e];
+      simplex.push_back(c);
+    }
+  } else {
+    simplex.push_back(AffineChild{});
+  }
+  std::vector<AffineChild> all;
+  for (const auto& base : simplex)
+    for (int bits = 0; bits < (1 << s.line_dims); ++bits) {
+      AffineChild c = base;
+      for (int l = 0; l < s.line_dims; ++l) {
+        const auto d = static_cast<std::size_t>(s.simplex_dim + l);
+        c.axes[d][d] = 0.5;                                // [-1,1] onto a half
+        c.origin[d] = (bits >> l) & 1 ? 0.5 : -0.5;
+      }
+      all.push_back(c);
+    }
+  return all;
+}
+
+inline void add_lattice(JacobianSpace& s) {
+  std::vector<std::array<int, 4>> simplex;
+  const int sd = s.simplex_dim, n = s.simplex_degree;
+  if (sd == 0) simplex.push_back({0, 0, 0, 0});
+  for (int a1 = 0; sd > 0 && a1 <= n; ++a1)
+    for (int a2 = 0; a1 + a2 <= n; ++a2) {
+      if (sd == 2) simplex.push_back({n - a1 - a2, a1, a2, 0});
+      for (int a3 = 0; sd == 3 && a1 + a2 + a3 <= n; ++a3) simplex.push_back({n - a1 - a2 - a3, a1, a2, a3});
+    }
+  std::vector<std::array<int, 3>> lines;
+  const int m = s.line_degree;
+  for (int i = 0; i <= (s.line_dims > 0 ? m : 0); ++i)
+    for (int j = 0; j <= (s.line_dims > 1 ? m : 0); ++j)
+      for (int k = 0; k <= (s.line_dims > 2 ? m : 0); ++k) lines.push_back({i, j, k});
+  for (const auto& alpha : simplex)
+    for (const auto& line : lines) {
+      RefPoint x{0, 0, 0};
+      for (int d = 0; d < sd; ++d)
+        x[static_cast<std::size_t>(d)] = n == 0 ? 1.0 / (sd + 1) : static_cast<double>(alpha[static_cast<std::size_t>(d + 1)]) / n;
+      for (int l = 0; l < s.line_dims; ++l)
+        x[static_cast<std::size_t>(sd + l)] = m == 0 ? 0.0 : 2.0 * line[static_cast<std::size_t>(l)] / m - 1.0;
+      s.points.push_back(x);
+      s.simplex_index.push_back(alpha);
+      s.line_index.push_back(line);
+    }
+}
+
+// Pyramid sampling: a lattice of order 4 on the levels w = k/4 below the apex (the apex
+// itself is a singular point of the rational map), plus the centroid.
+inline void add_pyramid_samples(JacobianSpace& s) {
+  const int n = 4;
+  for (int k = 0; k < n; ++k) {
+    const double w = static_cast<double>(k) / n, half = 1.0 - w;
+    const int m = n - k;
+    for (int i = 0; i <= m; ++i)
+      for (int j = 0; j <= m; ++j) s.points.push_back({half * (2.0 * i / m - 1.0), half * (2.0 * j / m - 1.0), w});
+  }
+  s.points.push_back({0.0, 0.0, 0.2});
+}
+
+inline JacobianSpace make_jacobian_space(ElementType t) {
+  JacobianSpace s;
+  s.dim = dimension(t);
+  s.num_nodes = num_nodes(t);
+  const int p = order(t);
+  switch (shape(t)) {
+    case Shape::triangle: s.simplex_dim = 2; s.simplex_degree = 2 * (p - 1); break;
+    case Shape::tetrahedron: s.simplex_dim = 3; s.simplex_degree = 3 * (p - 1); break;
+    case Shape::quadrilateral: s.line_dims = 2; s.line_degree = 2 * p - 1; break;
+    case Shape::hexahedron: s.line_dims = 3; s.line_degree = 3 * p - 1; break;
+    case Shape::prism:
+      s.simplex_dim = 2; s.simplex_degree = 3 * p - 2;
+      s.line_dims = 1; s.line_degree = 3 * p - 1;
+      break;
+    default: break;
+  }
+  s.bezier = s.dim >= 2 && shape(t) != Shape::pyramid;
+  if (s.bezier) add_lattice(s);
+  else if (shape(t) == Shape::pyramid) add_pyramid_samples(s);
+  s.num_points = static_cast<int>(s.points.size());
+
+  std::vector<std::array<double, 3>> g(static_cast<std::size_t>(s.num_nodes));
+  for (const auto& x : s.points) {
+    shape_derivatives(t, x, g);
+    for (const auto& gi : g)
+      for (int d = 0; d < s.dim; ++d) s.gradients.push_back(gi[static_cast<std::size_t>(d)]);
+  }
+  const ElementType lin = linear_type(t);
+  std::vector<std::array<double, 3>> gl(static_cast<std::size_t>(num_nodes(lin)));
+  shape_derivatives(lin, reference_centroid(lin), gl);
+  for (const auto& gi : gl)
+    for (int d = 0; d < s.dim; ++d) s.linear_gradients.push_back(gi[static_cast<std::size_t>(d)]);
+
+  if (!s.bezier) return s;
+  const auto np = static_cast<Index>(s.num_points);
+  Eigen::MatrixXd eval(np, np);
+  for (Index j = 0; j < np; ++j)
+    for (Index k = 0; k < np; ++k) eval(j, k) = bernstein(s, static_cast<std::size_t>(k), s.points[static_cast<std::size_t>(j)]);
+  s.lag2bez = eval.inverse();
+  for (const auto& child : make_children(s)) {
+    Eigen::MatrixXd e(np, np);
+    for (Index j = 0; j < np; ++j) {
+      const RefPoint y = map_child(child, s.points[static_cast<std::size_t>(j)]);
+      for (Index k = 0; k < np; ++k) e(j, k) = bernstein(s, static_cast<std::size_t>(k), y);
+    }
+    s.child_values.push_back(e);
+  }
+  return s;
+}
+
+inline const JacobianSpace& jacobian_space(ElementType t) {
+  static const std::array<JacobianSpace, num_element_types> spaces = [] {
+    std::array<JacobianSpace, num_element_types> s;
+    for (int i = 0; i < num_element_types; ++i)
+      if (dimension(static_cast<ElementType>(i)) >= 2) s[static_cast<std::size_t>(i)] = make_jacobian_space(static_cast<ElementType>(i));
+    return s;
+  }();
+  return spaces[static_cast<std::size_t>(t)];
+}
+
+}  // namespace meshmotion::detail

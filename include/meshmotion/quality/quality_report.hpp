@@ -1,0 +1,199 @@
+#pragma once
+/// \file
+/// Mesh-level quality report: min, max, mean, a histogram on [0, 1], the invalid count, the
+/// worst elements (id, type, value, centroid) and a breakdown per element type; printed as a
+/// table or written as JSON.
+
+#include "meshmotion/core/detail/json.hpp"
+#include "meshmotion/core/element.hpp"
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/quality/cell_quality.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <ostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace meshmotion {
+
+/// One of the worst cells of a report.
+struct WorstElement {
+  Index id = 0;                       ///< position in cell order
+  std::int64_t file_id = 0;           ///< the element id the file gave (1-based position when none)
+  ElementType type = ElementType::tri3;
+  double value = 0.0;
+  bool valid = false;
+  std::array<double, 3> centroid{};   ///< mean of the vertices (z = 0 in 2D)
+};
+
+/// Statistics of the cells of one element type.
+struct TypeQuality {
+  ElementType type = ElementType::tri3;
+  Index num_elements = 0;
+  Index num_invalid = 0;
+  double min = 0.0, max = 0.0, mean = 0.0;
+};
+
+/// The report of one metric over a mesh. Never holds NaN: invalid cells count with their
+/// (finite) value, 0 for Knupp metrics, the signed bound for the scaled Jacobian.
+struct QualityReport {
+  Metric metric = Metric::shape;
+  Index num_elements = 0;
+  Index num_invalid = 0;
+  double min = 0.0, max = 0.0, mean = 0.0;   ///< 0 for a mesh without cells
+  std::vector<Index> histogram;              ///< equal bins on [0, 1]; values outside go to the end bins
+  std::vector<WorstElement> worst;           ///< lowest values first
+  std::vector<TypeQuality> per_type;         ///< in the order of mesh.cells
+};
+
+/// Options of quality_report().
+struct ReportOptions {
+  int bins = 10;
+  int num_worst = 10;
+  QualityOptions quality{};
+};
+
+/// Builds the report from per-cell results already computed (cell order).
+template <int Dim>
+[[nodiscard]] QualityReport make_report(const Mesh<Dim>& mesh, Metric metric, const std::vector<CellQuality>& cells,
+                                        const ReportOptions& options = {}) {
+  QualityReport r;
+  r.metric = metric;
+  r.num_elements = static_cast<Index>(cells.size());
+  r.histogram.assign(static_cast<std::size_t>(std::max(1, options.bins)), 0);
+  const auto finite = [](double v) { return std::isfinite(v) ? v : 0.0; };
+  double sum = 0.0;
+  r.min = cells.empty() ? 0.0 : std::numeric_limits<double>::infinity();
+  r.max = cells.empty() ? 0.0 : -std::numeric_limits<double>::infinity();
+  std::vector<Index> order;
+  Index offset = 0;
+  for (const auto& block : mesh.cells) {
+    TypeQuality t{block.type, block.size(), 0, std::numeric_limits<double>::infinity(),
+                  -std::numeric_limits<double>::infinity(), 0.0};
+    for (Index e = 0; e < block.size(); ++e) {
+      const auto& c = cells[static_cast<std::size_t>(offset + e)];
+      const double v = finite(c.value);
+      t.num_invalid += c.valid ? 0 : 1;
+      t.min = std::min(t.min, v);
+      t.max = std::max(t.max, v);
+      t.mean += v;
+      const auto bins = static_cast<double>(r.histogram.size());
+      const auto bin = static_cast<std::size_t>(std::clamp(std::floor(v * bins), 0.0, bins - 1));
+      ++r.histogram[bin];
+    }
+    if (t.num_elements > 0) {
+      r.min = std::min(r.min, t.min);
+      r.max = std::max(r.max, t.max);
+      sum += t.mean;
+      t.mean /= static_cast<double>(t.num_elements);
+    } else {
+      t.min = t.max = 0.0;
+    }
+    r.num_invalid += t.num_invalid;
+    r.per_type.push_back(t);
+    offset += block.size();
+  }
+  if (r.num_elements > 0) r.mean = sum / static_cast<double>(r.num_elements);
+
+  order.resize(cells.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<Index>(i);
+  const auto k = std::min<std::size_t>(order.size(), static_cast<std::size_t>(std::max(0, options.num_worst)));
+  std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(k), order.end(), [&](Index a, Index b) {
+    return finite(cells[static_cast<std::size_t>(a)].value) < finite(cells[static_cast<std::size_t>(b)].value);
+  });
+  for (std::size_t i = 0; i < k; ++i) {
+    Index id = order[i], local = id;
+    const ElementBlock* block = nullptr;
+    for (const auto& b : mesh.cells) {
+      if (local < b.size()) {
+        block = &b;
+        break;
+      }
+      local -= b.size();
+    }
+    WorstElement w;
+    w.id = id;
+    w.type = block->type;
+    w.file_id = block->ids.empty() ? local + 1 : block->ids[static_cast<std::size_t>(local)];
+    w.value = finite(cells[static_cast<std::size_t>(id)].value);
+    w.valid = cells[static_cast<std::size_t>(id)].valid;
+    const auto nodes = block->element(local);
+    const int nv = num_vertices(block->type);
+    for (int v = 0; v < nv; ++v)
+      for (int d = 0; d < Dim; ++d)
+        w.centroid[static_cast<std::size_t>(d)] += mesh.points(d, nodes[static_cast<std::size_t>(v)]) / nv;
+    r.worst.push_back(w);
+  }
+  return r;
+}
+
+/// Report of `metric` over the cells of `mesh`. Throws as evaluate_cells().
+template <int Dim>
+[[nodiscard]] QualityReport quality_report(const Mesh<Dim>& mesh, Metric metric, const ReportOptions& options = {}) {
+  return make_report(mesh, metric, evaluate_cells(mesh, metric, options.quality), options);
+}
+
+/// Writes the report as one JSON object.
+inline void write_json(detail::JsonWriter& w, const QualityReport& r) {
+  w.begin_object();
+  w.key("metric").value(metric_name(r.metric));
+  w.key("elements").value(r.num_elements).key("invalid").value(r.num_invalid);
+  w.key("min").value(r.min).key("max").value(r.max).key("mean").value(r.mean);
+  w.key("histogram").array(r.histogram);
+  w.key("worst").begin_array();
+  for (const auto& e : r.worst) {
+    w.begin_object().key("id").value(e.id).key("file_id").value(e.file_id).key("type").value(name(e.type));
+    w.key("value").value(e.value).key("valid").value(e.valid);
+    w.key("centroid").begin_array().value(e.centroid[0]).value(e.centroid[1]).value(e.centroid[2]).end_array();
+    w.end_object();
+  }
+  w.end_array();
+  w.key("per_type").begin_array();
+  for (const auto& t : r.per_type) {
+    w.begin_object().key("type").value(name(t.type)).key("elements").value(t.num_elements);
+    w.key("invalid").value(t.num_invalid).key("min").value(t.min).key("max").value(t.max).key("mean").value(t.mean);
+    w.end_object();
+  }
+  w.end_array();
+  w.end_object();
+}
+
+/// The report as a JSON string.
+[[nodiscard]] inline std::string to_json(const QualityReport& r) {
+  std::ostringstream s;
+  detail::JsonWriter w(s);
+  write_json(w, r);
+  return s.str();
+}
+
+/// Prints the report as a readable table.
+inline void print_report(std::ostream& out, const QualityReport& r) {
+  char line[256];
+  std::snprintf(line, sizeof line, "%-16s elements %10lld  invalid %8lld  min %10.4g  mean %10.4g  max %10.4g\n",
+                std::string(metric_name(r.metric)).c_str(), static_cast<long long>(r.num_elements),
+                static_cast<long long>(r.num_invalid), r.min, r.mean, r.max);
+  out << line;
+  for (const auto& t : r.per_type) {
+    std::snprintf(line, sizeof line, "  %-14s elements %10lld  invalid %8lld  min %10.4g  mean %10.4g  max %10.4g\n",
+                  std::string(name(t.type)).c_str(), static_cast<long long>(t.num_elements),
+                  static_cast<long long>(t.num_invalid), t.min, t.mean, t.max);
+    out << line;
+  }
+  out << "  histogram:";
+  for (const Index h : r.histogram) out << ' ' << h;
+  out << '\n';
+  for (const auto& e : r.worst) {
+    std::snprintf(line, sizeof line, "  worst: cell %lld (id %lld, %s) %.6g%s at (%.6g, %.6g, %.6g)\n",
+                  static_cast<long long>(e.id), static_cast<long long>(e.file_id), std::string(name(e.type)).c_str(),
+                  e.value, e.valid ? "" : " INVALID", e.centroid[0], e.centroid[1], e.centroid[2]);
+    out << line;
+  }
+}
+
+}  // namespace meshmotion
