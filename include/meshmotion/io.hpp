@@ -5,6 +5,7 @@
 #include "meshmotion/io/any_mesh.hpp"
 #include "meshmotion/io/gmsh_reader.hpp"
 #include "meshmotion/io/gmsh_writer.hpp"
+#include "meshmotion/io/mesh_summary.hpp"
 #include "meshmotion/io/mesh_io.hpp"
 #include "meshmotion/io/su2_reader.hpp"
 #include "meshmotion/io/su2_writer.hpp"

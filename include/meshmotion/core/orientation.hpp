@@ -1,0 +1,154 @@
+#pragma once
+/// \file
+/// Element orientation: the signed measure (area in 2D, volume in 3D) of a cell's linear
+/// vertices, a count of inverted cells, and a fix that reorders the nodes of inverted cells.
+/// Files differ here (SU2 meshes exist that are all clockwise), so readers keep the file's
+/// order and fixing is only ever done on request.
+
+#include "meshmotion/core/element.hpp"
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/types.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <span>
+#include <vector>
+
+namespace meshmotion {
+
+/// Signed measure of the linear vertices of one cell (Dim-dimensional element): shoelace area
+/// in 2D; in 3D the volume enclosed by the outward-listed facets (quadrilaterals split in two
+/// triangles). Positive for elements ordered as Gmsh orders them.
+template <int Dim>
+[[nodiscard]] double signed_measure(const Mesh<Dim>& mesh, ElementType type, std::span<const Index> nodes) {
+  if constexpr (Dim == 2) {
+    const int nv = num_vertices(type);
+    double twice_area = 0;
+    for (int k = 0; k < nv; ++k) {
+      const auto a = mesh.points.col(nodes[static_cast<std::size_t>(k)]);
+      const auto b = mesh.points.col(nodes[static_cast<std::size_t>((k + 1) % nv)]);
+      twice_area += a.x() * b.y() - a.y() * b.x();
+    }
+    return 0.5 * twice_area;
+  } else {
+    Vec<3> centre = Vec<3>::Zero();
+    const int nv = num_vertices(type);
+    for (int k = 0; k < nv; ++k) centre += mesh.points.col(nodes[static_cast<std::size_t>(k)]);
+    centre /= nv;
+    double six_volume = 0;
+    for (const LocalFacet& f : facets(type)) {
+      const auto p = [&](int k) -> Vec<3> {
+        return mesh.points.col(nodes[static_cast<std::size_t>(f.vertices[static_cast<std::size_t>(k)])]) - centre;
+      };
+      for (int t = 1; t + 1 < f.num_vertices; ++t) six_volume += p(0).dot(p(t).cross(p(t + 1)));
+    }
+    return six_volume / 6.0;
+  }
+}
+
+/// Orientation count of a mesh's cells.
+struct OrientationReport {
+  Index num_cells = 0;
+  Index num_negative = 0;     ///< cells with negative signed measure
+  Index num_degenerate = 0;   ///< cells with zero signed measure
+  Index first_negative = -1;  ///< position in cell order of the first negative cell, -1 if none
+};
+
+/// Counts the cells whose signed_measure() is negative or zero.
+template <int Dim>
+[[nodiscard]] OrientationReport orientation_report(const Mesh<Dim>& mesh) {
+  OrientationReport report;
+  for (const auto& b : mesh.cells)
+    for (Index e = 0; e < b.size(); ++e, ++report.num_cells) {
+      const double m = signed_measure(mesh, b.type, b.element(e));
+      if (m < 0) {
+        if (report.first_negative < 0) report.first_negative = report.num_cells;
+        ++report.num_negative;
+      } else if (m == 0) {
+        ++report.num_degenerate;
+      }
+    }
+  return report;
+}
+
+namespace detail {
+
+inline constexpr std::array<int, 3> mirror_triangle{0, 2, 1};
+inline constexpr std::array<int, 4> mirror_quadrilateral{0, 3, 2, 1};
+inline constexpr std::array<int, 4> mirror_tetrahedron{0, 2, 1, 3};
+inline constexpr std::array<int, 8> mirror_hexahedron{0, 3, 2, 1, 4, 7, 6, 5};
+inline constexpr std::array<int, 6> mirror_prism{0, 2, 1, 3, 5, 4};
+inline constexpr std::array<int, 5> mirror_pyramid{0, 3, 2, 1, 4};
+
+/// Vertex permutation that mirrors an element of the shape (new vertex k = old vertex mirror[k]).
+[[nodiscard]] constexpr std::span<const int> mirror_vertices(Shape s) {
+  switch (s) {
+    case Shape::triangle: return mirror_triangle;
+    case Shape::quadrilateral: return mirror_quadrilateral;
+    case Shape::tetrahedron: return mirror_tetrahedron;
+    case Shape::hexahedron: return mirror_hexahedron;
+    case Shape::prism: return mirror_prism;
+    case Shape::pyramid: return mirror_pyramid;
+    default: return {};
+  }
+}
+
+/// Full node permutation (vertices, edge nodes, face nodes, centre) mirroring an element of
+/// type t: new local node k is old local node result[k]. Edge and face nodes follow their
+/// edges and faces, so high-order nodes stay where they are in space.
+[[nodiscard]] inline std::vector<int> mirror_permutation(ElementType t) {
+  const auto vertices = mirror_vertices(shape(t));
+  std::vector<int> perm(vertices.begin(), vertices.end());
+  if (order(t) < 2) return perm;
+  const int nv = num_vertices(t);
+  for (const auto& e : edges(t)) perm.push_back(nv + local_edge(t, vertices[static_cast<std::size_t>(e[0])], vertices[static_cast<std::size_t>(e[1])]));
+  if (has_face_nodes(t)) {
+    // Quadrilateral faces carry nodes in facets() order: match them by vertex set.
+    std::vector<int> quad_faces;
+    for (int f = 0; f < static_cast<int>(facets(t).size()); ++f)
+      if (facets(t)[static_cast<std::size_t>(f)].shape == Shape::quadrilateral) quad_faces.push_back(f);
+    const int first_face_node = nv + static_cast<int>(edges(t).size());
+    const auto vertex_set = [&](int f, bool mapped) {
+      std::array<int, 4> v{};
+      for (int k = 0; k < 4; ++k) {
+        const int local = facets(t)[static_cast<std::size_t>(f)].vertices[static_cast<std::size_t>(k)];
+        v[static_cast<std::size_t>(k)] = mapped ? vertices[static_cast<std::size_t>(local)] : local;
+      }
+      std::sort(v.begin(), v.end());
+      return v;
+    };
+    for (const int f : quad_faces)
+      for (std::size_t g = 0; g < quad_faces.size(); ++g)
+        if (vertex_set(quad_faces[g], false) == vertex_set(f, true)) perm.push_back(first_face_node + static_cast<int>(g));
+  }
+  // The centre node (quad9, hex27) stays.
+  while (static_cast<int>(perm.size()) < num_nodes(t)) perm.push_back(static_cast<int>(perm.size()));
+  return perm;
+}
+
+}  // namespace detail
+
+/// Reorders the nodes of every cell with negative signed_measure() so it becomes positive
+/// (high-order nodes permuted consistently). Returns the number of cells changed. Facets are
+/// left as they are. Never called by the readers: use it when orientation_report() says so.
+template <int Dim>
+Index fix_orientation(Mesh<Dim>& mesh) {
+  Index changed = 0;
+  std::vector<Index> old_nodes;
+  for (auto& b : mesh.cells) {
+    const auto perm = detail::mirror_permutation(b.type);
+    for (Index e = 0; e < b.size(); ++e) {
+      auto nodes = b.element(e);
+      if (signed_measure(mesh, b.type, std::span<const Index>(nodes.data(), nodes.size())) >= 0) continue;
+      old_nodes.assign(nodes.begin(), nodes.end());
+      for (std::size_t k = 0; k < nodes.size(); ++k) nodes[k] = old_nodes[static_cast<std::size_t>(perm[k])];
+      ++changed;
+    }
+  }
+  return changed;
+}
+
+}  // namespace meshmotion
