@@ -1,0 +1,148 @@
+#include "meshmotion/core/generators.hpp"
+
+#include <Eigen/Geometry>
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <limits>
+
+using namespace meshmotion;
+
+namespace {
+
+// Signed area (2D, shoelace) or volume (3D, divergence theorem over the element's outward
+// facets) of a linear element: negative when the element is inverted.
+template <int Dim>
+double signed_measure(const Mesh<Dim>& m, ElementType t, std::span<const Index> el) {
+  const auto p = [&](int k) { return Vec<Dim>(m.points.col(el[static_cast<std::size_t>(k)])); };
+  double s = 0.0;
+  if constexpr (Dim == 2) {
+    const int n = num_vertices(t);
+    for (int k = 0; k < n; ++k) s += 0.5 * (p(k).x() * p((k + 1) % n).y() - p((k + 1) % n).x() * p(k).y());
+  } else {
+    for (const LocalFacet& f : facets(t)) {
+      const auto v = [&](int k) { return p(f.vertices[static_cast<std::size_t>(k)]); };
+      const Vec<3> area = f.num_vertices == 3 ? Vec<3>(0.5 * (v(1) - v(0)).cross(v(2) - v(0)))
+                                              : Vec<3>(0.5 * (v(2) - v(0)).cross(v(3) - v(1)));
+      Vec<3> centroid = Vec<3>::Zero();
+      for (int k = 0; k < f.num_vertices; ++k) centroid += v(k) / f.num_vertices;
+      s += area.dot(centroid) / 3.0;
+    }
+  }
+  return s;
+}
+
+template <int Dim>
+double min_measure(const Mesh<Dim>& m) {
+  double lo = std::numeric_limits<double>::infinity();
+  for (const auto& b : m.cells)
+    for (Index e = 0; e < b.size(); ++e) lo = std::min(lo, signed_measure(m, b.type, b.element(e)));
+  return lo;
+}
+
+}  // namespace
+
+TEST_CASE("rectangle meshes: counts, groups, orientation", "[core]") {
+  const Index nx = 5, ny = 3;
+  for (RectangleCells cells : {RectangleCells::quad4, RectangleCells::tri3, RectangleCells::tri_quad}) {
+    const Mesh<2> m = rectangle_mesh({.nx = nx, .ny = ny, .x_min = -1.0, .x_max = 2.0, .cells = cells});
+    INFO("cells " << static_cast<int>(cells));
+    CHECK(m.num_nodes() == (nx + 1) * (ny + 1));
+    const Index tris = cells == RectangleCells::tri3 ? 2 * nx * ny : cells == RectangleCells::tri_quad ? 2 * ny * 3 : 0;
+    const Index quads = cells == RectangleCells::quad4 ? nx * ny : cells == RectangleCells::tri_quad ? ny * 2 : 0;
+    CHECK(m.num_cells() == tris + quads);
+    CHECK(min_measure(m) > 0);
+    CHECK(m.num_facets() == 2 * (nx + ny));
+    CHECK(m.group_nodes("left").size() == static_cast<std::size_t>(ny + 1));
+    CHECK(m.group_nodes("right").size() == static_cast<std::size_t>(ny + 1));
+    CHECK(m.group_nodes("bottom").size() == static_cast<std::size_t>(nx + 1));
+    CHECK(m.group_nodes("top").size() == static_cast<std::size_t>(nx + 1));
+    for (Index v : m.group_nodes("left")) CHECK(m.points(0, v) == -1.0);
+    for (Index v : m.group_nodes("top")) CHECK(m.points(1, v) == 1.0);
+    CHECK_NOTHROW(validate(m));
+  }
+}
+
+TEST_CASE("box meshes of every cell kind: counts, groups, orientation", "[core]") {
+  const Index nx = 3, ny = 2, nz = 4;
+  const Index grid_cells = nx * ny * nz;
+  const std::vector<std::pair<BoxCells, Index>> kinds{{BoxCells::hex8, grid_cells},
+                                                      {BoxCells::tet4, 6 * grid_cells},
+                                                      {BoxCells::prism6, 2 * grid_cells},
+                                                      {BoxCells::pyramid5, 6 * grid_cells},
+                                                      {BoxCells::hex_prism, ny * nz * (2 * 2 + 1)},
+                                                      {BoxCells::tet_pyramid_prism, ny * nz * (2 + 7 + 6)}};
+  for (const auto& [cells, count] : kinds) {
+    INFO("cells " << static_cast<int>(cells));
+    const Mesh<3> m = box_mesh({.nx = nx, .ny = ny, .nz = nz, .z_max = 3.0, .cells = cells});
+    CHECK(m.num_cells() == count);
+    CHECK(min_measure(m) > 0);
+    double volume = 0;
+    for (const auto& b : m.cells)
+      for (Index e = 0; e < b.size(); ++e) volume += signed_measure(m, b.type, b.element(e));
+    CHECK(volume == Approx(3.0));
+    const auto side = [&](const char* g) { return m.group_nodes(g).size(); };
+    CHECK(side("left") == static_cast<std::size_t>((ny + 1) * (nz + 1)));
+    CHECK(side("right") == static_cast<std::size_t>((ny + 1) * (nz + 1)));
+    CHECK(side("front") == static_cast<std::size_t>((nx + 1) * (nz + 1)));
+    CHECK(side("back") == static_cast<std::size_t>((nx + 1) * (nz + 1)));
+    CHECK(side("bottom") == static_cast<std::size_t>((nx + 1) * (ny + 1)));
+    CHECK(side("top") == static_cast<std::size_t>((nx + 1) * (ny + 1)));
+    for (Index v : m.group_nodes("top")) CHECK(m.points(2, v) == 3.0);
+    CHECK_NOTHROW(validate(m));
+  }
+  // The mixed kinds really are mixed.
+  const Mesh<3> mixed = box_mesh({.nx = 3, .cells = BoxCells::tet_pyramid_prism});
+  CHECK(mixed.find_block(ElementType::tet4));
+  CHECK(mixed.find_block(ElementType::pyramid5));
+  CHECK(mixed.find_block(ElementType::prism6));
+}
+
+TEST_CASE("default O-mesh is a valid boundary-layer mesh with aspect ratio above 1000", "[core]") {
+  const OMeshOptions opt;
+  const Mesh<2> m = o_mesh();
+  const Index n = opt.n_around;
+  CHECK(m.num_nodes() == n * (opt.n_radial + 1));
+  CHECK(m.num_cells() == n * opt.n_radial);
+  CHECK(min_measure(m) > 0);
+  CHECK(m.group_nodes("wall").size() == static_cast<std::size_t>(n));
+  CHECK(m.group_nodes("farfield").size() == static_cast<std::size_t>(n));
+  const double wall_spacing = (m.points.col(1) - m.points.col(0)).norm();
+  const double first_height = (m.points.col(n) - m.points.col(0)).norm();
+  CHECK(first_height == Approx(opt.first_height).epsilon(1e-9));
+  CHECK(wall_spacing / first_height >= 1000.0);
+  for (Index v : m.group_nodes("wall")) CHECK(m.points.col(v).norm() == Approx(0.5).epsilon(1e-15));
+  for (Index v : m.group_nodes("farfield")) CHECK(m.points.col(v).norm() == Approx(opt.farfield_radius).epsilon(1e-13));
+}
+
+TEST_CASE("O-mesh around an ellipse and a square, quads and triangles", "[core]") {
+  const OMeshOptions ellipse{.semi_axis_x = 1.0, .semi_axis_y = 0.25, .n_around = 40, .n_radial = 12,
+                             .first_height = 1e-4, .farfield_radius = 10.0, .triangles = true};
+  const Mesh<2> m = o_mesh(ellipse);
+  CHECK(m.num_cells() == 2 * 40 * 12);
+  CHECK(min_measure(m) > 0);
+  for (Index v : m.group_nodes("wall")) {
+    const double x = m.points(0, v), y = m.points(1, v) / 0.25;
+    CHECK(std::abs(x * x + y * y - 1.0) < 1e-14);
+  }
+  // Each ray starts with the requested first height.
+  for (Index i = 0; i < 40; ++i) CHECK((m.points.col(40 + i) - m.points.col(i)).norm() == Approx(1e-4).epsilon(1e-9));
+
+  const Mesh<2> sq = o_mesh({.body = OMeshBody::square, .semi_axis_x = 0.5, .n_around = 32, .n_radial = 10,
+                             .first_height = 1e-3, .growth = 1.3});
+  CHECK(min_measure(sq) > 0);
+  for (Index v : sq.group_nodes("wall")) CHECK(sq.points.col(v).lpNorm<Eigen::Infinity>() == Approx(0.5).epsilon(1e-15));
+  // With a given growth the second layer is growth × the first.
+  const double h1 = (sq.points.col(32) - sq.points.col(0)).norm();
+  const double h2 = (sq.points.col(64) - sq.points.col(32)).norm();
+  CHECK(h1 == Approx(1e-3));
+  CHECK(h2 / h1 == Approx(1.3));
+}
+
+TEST_CASE("generators reject impossible sizes", "[core]") {
+  CHECK_THROWS_AS(rectangle_mesh({.nx = 0}), InputError);
+  CHECK_THROWS_AS(box_mesh({.nz = -1}), InputError);
+  CHECK_THROWS_WITH(o_mesh({.body = OMeshBody::square, .n_around = 30}), Catch::Contains("multiple of 4"));
+  CHECK_THROWS_WITH(o_mesh({.farfield_radius = 0.4}), Catch::Contains("does not enclose"));
+  CHECK_THROWS_WITH(o_mesh({.n_radial = 10, .first_height = 5.0}), Catch::Contains("past the farfield"));
+}
