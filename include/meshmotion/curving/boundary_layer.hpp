@@ -1,0 +1,185 @@
+#pragma once
+/// \file
+/// Boundary-layer thickness of each wall, estimated from the mesh alone: the layer is the
+/// region of anisotropic cells connected to the wall, and its thickness the wall distance
+/// where those cells stop being anisotropic. The curving pipeline derives its default RBF
+/// support radius and blending length from it (issue 5: a radius much larger than the
+/// layer makes the interpolant overshoot away from the wall).
+///
+/// Method: cells whose aspect ratio (longest over shortest vertex edge) is at least
+/// `aspect_ratio_threshold` and that touch a wall seed a flood fill through shared facets
+/// restricted to such cells. Every vertex reached is measured against the straight wall
+/// facets (exact point-facet distance) and credited to its nearest wall vertex; a wall
+/// vertex's thickness is the largest distance credited to it, a wall's thickness the median
+/// over its vertices (robust to the wake of a trailing edge, which is anisotropic too).
+/// Cost: linear in the cells of the layer, plus a k-d tree query per vertex reached.
+
+#include "meshmotion/core/element.hpp"
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/topology.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/curving/detail/wall_distance.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace meshmotion {
+
+/// Options of estimate_boundary_layer().
+struct BoundaryLayerOptions {
+  /// Cells with longest/shortest vertex edge at least this belong to the layer; 2–4 separates
+  /// the stretched layer from the isotropic core of usual meshes.
+  double aspect_ratio_threshold = 3.0;
+};
+
+/// The estimated layer of one wall group.
+struct WallLayer {
+  std::string group;
+  int tag = 0;
+  double thickness = 0.0;      ///< median over the wall's vertices of their layer thickness
+  double max_thickness = 0.0;  ///< largest over the wall's vertices
+  Index layer_cells = 0;       ///< anisotropic cells credited to this wall
+};
+
+/// Layer thickness per wall and per wall vertex.
+struct BoundaryLayerEstimate {
+  std::vector<WallLayer> walls;       ///< in the order the groups were given
+  std::vector<Index> wall_nodes;      ///< sorted wall vertices of all walls
+  std::vector<double> node_thickness;  ///< thickness at each of wall_nodes (0: no layer there)
+
+  /// The layer of the named wall; throws InputError when it was not estimated.
+  [[nodiscard]] const WallLayer& wall(std::string_view group) const {
+    for (const auto& w : walls)
+      if (w.group == group) return w;
+    throw InputError("BoundaryLayerEstimate::wall: no estimate for group '" + std::string(group) + "'");
+  }
+};
+
+/// Longest over shortest edge among the vertex edges of one cell (1 for an equilateral
+/// cell, large for a stretched one; infinite for a degenerate edge).
+template <int Dim>
+[[nodiscard]] double cell_aspect_ratio(const Points<Dim>& points, ElementType type, std::span<const Index> nodes) {
+  double longest = 0.0, shortest = std::numeric_limits<double>::infinity();
+  for (const auto& e : edges(type)) {
+    const double length = (points.col(nodes[static_cast<std::size_t>(e[1])]) - points.col(nodes[static_cast<std::size_t>(e[0])])).norm();
+    longest = std::max(longest, length);
+    shortest = std::min(shortest, length);
+  }
+  return shortest > 0.0 ? longest / shortest : std::numeric_limits<double>::infinity();
+}
+
+/// Estimates the boundary-layer thickness of each of `wall_groups` (groups of dimension
+/// Dim - 1) of a linear or quadratic mesh (only vertices are used). Throws InputError for an
+/// empty group list, an unknown group or one that is not a facet group, and a threshold
+/// below 1.
+template <int Dim>
+[[nodiscard]] BoundaryLayerEstimate estimate_boundary_layer(const Mesh<Dim>& mesh,
+                                                            std::span<const std::string> wall_groups,
+                                                            const BoundaryLayerOptions& options = {}) {
+  if (wall_groups.empty()) throw InputError("estimate_boundary_layer: no wall group given (expected at least one)");
+  if (!(options.aspect_ratio_threshold >= 1.0))
+    throw InputError("estimate_boundary_layer: aspect_ratio_threshold " + std::to_string(options.aspect_ratio_threshold) +
+                     " (expected >= 1)");
+  BoundaryLayerEstimate out;
+  std::vector<int> tags;
+  for (const auto& name : wall_groups) {
+    const PhysicalGroup& g = mesh.group(name);
+    if (g.dim != Dim - 1)
+      throw InputError("estimate_boundary_layer: group '" + name + "' has dimension " + std::to_string(g.dim) +
+                       " (expected a wall of dimension " + std::to_string(Dim - 1) + ")");
+    tags.push_back(g.tag);
+    out.walls.push_back({name, g.tag, 0.0, 0.0, 0});
+  }
+  const detail::WallDistance<Dim> wall(mesh.points, detail::wall_facets(mesh, tags));
+  if (wall.empty()) return out;
+  out.wall_nodes = wall.vertices();
+  out.node_thickness.assign(out.wall_nodes.size(), 0.0);
+  const auto slot = [&](Index v) {
+    return static_cast<std::size_t>(std::lower_bound(out.wall_nodes.begin(), out.wall_nodes.end(), v) - out.wall_nodes.begin());
+  };
+  // The wall (index into out.walls) of each wall vertex: the first listed group holding it.
+  std::vector<std::size_t> owner(out.wall_nodes.size(), out.walls.size());
+  for (std::size_t w = out.walls.size(); w-- > 0;)
+    for (const Index v : mesh.group_nodes(out.walls[w].tag, Dim - 1))
+      if (std::binary_search(out.wall_nodes.begin(), out.wall_nodes.end(), v)) owner[slot(v)] = w;
+
+  std::vector<Index> block_start{0};
+  for (const auto& b : mesh.cells) block_start.push_back(block_start.back() + b.size());
+  const auto locate = [&](Index cell) {
+    const auto b = static_cast<Index>(std::upper_bound(block_start.begin(), block_start.end(), cell) - block_start.begin()) - 1;
+    return std::pair<Index, Index>{b, cell - block_start[static_cast<std::size_t>(b)]};
+  };
+  const auto cell_nodes = [&](Index cell) {
+    const auto [b, e] = locate(cell);
+    const auto& block = mesh.cells[static_cast<std::size_t>(b)];
+    return std::pair{block.type, block.element(e)};
+  };
+  std::vector<double> aspect(static_cast<std::size_t>(block_start.back()), -1.0);
+  const auto anisotropic = [&](Index cell) {
+    double& a = aspect[static_cast<std::size_t>(cell)];
+    if (a < 0.0) {
+      const auto [type, nodes] = cell_nodes(cell);
+      a = cell_aspect_ratio<Dim>(mesh.points, type, nodes.first(static_cast<std::size_t>(num_vertices(type))));
+    }
+    return a >= options.aspect_ratio_threshold;
+  };
+
+  std::vector<char> is_wall(static_cast<std::size_t>(mesh.num_nodes()), 0);
+  for (const Index v : out.wall_nodes) is_wall[static_cast<std::size_t>(v)] = 1;
+  std::vector<char> reached(aspect.size(), 0);
+  std::deque<Index> queue;
+  for (Index cell = 0; cell < block_start.back(); ++cell) {
+    const auto [type, nodes] = cell_nodes(cell);
+    bool touches = false;
+    for (int k = 0; k < num_vertices(type); ++k) touches = touches || is_wall[static_cast<std::size_t>(nodes[static_cast<std::size_t>(k)])];
+    if (touches && anisotropic(cell)) {
+      reached[static_cast<std::size_t>(cell)] = 1;
+      queue.push_back(cell);
+    }
+  }
+  const FacetTopology topo = unique_facets(mesh);
+  std::vector<char> measured(static_cast<std::size_t>(mesh.num_nodes()), 0);
+  while (!queue.empty()) {
+    const Index cell = queue.front();
+    queue.pop_front();
+    const auto [type, nodes] = cell_nodes(cell);
+    std::size_t credited = out.walls.size();
+    for (int k = 0; k < num_vertices(type); ++k) {
+      const Index v = nodes[static_cast<std::size_t>(k)];
+      const Vec<Dim> p = mesh.points.col(v);
+      const std::size_t s = slot(wall.nearest_vertex(p).first);
+      credited = std::min(credited, owner[s]);
+      if (measured[static_cast<std::size_t>(v)] || is_wall[static_cast<std::size_t>(v)]) continue;
+      measured[static_cast<std::size_t>(v)] = 1;
+      out.node_thickness[s] = std::max(out.node_thickness[s], wall.closest(p).distance);
+    }
+    if (credited < out.walls.size()) ++out.walls[credited].layer_cells;
+    const auto [b, e] = locate(cell);
+    for (const Index f : topo.element_facets.of(b, e))
+      for (const Index next : topo.elements[static_cast<std::size_t>(f)])
+        if (next >= 0 && !reached[static_cast<std::size_t>(next)] && anisotropic(next)) {
+          reached[static_cast<std::size_t>(next)] = 1;
+          queue.push_back(next);
+        }
+  }
+  for (std::size_t w = 0; w < out.walls.size(); ++w) {
+    std::vector<double> values;
+    for (std::size_t s = 0; s < out.wall_nodes.size(); ++s)
+      if (owner[s] == w) values.push_back(out.node_thickness[s]);
+    if (values.empty()) continue;
+    auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), mid, values.end());
+    out.walls[w].thickness = *mid;
+    out.walls[w].max_thickness = *std::max_element(values.begin(), values.end());
+  }
+  return out;
+}
+
+}  // namespace meshmotion
