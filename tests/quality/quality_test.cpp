@@ -1,0 +1,438 @@
+#include "meshmotion/core/shape_functions.hpp"
+#include "meshmotion/io.hpp"
+#include "meshmotion/quality.hpp"
+
+#include "test_data.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+#include <string>
+
+using namespace meshmotion;
+
+namespace {
+
+const double sqrt3 = std::sqrt(3.0);
+
+template <int D>
+Eigen::Matrix<double, D, Eigen::Dynamic> columns(std::initializer_list<std::array<double, D>> pts) {
+  Eigen::Matrix<double, D, Eigen::Dynamic> x(D, static_cast<Index>(pts.size()));
+  Index i = 0;
+  for (const auto& p : pts) {
+    for (int d = 0; d < D; ++d) x(d, i) = p[static_cast<std::size_t>(d)];
+    ++i;
+  }
+  return x;
+}
+
+// The nodes of `type` mapped by x -> a x + b from the reference element.
+template <int D>
+Eigen::Matrix<double, D, Eigen::Dynamic> affine_element(ElementType type, const Eigen::Matrix<double, D, D>& a,
+                                                       const Eigen::Matrix<double, D, 1>& b) {
+  const auto ref = reference_nodes(type);
+  Eigen::Matrix<double, D, Eigen::Dynamic> x(D, num_nodes(type));
+  for (int i = 0; i < num_nodes(type); ++i) {
+    Eigen::Matrix<double, D, 1> r;
+    for (int d = 0; d < D; ++d) r(d) = ref[static_cast<std::size_t>(i)][static_cast<std::size_t>(d)];
+    x.col(i) = a * r + b;
+  }
+  return x;
+}
+
+template <int D>
+double dense_min(ElementType type, const Eigen::Matrix<double, D, Eigen::Dynamic>& x, double linear_det, int n) {
+  double m = std::numeric_limits<double>::infinity();
+  const Shape s = shape(type);
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j)
+      for (int k = 0; k <= (D == 3 ? n : 0); ++k) {
+        const double a = static_cast<double>(i) / n, b = static_cast<double>(j) / n, c = static_cast<double>(k) / n;
+        RefPoint p{};
+        if (s == Shape::triangle || s == Shape::tetrahedron) {
+          if (a + b + c > 1 + 1e-12) continue;
+          p = {a, b, c};
+        } else if (s == Shape::prism) {
+          if (a + b > 1 + 1e-12) continue;
+          p = {a, b, 2 * c - 1};
+        } else {
+          p = {2 * a - 1, 2 * b - 1, D == 3 ? 2 * c - 1 : 0.0};
+        }
+        m = std::min(m, jacobian_determinant(type, x, p) / linear_det);
+      }
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("Knupp metrics: known values", "[quality]") {
+  const auto equilateral = columns<2>({{0, 0}, {1, 0}, {0.5, sqrt3 / 2}});
+  const auto q_eq = knupp_quality(ElementType::tri3, equilateral, sqrt3 / 4);
+  CHECK(q_eq.valid);
+  CHECK(q_eq.shape == Approx(1.0));
+  CHECK(q_eq.relative_size == Approx(1.0));
+  CHECK(q_eq.measure == Approx(sqrt3 / 4));
+
+  const auto regular_tet = columns<3>({{0, 0, 0}, {1, 0, 0}, {0.5, sqrt3 / 2, 0}, {0.5, sqrt3 / 6, std::sqrt(2.0 / 3.0)}});
+  CHECK(knupp_quality(ElementType::tet4, regular_tet, 1.0).shape == Approx(1.0));
+
+  // Right isosceles triangle: eq. 2.19 with r = 1, θ = 90°: √3 / 2.
+  const auto right = columns<2>({{0, 0}, {1, 0}, {0, 1}});
+  CHECK(knupp_quality(ElementType::tri3, right, 1.0).shape == Approx(sqrt3 / 2));
+  // Its relative size against twice its area is 1/2.
+  CHECK(knupp_quality(ElementType::tri3, right, 1.0).relative_size == Approx(0.5));
+
+  // 2:1 rectangle: right angles (skew 1) but unequal sides: 8 / (4 × 2.5) = 0.8.
+  const auto rect = columns<2>({{0, 0}, {2, 0}, {2, 1}, {0, 1}});
+  const auto q_rect = knupp_quality(ElementType::quad4, rect, 2.0);
+  CHECK(q_rect.skew == Approx(1.0));
+  CHECK(q_rect.shape == Approx(0.8));
+  CHECK(q_rect.size_skew == Approx(1.0));
+  CHECK(q_rect.size_shape == Approx(0.8));
+  CHECK(knupp_quality(ElementType::hex8, affine_element<3>(ElementType::hex8, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()), 8.0).shape ==
+        Approx(1.0));
+
+  // Prism on an equilateral triangle with unit height, pyramid with equilateral sides.
+  const auto prism = columns<3>({{0, 0, 0}, {1, 0, 0}, {0.5, sqrt3 / 2, 0}, {0, 0, 1}, {1, 0, 1}, {0.5, sqrt3 / 2, 1}});
+  CHECK(knupp_quality(ElementType::prism6, prism, 1.0).shape == Approx(1.0));
+  const auto pyramid = columns<3>({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, 1 / std::sqrt(2.0)}});
+  CHECK(knupp_quality(ElementType::pyramid5, pyramid, 1.0).shape == Approx(1.0));
+  const auto flat_pyramid = columns<3>({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, 0.1}});
+  CHECK(knupp_quality(ElementType::pyramid5, flat_pyramid, 1.0).shape < 0.5);
+}
+
+TEST_CASE("Knupp metrics: degenerate and inverted elements are 0 and invalid", "[quality]") {
+  const auto collapsed = columns<2>({{0, 0}, {1, 1}, {2, 2}});
+  const auto q = knupp_quality(ElementType::tri3, collapsed, 1.0);
+  CHECK_FALSE(q.valid);
+  CHECK(q.shape == 0.0);
+  CHECK(q.relative_size == 0.0);
+  const auto repeated = columns<2>({{0, 0}, {1, 0}, {1, 0}, {0, 1}});
+  CHECK_FALSE(knupp_quality(ElementType::quad4, repeated, 1.0).valid);
+  const auto inverted = columns<2>({{0, 0}, {0, 1}, {1, 0}});  // clockwise
+  const auto qi = knupp_quality(ElementType::tri3, inverted, 1.0);
+  CHECK_FALSE(qi.valid);
+  CHECK(qi.shape == 0.0);
+  CHECK(qi.skew == 0.0);
+  const auto bowtie = columns<2>({{0, 0}, {1, 0}, {0, 1}, {1, 1}});
+  CHECK_FALSE(knupp_quality(ElementType::quad4, bowtie, 1.0).valid);
+  const auto nan = columns<2>({{0, 0}, {1, 0}, {std::nan(""), 1}});
+  const auto qn = knupp_quality(ElementType::tri3, nan, 1.0);
+  CHECK_FALSE(qn.valid);
+  CHECK(qn.shape == 0.0);
+  CHECK(qn.measure == 0.0);
+}
+
+TEST_CASE("Knupp metrics: thesis eqs. 2.19-2.21 equal the matrix form", "[quality]") {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  const auto angle = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+  };
+  for (int trial = 0; trial < 50; ++trial) {
+    auto tri = columns<2>({{0, 0}, {1, 0}, {0.5, 0.9}});
+    for (int i = 0; i < 3; ++i) tri.col(i) += Eigen::Vector2d(u(rng), u(rng));
+    const Eigen::Vector2d e1 = tri.col(1) - tri.col(0), e2 = tri.col(2) - tri.col(0);
+    const double r = e2.norm() / e1.norm(), th = angle(e1, e2);
+    const double eq219 = sqrt3 * r * std::sin(th) / (1 - r * std::cos(th) + r * r);
+    CHECK(knupp_quality(ElementType::tri3, tri, 1.0).shape == Approx(eq219).epsilon(1e-12));
+
+    auto quad = columns<2>({{0, 0}, {1, 0}, {1, 1}, {0, 1}});
+    for (int i = 0; i < 4; ++i) quad.col(i) += Eigen::Vector2d(u(rng), u(rng));
+    double sum_shape = 0, sum_skew = 0;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector2d a = quad.col((k + 1) % 4) - quad.col(k), b = quad.col((k + 3) % 4) - quad.col(k);
+      const double rk = b.norm() / a.norm(), tk = angle(a, b);
+      sum_shape += (1 + rk * rk) / (rk * std::sin(tk));
+      sum_skew += 1 / std::sin(tk);
+    }
+    const auto q = knupp_quality(ElementType::quad4, quad, 1.0);
+    CHECK(q.shape == Approx(8 / sum_shape).epsilon(1e-12));
+    CHECK(q.skew == Approx(4 / sum_skew).epsilon(1e-12));
+  }
+}
+
+TEST_CASE("Knupp metrics: invariant under translation, rotation and uniform scaling", "[quality]") {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.25, 0.25);
+  Eigen::Matrix3d rot = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const double scale = 3.7;
+  for (ElementType t : {ElementType::tet4, ElementType::hex8, ElementType::prism6, ElementType::pyramid5}) {
+    INFO(name(t));
+    Eigen::Matrix<double, 3, Eigen::Dynamic> x = affine_element<3>(t, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+    for (Index i = 0; i < x.cols(); ++i) x.col(i) += Eigen::Vector3d(u(rng), u(rng), u(rng));
+    const Eigen::Matrix<double, 3, Eigen::Dynamic> y = ((scale * rot) * x).colwise() + Eigen::Vector3d(5, -3, 2);
+    const auto qx = knupp_quality(t, x, 1.0), qy = knupp_quality(t, y, scale * scale * scale);
+    CHECK(qx.valid);
+    CHECK(qy.shape == Approx(qx.shape).epsilon(1e-12));
+    CHECK(qy.skew == Approx(qx.skew).epsilon(1e-12));
+    CHECK(qy.relative_size == Approx(qx.relative_size).epsilon(1e-12));  // reference scaled alike
+  }
+  Eigen::Matrix2d rot2 = Eigen::Rotation2Dd(1.1).toRotationMatrix();
+  for (ElementType t : {ElementType::tri3, ElementType::quad4}) {
+    Eigen::Matrix<double, 2, Eigen::Dynamic> x = affine_element<2>(t, Eigen::Matrix2d::Identity(), Eigen::Vector2d::Zero());
+    for (Index i = 0; i < x.cols(); ++i) x.col(i) += Eigen::Vector2d(u(rng), u(rng));
+    const Eigen::Matrix<double, 2, Eigen::Dynamic> y = ((scale * rot2) * x).colwise() + Eigen::Vector2d(-1, 4);
+    CHECK(knupp_quality(t, y, 1.0).shape == Approx(knupp_quality(t, x, 1.0).shape).epsilon(1e-12));
+    CHECK(knupp_quality(t, y, 1.0).skew == Approx(knupp_quality(t, x, 1.0).skew).epsilon(1e-12));
+  }
+}
+
+TEST_CASE("scaled Jacobian is 1 on straight-sided elements of every type", "[quality]") {
+  Eigen::Matrix3d a3;
+  a3 << 1.3, 0.2, -0.1, 0.1, 0.9, 0.3, 0.0, -0.2, 1.1;
+  Eigen::Matrix2d a2;
+  a2 << 1.5, 0.4, -0.2, 0.7;
+  for (int i = 0; i < num_element_types; ++i) {
+    const auto t = static_cast<ElementType>(i);
+    if (dimension(t) < 2) continue;
+    INFO(name(t));
+    const auto s = dimension(t) == 2 ? scaled_jacobian(t, affine_element<2>(t, a2, Eigen::Vector2d(1, 2)))
+                                     : scaled_jacobian(t, affine_element<3>(t, a3, Eigen::Vector3d(1, 2, 3)));
+    CHECK(s.valid);
+    CHECK(s.certified == (shape(t) != Shape::pyramid));
+    CHECK(s.certified_min == Approx(1.0).epsilon(1e-10));
+    CHECK(s.certified_max == Approx(1.0).epsilon(1e-10));
+    CHECK(s.sampled_min == Approx(1.0).epsilon(1e-10));
+    CHECK(s.leaves == 1);
+  }
+  // A mirrored (negatively oriented) straight element is inverted: -1.
+  Eigen::Matrix2d mirror;
+  mirror << -1, 0, 0, 1;
+  const auto m = scaled_jacobian(ElementType::tri6, affine_element<2>(ElementType::tri6, mirror, Eigen::Vector2d::Zero()));
+  CHECK(m.certified_min == Approx(-1.0));
+  CHECK_FALSE(m.valid);
+}
+
+TEST_CASE("scaled Jacobian of a non-parallelogram quad is below 1", "[quality]") {
+  // Trapezoid: det J at the top corners is 1/4, at the centre 3/8.
+  const auto trapezoid = columns<2>({{0, 0}, {2, 0}, {1.5, 1}, {0.5, 1}});
+  const auto s = scaled_jacobian(ElementType::quad4, trapezoid);
+  CHECK(s.linear_det == Approx(0.375));
+  CHECK(s.certified_min == Approx(2.0 / 3.0));
+  CHECK(s.certified_max == Approx(4.0 / 3.0));
+  CHECK(s.valid);
+}
+
+TEST_CASE("certified bound is below the sampled minimum and sharp on curved elements", "[quality]") {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-0.12, 0.12);
+  for (ElementType t : {ElementType::tri6, ElementType::quad8, ElementType::quad9, ElementType::tet10, ElementType::hex20,
+                        ElementType::hex27, ElementType::prism15, ElementType::prism18}) {
+    INFO(name(t));
+    for (int trial = 0; trial < 3; ++trial) {
+      if (dimension(t) == 2) {
+        auto x = affine_element<2>(t, Eigen::Matrix2d::Identity(), Eigen::Vector2d::Zero());
+        for (Index i = num_vertices(t); i < x.cols(); ++i) x.col(i) += Eigen::Vector2d(u(rng), u(rng));
+        const auto s = scaled_jacobian(t, x);
+        CHECK(s.certified_min <= s.sampled_min);
+        CHECK(s.certified_min == Approx(dense_min<2>(t, x, s.linear_det, 120)).margin(2e-3));
+      } else {
+        auto x = affine_element<3>(t, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+        for (Index i = num_vertices(t); i < x.cols(); ++i) x.col(i) += Eigen::Vector3d(u(rng), u(rng), u(rng));
+        const auto s = scaled_jacobian(t, x);
+        CHECK(s.certified_min <= s.sampled_min);
+        CHECK(s.certified_min == Approx(dense_min<3>(t, x, s.linear_det, 24)).margin(5e-3));
+      }
+    }
+  }
+}
+
+TEST_CASE("scaled Jacobian flags tangled curved elements", "[quality]") {
+  // Midpoint of edge (1,2) pushed across vertex 0.
+  auto tri = columns<2>({{0, 0}, {1, 0}, {0, 1}, {0.5, 0}, {-0.3, -0.3}, {0, 0.5}});
+  const auto s = scaled_jacobian(ElementType::tri6, tri);
+  CHECK(s.certified_min < 0);
+  CHECK_FALSE(s.valid);
+  CHECK(s.certified_max > 0);
+
+  // A quad9 whose det J is positive at all nine nodes but negative inside: sampling at the
+  // nodes misses it, the Bézier bound does not.
+  const auto quad = columns<2>({{-1, -1}, {1, -1}, {1, 1}, {-1, 1}, {0.3, -1.1}, {0.9, 0.4}, {-0.3, 1.4}, {-0.4, 0.5}, {0.3, -0.2}});
+  const auto q = scaled_jacobian(ElementType::quad9, quad);
+  double at_nodes = std::numeric_limits<double>::infinity();
+  for (const auto& p : reference_nodes(ElementType::quad9))
+    at_nodes = std::min(at_nodes, jacobian_determinant(ElementType::quad9, quad, p) / q.linear_det);
+  CHECK(at_nodes > 0.4);
+  CHECK(q.certified_min < -0.15);
+  CHECK(dense_min<2>(ElementType::quad9, quad, q.linear_det, 100) < -0.15);
+  CHECK_FALSE(q.valid);
+  // Validity-only mode decides the same without sharpening.
+  ScaledJacobianOptions fast;
+  fast.sharp = false;
+  CHECK_FALSE(scaled_jacobian(ElementType::quad9, quad, fast).valid);
+}
+
+TEST_CASE("bad input gives defined results, never NaN", "[quality]") {
+  auto tri = columns<2>({{0, 0}, {1, 0}, {0, 1}, {0.5, 0}, {0.5, 0.5}, {0, 0.5}});
+  tri(0, 4) = std::nan("");
+  const auto s = scaled_jacobian(ElementType::tri6, tri);
+  CHECK(s.degenerate);
+  CHECK_FALSE(s.valid);
+  CHECK(s.certified_min == 0.0);
+  const auto repeated = columns<2>({{0, 0}, {1, 0}, {1, 0}, {0.5, 0}, {1, 0}, {0.5, 0}});
+  CHECK(scaled_jacobian(ElementType::tri6, repeated).degenerate);
+  CHECK_THROWS_AS(scaled_jacobian(ElementType::tri6, columns<3>({{0, 0, 0}})), InputError);
+
+  Mesh<2> mesh;
+  mesh.points = columns<2>({{0, 0}, {1, 0}, {0, 1}, {2, 2}, {std::nan(""), 0}});
+  mesh.block(ElementType::tri3).add({0, 1, 2});
+  mesh.cells[0].add({0, 0, 1});  // repeated node
+  mesh.cells[0].add({0, 1, 4});  // NaN coordinate
+  mesh.cells[0].add({0, 2, 1});  // inverted
+  for (Metric m : all_metrics) {
+    INFO(metric_name(m));
+    const auto r = quality_report(mesh, m);
+    CHECK(r.num_elements == 4);
+    CHECK(r.num_invalid == 3);
+    CHECK(std::isfinite(r.min));
+    CHECK(std::isfinite(r.mean));
+    CHECK(std::isfinite(r.max));
+    CHECK(to_json(r).find("nan") == std::string::npos);
+  }
+  CHECK_THROWS_AS(metric_from_name("beauty"), InputError);
+}
+
+TEST_CASE("quality report: values, histogram, worst elements, JSON", "[quality]") {
+  Mesh<2> mesh;
+  mesh.points = columns<2>({{0, 0}, {1, 0}, {0.5, sqrt3 / 2}, {2, 0}, {2, 1}, {0, 1}});
+  mesh.block(ElementType::tri3).add({0, 1, 2});
+  mesh.block(ElementType::quad4).add({1, 3, 4, 5});
+  const auto shape_values = cell_quality(mesh, Metric::shape);
+  REQUIRE(shape_values.size() == 2);
+  CHECK(shape_values[0] == Approx(1.0));
+  ReportOptions opt;
+  opt.num_worst = 1;
+  const auto r = quality_report(mesh, Metric::shape, opt);
+  CHECK(r.num_invalid == 0);
+  CHECK(r.max == Approx(1.0));
+  CHECK(r.min == shape_values[1]);
+  CHECK(r.mean == Approx((shape_values[0] + shape_values[1]) / 2));
+  CHECK(r.histogram.back() == 1);
+  REQUIRE(r.worst.size() == 1);
+  CHECK(r.worst[0].id == 1);
+  CHECK(r.worst[0].type == ElementType::quad4);
+  CHECK(r.worst[0].centroid[0] == Approx(1.25));
+  REQUIRE(r.per_type.size() == 2);
+  CHECK(r.per_type[1].type == ElementType::quad4);
+  const std::string json = to_json(r);
+  CHECK(json.find("\"metric\":\"shape\"") != std::string::npos);
+  CHECK(json.find("\"elements\":2") != std::string::npos);
+  // Default reference size is the mean cell measure: (√3/4 + 1.5) / 2.
+  CHECK(mean_cell_measure(mesh) == Approx((sqrt3 / 4 + 1.5) / 2));
+}
+
+// ---- Agreement with Gmsh's AnalyseMeshQuality plugin --------------------------------------
+// tests/quality/data/boundary_layer_{tri6,quad9}.msh were made by Gmsh 4.8.4 from the .geo
+// files beside them (`gmsh X.geo -2 -order 2`), and the plugin (JacobianDeterminant = 1,
+// CreateView = 1) gave, per element, minJ/maxJ; straight elements have 1 and are not listed.
+
+namespace {
+
+struct GmshRatio {
+  std::int64_t id;
+  double min_over_max;
+};
+
+struct GmshCase {
+  const char* file;
+  Index invalid;
+  std::array<double, 3> min_j;  // plugin's "minJ (min, avg, max)" log line, 3 digits
+  std::vector<GmshRatio> curved;
+};
+
+std::filesystem::path quality_data(const std::string& name) {
+  return std::filesystem::path(__FILE__).parent_path() / "data" / name;
+}
+
+// Per-element min/max ratio and invalid count of ours, by element id.
+std::map<std::int64_t, ScaledJacobian> ours_by_id(const Mesh<2>& mesh) {
+  const auto sj = scaled_jacobians(mesh);
+  std::map<std::int64_t, ScaledJacobian> out;
+  std::size_t k = 0;
+  for (const auto& b : mesh.cells)
+    for (Index e = 0; e < b.size(); ++e, ++k) out[b.ids.empty() ? static_cast<std::int64_t>(k) + 1 : b.ids[static_cast<std::size_t>(e)]] = sj[k];
+  return out;
+}
+
+void check_against(const Mesh<2>& mesh, const std::map<std::int64_t, double>& gmsh_ratio_by_id, Index gmsh_invalid) {
+  const auto ours = ours_by_id(mesh);
+  Index invalid = 0;
+  for (const auto& [id, s] : ours) invalid += s.valid ? 0 : 1;
+  CHECK(invalid == gmsh_invalid);
+  for (const auto& [id, s] : ours) {
+    INFO("element " << id);
+    const auto it = gmsh_ratio_by_id.find(id);
+    const double expected = it == gmsh_ratio_by_id.end() ? 1.0 : it->second;
+    CHECK(s.certified_min / s.certified_max == Approx(expected).epsilon(1e-3).margin(1e-9));
+  }
+}
+
+#include "data/gmsh_reference.inc"
+
+}  // namespace
+
+TEST_CASE("scaled Jacobian agrees with Gmsh's AnalyseMeshQuality on its own P2 meshes", "[quality]") {
+  for (const GmshCase& c : gmsh_cases) {
+    INFO(c.file);
+    const auto mesh = read_mesh_as<2>(quality_data(c.file));
+    std::map<std::int64_t, double> ratio;
+    for (const auto& r : c.curved) ratio[r.id] = r.min_over_max;
+    check_against(mesh, ratio, c.invalid);
+    // The plugin's summary of raw min det J over the elements.
+    const auto ours = ours_by_id(mesh);
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo, sum = 0;
+    for (const auto& [id, s] : ours) {
+      lo = std::min(lo, s.min_det());
+      hi = std::max(hi, s.min_det());
+      sum += s.min_det();
+    }
+    CHECK(lo == Approx(c.min_j[0]).epsilon(5e-3));
+    CHECK(sum / static_cast<double>(ours.size()) == Approx(c.min_j[1]).epsilon(5e-3));
+    CHECK(hi == Approx(c.min_j[2]).epsilon(5e-3));
+  }
+}
+
+TEST_CASE("scaled Jacobian agrees with a live gmsh run", "[quality]") {
+  if (std::system("gmsh --version > /dev/null 2>&1") != 0) {
+    WARN("skipped: gmsh is not on PATH");
+    return;
+  }
+  for (const GmshCase& c : gmsh_cases) {
+    INFO(c.file);
+    const auto script = test::scratch_path(std::string("analyse_") + c.file + ".geo");
+    const auto view = test::scratch_path(std::string("view_") + c.file);
+    {
+      std::ofstream geo(script);
+      geo << "Merge \"" << quality_data(c.file).string() << "\";\n"
+          << "Plugin(AnalyseMeshQuality).JacobianDeterminant = 1;\n"
+          << "Plugin(AnalyseMeshQuality).CreateView = 1;\n"
+          << "Plugin(AnalyseMeshQuality).DimensionOfElements = 2;\n"
+          << "Plugin(AnalyseMeshQuality).Run;\n"
+          << "Save View[0] \"" << view.string() << "\";\n";
+    }
+    std::filesystem::remove(view);
+    REQUIRE(std::system(("gmsh \"" + script.string() + "\" -nopopup -0 > /dev/null 2>&1").c_str()) == 0);
+    std::ifstream in(view);
+    std::string line;
+    while (std::getline(in, line) && line != "$ElementData") {}
+    for (int k = 0; k < 9; ++k) std::getline(in, line);  // tags: names, time, step, components, count
+    std::map<std::int64_t, double> ratio;
+    Index invalid = 0;
+    while (std::getline(in, line) && line != "$EndElementData") {
+      std::istringstream s(line);
+      std::int64_t id = 0;
+      double v = 0;
+      s >> id >> v;
+      ratio[id] = v;
+      invalid += v <= 0 ? 1 : 0;
+    }
+    REQUIRE(!ratio.empty());
+    check_against(read_mesh_as<2>(quality_data(c.file)), ratio, invalid);
+  }
+}
