@@ -1,9 +1,14 @@
 #pragma once
 /// \file
-/// The core layer: element catalogue, Mesh<Dim>, the MeshLike concept, topology, errors.
+/// The core layer: element catalogue, shape functions, Mesh<Dim>, the MeshLike concept,
+/// topology, orientation, built-in mesh generators, errors.
 
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
+#include "meshmotion/core/generators.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/mesh_like.hpp"
+#include "meshmotion/core/orientation.hpp"
+#include "meshmotion/core/shape_functions.hpp"
+#include "meshmotion/core/topology.hpp"
 #include "meshmotion/core/types.hpp"
