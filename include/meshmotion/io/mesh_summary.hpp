@@ -133,9 +133,9 @@ namespace detail {
     out += "  " + (g.name.empty() ? "(unnamed)" : g.name) + " (dim " + std::to_string(g.dim) + ", tag " + std::to_string(g.tag) +
            "): " + std::to_string(g.num_elements) + " elements, " + std::to_string(g.num_nodes) + " nodes\n";
   out += "bounding box: [";
-  for (int d = 0; d < s.dim; ++d) out += (d ? ", " : "") + detail::format_real(s.bbox_min[static_cast<std::size_t>(d)]);
+  for (int d = 0; d < s.dim; ++d) (out += d ? ", " : "") += detail::format_real(s.bbox_min[static_cast<std::size_t>(d)]);
   out += "] to [";
-  for (int d = 0; d < s.dim; ++d) out += (d ? ", " : "") + detail::format_real(s.bbox_max[static_cast<std::size_t>(d)]);
+  for (int d = 0; d < s.dim; ++d) (out += d ? ", " : "") += detail::format_real(s.bbox_max[static_cast<std::size_t>(d)]);
   out += "]\nedge length: min " + detail::format_real(s.min_edge) + ", max " + detail::format_real(s.max_edge) + "\n";
   out += "orientation: " + std::to_string(s.orientation.num_negative) + " of " + std::to_string(s.orientation.num_cells) +
          " cells negative, " + std::to_string(s.orientation.num_degenerate) + " degenerate\n";
@@ -146,19 +146,30 @@ namespace detail {
 [[nodiscard]] inline std::string to_json(const MeshSummary& s) {
   const auto counts = [](const std::vector<std::pair<std::string, Index>>& list) {
     std::string out = "{";
-    for (const auto& [type, n] : list) out += (out.size() > 1 ? "," : "") + detail::json_string(type) + ":" + std::to_string(n);
-    return out + "}";
+    for (const auto& [type, n] : list) {
+      if (out.size() > 1) out += ',';
+      out += detail::json_string(type);
+      out += ':';
+      out += std::to_string(n);
+    }
+    out += '}';
+    return out;
   };
   const auto point = [&](const std::array<double, 3>& p) {
     std::string out = "[";
-    for (int d = 0; d < s.dim; ++d) out += (d ? "," : "") + detail::format_real(p[static_cast<std::size_t>(d)]);
-    return out + "]";
+    for (int d = 0; d < s.dim; ++d) {
+      if (d) out += ',';
+      out += detail::format_real(p[static_cast<std::size_t>(d)]);
+    }
+    out += ']';
+    return out;
   };
   std::string out = "{\"dim\":" + std::to_string(s.dim) + ",\"nodes\":" + std::to_string(s.num_nodes) + ",\"cells\":" +
                     counts(s.cells) + ",\"facets\":" + counts(s.facets) + ",\"lower\":" + counts(s.lower) + ",\"groups\":[";
   for (std::size_t k = 0; k < s.groups.size(); ++k) {
     const auto& g = s.groups[k];
-    out += (k ? "," : "") + std::string("{\"name\":") + detail::json_string(g.name) + ",\"dim\":" + std::to_string(g.dim) +
+    if (k) out += ',';
+    out += "{\"name\":" + detail::json_string(g.name) + ",\"dim\":" + std::to_string(g.dim) +
            ",\"tag\":" + std::to_string(g.tag) + ",\"elements\":" + std::to_string(g.num_elements) +
            ",\"nodes\":" + std::to_string(g.num_nodes) + "}";
   }

@@ -1,0 +1,533 @@
+// Tests of the io layer: real meshes read with the counts of SOURCES.md, round trips between
+// every format variant, P2 elements of every type, VTK node orders, orientation, bad input.
+
+#include "meshmotion/core/orientation.hpp"
+#include "meshmotion/core/shape_functions.hpp"
+#include "meshmotion/io.hpp"
+
+#include "test_data.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+using namespace meshmotion;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::map<std::string, Index> type_counts(const std::vector<ElementBlock>& blocks) {
+  std::map<std::string, Index> counts;
+  for (const auto& b : blocks) counts[std::string(name(b.type))] += b.size();
+  return counts;
+}
+
+template <int Dim>
+Index group_size(const Mesh<Dim>& mesh, const std::string& group_name) {
+  const auto& g = mesh.group(group_name);
+  Index n = 0;
+  for (const auto& b : mesh.blocks_of_dim(g.dim)) n += std::count(b.tags.begin(), b.tags.end(), g.tag);
+  return n;
+}
+
+template <int Dim>
+Index tag_size(const Mesh<Dim>& mesh, int tag) {
+  Index n = 0;
+  for (const auto& b : mesh.facets) n += std::count(b.tags.begin(), b.tags.end(), tag);
+  return n;
+}
+
+void write_text(const fs::path& file, const std::string& text) {
+  std::ofstream(file, std::ios::binary) << text;
+}
+
+// Expects a ParseError whose message names the file and contains `what`, and returns its position.
+template <class F>
+std::uint64_t parse_error_position(F&& f, const std::string& what) {
+  try {
+    f();
+  } catch (const ParseError& e) {
+    INFO(e.what());
+    CHECK(std::string(e.what()).find(what) != std::string::npos);
+    return e.position();
+  }
+  FAIL("no ParseError thrown (expected one mentioning '" << what << "')");
+  return 0;
+}
+
+std::vector<fs::path> files_in(const fs::path& dir) {
+  std::vector<fs::path> out;
+  for (const auto& entry : fs::directory_iterator(dir)) out.push_back(entry.path());
+  return out;
+}
+
+// Element ids as written: the stored ones or positions over the blocks in file order.
+template <int Dim>
+void require_same_mesh(const Mesh<Dim>& a, const Mesh<Dim>& b, bool exact_ids = true) {
+  REQUIRE(a.num_nodes() == b.num_nodes());
+  CHECK(a.points == b.points);  // bitwise
+  for (Index i = 0; i < a.num_nodes(); ++i) REQUIRE(a.node_id(i) == b.node_id(i));
+  for (const auto& lists : {std::pair{&a.cells, &b.cells}, std::pair{&a.facets, &b.facets}, std::pair{&a.lower, &b.lower}}) {
+    REQUIRE(lists.first->size() == lists.second->size());
+    for (std::size_t k = 0; k < lists.first->size(); ++k) {
+      const auto& x = (*lists.first)[k];
+      const auto& y = (*lists.second)[k];
+      CHECK(x.type == y.type);
+      CHECK(x.connectivity == y.connectivity);
+      CHECK(x.tags == y.tags);
+      if (exact_ids && !x.ids.empty()) CHECK(x.ids == y.ids);
+    }
+  }
+  REQUIRE(a.groups.size() == b.groups.size());
+  for (std::size_t k = 0; k < a.groups.size(); ++k) {
+    CHECK(a.groups[k].name == b.groups[k].name);
+    CHECK(a.groups[k].tag == b.groups[k].tag);
+    CHECK(a.groups[k].dim == b.groups[k].dim);
+  }
+}
+
+const std::vector<WriteOptions> msh_variants{
+    {MshVersion::v2_2, false, false}, {MshVersion::v2_2, true, false}, {MshVersion::v4_1, false, false}, {MshVersion::v4_1, true, false}};
+
+// One element of each type of dimension <= Dim, each at its reference nodes shifted apart, with
+// non-contiguous node ids and element ids.
+template <int Dim>
+Mesh<Dim> all_types_mesh(int order_wanted) {
+  Mesh<Dim> mesh;
+  std::vector<Vec<Dim>> points;
+  int shift = 0;
+  for (int t = 0; t < num_element_types; ++t) {
+    const auto type = static_cast<ElementType>(t);
+    if (dimension(type) > Dim || (order(type) != order_wanted && order(type) != 0)) continue;
+    auto& block = mesh.block(type);
+    std::vector<Index> nodes;
+    for (const auto& x : reference_nodes(type)) {
+      Vec<Dim> p;
+      for (int d = 0; d < Dim; ++d) p[d] = x[static_cast<std::size_t>(d)] + (d == 0 ? 3.0 * shift : 0.1 * d);
+      nodes.push_back(static_cast<Index>(points.size()));
+      points.push_back(p);
+    }
+    block.add(nodes, dimension(type) == Dim ? 0 : 10 + t);
+    block.ids.push_back(1000 + 7 * t);
+    ++shift;
+  }
+  mesh.points.resize(Dim, static_cast<Index>(points.size()));
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    mesh.points.col(static_cast<Index>(i)) = points[i];
+    mesh.node_ids.push_back(static_cast<std::int64_t>(5 + 3 * i));
+  }
+  mesh.groups.push_back({Dim - 1, 10 + static_cast<int>(mesh.facets.front().type), "first facets"});
+  return mesh;
+}
+
+}  // namespace
+
+TEST_CASE("real SU2 meshes read with the counts of SOURCES.md", "[io]") {
+  struct Expected {
+    const char* file;
+    Index nodes;
+    std::map<std::string, Index> cells;
+    std::map<std::string, Index> markers;
+    Index negative;
+  };
+  const std::vector<Expected> cases{
+      {"su2_naca0012_inviscid_tri.su2", 5233, {{"tri3", 10216}}, {{"airfoil", 200}, {"farfield", 50}}, 0},
+      {"su2_rae2822_rans_hybrid.su2", 13937, {{"tri3", 18042}, {"quad4", 4800}}, {{"AIRFOIL", 192}, {"FARFIELD", 40}}, 0},
+      {"su2_30p30n_rans_L1_coarse.su2", 64540, {{"quad4", 63957}}, {{"wall", 610}, {"farfield", 560}}, 0},
+      {"su2_naca64a010_aeroelastic_hybrid.su2", 6532, {{"quad4", 3584}, {"tri3", 5729}}, {{"airfoil", 128}, {"farfield", 39}}, 9313},
+      {"su2_bump_channel_deforming_tri.su2", 4550, {{"tri3", 8778}},
+       {{"inlet", 20}, {"outlet", 20}, {"top", 140}, {"slip_bottom", 20}, {"bottom_front", 36}, {"interface", 40}, {"bottom_rear", 44}}, 0},
+  };
+  for (const auto& c : cases) {
+    SECTION(c.file) {
+      MESHMOTION_REQUIRE_DATA(file, c.file);
+      const auto mesh = read_mesh_as<2>(file);
+      CHECK(mesh.num_nodes() == c.nodes);
+      CHECK(type_counts(mesh.cells) == c.cells);
+      CHECK(mesh.groups.size() == c.markers.size());
+      for (const auto& [marker, n] : c.markers) CHECK(group_size(mesh, marker) == n);
+      const auto report = orientation_report(mesh);
+      CHECK(report.num_negative == c.negative);
+      CHECK(report.num_cells == mesh.num_cells());
+    }
+  }
+}
+
+TEST_CASE("30P30N wall marker holds three closed loops with the documented node counts", "[io]") {
+  MESHMOTION_REQUIRE_DATA(file, "su2_30p30n_rans_L1_coarse.su2");
+  const auto mesh = read_mesh_as<2>(file);
+  const auto nodes = mesh.group_nodes("wall");
+  Index slat = 0, main = 0, flap = 0;
+  for (const Index i : nodes) {
+    const double x = mesh.points(0, i);
+    if (x < 0.0095) ++slat;
+    else if (x < 0.3975) ++main;
+    else ++flap;
+  }
+  CHECK(nodes.size() == 610);  // closed loops: as many nodes as lines
+  CHECK(slat + main + flap == 610);
+  CHECK(flap >= 90);
+}
+
+TEST_CASE("real Gmsh 2.2 meshes with $ParametricNodes read with their counts and CAD parameters", "[io]") {
+  SECTION("RAE2822 2D") {
+    MESHMOTION_REQUIRE_DATA(file, "meshopt_rae2822_linear_tri.msh");
+    const auto mesh = read_mesh_as<2>(file);
+    CHECK(mesh.num_nodes() == 3052);
+    CHECK(type_counts(mesh.cells) == std::map<std::string, Index>{{"tri3", 6009}});
+    CHECK(type_counts(mesh.facets) == std::map<std::string, Index>{{"line2", 95}});
+    CHECK(tag_size(mesh, 6) == 53);
+    CHECK(tag_size(mesh, 7) == 42);
+    CHECK(orientation_report(mesh).num_negative == 0);
+    REQUIRE(mesh.node_params.size() == 3052);
+    // "7 -25 18.74999999999997 0 1 1 -243.75": node 7 on curve 1 at u = -243.75
+    CHECK(mesh.node_params[6].entity_dim == 1);
+    CHECK(mesh.node_params[6].entity_tag == 1);
+    CHECK(mesh.node_params[6].u == -243.75);
+    CHECK(mesh.points(1, 6) == 18.74999999999997);
+  }
+  SECTION("sphere 3D") {
+    MESHMOTION_REQUIRE_DATA(file, "meshopt_sphere_symmetry_linear_tet.msh");
+    const auto mesh = read_mesh_as<3>(file);
+    CHECK(mesh.num_nodes() == 1189);
+    CHECK(type_counts(mesh.cells) == std::map<std::string, Index>{{"tet4", 5615}});
+    CHECK(type_counts(mesh.facets) == std::map<std::string, Index>{{"tri3", 868}});
+    CHECK(type_counts(mesh.lower) == std::map<std::string, Index>{{"line2", 76}});
+    CHECK(tag_size(mesh, 7) == 106);
+    CHECK(tag_size(mesh, 6) == 128);
+    CHECK(tag_size(mesh, 20) == 634);
+    CHECK(orientation_report(mesh).num_negative == 0);
+    for (const Index i : mesh.group_nodes(7)) CHECK(mesh.points.col(i).norm() == Approx(0.5).epsilon(1e-6));
+  }
+}
+
+TEST_CASE("every real mesh round-trips through all msh variants and SU2", "[io]") {
+  const auto data_dir = test::shared_data("SOURCES.md");
+  if (!data_dir) {
+    WARN("skipped: ../shared/data is absent");
+    return;
+  }
+  for (const auto& file : files_in(data_dir->parent_path())) {
+    const auto ext = file.extension();
+    if (ext != ".su2" && ext != ".msh") continue;
+    if (file.filename() == "su2_30p30n_rans_L1_coarse.su2") continue;  // large: covered by the read test
+    INFO(file);
+    const AnyMesh any = read_mesh(file);
+    std::visit(
+        [&](const auto& mesh) {
+          for (const auto& options : msh_variants) {
+            const auto out = test::scratch_path("roundtrip.msh");
+            write_mesh(out, mesh, options);
+            auto back = std::get<std::decay_t<decltype(mesh)>>(read_mesh(out));
+            INFO("msh " << (options.msh_version == MshVersion::v2_2 ? "2.2" : "4.1") << (options.binary ? " binary" : " ascii"));
+            require_same_mesh(mesh, back);
+            // CAD parameters are written as 2.2 ASCII $ParametricNodes only
+            const bool keeps_params = options.msh_version == MshVersion::v2_2 && !options.binary;
+            CHECK(back.node_params.size() == (keeps_params ? mesh.node_params.size() : 0));
+          }
+          // msh -> su2 -> msh keeps nodes, cells, facet groups (SU2 stores no lower elements, no ids)
+          auto linear = mesh;
+          linear.lower.clear();
+          const auto su2 = test::scratch_path("roundtrip.su2");
+          write_mesh(su2, linear);
+          const auto from_su2 = std::get<std::decay_t<decltype(mesh)>>(read_mesh(su2));
+          CHECK(from_su2.points == mesh.points);
+          REQUIRE(from_su2.cells.size() == mesh.cells.size());
+          for (std::size_t k = 0; k < mesh.cells.size(); ++k) CHECK(from_su2.cells[k].connectivity == mesh.cells[k].connectivity);
+          CHECK(from_su2.num_facets() == mesh.num_facets());
+          for (const auto& g : from_su2.groups) {
+            const auto* original = mesh.find_group(g.name);
+            const int original_tag = original ? original->tag : std::stoi(g.name.substr(4));
+            CHECK(from_su2.group_nodes(g.tag) == mesh.group_nodes(original_tag));
+          }
+          const auto again = test::scratch_path("roundtrip2.msh");
+          write_mesh(again, from_su2, {MshVersion::v4_1, true, false});
+          require_same_mesh(from_su2, std::get<std::decay_t<decltype(mesh)>>(read_mesh(again)), false);
+        },
+        any);
+  }
+}
+
+TEST_CASE("P1 and P2 elements of every type round-trip with non-contiguous ids", "[io]") {
+  for (const int element_order : {1, 2}) {
+    for (const auto& options : msh_variants) {
+      INFO("order " << element_order << " msh " << (options.msh_version == MshVersion::v2_2 ? "2.2" : "4.1") << (options.binary ? " binary" : " ascii"));
+      const auto mesh3 = all_types_mesh<3>(element_order);
+      const auto out3 = test::scratch_path("all_types3.msh");
+      write_mesh(out3, mesh3, options);
+      const auto back3 = read_mesh_as<3>(out3);
+      require_same_mesh(mesh3, back3);
+      CHECK(back3.cells.size() == (element_order == 1 ? 4 : 7));  // P2: complete and serendipity types
+      CHECK(back3.lower.size() == 2);  // lines and the point (Gmsh type 15)
+
+      const auto mesh2 = all_types_mesh<2>(element_order);
+      const auto out2 = test::scratch_path("all_types2.msh");
+      write_mesh(out2, mesh2, options);
+      require_same_mesh(mesh2, read_mesh_as<2>(out2));
+    }
+  }
+  // SU2 round trip of the linear types
+  const auto linear = all_types_mesh<3>(1);
+  auto su2_mesh = linear;
+  su2_mesh.lower.clear();
+  const auto out = test::scratch_path("all_types3.su2");
+  write_mesh(out, su2_mesh);
+  const auto back = read_mesh_as<3>(out);
+  CHECK(back.points == su2_mesh.points);
+  CHECK(type_counts(back.cells) == type_counts(su2_mesh.cells));
+  CHECK(type_counts(back.facets) == type_counts(su2_mesh.facets));
+  CHECK_THROWS_AS(write_mesh(test::scratch_path("p2.su2"), all_types_mesh<2>(2)), InputError);
+}
+
+TEST_CASE("orientation: reference elements are positive and fix_orientation mirrors P2 nodes consistently", "[io]") {
+  for (const int element_order : {1, 2}) {
+    auto mesh = all_types_mesh<3>(element_order);
+    auto mesh2 = all_types_mesh<2>(element_order);
+    CHECK(orientation_report(mesh).num_negative == 0);
+    CHECK(orientation_report(mesh2).num_negative == 0);
+    // Reflect x: every cell becomes negative while each node keeps its role.
+    mesh.points.row(0) *= -1.0;
+    mesh2.points.row(0) *= -1.0;
+    const auto before = mesh;
+    CHECK(orientation_report(mesh).num_negative == mesh.num_cells());
+    CHECK(fix_orientation(mesh) == mesh.num_cells());
+    CHECK(fix_orientation(mesh2) == mesh2.num_cells());
+    CHECK(orientation_report(mesh).num_negative == 0);
+    CHECK(orientation_report(mesh2).num_negative == 0);
+    // After the fix each element is a valid Gmsh element: the nodes sit where the reference
+    // element maps them (edge nodes at edge midpoints, face nodes at face centres).
+    for (const auto* m : {&mesh}) {
+      for (const auto& b : m->cells) {
+        const auto nodes = b.element(0);
+        const auto nv = static_cast<std::size_t>(num_vertices(b.type));
+        Eigen::MatrixXd vertices(3, static_cast<Index>(nv));
+        for (std::size_t k = 0; k < nv; ++k) vertices.col(static_cast<Index>(k)) = m->points.col(nodes[k]);
+        for (std::size_t k = 0; k < nodes.size(); ++k) {
+          // map the reference node through the linear element
+          const auto ref = reference_nodes(b.type)[k];
+          const auto p = map_to_physical(linear_type(b.type), vertices, ref);
+          INFO(name(b.type) << " node " << k);
+          CHECK((p - m->points.col(nodes[k])).norm() < 1e-12);
+        }
+      }
+    }
+    (void)before;
+  }
+  SECTION("the clockwise NACA64A010 file is fixed on request only") {
+    MESHMOTION_REQUIRE_DATA(file, "su2_naca64a010_aeroelastic_hybrid.su2");
+    auto mesh = read_mesh_as<2>(file);
+    CHECK(orientation_report(mesh).num_negative == 9313);
+    CHECK(fix_orientation(mesh) == 9313);
+    CHECK(orientation_report(mesh).num_negative == 0);
+  }
+}
+
+TEST_CASE("VTK Lagrange node orders put each VTK node where VTK expects it", "[io]") {
+  // VTK's order-2 Lagrange cells (vtkHigherOrder{Curve,Triangle,Quadrilateral,Tetra,Hexahedron,
+  // Wedge}::PointIndexFromIJK): each node is the centroid of these VTK vertices.
+  const std::map<ElementType, std::vector<std::vector<int>>> vtk_nodes{
+      {ElementType::line3, {{0}, {1}, {0, 1}}},
+      {ElementType::tri6, {{0}, {1}, {2}, {0, 1}, {1, 2}, {2, 0}}},
+      {ElementType::quad9, {{0}, {1}, {2}, {3}, {0, 1}, {1, 2}, {3, 2}, {0, 3}, {0, 1, 2, 3}}},
+      {ElementType::tet10, {{0}, {1}, {2}, {3}, {0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}}},
+      {ElementType::hex27, {{0}, {1}, {2}, {3}, {4}, {5}, {6}, {7},
+                            {0, 1}, {1, 2}, {3, 2}, {0, 3}, {4, 5}, {5, 6}, {7, 6}, {4, 7}, {0, 4}, {1, 5}, {3, 7}, {2, 6},
+                            {0, 3, 7, 4}, {1, 2, 6, 5}, {0, 1, 5, 4}, {3, 2, 6, 7}, {0, 1, 2, 3}, {4, 5, 6, 7},
+                            {0, 1, 2, 3, 4, 5, 6, 7}}},
+      {ElementType::prism18, {{0}, {1}, {2}, {3}, {4}, {5}, {0, 1}, {1, 2}, {2, 0}, {3, 4}, {4, 5}, {5, 3}, {0, 3}, {1, 4}, {2, 5},
+                              {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}}},
+  };
+  for (const auto& [type, expected] : vtk_nodes) {
+    INFO(name(type));
+    const auto order = vtk_order(type, true);
+    const auto ref = reference_nodes(type);
+    REQUIRE(static_cast<std::size_t>(num_nodes(type)) == expected.size());
+    for (std::size_t k = 0; k < expected.size(); ++k) {
+      std::array<double, 3> centroid{};
+      for (const int v : expected[k])
+        for (int d = 0; d < 3; ++d) centroid[static_cast<std::size_t>(d)] += ref[static_cast<std::size_t>(v)][static_cast<std::size_t>(d)] / static_cast<double>(expected[k].size());
+      const auto ours = ref[static_cast<std::size_t>(order.empty() ? static_cast<int>(k) : order[k])];
+      INFO("VTK node " << k);
+      for (int d = 0; d < 3; ++d) CHECK(ours[static_cast<std::size_t>(d)] == Approx(centroid[static_cast<std::size_t>(d)]).margin(1e-14));
+    }
+  }
+}
+
+TEST_CASE("VTU output: Lagrange cell types, point and cell data, facets on request", "[io]") {
+  const auto mesh = all_types_mesh<3>(2);
+  VtuFields fields;
+  fields.point_data.emplace_back("displacement", Eigen::MatrixXd::Ones(3, mesh.num_nodes()));
+  fields.cell_data.emplace_back("quality", Eigen::MatrixXd::Constant(1, mesh.num_cells(), 0.5));
+  const auto text = format_vtu(mesh, fields);
+  CHECK(text.find("NumberOfCells=\"7\"") != std::string::npos);
+  const auto types_at = text.find("Name=\"types\"");
+  const auto types = text.substr(types_at, text.find("</DataArray>", types_at) - types_at);
+  // Lagrange tet10 hex27 prism18; classic hex20 prism15 and pyramid13 (also for pyramid14)
+  for (const char* t : {"\n71\n", "\n72\n", "\n73\n", "\n25\n", "\n26\n", "\n27\n"}) CHECK(types.find(t) != std::string::npos);
+  CHECK(text.find("Name=\"displacement\" NumberOfComponents=\"3\"") != std::string::npos);
+  CHECK(text.find("Name=\"quality\"") != std::string::npos);
+  const auto with_facets = format_vtu(mesh, fields, VtuOptions{true});
+  CHECK(with_facets.find("NumberOfCells=\"" + std::to_string(mesh.num_cells() + mesh.num_facets()) + "\"") != std::string::npos);
+  CHECK(with_facets.find("Name=\"facet_tag\"") != std::string::npos);
+  fields.cell_data.emplace_back("wrong", Eigen::MatrixXd::Zero(1, 2));
+  CHECK_THROWS_AS(format_vtu(mesh, fields), InputError);
+  const auto out = test::scratch_path("mesh.vtu");
+  write_mesh(out, mesh);
+  CHECK(fs::file_size(out) > 0);
+}
+
+TEST_CASE("mesh summary counts groups, edges and orientation", "[io]") {
+  Mesh<2> mesh;
+  mesh.points.resize(2, 4);
+  mesh.points << 0, 2, 2, 0, 0, 0, 1, 1;
+  mesh.block(ElementType::tri3).add({0, 1, 2});
+  mesh.block(ElementType::tri3).add({0, 3, 2});  // clockwise
+  mesh.block(ElementType::line2).add({0, 1}, 5);
+  mesh.groups.push_back({1, 5, "bottom"});
+  const auto s = summarize(mesh);
+  CHECK(s.num_nodes == 4);
+  CHECK(s.orientation.num_negative == 1);
+  CHECK(s.min_edge == 1.0);
+  CHECK(s.max_edge == Approx(std::sqrt(5.0)));
+  REQUIRE(s.groups.size() == 1);
+  CHECK(s.groups[0].num_elements == 1);
+  CHECK(s.groups[0].num_nodes == 2);
+  CHECK(to_json(s).find("\"negative_cells\":1") != std::string::npos);
+  CHECK(to_text(s).find("bottom") != std::string::npos);
+}
+
+TEST_CASE("malformed files give ParseError with file, line and what was expected", "[io]") {
+  const auto bad = test::scratch_path("bad.msh");
+  const std::string header = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
+  const std::string nodes = "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n";
+  const auto read = [&] { (void)read_mesh(bad); };
+
+  write_text(bad, header + nodes + "$Elements\n1\n1 2 2 0 1 1 2 3\n");  // truncated
+  CHECK(parse_error_position(read, "unexpected end of file") == 13);
+  write_text(bad, header + "$Nodes\n3\n1 0 0 0\n2 1.5e 0 0\n3 0 1 0\n$EndNodes\n");
+  CHECK(parse_error_position(read, "expected node coordinate as a number (got '1.5e')") == 7);
+  write_text(bad, header + "$Nodes\n3\n1 0 0 0\n2 nan 0 0\n3 0 1 0\n$EndNodes\n");
+  CHECK(parse_error_position(read, "not finite") == 7);
+  write_text(bad, header + "$Nodes\n3\n1 0 0 0\n2 inf 0 0\n3 0 1 0\n$EndNodes\n");
+  CHECK(parse_error_position(read, "not finite") == 7);
+  write_text(bad, header + nodes + "$Elements\n1\n1 42 2 0 1 1 2 3\n$EndElements\n");
+  CHECK(parse_error_position(read, "unknown element type 42") == 12);
+  write_text(bad, header + nodes + "$Elements\n2\n1 2 2 0 1 1 2 3\n$EndElements\n");
+  CHECK(parse_error_position(read, "expected element id") == 13);
+  write_text(bad, header + nodes + "$Elements\n1\n1 2 2 0 1 1 2 3\n2 2 2 0 1 1 2 3\n$EndElements\n");
+  CHECK(parse_error_position(read, "more or fewer entries than its count") == 13);
+  write_text(bad, header + nodes + "$Elements\n1\n1 2 2 0 1 1 2 7\n$EndElements\n");
+  CHECK(parse_error_position(read, "refers to node 7") == 12);
+  write_text(bad, header + nodes + "$Elements\n1\n1 2 2 0 1 1 2 -3\n$EndElements\n");
+  CHECK(parse_error_position(read, "refers to node -3") == 12);
+  write_text(bad, "$MeshFormat\n3.0 0 8\n$EndMeshFormat\n");
+  CHECK(parse_error_position(read, "unsupported msh version 3.0") == 2);
+  write_text(bad, "");
+  CHECK(parse_error_position(read, "empty file") == 1);
+
+  SECTION("binary: truncated data reports the byte offset") {
+    auto mesh = all_types_mesh<3>(1);
+    const auto good = test::scratch_path("good_binary.msh");
+    write_mesh(good, mesh, {MshVersion::v4_1, true, false});
+    std::string data;
+    {
+      std::ifstream in(good, std::ios::binary);
+      data.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    const auto cut = data.find("$Elements") + 40;
+    write_text(bad, data.substr(0, cut));
+    try {
+      (void)read_mesh(bad);
+      FAIL("no error");
+    } catch (const ParseError& e) {
+      CHECK(e.position_kind() == ParseError::Position::byte_offset);
+      CHECK(e.position() <= cut);
+      CHECK(std::string(e.what()).find("truncated binary data") != std::string::npos);
+    }
+    // the endianness check word must read 1 one way or the other
+    auto wrong = data;
+    wrong[wrong.find("1 8\n") + 4] = 7;
+    write_text(bad, wrong);
+    CHECK(parse_error_position(read, "endianness check word") > 0);
+    // a byte-swapped file reads the same (swap every value by hand for 2.2)
+  }
+
+  SECTION("SU2") {
+    const auto su2 = test::scratch_path("bad.su2");
+    const auto read_su2_file = [&] { (void)read_mesh(su2); };
+    const std::string points = "NPOIN= 3\n0 0 0\n1 0 1\n0 1 2\n";
+    write_text(su2, "NDIME= 2\nNELEM= 1\n5 0 1 3 0\n" + points + "NMARK= 0\n");
+    CHECK(parse_error_position(read_su2_file, "node index 3 out of range (expected 0 to 2)") == 3);
+    write_text(su2, "NDIME= 2\nNELEM= 1\n5 0 -1 2 0\n" + points);
+    CHECK(parse_error_position(read_su2_file, "node index out of range (got -1") == 3);
+    write_text(su2, "NDIME= 2\nNELEM= 1\n7 0 1 2 0\n" + points);
+    CHECK(parse_error_position(read_su2_file, "unknown SU2 element type 7") == 3);
+    write_text(su2, "NDIME= 2\nNELEM= 1\n9 0 1 2\n" + points);
+    CHECK(parse_error_position(read_su2_file, "quad4 element with 3 nodes (expected 4)") == 3);
+    write_text(su2, "NDIME= 2\nNELEM= 2\n5 0 1 2\n" + points);
+    CHECK(parse_error_position(read_su2_file, "expected element type as an integer (got 'NPOIN=')") == 4);
+    write_text(su2, "NDIME= 2\nNELEM= 1\n5 0 1 2\nNPOIN= 3\n0 0\n1 x\n0 1\n");
+    CHECK(parse_error_position(read_su2_file, "expected point coordinate as a number (got 'x')") == 6);
+    write_text(su2, "NDIME= 2\nNELEM= 1\n5 0 1 2\n" + points + "NMARK= 1\nMARKER_TAG= wall\nMARKER_ELEMS= 1\n5 0 1 2\n");
+    CHECK(parse_error_position(read_su2_file, "tri3 element of dimension 2 (expected dimension 1 here)") == 11);
+    write_text(su2, "NELEM= 1\n");
+    CHECK(parse_error_position(read_su2_file, "NDIME must come first") == 1);
+  }
+}
+
+TEST_CASE("bad paths, dimensions and meshes give clear errors", "[io]") {
+  CHECK_THROWS_AS((void)read_mesh(test::scratch_path("missing.msh")), IoError);
+  CHECK_THROWS_WITH((void)read_mesh(test::scratch_path("mesh.obj")), Catch::Contains("unknown mesh format '.obj'"));
+  CHECK_THROWS_AS(write_mesh(test::scratch_path("mesh.obj"), all_types_mesh<2>(1)), InputError);
+
+  const auto flat = test::scratch_path("nonzero_z.msh");
+  write_text(flat, "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n2 1 0 0.5\n3 0 1 0\n$EndNodes\n"
+                   "$Elements\n1\n1 2 2 0 1 1 2 3\n$EndElements\n");
+  CHECK_THROWS_WITH((void)read_mesh(flat), Catch::Contains("node 2 has z = 0.5"));
+
+  const auto tri = test::scratch_path("tri.msh");
+  write_mesh(tri, all_types_mesh<2>(1));
+  CHECK_THROWS_WITH((void)read_mesh_as<3>(tri), Catch::Contains("holds a 2D mesh (expected 3D)"));
+  CHECK_NOTHROW((void)read_mesh_as<2>(tri));
+}
+
+TEST_CASE("a failing write leaves no output and no temporary file, and never touches the input", "[io]") {
+  const auto dir = test::scratch_path("atomic");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  auto mesh = all_types_mesh<3>(1);
+  mesh.cells.front().connectivity[0] = 999;  // out of range: invalid mesh
+  for (const char* name : {"out.msh", "out.su2", "out.vtu"}) CHECK_THROWS_AS(write_mesh(dir / name, mesh), InputError);
+  CHECK(files_in(dir).empty());
+
+  // an existing file is replaced only by a complete new one
+  const auto valid = all_types_mesh<3>(1);
+  write_mesh(dir / "keep.msh", valid);
+  const auto size_before = fs::file_size(dir / "keep.msh");
+  CHECK_THROWS_AS(write_mesh(dir / "keep.msh", mesh), InputError);
+  CHECK(fs::file_size(dir / "keep.msh") == size_before);
+  CHECK(files_in(dir).size() == 1);
+
+  CHECK_THROWS_AS(write_mesh(dir / "no_such_folder" / "out.msh", valid), IoError);
+  CHECK(files_in(dir).size() == 1);
+
+  // reading then writing elsewhere leaves the input byte for byte
+  const auto input = dir / "keep.msh";
+  const auto time_before = fs::last_write_time(input);
+  write_mesh(dir / "copy.msh", read_mesh_as<3>(input));
+  CHECK(fs::last_write_time(input) == time_before);
+  CHECK(fs::file_size(input) == size_before);
+}
+
+TEST_CASE("in-memory parsing entry points name the source in errors", "[io]") {
+  CHECK_THROWS_WITH((void)parse_gmsh("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n", "memory.msh"), Catch::Contains("memory.msh:") && Catch::Contains("no $Nodes"));
+  const auto mesh = parse_su2("NDIME= 2\nNPOIN= 3\n0 0\n1 0\n0 1\nNELEM= 1\n5 0 1 2\nNMARK= 1\nMARKER_TAG= wall\nMARKER_ELEMS= 1\n3 0 1\n", "memory.su2");
+  const auto& m = std::get<Mesh<2>>(mesh);
+  CHECK(m.num_cells() == 1);
+  CHECK(m.group("wall").tag == 1);
+  CHECK(m.group_nodes("wall") == std::vector<Index>{0, 1});
+}
