@@ -1,0 +1,234 @@
+#pragma once
+/// \file
+/// Robust geometric predicates: orient2d, orient3d, incircle, insphere. Each returns the exact
+/// sign (-1, 0, +1) of its determinant for double inputs. A floating-point evaluation decides
+/// whenever its result exceeds Shewchuk's forward error bound (DCG 18, 1997, section 4); the
+/// rest are evaluated exactly with expansion arithmetic (detail/expansion.hpp). Exact results
+/// assume no overflow or underflow in the products (coordinates of magnitude between about
+/// 1e-70 and 1e70). Requires IEEE double arithmetic: do not compile with -ffast-math.
+///
+/// Orientation conventions (these are what "positively oriented" means in the library):
+/// - orient2d(a, b, c) > 0 when a, b, c turn counterclockwise;
+/// - orient3d(a, b, c, d) > 0 when det[b - a, c - a, d - a] > 0 (Gmsh's positive tetrahedron:
+///   d lies on the side of plane abc that (b - a) × (c - a) points to);
+/// - incircle(a, b, c, d) > 0 when d lies strictly inside the circle through a, b, c and a, b,
+///   c are counterclockwise (the sign flips for clockwise a, b, c);
+/// - insphere(a, b, c, d, e) > 0 when e lies strictly inside the sphere through a, b, c, d
+///   and orient3d(a, b, c, d) > 0 (the sign flips for negative orientation).
+
+#include "meshmotion/delaunay/detail/expansion.hpp"
+
+#include <Eigen/Core>
+
+#include <cmath>
+
+namespace meshmotion {
+
+namespace detail {
+
+/// Half an ulp of 1: the relative rounding error of one double operation.
+inline constexpr double predicate_epsilon = 0x1p-53;
+
+[[nodiscard]] inline int sign_of(double value) noexcept {
+  return (value > 0.0) - (value < 0.0);
+}
+
+/// Shewchuk's orient2d determinant: > 0 when a, b, c are counterclockwise.
+[[nodiscard]] inline int orient2d_exact(const double* a, const double* b, const double* c) {
+  const Expansion acx = Expansion::difference(a[0], c[0]);
+  const Expansion acy = Expansion::difference(a[1], c[1]);
+  const Expansion bcx = Expansion::difference(b[0], c[0]);
+  const Expansion bcy = Expansion::difference(b[1], c[1]);
+  return (acx * bcy - acy * bcx).sign();
+}
+
+/// Shewchuk's orient3d determinant det[a - d; b - d; c - d] (the negative of ours).
+[[nodiscard]] inline int orient3d_shewchuk_exact(const double* a, const double* b, const double* c,
+                                                 const double* d) {
+  Expansion ad[3];
+  Expansion bd[3];
+  Expansion cd[3];
+  for (int k = 0; k < 3; ++k) {
+    ad[k] = Expansion::difference(a[k], d[k]);
+    bd[k] = Expansion::difference(b[k], d[k]);
+    cd[k] = Expansion::difference(c[k], d[k]);
+  }
+  const Expansion det = ad[2] * (bd[0] * cd[1] - cd[0] * bd[1]) +
+                        bd[2] * (cd[0] * ad[1] - ad[0] * cd[1]) +
+                        cd[2] * (ad[0] * bd[1] - bd[0] * ad[1]);
+  return det.sign();
+}
+
+[[nodiscard]] inline int incircle_exact(const double* a, const double* b, const double* c,
+                                        const double* d) {
+  const Expansion adx = Expansion::difference(a[0], d[0]);
+  const Expansion ady = Expansion::difference(a[1], d[1]);
+  const Expansion bdx = Expansion::difference(b[0], d[0]);
+  const Expansion bdy = Expansion::difference(b[1], d[1]);
+  const Expansion cdx = Expansion::difference(c[0], d[0]);
+  const Expansion cdy = Expansion::difference(c[1], d[1]);
+  const Expansion alift = adx * adx + ady * ady;
+  const Expansion blift = bdx * bdx + bdy * bdy;
+  const Expansion clift = cdx * cdx + cdy * cdy;
+  const Expansion det = alift * (bdx * cdy - cdx * bdy) + blift * (cdx * ady - adx * cdy) +
+                        clift * (adx * bdy - bdx * ady);
+  return det.sign();
+}
+
+/// Shewchuk's insphere determinant (positive inside for his orientation, i.e. the negative of
+/// ours).
+[[nodiscard]] inline int insphere_shewchuk_exact(const double* a, const double* b, const double* c,
+                                                 const double* d, const double* e) {
+  Expansion ae[3];
+  Expansion be[3];
+  Expansion ce[3];
+  Expansion de[3];
+  for (int k = 0; k < 3; ++k) {
+    ae[k] = Expansion::difference(a[k], e[k]);
+    be[k] = Expansion::difference(b[k], e[k]);
+    ce[k] = Expansion::difference(c[k], e[k]);
+    de[k] = Expansion::difference(d[k], e[k]);
+  }
+  const Expansion ab = ae[0] * be[1] - be[0] * ae[1];
+  const Expansion bc = be[0] * ce[1] - ce[0] * be[1];
+  const Expansion cd = ce[0] * de[1] - de[0] * ce[1];
+  const Expansion da = de[0] * ae[1] - ae[0] * de[1];
+  const Expansion ac = ae[0] * ce[1] - ce[0] * ae[1];
+  const Expansion bd = be[0] * de[1] - de[0] * be[1];
+  const Expansion abc = ae[2] * bc - be[2] * ac + ce[2] * ab;
+  const Expansion bcd = be[2] * cd - ce[2] * bd + de[2] * bc;
+  const Expansion cda = ce[2] * da + de[2] * ac + ae[2] * cd;
+  const Expansion dab = de[2] * ab + ae[2] * bd + be[2] * da;
+  auto lift = [](const Expansion* v) { return v[0] * v[0] + v[1] * v[1] + v[2] * v[2]; };
+  const Expansion det =
+      (lift(de) * abc - lift(ce) * dab) + (lift(be) * cda - lift(ae) * bcd);
+  return det.sign();
+}
+
+}  // namespace detail
+
+/// Sign of the orientation of the triangle (a, b, c): +1 counterclockwise, -1 clockwise,
+/// 0 collinear (exact). a, b, c point to 2 consecutive coordinates.
+[[nodiscard]] inline int orient2d(const double* a, const double* b, const double* c) {
+  const double detleft = (a[0] - c[0]) * (b[1] - c[1]);
+  const double detright = (a[1] - c[1]) * (b[0] - c[0]);
+  const double det = detleft - detright;
+  constexpr double eps = detail::predicate_epsilon;
+  constexpr double bound = (3.0 + 16.0 * eps) * eps;
+  const double errbound = bound * (std::abs(detleft) + std::abs(detright));
+  if (det > errbound || -det > errbound) return detail::sign_of(det);
+  return detail::orient2d_exact(a, b, c);
+}
+
+/// Sign of det[b - a, c - a, d - a]: +1 for a positively oriented tetrahedron, 0 when the
+/// four points are coplanar (exact). Arguments point to 3 consecutive coordinates.
+[[nodiscard]] inline int orient3d(const double* a, const double* b, const double* c,
+                                  const double* d) {
+  const double adx = a[0] - d[0], bdx = b[0] - d[0], cdx = c[0] - d[0];
+  const double ady = a[1] - d[1], bdy = b[1] - d[1], cdy = c[1] - d[1];
+  const double adz = a[2] - d[2], bdz = b[2] - d[2], cdz = c[2] - d[2];
+  const double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy;
+  const double cdxady = cdx * ady, adxcdy = adx * cdy;
+  const double adxbdy = adx * bdy, bdxady = bdx * ady;
+  const double det =
+      adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
+  const double permanent = (std::abs(bdxcdy) + std::abs(cdxbdy)) * std::abs(adz) +
+                           (std::abs(cdxady) + std::abs(adxcdy)) * std::abs(bdz) +
+                           (std::abs(adxbdy) + std::abs(bdxady)) * std::abs(cdz);
+  constexpr double eps = detail::predicate_epsilon;
+  constexpr double bound = (7.0 + 56.0 * eps) * eps;
+  const double errbound = bound * permanent;
+  // Shewchuk's determinant is det[a - d; b - d; c - d] = -det[b - a, c - a, d - a].
+  if (det > errbound || -det > errbound) return -detail::sign_of(det);
+  return -detail::orient3d_shewchuk_exact(a, b, c, d);
+}
+
+/// +1 when d is strictly inside the circle through a, b, c (counterclockwise), 0 when the four
+/// points are co-circular (exact), -1 outside; the sign flips when a, b, c are clockwise.
+[[nodiscard]] inline int incircle(const double* a, const double* b, const double* c,
+                                  const double* d) {
+  const double adx = a[0] - d[0], bdx = b[0] - d[0], cdx = c[0] - d[0];
+  const double ady = a[1] - d[1], bdy = b[1] - d[1], cdy = c[1] - d[1];
+  const double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy;
+  const double cdxady = cdx * ady, adxcdy = adx * cdy;
+  const double adxbdy = adx * bdy, bdxady = bdx * ady;
+  const double alift = adx * adx + ady * ady;
+  const double blift = bdx * bdx + bdy * bdy;
+  const double clift = cdx * cdx + cdy * cdy;
+  const double det = alift * (bdxcdy - cdxbdy) + blift * (cdxady - adxcdy) +
+                     clift * (adxbdy - bdxady);
+  const double permanent = (std::abs(bdxcdy) + std::abs(cdxbdy)) * alift +
+                           (std::abs(cdxady) + std::abs(adxcdy)) * blift +
+                           (std::abs(adxbdy) + std::abs(bdxady)) * clift;
+  constexpr double eps = detail::predicate_epsilon;
+  constexpr double bound = (10.0 + 96.0 * eps) * eps;
+  const double errbound = bound * permanent;
+  if (det > errbound || -det > errbound) return detail::sign_of(det);
+  return detail::incircle_exact(a, b, c, d);
+}
+
+/// +1 when e is strictly inside the sphere through a, b, c, d with orient3d(a, b, c, d) > 0,
+/// 0 when the five points are co-spherical (exact), -1 outside; the sign flips when
+/// orient3d(a, b, c, d) < 0.
+[[nodiscard]] inline int insphere(const double* a, const double* b, const double* c,
+                                  const double* d, const double* e) {
+  const double aex = a[0] - e[0], bex = b[0] - e[0], cex = c[0] - e[0], dex = d[0] - e[0];
+  const double aey = a[1] - e[1], bey = b[1] - e[1], cey = c[1] - e[1], dey = d[1] - e[1];
+  const double aez = a[2] - e[2], bez = b[2] - e[2], cez = c[2] - e[2], dez = d[2] - e[2];
+  const double aexbey = aex * bey, bexaey = bex * aey;
+  const double bexcey = bex * cey, cexbey = cex * bey;
+  const double cexdey = cex * dey, dexcey = dex * cey;
+  const double dexaey = dex * aey, aexdey = aex * dey;
+  const double aexcey = aex * cey, cexaey = cex * aey;
+  const double bexdey = bex * dey, dexbey = dex * bey;
+  const double ab = aexbey - bexaey, bc = bexcey - cexbey, cd = cexdey - dexcey;
+  const double da = dexaey - aexdey, ac = aexcey - cexaey, bd = bexdey - dexbey;
+  const double abc = aez * bc - bez * ac + cez * ab;
+  const double bcd = bez * cd - cez * bd + dez * bc;
+  const double cda = cez * da + dez * ac + aez * cd;
+  const double dab = dez * ab + aez * bd + bez * da;
+  const double alift = aex * aex + aey * aey + aez * aez;
+  const double blift = bex * bex + bey * bey + bez * bez;
+  const double clift = cex * cex + cey * cey + cez * cez;
+  const double dlift = dex * dex + dey * dey + dez * dez;
+  const double det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+  const double aez_abs = std::abs(aez), bez_abs = std::abs(bez);
+  const double cez_abs = std::abs(cez), dez_abs = std::abs(dez);
+  const double ab_abs = std::abs(aexbey) + std::abs(bexaey);
+  const double bc_abs = std::abs(bexcey) + std::abs(cexbey);
+  const double cd_abs = std::abs(cexdey) + std::abs(dexcey);
+  const double da_abs = std::abs(dexaey) + std::abs(aexdey);
+  const double ac_abs = std::abs(aexcey) + std::abs(cexaey);
+  const double bd_abs = std::abs(bexdey) + std::abs(dexbey);
+  const double permanent = (cd_abs * bez_abs + bd_abs * cez_abs + bc_abs * dez_abs) * alift +
+                           (da_abs * cez_abs + ac_abs * dez_abs + cd_abs * aez_abs) * blift +
+                           (ab_abs * dez_abs + bd_abs * aez_abs + da_abs * bez_abs) * clift +
+                           (bc_abs * aez_abs + ac_abs * bez_abs + ab_abs * cez_abs) * dlift;
+  constexpr double eps = detail::predicate_epsilon;
+  constexpr double bound = (16.0 + 224.0 * eps) * eps;
+  const double errbound = bound * permanent;
+  // Shewchuk's insphere is positive inside for his (opposite) orientation convention.
+  if (det > errbound || -det > errbound) return -detail::sign_of(det);
+  return -detail::insphere_shewchuk_exact(a, b, c, d, e);
+}
+
+/// Eigen overloads of the predicates above.
+[[nodiscard]] inline int orient2d(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                                  const Eigen::Vector2d& c) {
+  return orient2d(a.data(), b.data(), c.data());
+}
+[[nodiscard]] inline int orient3d(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                  const Eigen::Vector3d& c, const Eigen::Vector3d& d) {
+  return orient3d(a.data(), b.data(), c.data(), d.data());
+}
+[[nodiscard]] inline int incircle(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                                  const Eigen::Vector2d& c, const Eigen::Vector2d& d) {
+  return incircle(a.data(), b.data(), c.data(), d.data());
+}
+[[nodiscard]] inline int insphere(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                  const Eigen::Vector3d& c, const Eigen::Vector3d& d,
+                                  const Eigen::Vector3d& e) {
+  return insphere(a.data(), b.data(), c.data(), d.data(), e.data());
+}
+
+}  // namespace meshmotion
