@@ -7,3 +7,4 @@
 #include "meshmotion/quality/knupp.hpp"
 #include "meshmotion/quality/quality_report.hpp"
 #include "meshmotion/quality/scaled_jacobian.hpp"
+#include "meshmotion/quality/svg_picture.hpp"

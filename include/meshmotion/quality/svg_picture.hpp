@@ -1,0 +1,155 @@
+#pragma once
+/// \file
+/// An SVG picture of a 2D mesh with its cells coloured by a per-cell value (quality), a
+/// colour bar, P2 edges drawn curved (the quadratic Bézier through the edge's mid node) and an
+/// optional zoom box (near-wall cells of boundary-layer meshes are 1e-5 thin).
+
+#include "meshmotion/core/element.hpp"
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/types.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <string>
+#include <system_error>
+#include <vector>
+
+namespace meshmotion {
+
+/// Options of svg_picture().
+struct SvgOptions {
+  std::optional<std::array<double, 4>> zoom;  ///< xmin, xmax, ymin, ymax; default: the whole mesh
+  int width = 1000;                           ///< picture width in pixels (height follows the aspect ratio)
+  double value_min = 0.0;                     ///< value at the bottom of the colour scale
+  double value_max = 1.0;                     ///< value at the top of the colour scale
+  std::string title;                          ///< shown above the colour bar
+  bool draw_edges = true;
+};
+
+namespace detail {
+
+// A perceptually ordered scale (dark blue → teal → yellow), close to viridis.
+inline std::string colour(double t) {
+  static constexpr std::array<std::array<double, 3>, 5> stops{{
+      {68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}}};
+  t = std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0) * (stops.size() - 1);
+  const auto k = std::min<std::size_t>(static_cast<std::size_t>(t), stops.size() - 2);
+  const double f = t - static_cast<double>(k);
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "#%02x%02x%02x", static_cast<int>(stops[k][0] + f * (stops[k + 1][0] - stops[k][0])),
+                static_cast<int>(stops[k][1] + f * (stops[k + 1][1] - stops[k][1])),
+                static_cast<int>(stops[k][2] + f * (stops[k + 1][2] - stops[k][2])));
+  return buf;
+}
+
+}  // namespace detail
+
+/// The SVG text of `mesh` with cell i coloured by values[i] (cell order). Cells whose value is
+/// ≤ 0 (invalid) are magenta. Throws InputError when values.size() != num_cells() or the
+/// zoom box is empty.
+[[nodiscard]] inline std::string svg_picture(const Mesh<2>& mesh, const std::vector<double>& values,
+                                             const SvgOptions& options = {}) {
+  if (static_cast<Index>(values.size()) != mesh.num_cells())
+    throw InputError("svg_picture: " + std::to_string(values.size()) + " values for " +
+                     std::to_string(mesh.num_cells()) + " cells");
+  std::array<double, 4> box{0, 1, 0, 1};
+  if (options.zoom) {
+    box = *options.zoom;
+  } else if (mesh.num_nodes() > 0) {
+    box = {mesh.points.row(0).minCoeff(), mesh.points.row(0).maxCoeff(), mesh.points.row(1).minCoeff(),
+           mesh.points.row(1).maxCoeff()};
+  }
+  if (!(box[1] > box[0]) || !(box[3] > box[2]))
+    throw InputError("svg_picture: empty zoom box (got x " + std::to_string(box[0]) + ".." + std::to_string(box[1]) +
+                     ", y " + std::to_string(box[2]) + ".." + std::to_string(box[3]) + ")");
+  const double w = options.width, h = std::clamp(w * (box[3] - box[2]) / (box[1] - box[0]), 50.0, 4.0 * w);
+  const double bar = 90;
+  const auto px = [&](double x) { return (x - box[0]) / (box[1] - box[0]) * w; };
+  const auto py = [&](double y) { return (box[3] - y) / (box[3] - box[2]) * h; };
+  std::string out;
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\">\n"
+                "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n<clipPath id=\"box\"><rect width=\"%.0f\" "
+                "height=\"%.0f\"/></clipPath>\n<g clip-path=\"url(#box)\" stroke=\"%s\" stroke-width=\"0.4\">\n",
+                w + bar, h, w + bar, h, w, h, options.draw_edges ? "black" : "none");
+  out += buf;
+  const double span = options.value_max - options.value_min;
+  Index cell = 0;
+  for (const auto& block : mesh.cells) {
+    const int nv = num_vertices(block.type);
+    const bool curved = order(block.type) == 2;
+    for (Index e = 0; e < block.size(); ++e, ++cell) {
+      const auto nodes = block.element(e);
+      const auto p = [&](int local) { return mesh.points.col(nodes[static_cast<std::size_t>(local)]); };
+      double xmin = p(0).x(), xmax = xmin, ymin = p(0).y(), ymax = ymin;
+      for (std::size_t k = 0; k < nodes.size(); ++k) {
+        const auto q = mesh.points.col(nodes[k]);
+        xmin = std::min(xmin, q.x()), xmax = std::max(xmax, q.x()), ymin = std::min(ymin, q.y()), ymax = std::max(ymax, q.y());
+      }
+      if (!(xmax >= box[0] && xmin <= box[1] && ymax >= box[2] && ymin <= box[3])) continue;  // also skips NaN
+      const double v = values[static_cast<std::size_t>(cell)];
+      const std::string fill = v <= 0 || !std::isfinite(v) ? std::string("#ff00ff")
+                                                           : detail::colour(span > 0 ? (v - options.value_min) / span : 1.0);
+      std::snprintf(buf, sizeof buf, "<path fill=\"%s\" d=\"M%.3f %.3f", fill.c_str(), px(p(0).x()), py(p(0).y()));
+      out += buf;
+      for (int k = 0; k < nv; ++k) {
+        const auto b = p((k + 1) % nv);
+        if (curved) {
+          // The quadratic through a, m (at t = 1/2) and b has control point 2m - (a + b)/2.
+          const Eigen::Vector2d c = 2.0 * p(nv + k) - 0.5 * (p(k) + b);
+          std::snprintf(buf, sizeof buf, " Q%.3f %.3f %.3f %.3f", px(c.x()), py(c.y()), px(b.x()), py(b.y()));
+        } else {
+          std::snprintf(buf, sizeof buf, " L%.3f %.3f", px(b.x()), py(b.y()));
+        }
+        out += buf;
+      }
+      out += "Z\"/>\n";
+    }
+  }
+  out += "</g>\n";
+  // Colour bar: 20 steps from value_max (top) to value_min (bottom).
+  const double bx = w + 15, bh = std::min(h - 40, 400.0), by = 25;
+  for (int k = 0; k < 20; ++k) {
+    std::snprintf(buf, sizeof buf, "<rect x=\"%.1f\" y=\"%.2f\" width=\"20\" height=\"%.2f\" fill=\"%s\"/>\n", bx,
+                  by + k * bh / 20, bh / 20 + 0.5, detail::colour(1.0 - (k + 0.5) / 20).c_str());
+    out += buf;
+  }
+  for (int k = 0; k <= 4; ++k) {
+    std::snprintf(buf, sizeof buf, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" font-family=\"sans-serif\">%.3g</text>\n",
+                  bx + 24, by + bh * (1.0 - k / 4.0) + 4, options.value_min + span * k / 4.0);
+    out += buf;
+  }
+  std::string title;
+  for (const char ch : options.title) title += ch == '<' ? std::string("&lt;") : ch == '&' ? std::string("&amp;") : std::string(1, ch);
+  std::snprintf(buf, sizeof buf, "<text x=\"%.1f\" y=\"15\" font-size=\"11\" font-family=\"sans-serif\">", bx);
+  out += buf + title + "</text>\n</svg>\n";
+  return out;
+}
+
+/// Writes svg_picture() to `file`, atomically (a temporary file in the same folder, then a
+/// rename). Throws IoError when the file cannot be written, InputError as svg_picture().
+inline void write_svg(const std::filesystem::path& file, const Mesh<2>& mesh, const std::vector<double>& values,
+                      const SvgOptions& options = {}) {
+  const std::string text = svg_picture(mesh, values, options);
+  const std::filesystem::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out << text;
+    if (!out.flush()) throw IoError("write_svg: cannot write " + tmp.string());
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, file, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw IoError("write_svg: cannot rename " + tmp.string() + " to " + file.string());
+  }
+}
+
+}  // namespace meshmotion
