@@ -1,0 +1,224 @@
+#pragma once
+/// \file
+/// Boundary specification for the movers: named groups (Gmsh physical groups, SU2 markers)
+/// each prescribed (a per-node displacement array or a rigid Motion), fixed, or sliding in a
+/// plane; resolved against a mesh into the node lists and target displacements a mover's
+/// setup/move take.
+///
+/// \code
+/// BoundarySpec<2> spec;
+/// spec.moving("wall", Rotation2D{{0.0, 0.0}, radians(60.0)});
+/// spec.fixed("farfield");
+/// spec.sliding("symmetry");                 // plane normal estimated from the group's nodes
+/// const ResolvedBoundary<2> b = spec.resolve(mesh);
+/// \endcode
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/movers/motion.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace meshmotion {
+
+/// How the nodes of a group move.
+enum class BoundaryKind {
+  prescribed,  ///< displacement given (array or rigid motion)
+  fixed,       ///< zero displacement
+  sliding,     ///< free to move in a plane, zero displacement along its normal
+};
+
+/// A boundary resolved to nodes: what a mover's setup and move take.
+///
+/// `nodes` are sorted, unique mesh node indices; `displacements` (Dim × nodes.size()) are
+/// their targets (zero for fixed and sliding nodes); `kinds[k]` tells how node nodes[k]
+/// moves; `normals` (Dim × nodes.size()) holds the unit plane normal of sliding nodes (zero
+/// columns elsewhere). A node in several groups takes the strongest condition: prescribed
+/// over fixed over sliding; a node sliding in two different planes is fixed.
+template <int Dim>
+struct ResolvedBoundary {
+  std::vector<Index> nodes;
+  std::vector<BoundaryKind> kinds;
+  Points<Dim> displacements;
+  Points<Dim> normals;
+
+  [[nodiscard]] Index size() const noexcept { return static_cast<Index>(nodes.size()); }
+  [[nodiscard]] bool has_sliding() const {
+    return std::find(kinds.begin(), kinds.end(), BoundaryKind::sliding) != kinds.end();
+  }
+};
+
+/// Node lists by group name, for meshes without named groups (any MeshLike).
+using GroupNodes = std::map<std::string, std::vector<Index>, std::less<>>;
+
+/// Named-group boundary conditions, resolved against a mesh by resolve().
+template <int Dim>
+class BoundarySpec {
+ public:
+  /// The group moves rigidly with `motion` (evaluated on the group's reference positions).
+  BoundarySpec& moving(std::string group, Motion<Dim> motion) {
+    groups_.push_back({std::move(group), BoundaryKind::prescribed, std::move(motion), {}, {}});
+    return *this;
+  }
+  /// The group moves by `displacements`: Dim × (number of group nodes), columns in the order
+  /// of the group's sorted node indices.
+  BoundarySpec& moving(std::string group, Points<Dim> displacements) {
+    groups_.push_back({std::move(group), BoundaryKind::prescribed, std::nullopt, std::move(displacements), {}});
+    return *this;
+  }
+  /// The group does not move.
+  BoundarySpec& fixed(std::string group) {
+    groups_.push_back({std::move(group), BoundaryKind::fixed, std::nullopt, {}, {}});
+    return *this;
+  }
+  /// The group slides in its plane; the normal is fitted to the group's nodes (least squares)
+  /// when not given. Throws at resolve() when the nodes are not coplanar.
+  BoundarySpec& sliding(std::string group, std::optional<Vec<Dim>> normal = std::nullopt) {
+    groups_.push_back({std::move(group), BoundaryKind::sliding, std::nullopt, {}, normal});
+    return *this;
+  }
+
+  [[nodiscard]] bool empty() const noexcept { return groups_.empty(); }
+
+  /// Resolves against a Mesh<Dim> (groups by name, reference positions mesh.points).
+  /// Displacements are those between fractions `from` and `to` of the motions (arrays scale
+  /// linearly), so a driver can split the motion into steps. Throws InputError for an unknown
+  /// group (listing the known ones), a wrong-sized or non-finite displacement array, or a
+  /// non-planar sliding group.
+  [[nodiscard]] ResolvedBoundary<Dim> resolve(const Mesh<Dim>& mesh, double to = 1.0, double from = 0.0) const {
+    GroupNodes nodes;
+    for (const auto& g : groups_) nodes.emplace(g.name, mesh.group_nodes(g.name));
+    return resolve(mesh.points, nodes, to, from);
+  }
+
+  /// Resolves with explicit node lists per group name (for MeshLike meshes without groups).
+  /// `points` (Dim × n_nodes) are the reference positions. Throws InputError as above and for
+  /// node indices outside [0, n_nodes).
+  [[nodiscard]] ResolvedBoundary<Dim> resolve(const Points<Dim>& points, const GroupNodes& group_nodes,
+                                              double to = 1.0, double from = 0.0) const {
+    std::map<Index, Entry> entries;
+    for (const auto& g : groups_) {
+      const auto found = group_nodes.find(g.name);
+      if (found == group_nodes.end()) {
+        std::string known;
+        for (const auto& [name, list] : group_nodes) known += (known.empty() ? "" : ", ") + name;
+        throw InputError("BoundarySpec::resolve: no group named '" + g.name + "' (known: " +
+                         (known.empty() ? std::string("none") : known) + ")");
+      }
+      std::vector<Index> list = found->second;
+      for (const Index v : list)
+        if (v < 0 || v >= points.cols())
+          throw InputError("BoundarySpec::resolve: group '" + g.name + "' refers to node " + std::to_string(v) +
+                           " (expected 0 to " + std::to_string(points.cols() - 1) + ")");
+      std::sort(list.begin(), list.end());
+      list.erase(std::unique(list.begin(), list.end()), list.end());
+      add_group(g, list, points, to, from, entries);
+    }
+    ResolvedBoundary<Dim> out;
+    const auto m = static_cast<Index>(entries.size());
+    out.displacements.setZero(Dim, m);
+    out.normals.setZero(Dim, m);
+    Index k = 0;
+    for (const auto& [node, e] : entries) {
+      out.nodes.push_back(node);
+      out.kinds.push_back(e.kind);
+      out.displacements.col(k) = e.displacement;
+      out.normals.col(k) = e.normal;
+      ++k;
+    }
+    return out;
+  }
+
+ private:
+  struct Group {
+    std::string name;
+    BoundaryKind kind;
+    std::optional<Motion<Dim>> motion;
+    Points<Dim> displacements;
+    std::optional<Vec<Dim>> normal;
+  };
+  struct Entry {
+    BoundaryKind kind;
+    Vec<Dim> displacement;
+    Vec<Dim> normal;
+  };
+
+  static Vec<Dim> plane_normal(const Group& g, const std::vector<Index>& list, const Points<Dim>& points) {
+    if (g.normal) {
+      const double length = g.normal->norm();
+      if (!(length > 0.0) || !std::isfinite(length))
+        throw InputError("BoundarySpec::resolve: sliding group '" + g.name + "' has a zero or non-finite normal");
+      return *g.normal / length;
+    }
+    if (static_cast<Index>(list.size()) < Dim)
+      throw InputError("BoundarySpec::resolve: sliding group '" + g.name + "' has " + std::to_string(list.size()) +
+                       " nodes, too few to fit a plane (give the normal)");
+    Vec<Dim> centroid = Vec<Dim>::Zero();
+    for (const Index v : list) centroid += points.col(v);
+    centroid /= static_cast<double>(list.size());
+    Eigen::Matrix<double, Dim, Dim> scatter = Eigen::Matrix<double, Dim, Dim>::Zero();
+    double extent = 0.0;
+    for (const Index v : list) {
+      const Vec<Dim> r = points.col(v) - centroid;
+      scatter += r * r.transpose();
+      extent = std::max(extent, r.norm());
+    }
+    // The eigenvector of the smallest scatter eigenvalue is the least-squares plane normal.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Dim, Dim>> eig(scatter);
+    const Vec<Dim> normal = eig.eigenvectors().col(0);
+    double off_plane = 0.0;
+    for (const Index v : list) off_plane = std::max(off_plane, std::abs(normal.dot(points.col(v) - centroid)));
+    if (off_plane > 1e-8 * std::max(extent, 1e-300))
+      throw InputError("BoundarySpec::resolve: sliding group '" + g.name + "' is not planar (a node lies " +
+                       std::to_string(off_plane) + " off the fitted plane, expected 0; give the normal)");
+    return normal;
+  }
+
+  static void add_group(const Group& g, const std::vector<Index>& list, const Points<Dim>& points, double to,
+                        double from, std::map<Index, Entry>& entries) {
+    const auto n = static_cast<Index>(list.size());
+    Points<Dim> targets = Points<Dim>::Zero(Dim, n);
+    if (g.kind == BoundaryKind::prescribed) {
+      if (g.motion) {
+        for (Index k = 0; k < n; ++k) targets.col(k) = g.motion->displacement(points.col(list[k]), to, from);
+      } else {
+        if (g.displacements.cols() != n)
+          throw InputError("BoundarySpec::resolve: group '" + g.name + "' has " + std::to_string(n) +
+                           " nodes (got " + std::to_string(g.displacements.cols()) + " displacements)");
+        if (!g.displacements.allFinite())
+          throw InputError("BoundarySpec::resolve: group '" + g.name + "' has a non-finite displacement");
+        targets = (to - from) * g.displacements;
+      }
+    }
+    const Vec<Dim> normal = g.kind == BoundaryKind::sliding ? plane_normal(g, list, points) : Vec<Dim>::Zero();
+    for (Index k = 0; k < n; ++k) {
+      const Entry incoming{g.kind, targets.col(k), normal};
+      const auto [it, inserted] = entries.emplace(list[k], incoming);
+      if (inserted) continue;
+      Entry& e = it->second;
+      if (e.kind == BoundaryKind::prescribed && g.kind == BoundaryKind::prescribed) {
+        const double scale = std::max({1.0, e.displacement.norm(), incoming.displacement.norm()});
+        if ((e.displacement - incoming.displacement).norm() > 1e-12 * scale)
+          throw InputError("BoundarySpec::resolve: node " + std::to_string(list[k]) +
+                           " gets two different displacements (group '" + g.name + "' conflicts with an earlier group)");
+      } else if (g.kind == BoundaryKind::sliding && e.kind == BoundaryKind::sliding) {
+        if (std::abs(std::abs(e.normal.dot(normal)) - 1.0) > 1e-10) e = Entry{BoundaryKind::fixed, Vec<Dim>::Zero(), Vec<Dim>::Zero()};
+      } else if (static_cast<int>(g.kind) < static_cast<int>(e.kind)) {
+        e = incoming;
+      }
+    }
+  }
+
+  std::vector<Group> groups_;
+};
+
+}  // namespace meshmotion

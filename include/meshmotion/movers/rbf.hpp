@@ -1,0 +1,426 @@
+#pragma once
+/// \file
+/// RbfMover: radial basis function interpolation of boundary displacements into the volume
+/// (thesis section 2.2.2, eqs. 2.10–2.14; de Boer, van der Schoot & Bijl 2007).
+///
+/// - Linear in the displacements: move(a d1 + b d2) = a move(d1) + b move(d2).
+/// - Setup caches: merged boundary centres and their k-d tree, the factorized interpolation
+///   matrix (sparse SimplicialLDLT for the compact Wendland kernels, dense LU for global
+///   kernels), and for compact kernels the evaluation operator E (a sparse matrix of kernel
+///   weights between each node and the boundary centres inside its support, found by k-d
+///   tree radius queries; nodes beyond every support are skipped).
+/// - Cost: setup O(m log m + n log m) queries plus one sparse factorization (m boundary
+///   nodes, n nodes); move = one solve with the cached factorization + one sparse
+///   mat-vec E α (parallel). Global kernels: dense O(m³) setup, O(n m) per move.
+/// - Sliding boundaries (exact): the interpolant over the prescribed and fixed nodes gives
+///   the sliding nodes a displacement, its normal component is removed, and the projected
+///   values join the constraints of a second interpolant over all nodes; both systems are
+///   factorized once in setup, so sliding nodes end exactly on their planes.
+/// - Optional linear polynomial augmentation reproduces affine motions exactly.
+/// - derivative_forward / derivative_reverse give J w and Jᵀ v for J = ∂(node displacements)
+///   / ∂(boundary displacements), reusing the factorizations (shape optimization).
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/mesh_like.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/detail/coincident_nodes.hpp"
+#include "meshmotion/movers/detail/rbf_system.hpp"
+#include "meshmotion/movers/mover.hpp"
+#include "meshmotion/movers/rbf_kernels.hpp"
+#include "meshmotion/solvers/detail/stopwatch.hpp"
+#include "meshmotion/solvers/solver_options.hpp"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace meshmotion {
+
+/// Options of RbfMover.
+struct RbfOptions {
+  RbfKernel kernel = RbfKernel::wendland2;
+  /// Support radius of compact kernels (shape scale of global ones), in mesh units; must be > 0.
+  /// See suggest_support_radius() for a heuristic.
+  double support_radius = 1.0;
+  /// Add a linear polynomial (reproduces affine motions exactly; needed by the thin plate spline).
+  bool polynomial = false;
+  /// Solver of the sparse system of compact kernels.
+  SolverOptions solver = {};
+  /// Factorization of the dense system of global kernels.
+  DenseSolverKind dense_solver = DenseSolverKind::partial_piv_lu;
+  /// Largest boundary-node count accepted for a global kernel (dense m × m system).
+  Index max_dense_centres = 4000;
+  /// Boundary nodes closer than this fraction of the boundary's bounding-box diagonal are one node.
+  double coincidence_tolerance = 1e-10;
+};
+
+/// The RBF mover in Dim dimensions; models MeshMover.
+template <int Dim>
+class RbfMover {
+ public:
+  static constexpr int dim = Dim;
+  using Coefficients = Eigen::MatrixXd;
+
+  explicit RbfMover(RbfOptions options = {}) : options_(options) {}
+
+  [[nodiscard]] const RbfOptions& options() const noexcept { return options_; }
+  [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
+
+  /// Reference-configuration work (see the file comment). `mesh`: any MeshLike of dimension
+  /// Dim; `boundary`: nodes and kinds (its displacements are not used here).
+  /// Throws InputError for a non-positive radius, out-of-range or non-finite boundary data,
+  /// a global kernel beyond max_dense_centres; SolverError when the factorization fails.
+  template <MeshLike M>
+    requires(mesh_dim<M> == Dim)
+  void setup(const M& mesh, const ResolvedBoundary<Dim>& boundary) {
+    const detail::Stopwatch watch;
+    if (!(options_.support_radius > 0.0) || !std::isfinite(options_.support_radius))
+      throw InputError("RbfMover::setup: support radius must be positive (got " +
+                       std::to_string(options_.support_radius) + ")");
+    points_ = copy_points(mesh);
+    const Index n = points_.cols();
+    if (!points_.allFinite()) throw InputError("RbfMover::setup: mesh has a non-finite coordinate");
+    check_boundary(boundary, n);
+    boundary_nodes_ = boundary.nodes;
+    kinds_ = boundary.kinds;
+    const Index m = boundary.size();
+
+    // Merge coincident boundary nodes into centres; constrained centres first, sliding after.
+    Points<Dim> positions(Dim, m);
+    for (Index b = 0; b < m; ++b) positions.col(b) = points_.col(boundary_nodes_[static_cast<std::size_t>(b)]);
+    const double diagonal = m > 0 ? (positions.rowwise().maxCoeff() - positions.rowwise().minCoeff()).norm() : 0.0;
+    const auto rep = detail::coincident_representatives(positions, options_.coincidence_tolerance * diagonal);
+    std::vector<bool> constrained(static_cast<std::size_t>(m), false);
+    for (Index b = 0; b < m; ++b)
+      if (kinds_[static_cast<std::size_t>(b)] != BoundaryKind::sliding) constrained[static_cast<std::size_t>(rep[static_cast<std::size_t>(b)])] = true;
+    centre_of_.assign(static_cast<std::size_t>(m), -1);
+    source_.clear();
+    std::vector<Index> sliding_reps;
+    for (Index b = 0; b < m; ++b) {
+      if (rep[static_cast<std::size_t>(b)] != b) continue;
+      if (constrained[static_cast<std::size_t>(b)]) {
+        centre_of_[static_cast<std::size_t>(b)] = static_cast<Index>(source_.size());
+        source_.push_back(-1);
+      } else {
+        sliding_reps.push_back(b);
+      }
+    }
+    n_constrained_ = static_cast<Index>(source_.size());
+    for (const Index b : sliding_reps) {
+      centre_of_[static_cast<std::size_t>(b)] = static_cast<Index>(source_.size());
+      source_.push_back(b);
+    }
+    for (Index b = 0; b < m; ++b) centre_of_[static_cast<std::size_t>(b)] = centre_of_[static_cast<std::size_t>(rep[static_cast<std::size_t>(b)])];
+    // A constrained centre takes its value from its first constrained member node.
+    for (Index b = m - 1; b >= 0; --b)
+      if (kinds_[static_cast<std::size_t>(b)] != BoundaryKind::sliding && centre_of_[static_cast<std::size_t>(b)] < n_constrained_)
+        source_[static_cast<std::size_t>(centre_of_[static_cast<std::size_t>(b)])] = b;
+    const auto k = static_cast<Index>(source_.size());
+    Points<Dim> centres(Dim, k);
+    normals_.setZero(Dim, k);
+    for (Index c = 0; c < k; ++c) {
+      centres.col(c) = positions.col(source_[static_cast<std::size_t>(c)]);
+      if (c >= n_constrained_) normals_.col(c) = boundary.normals.col(source_[static_cast<std::size_t>(c)]);
+    }
+
+    const detail::RbfKernelSettings kernel{options_.kernel, options_.support_radius, options_.polynomial};
+    all_.setup(centres, kernel, options_.solver, options_.dense_solver, options_.max_dense_centres);
+    stats_ = MoverStats{};
+    stats_.boundary_nodes = k;
+    stats_.nonzeros = all_.nonzeros();
+    if (k > n_constrained_) {
+      constrained_.setup(Points<Dim>(centres.leftCols(n_constrained_)), kernel, options_.solver, options_.dense_solver,
+                         options_.max_dense_centres);
+      sliding_rows_.resize(static_cast<std::size_t>(k - n_constrained_));
+      for (Index c = n_constrained_; c < k; ++c) sliding_rows_[static_cast<std::size_t>(c - n_constrained_)] = c;
+      sliding_operator_ = build_operator(centres, sliding_rows_, constrained_);
+      stats_.nonzeros += constrained_.nonzeros() + sliding_operator_.nonZeros();
+    }
+
+    // Nodes evaluated: every non-boundary node inside some support (all of them for global
+    // kernels); the polynomial part reaches every non-boundary node.
+    std::vector<bool> is_boundary(static_cast<std::size_t>(n), false);
+    for (const Index v : boundary_nodes_) is_boundary[static_cast<std::size_t>(v)] = true;
+    interior_.clear();
+    for (Index i = 0; i < n; ++i)
+      if (!is_boundary[static_cast<std::size_t>(i)]) interior_.push_back(i);
+    evaluated_.clear();
+    if (is_compact(options_.kernel)) {
+      auto rows = detail::compact_kernel_rows(points_, interior_, all_.tree(), k, kernel);
+      // Keep only rows with weights, so skipped nodes cost nothing per move.
+      std::vector<Index> keep;
+      for (Index r = 0; r < rows.rows(); ++r)
+        if (rows.outerIndexPtr()[r + 1] > rows.outerIndexPtr()[r]) keep.push_back(r);
+      operator_.resize(static_cast<Index>(keep.size()), k);
+      operator_.reserve(rows.nonZeros());
+      for (const Index r : keep) {
+        evaluated_.push_back(interior_[static_cast<std::size_t>(r)]);
+        operator_.startVec(static_cast<Index>(evaluated_.size()) - 1);
+        for (typename Operator::InnerIterator it(rows, r); it; ++it)
+          operator_.insertBack(static_cast<Index>(evaluated_.size()) - 1, it.col()) = it.value();
+      }
+      operator_.finalize();
+      stats_.nonzeros += operator_.nonZeros();
+    } else {
+      evaluated_ = interior_;
+      operator_.resize(0, 0);
+    }
+    stats_.evaluated_nodes = options_.polynomial ? static_cast<Index>(interior_.size()) : static_cast<Index>(evaluated_.size());
+    stats_.factorizations = all_.report().factorizations + (k > n_constrained_ ? constrained_.report().factorizations : 0);
+    ready_ = true;
+    stats_.setup_seconds = watch.seconds();
+  }
+
+  /// Displacement of every node (Dim × n_nodes) for boundary displacements `d`
+  /// (Dim × boundary.size(), boundary.nodes order; sliding entries ignored). Boundary nodes
+  /// get their targets exactly (sliding ones their projected displacement). Throws
+  /// InputError for a wrong shape, a non-finite value, or coincident nodes given different
+  /// displacements (naming them); SolverError when an iterative solve fails.
+  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
+    Points<Dim> out;
+    move_into(d, out);
+    return out;
+  }
+
+  /// move() into `out` (resized only when its shape differs).
+  void move_into(const Points<Dim>& d, Points<Dim>& out) {
+    const detail::Stopwatch watch;
+    check_displacements(d, "move");
+    apply(d, out);
+    ++stats_.moves;
+    const SolverReport& r = all_.report();
+    stats_.iterations = r.iterations;
+    stats_.residual = r.residual;
+    stats_.fell_back = r.fell_back;
+    stats_.move_seconds = watch.seconds();
+  }
+
+  /// Forward derivative J w: the displacement change of every node (Dim × n_nodes) for a
+  /// boundary displacement change w (Dim × boundary.size()). The mover is linear in the
+  /// displacements, so this is move(w); coincident nodes must agree in w too.
+  [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w) {
+    check_displacements(w, "derivative_forward");
+    Points<Dim> out;
+    apply(w, out);
+    return out;
+  }
+
+  /// Reverse derivative Jᵀ v: for v (Dim × n_nodes), the gradient with respect to the
+  /// boundary displacements (Dim × boundary.size()) of ⟨v, move(d)⟩. Sliding nodes' entries are
+  /// zero (their input is ignored); a merged centre's gradient goes to its first constrained
+  /// node. Throws InputError for a wrong shape or a non-finite value.
+  [[nodiscard]] Points<Dim> derivative_reverse(const Points<Dim>& v) {
+    require_ready("derivative_reverse");
+    if (v.cols() != points_.cols() || !v.allFinite())
+      throw InputError("RbfMover::derivative_reverse: v must be finite and " + std::to_string(Dim) + " × " +
+                       std::to_string(points_.cols()) + " (got " + std::to_string(v.cols()) + " columns)");
+    const Index m = static_cast<Index>(boundary_nodes_.size());
+    const Index k = all_.size();
+    Points<Dim> grad = Points<Dim>::Zero(Dim, m);
+    // Boundary nodes output their target directly.
+    Eigen::MatrixXd values_bar = Eigen::MatrixXd::Zero(k, Dim);
+    for (Index b = 0; b < m; ++b) {
+      const Index node = boundary_nodes_[static_cast<std::size_t>(b)];
+      if (kinds_[static_cast<std::size_t>(b)] != BoundaryKind::sliding)
+        grad.col(b) += v.col(node);
+      else
+        values_bar.row(centre_of_[static_cast<std::size_t>(b)]) += v.col(node).transpose();
+    }
+    Eigen::MatrixXd alpha_bar;
+    typename detail::RbfSystem<Dim>::PolyCoefficients beta_bar;
+    interior_transpose(v, alpha_bar, beta_bar);
+    Eigen::MatrixXd through_all;
+    all_.solve_transpose(alpha_bar, beta_bar, through_all);
+    values_bar += through_all;
+    if (k > n_constrained_) {
+      Eigen::MatrixXd s_bar = values_bar.bottomRows(k - n_constrained_);
+      project_rows(s_bar);
+      const Eigen::MatrixXd a_bar = sliding_operator_.transpose() * s_bar;
+      typename detail::RbfSystem<Dim>::PolyCoefficients b_bar = polynomial_transpose(constrained_, sliding_rows_, all_centres(), s_bar);
+      Eigen::MatrixXd through_constrained;
+      constrained_.solve_transpose(a_bar, b_bar, through_constrained);
+      values_bar.topRows(n_constrained_) += through_constrained;
+    }
+    for (Index c = 0; c < n_constrained_; ++c) grad.col(source_[static_cast<std::size_t>(c)]) += values_bar.row(c).transpose();
+    return grad;
+  }
+
+ private:
+  using Operator = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
+  using Poly = typename detail::RbfSystem<Dim>::PolyCoefficients;
+
+  [[nodiscard]] const Points<Dim>& all_centres() const { return all_.centres(); }
+
+  void require_ready(const char* where) const {
+    if (!ready_) throw InputError(std::string("RbfMover::") + where + ": setup() was not called");
+  }
+
+  static void check_boundary(const ResolvedBoundary<Dim>& b, Index n) {
+    const Index m = b.size();
+    if (static_cast<Index>(b.kinds.size()) != m || b.normals.cols() != m)
+      throw InputError("RbfMover::setup: boundary has " + std::to_string(m) + " nodes but " +
+                       std::to_string(b.kinds.size()) + " kinds and " + std::to_string(b.normals.cols()) + " normals");
+    for (Index k = 0; k < m; ++k) {
+      const Index v = b.nodes[static_cast<std::size_t>(k)];
+      if (v < 0 || v >= n)
+        throw InputError("RbfMover::setup: boundary node " + std::to_string(v) + " is out of range (expected 0 to " +
+                         std::to_string(n - 1) + ")");
+      if (k > 0 && v <= b.nodes[static_cast<std::size_t>(k - 1)])
+        throw InputError("RbfMover::setup: boundary nodes must be sorted and unique (node " + std::to_string(v) +
+                         " follows " + std::to_string(b.nodes[static_cast<std::size_t>(k - 1)]) + ")");
+      if (b.kinds[static_cast<std::size_t>(k)] == BoundaryKind::sliding && std::abs(b.normals.col(k).norm() - 1.0) > 1e-8)
+        throw InputError("RbfMover::setup: sliding node " + std::to_string(v) + " needs a unit normal (got length " +
+                         std::to_string(b.normals.col(k).norm()) + ")");
+    }
+    if (m == 0) throw InputError("RbfMover::setup: the boundary has no nodes (expected at least one)");
+  }
+
+  void check_displacements(const Points<Dim>& d, const char* where) const {
+    require_ready(where);
+    const auto m = static_cast<Index>(boundary_nodes_.size());
+    if (d.cols() != m)
+      throw InputError(std::string("RbfMover::") + where + ": got " + std::to_string(d.cols()) +
+                       " displacement columns (expected " + std::to_string(m) + ", one per boundary node)");
+    for (Index b = 0; b < m; ++b)
+      if (!d.col(b).allFinite())
+        throw InputError(std::string("RbfMover::") + where + ": displacement of node " +
+                         std::to_string(boundary_nodes_[static_cast<std::size_t>(b)]) + " is not finite");
+  }
+
+  /// Operator rows (kernel weights) of centres `rows` of `at` against the system's centres.
+  [[nodiscard]] static Operator build_operator(const Points<Dim>& at, const std::vector<Index>& rows,
+                                               const detail::RbfSystem<Dim>& system) {
+    if (is_compact(system.kernel().kernel))
+      return detail::compact_kernel_rows(at, rows, system.tree(), system.size(), system.kernel());
+    Eigen::MatrixXd dense(static_cast<Index>(rows.size()), system.size());
+    for (Index r = 0; r < dense.rows(); ++r)
+      for (Index c = 0; c < system.size(); ++c)
+        dense(r, c) = rbf_value(system.kernel().kernel, (at.col(rows[static_cast<std::size_t>(r)]) - system.centres().col(c)).norm(),
+                                system.kernel().radius);
+    return dense.sparseView();
+  }
+
+  /// Σ_r q(x_r) s_rᵀ: transpose of the polynomial evaluation at the listed points.
+  [[nodiscard]] Poly polynomial_transpose(const detail::RbfSystem<Dim>& system, const std::vector<Index>& rows,
+                                          const Points<Dim>& at, const Eigen::MatrixXd& s) const {
+    Poly out = Poly::Zero();
+    if (!options_.polynomial) return out;
+    for (std::size_t r = 0; r < rows.size(); ++r) out += system.polynomial(at.col(rows[r])) * s.row(static_cast<Index>(r));
+    return out;
+  }
+
+  void project_rows(Eigen::MatrixXd& s) const {
+    for (Index r = 0; r < s.rows(); ++r) {
+      const Vec<Dim> normal = normals_.col(n_constrained_ + r);
+      s.row(r) -= normal.dot(s.row(r).transpose()) * normal.transpose();
+    }
+  }
+
+  /// The linear map boundary displacements → node displacements.
+  void apply(const Points<Dim>& d, Points<Dim>& out) {
+    const Index k = all_.size();
+    const auto m = static_cast<Index>(boundary_nodes_.size());
+    values_.resize(k, Dim);
+    for (Index c = 0; c < n_constrained_; ++c) values_.row(c) = d.col(source_[static_cast<std::size_t>(c)]).transpose();
+    for (Index b = 0; b < m; ++b) {
+      const Index c = centre_of_[static_cast<std::size_t>(b)];
+      if (kinds_[static_cast<std::size_t>(b)] == BoundaryKind::sliding || c >= n_constrained_) continue;
+      const Index first = source_[static_cast<std::size_t>(c)];
+      const double scale = std::max({1.0, d.col(b).norm(), d.col(first).norm()});
+      if ((d.col(b) - d.col(first)).norm() > 1e-12 * scale)
+        throw InputError("RbfMover::move: boundary nodes " + std::to_string(boundary_nodes_[static_cast<std::size_t>(first)]) +
+                         " and " + std::to_string(boundary_nodes_[static_cast<std::size_t>(b)]) +
+                         " coincide but get different displacements");
+    }
+    if (k > n_constrained_) {
+      constrained_.solve(values_.topRows(n_constrained_), alpha_, beta_);
+      Eigen::MatrixXd s = sliding_operator_ * alpha_;
+      if (options_.polynomial)
+        for (Index r = 0; r < s.rows(); ++r)
+          s.row(r) += constrained_.polynomial(all_centres().col(sliding_rows_[static_cast<std::size_t>(r)])).transpose() * beta_;
+      project_rows(s);
+      values_.bottomRows(k - n_constrained_) = s;
+    }
+    all_.solve(values_, alpha_, beta_);
+
+    const Index n = points_.cols();
+    if (out.cols() != n) out.resize(Dim, n);
+    out.setZero();
+    evaluate_interior(out);
+    for (Index b = 0; b < m; ++b) {
+      const Index node = boundary_nodes_[static_cast<std::size_t>(b)];
+      out.col(node) = kinds_[static_cast<std::size_t>(b)] == BoundaryKind::sliding
+                          ? Vec<Dim>(values_.row(centre_of_[static_cast<std::size_t>(b)]).transpose())
+                          : Vec<Dim>(d.col(b));
+    }
+  }
+
+  void evaluate_interior(Points<Dim>& out) {
+    const auto n_eval = static_cast<Index>(evaluated_.size());
+    if (is_compact(options_.kernel)) {
+      evaluated_values_.noalias() = operator_ * alpha_;
+#pragma omp parallel for schedule(static)
+      for (Index r = 0; r < n_eval; ++r) out.col(evaluated_[static_cast<std::size_t>(r)]) = evaluated_values_.row(r).transpose();
+    } else {
+      const Points<Dim>& centres = all_centres();
+#pragma omp parallel for schedule(static)
+      for (Index r = 0; r < n_eval; ++r) {
+        const Index node = evaluated_[static_cast<std::size_t>(r)];
+        Vec<Dim> sum = Vec<Dim>::Zero();
+        for (Index c = 0; c < centres.cols(); ++c)
+          sum += rbf_value(options_.kernel, (points_.col(node) - centres.col(c)).norm(), options_.support_radius) *
+                 alpha_.row(c).transpose();
+        out.col(node) = sum;
+      }
+    }
+    if (!options_.polynomial) return;
+    const auto n_interior = static_cast<Index>(interior_.size());
+#pragma omp parallel for schedule(static)
+    for (Index r = 0; r < n_interior; ++r) {
+      const Index node = interior_[static_cast<std::size_t>(r)];
+      out.col(node) += beta_.transpose() * all_.polynomial(points_.col(node));
+    }
+  }
+
+  /// Transpose of evaluate_interior: ᾱ = Eᵀ v_eval, β̄ = Σ q(x_i) v_iᵀ over interior nodes.
+  void interior_transpose(const Points<Dim>& v, Eigen::MatrixXd& alpha_bar, Poly& beta_bar) const {
+    const Index k = all_.size();
+    Eigen::MatrixXd v_eval(static_cast<Index>(evaluated_.size()), Dim);
+    for (std::size_t r = 0; r < evaluated_.size(); ++r) v_eval.row(static_cast<Index>(r)) = v.col(evaluated_[r]).transpose();
+    if (is_compact(options_.kernel)) {
+      alpha_bar = operator_.transpose() * v_eval;
+    } else {
+      alpha_bar.setZero(k, Dim);
+      for (std::size_t r = 0; r < evaluated_.size(); ++r)
+        for (Index c = 0; c < k; ++c)
+          alpha_bar.row(c) += rbf_value(options_.kernel, (points_.col(evaluated_[r]) - all_centres().col(c)).norm(),
+                                        options_.support_radius) * v_eval.row(static_cast<Index>(r));
+    }
+    Eigen::MatrixXd v_interior(static_cast<Index>(interior_.size()), Dim);
+    for (std::size_t r = 0; r < interior_.size(); ++r) v_interior.row(static_cast<Index>(r)) = v.col(interior_[r]).transpose();
+    beta_bar = polynomial_transpose(all_, interior_, points_, v_interior);
+  }
+
+  RbfOptions options_;
+  MoverStats stats_;
+  bool ready_ = false;
+  Points<Dim> points_;                      ///< reference coordinates, Dim × n
+  std::vector<Index> boundary_nodes_;       ///< as given to setup
+  std::vector<BoundaryKind> kinds_;
+  std::vector<Index> centre_of_;            ///< boundary entry → centre
+  std::vector<Index> source_;               ///< centre → boundary entry giving its value
+  Index n_constrained_ = 0;                 ///< centres 0..n_constrained_-1 are prescribed/fixed
+  Points<Dim> normals_;                     ///< unit normals of sliding centres
+  detail::RbfSystem<Dim> all_;              ///< over every centre
+  detail::RbfSystem<Dim> constrained_;      ///< over constrained centres (sliding boundaries only)
+  std::vector<Index> sliding_rows_;         ///< sliding centres
+  Operator sliding_operator_;               ///< sliding centres × constrained centres
+  std::vector<Index> interior_;             ///< non-boundary nodes
+  std::vector<Index> evaluated_;            ///< interior nodes with kernel weights
+  Operator operator_;                       ///< evaluated_ × centres (compact kernels)
+  Eigen::MatrixXd values_, alpha_, evaluated_values_;
+  Poly beta_ = Poly::Zero();
+};
+
+}  // namespace meshmotion

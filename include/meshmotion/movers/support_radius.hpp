@@ -1,0 +1,58 @@
+#pragma once
+/// \file
+/// A heuristic support radius for compactly supported RBF kernels, which the thesis asks for
+/// (section 2.2.2: "big enough to accommodate the expected deformation of the boundary, but
+/// small enough that the linear system is sparse").
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/spatial/kd_tree.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace meshmotion {
+
+/// Factors of suggest_support_radius().
+struct SupportRadiusOptions {
+  double displacement_factor = 5.0;  ///< radius ≥ this × the largest boundary displacement
+  double spacing_factor = 10.0;      ///< radius ≥ this × the median boundary node spacing
+};
+
+/// A support radius proposed from the boundary: max(displacement_factor × largest
+/// displacement, spacing_factor × median nearest-neighbour spacing of the boundary nodes).
+/// A HEURISTIC, not a guarantee: a larger radius spreads the deformation over more cells
+/// (better for large rotations, thesis fig. 4.11) and makes the system denser.
+/// `boundary_points` and `displacements` are Dim × m; throws InputError when m < 2 or the
+/// shapes differ, or when no positive radius follows (coincident nodes, no motion).
+template <int Dim>
+[[nodiscard]] double suggest_support_radius(const Points<Dim>& boundary_points, const Points<Dim>& displacements,
+                                            const SupportRadiusOptions& options = {}) {
+  const Index m = boundary_points.cols();
+  if (m < 2 || displacements.cols() != m)
+    throw InputError("suggest_support_radius: needs at least 2 boundary nodes and one displacement each (got " +
+                     std::to_string(m) + " nodes, " + std::to_string(displacements.cols()) + " displacements)");
+  const KdTree<Dim> tree(boundary_points);
+  std::vector<double> spacing;
+  spacing.reserve(static_cast<std::size_t>(m));
+  for (Index i = 0; i < m; ++i) {
+    const auto nn = tree.nearest(boundary_points.col(i), 2);
+    if (nn.size() == 2 && nn[1].second > 0.0) spacing.push_back(std::sqrt(nn[1].second));
+  }
+  double median = 0.0;
+  if (!spacing.empty()) {
+    auto mid = spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2);
+    std::nth_element(spacing.begin(), mid, spacing.end());
+    median = *mid;
+  }
+  const double largest = displacements.colwise().norm().maxCoeff();
+  const double radius = std::max(options.displacement_factor * largest, options.spacing_factor * median);
+  if (!(radius > 0.0) || !std::isfinite(radius))
+    throw InputError("suggest_support_radius: cannot propose a radius (got " + std::to_string(radius) +
+                     "; all boundary nodes coincide and do not move?)");
+  return radius;
+}
+
+}  // namespace meshmotion

@@ -1,0 +1,317 @@
+#include "meshmotion/movers.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <random>
+
+using namespace meshmotion;
+
+namespace {
+
+/// Structured grid on [0,1]^Dim with n intervals per axis (quads / hexes), with node groups
+/// "x0", "x1", "y0", "y1" (and "z0", "z1") for the sides.
+template <int Dim>
+struct Grid {
+  Mesh<Dim> mesh;
+  GroupNodes groups;
+};
+
+template <int Dim>
+Grid<Dim> grid(int n) {
+  Grid<Dim> g;
+  const int nz = Dim == 3 ? n : 0;
+  const auto id = [n](int i, int j, int k) { return static_cast<Index>(i + (n + 1) * (j + (n + 1) * k)); };
+  g.mesh.points.resize(Dim, static_cast<Index>((n + 1) * (n + 1) * (nz + 1)));
+  for (int k = 0; k <= nz; ++k)
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) {
+        const Index v = id(i, j, k);
+        g.mesh.points(0, v) = double(i) / n;
+        g.mesh.points(1, v) = double(j) / n;
+        if constexpr (Dim == 3) g.mesh.points(2, v) = double(k) / n;
+        const int c[3] = {i, j, k};
+        for (int d = 0; d < Dim; ++d) {
+          if (c[d] == 0) g.groups[std::string(1, "xyz"[d]) + "0"].push_back(v);
+          if (c[d] == n) g.groups[std::string(1, "xyz"[d]) + "1"].push_back(v);
+        }
+      }
+  ElementBlock& b = g.mesh.block(Dim == 2 ? ElementType::quad4 : ElementType::hex8);
+  for (int k = 0; k < std::max(nz, 1); ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        if constexpr (Dim == 2)
+          b.add({id(i, j, 0), id(i + 1, j, 0), id(i + 1, j + 1, 0), id(i, j + 1, 0)});
+        else
+          b.add({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k), id(i, j, k + 1),
+                 id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)});
+      }
+  return g;
+}
+
+/// The whole outer boundary of the grid as one group "outer".
+template <int Dim>
+GroupNodes with_outer(GroupNodes groups) {
+  std::vector<Index> all;
+  for (const auto& [name, list] : groups) all.insert(all.end(), list.begin(), list.end());
+  groups["outer"] = all;
+  return groups;
+}
+
+template <int Dim>
+Points<Dim> random_displacements(Index m, unsigned seed, double scale = 0.01) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-scale, scale);
+  Points<Dim> d(Dim, m);
+  for (Index i = 0; i < m; ++i)
+    for (int k = 0; k < Dim; ++k) d(k, i) = u(rng);
+  return d;
+}
+
+template <int Dim>
+void check_properties(int n) {
+  const Grid<Dim> g = grid<Dim>(n);
+  const GroupNodes groups = with_outer<Dim>(g.groups);
+  BoundarySpec<Dim> spec;
+  spec.fixed("outer");
+  const ResolvedBoundary<Dim> boundary = spec.resolve(g.mesh.points, groups);
+  const Index m = boundary.size();
+  RbfOptions options;
+  options.support_radius = 0.35;
+  RbfMover<Dim> mover(options);
+  mover.setup(g.mesh, boundary);
+  static_assert(MeshMover<RbfMover<Dim>>);
+
+  const Points<Dim> d1 = random_displacements<Dim>(m, 1);
+  const Points<Dim> d2 = random_displacements<Dim>(m, 2);
+  const Points<Dim> u1 = mover.move(d1);
+
+  SECTION("boundary targets met, and the interpolant meets them too") {
+    for (Index b = 0; b < m; ++b) CHECK((u1.col(boundary.nodes[std::size_t(b)]) - d1.col(b)).norm() <= 1e-10 * d1.norm());
+    CHECK(mover.stats().residual < 1e-10);
+  }
+  SECTION("zero displacement is the identity") { CHECK(mover.move(Points<Dim>::Zero(Dim, m)).norm() == 0.0); }
+  SECTION("superposition") {
+    const Points<Dim> u = mover.move(2.0 * d1 - 3.0 * d2);
+    CHECK((u - (2.0 * u1 - 3.0 * mover.move(d2))).norm() < 1e-12 * u.norm());
+  }
+  SECTION("repeated move equals a fresh setup and move; one factorization over many moves") {
+    for (int i = 0; i < 20; ++i) (void)mover.move(random_displacements<Dim>(m, 10u + unsigned(i)));
+    CHECK(mover.stats().factorizations == 1);
+    CHECK(mover.stats().moves == 21);
+    RbfMover<Dim> fresh(options);
+    fresh.setup(g.mesh, boundary);
+    CHECK((fresh.move(d1) - mover.move(d1)).norm() < 1e-13);
+  }
+  SECTION("displacement vanishes beyond the support radius of every boundary node") {
+    Index beyond = 0;
+    for (Index i = 0; i < g.mesh.num_nodes(); ++i) {
+      double nearest = 1e300;
+      for (const Index v : boundary.nodes) nearest = std::min(nearest, (g.mesh.points.col(i) - g.mesh.points.col(v)).norm());
+      if (nearest >= options.support_radius) {
+        ++beyond;
+        CHECK(u1.col(i).norm() == 0.0);
+      } else if (nearest > 0.0) {
+        CHECK(u1.col(i).norm() > 0.0);
+      }
+    }
+    CHECK(beyond > 0);
+    CHECK(mover.stats().evaluated_nodes < g.mesh.num_nodes() - m);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("RBF mover properties on 2D and 3D grids", "[movers]") {
+  SECTION("2D") { check_properties<2>(24); }
+  SECTION("3D") { check_properties<3>(10); }
+}
+
+TEST_CASE("Wendland C2 matrices are symmetric positive definite in 2D and 3D", "[movers]") {
+  const auto check = [](auto dim_tag) {
+    constexpr int Dim = decltype(dim_tag)::value;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    Points<Dim> c(Dim, 200);
+    for (Index i = 0; i < c.cols(); ++i)
+      for (int d = 0; d < Dim; ++d) c(d, i) = u(rng);
+    std::vector<Index> rows(200);
+    for (Index i = 0; i < 200; ++i) rows[std::size_t(i)] = i;
+    const KdTree<Dim> tree(c);
+    const Eigen::MatrixXd a(detail::compact_kernel_rows<Dim>(c, rows, tree, 200, {RbfKernel::wendland2, 0.4, false}));
+    CHECK((a - a.transpose()).norm() == 0.0);
+    CHECK(a(3, 3) == 1.0);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a);
+    CHECK(eig.eigenvalues().minCoeff() > 0.0);
+  };
+  check(std::integral_constant<int, 2>{});
+  check(std::integral_constant<int, 3>{});
+}
+
+TEST_CASE("kernels: Wendland values and support", "[movers]") {
+  CHECK(rbf_value(RbfKernel::wendland2, 0.5, 1.0) == Approx(0.0625 * 3.0));  // (1-ξ)^4 (4ξ+1), eq. 2.14
+  for (const RbfKernel k : {RbfKernel::wendland0, RbfKernel::wendland2, RbfKernel::wendland4, RbfKernel::wendland6}) {
+    CHECK(rbf_value(k, 0.0, 2.0) == Approx(1.0));
+    CHECK(rbf_value(k, 2.0, 2.0) == 0.0);
+    CHECK(rbf_value(k, 1.99, 2.0) > 0.0);
+    CHECK(rbf_kernel_from_name(name(k)) == k);
+  }
+  CHECK_THROWS_AS(rbf_kernel_from_name("cubic"), InputError);
+}
+
+TEST_CASE("affine motions are reproduced exactly with polynomial augmentation", "[movers]") {
+  const Grid<2> g = grid<2>(16);
+  const GroupNodes groups = with_outer<2>(g.groups);
+  Eigen::Matrix2d a;
+  a << 0.05, -0.02, 0.03, 0.01;
+  const Vec<2> t(0.1, -0.05);
+  for (const RbfKernel kernel : {RbfKernel::wendland2, RbfKernel::wendland6, RbfKernel::thin_plate_spline,
+                                 RbfKernel::gaussian, RbfKernel::multiquadric, RbfKernel::inverse_multiquadric}) {
+    CAPTURE(name(kernel));
+    BoundarySpec<2> spec;
+    const std::vector<Index>& outer = [&]() -> const std::vector<Index>& { return groups.at("outer"); }();
+    std::vector<Index> sorted = outer;
+    std::sort(sorted.begin(), sorted.end());
+    sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+    Points<2> d(2, Index(sorted.size()));
+    for (std::size_t k = 0; k < sorted.size(); ++k) d.col(Index(k)) = a * g.mesh.points.col(sorted[k]) + t;
+    spec.moving("outer", d);
+    RbfOptions options;
+    options.kernel = kernel;
+    options.support_radius = is_compact(kernel) ? 0.3 : 0.15;  // smooth global kernels: small scale, well conditioned
+    options.polynomial = true;
+    RbfMover<2> mover(options);
+    const auto boundary = spec.resolve(g.mesh.points, groups);
+    mover.setup(g.mesh, boundary);
+    const Points<2> u = mover.move(boundary.displacements);
+    for (Index i = 0; i < g.mesh.num_nodes(); ++i) CHECK((u.col(i) - (a * g.mesh.points.col(i) + t)).norm() < 1e-9);
+  }
+}
+
+TEST_CASE("global kernels refuse large systems and suggest a compact kernel", "[movers]") {
+  const Grid<2> g = grid<2>(30);
+  BoundarySpec<2> spec;
+  spec.fixed("outer");
+  RbfOptions options;
+  options.kernel = RbfKernel::gaussian;
+  options.max_dense_centres = 50;
+  RbfMover<2> mover(options);
+  CHECK_THROWS_WITH(mover.setup(g.mesh, spec.resolve(g.mesh.points, with_outer<2>(g.groups))),
+                    Catch::Contains("compact kernel"));
+}
+
+TEST_CASE("sliding channel walls: nodes stay on their walls exactly", "[movers]") {
+  // Channel [0,1]^2: the left side translates up and right, the right side is fixed, the
+  // bottom and top walls slide along themselves.
+  const Grid<2> g = grid<2>(20);
+  BoundarySpec<2> spec;
+  spec.moving("x0", Translation<2>{Vec<2>(0.05, 0.08)}).fixed("x1").sliding("y0").sliding("y1", Vec<2>(0.0, 2.0));
+  const auto boundary = spec.resolve(g.mesh.points, g.groups);
+  RbfOptions options;
+  options.support_radius = 0.5;
+  RbfMover<2> mover(options);
+  mover.setup(g.mesh, boundary);
+  const Points<2> u = mover.move(boundary.displacements);
+  Index moved = 0;
+  for (const auto& [wall, y] : {std::pair<const char*, double>{"y0", 0.0}, {"y1", 1.0}}) {
+    for (const Index v : g.groups.at(wall)) {
+      const bool corner = g.mesh.points(0, v) == 0.0 || g.mesh.points(0, v) == 1.0;
+      if (corner) continue;  // the corners belong to the prescribed/fixed sides
+      CHECK(std::abs(g.mesh.points(1, v) + u(1, v) - y) < 1e-14);
+      if (std::abs(u(0, v)) > 1e-4) ++moved;
+    }
+  }
+  CHECK(moved > 4);  // they do slide
+  CHECK(mover.stats().factorizations == 2);
+}
+
+TEST_CASE("coincident boundary nodes are merged; conflicting displacements are named", "[movers]") {
+  // Two nodes at the same place (a seam): node 4 duplicates node 0.
+  Mesh<2> mesh;
+  mesh.points.resize(2, 6);
+  mesh.points << 0, 1, 1, 0, 0, 0.5, 0, 0, 1, 1, 0, 0.5;
+  mesh.block(ElementType::tri3).add({0, 1, 5});
+  mesh.block(ElementType::tri3).add({1, 2, 5});
+  mesh.block(ElementType::tri3).add({2, 3, 5});
+  mesh.block(ElementType::tri3).add({3, 4, 5});
+  BoundarySpec<2> spec;
+  spec.fixed("walls");
+  const auto boundary = spec.resolve(mesh.points, GroupNodes{{"walls", {0, 1, 2, 3, 4}}});
+  RbfMover<2> mover(RbfOptions{RbfKernel::wendland2, 2.0});
+  mover.setup(mesh, boundary);
+  CHECK(mover.stats().boundary_nodes == 4);
+  Points<2> d = Points<2>::Zero(2, 5);
+  d(0, 0) = d(0, 4) = 0.1;
+  const Points<2> u = mover.move(d);
+  CHECK(u(0, 5) > 0.0);
+  d(0, 4) = 0.2;
+  CHECK_THROWS_WITH(mover.move(d), Catch::Contains("nodes 0 and 4 coincide"));
+}
+
+TEST_CASE("bad inputs raise InputError", "[movers]") {
+  const Grid<2> g = grid<2>(6);
+  const GroupNodes groups = with_outer<2>(g.groups);
+  BoundarySpec<2> spec;
+  spec.fixed("outer");
+  const auto boundary = spec.resolve(g.mesh.points, groups);
+  RbfMover<2> mover;
+  CHECK_THROWS_AS(mover.move(Points<2>::Zero(2, boundary.size())), InputError);  // no setup
+  mover.setup(g.mesh, boundary);
+  Points<2> d = Points<2>::Zero(2, boundary.size());
+  d(1, 3) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(mover.move(d), InputError);
+  CHECK_THROWS_AS(mover.move(Points<2>::Zero(2, boundary.size() + 1)), InputError);
+  BoundarySpec<2> unknown;
+  unknown.fixed("inlet");
+  CHECK_THROWS_WITH(unknown.resolve(g.mesh.points, groups), Catch::Contains("no group named 'inlet'"));
+  BoundarySpec<2> wrong_size;
+  wrong_size.moving("x0", Points<2>::Zero(2, 3));
+  CHECK_THROWS_AS(wrong_size.resolve(g.mesh.points, groups), InputError);
+  CHECK_THROWS_AS(spec.resolve(g.mesh.points, GroupNodes{{"outer", {0, 1000}}}), InputError);
+  ResolvedBoundary<2> bad = boundary;
+  bad.nodes.back() = 1000;
+  CHECK_THROWS_AS(mover.setup(g.mesh, bad), InputError);
+  CHECK_THROWS_AS(RbfMover<2>(RbfOptions{RbfKernel::wendland2, -1.0}).setup(g.mesh, boundary), InputError);
+  BoundarySpec<2> curved;
+  curved.sliding("outer");
+  CHECK_THROWS_WITH(curved.resolve(g.mesh.points, groups), Catch::Contains("not planar"));
+}
+
+TEST_CASE("derivatives: forward and reverse products agree with finite differences", "[movers]") {
+  const Grid<2> g = grid<2>(14);
+  BoundarySpec<2> spec;
+  spec.moving("x0", Rotation2D{Vec<2>(0.5, 0.5), 0.1}).fixed("x1").sliding("y0").sliding("y1");
+  const auto boundary = spec.resolve(g.mesh.points, g.groups);
+  for (const bool polynomial : {false, true}) {
+    RbfOptions options;
+    options.support_radius = 0.6;
+    options.polynomial = polynomial;
+    RbfMover<2> mover(options);
+    mover.setup(g.mesh, boundary);
+    const Points<2> d = boundary.displacements;
+    const Points<2> w = random_displacements<2>(boundary.size(), 3, 1.0);
+    const Points<2> v = random_displacements<2>(g.mesh.num_nodes(), 4, 1.0);
+    const double h = 1e-6;
+    const Points<2> fd = (mover.move(d + h * w) - mover.move(d - h * w)) / (2.0 * h);
+    const Points<2> jw = mover.derivative_forward(w);
+    CHECK((fd - jw).norm() < 1e-6 * jw.norm());
+    const Points<2> jtv = mover.derivative_reverse(v);
+    // ⟨v, J w⟩ = ⟨Jᵀ v, w⟩, with the finite-difference J w.
+    CHECK((v.array() * fd.array()).sum() == Approx((jtv.array() * w.array()).sum()).epsilon(1e-6));
+    // Reverse against finite differences of ⟨v, move(d)⟩ in one boundary coordinate.
+    Points<2> e = Points<2>::Zero(2, boundary.size());
+    e(0, 2) = 1.0;
+    const double fd_scalar = ((v.array() * (mover.move(d + h * e) - mover.move(d - h * e)).array()).sum()) / (2.0 * h);
+    CHECK(jtv(0, 2) == Approx(fd_scalar).epsilon(1e-6));
+  }
+}
+
+TEST_CASE("support radius heuristic grows with displacement and spacing", "[movers]") {
+  Points<2> b(2, 11);
+  for (Index i = 0; i < 11; ++i) b.col(i) = Vec<2>(0.1 * double(i), 0.0);
+  const double small = suggest_support_radius<2>(b, Points<2>::Zero(2, 11));
+  CHECK(small == Approx(1.0));  // 10 × spacing 0.1
+  Points<2> d = Points<2>::Zero(2, 11);
+  d(1, 5) = 0.5;
+  CHECK(suggest_support_radius(b, d) == Approx(2.5));
+  CHECK_THROWS_AS(suggest_support_radius<2>(Points<2>(2, 1), Points<2>(2, 1)), InputError);
+}
