@@ -102,7 +102,9 @@ inline BezierLeaf make_leaf(const JacobianSpace& s, const LatticeVector& values,
 // from the best sampled value until every gap is within tolerance.
 inline void certify(const JacobianSpace& s, const LatticeVector& values, const ScaledJacobianOptions& opt,
                     ScaledJacobian& r) {
-  std::vector<BezierLeaf> leaves;
+  // Reused per thread: the common case (no subdivision) then allocates nothing.
+  thread_local std::vector<BezierLeaf> leaves;
+  leaves.clear();
   leaves.push_back(make_leaf(s, values, 0));
   double upper_min = r.sampled_min, lower_max = r.sampled_max;
   for (;;) {
