@@ -58,6 +58,7 @@ class BinaryCursor {
   template <class T>
   void read_array(T* out, std::size_t count, std::string_view what) {
     require(count, sizeof(T), what);
+    if (count == 0) return;  // `out` may be null for an empty array
     std::memcpy(static_cast<void*>(out), data_.data() + pos_, count * sizeof(T));
     pos_ += count * sizeof(T);
     if (swap_)
