@@ -1,0 +1,115 @@
+// io_bench: writes and reads a >= 1M-node tetrahedral mesh (a structured box split into six
+// tets per cube) as msh 4.1 binary, 4.1 ASCII and 2.2 ASCII; prints MB/s and nodes/s, and
+// compares binary reading against Gmsh's own reader (`gmsh FILE -0`) when gmsh is installed.
+// Usage: io_bench [cells_per_side = 100]
+
+#include "meshmotion/io.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+using namespace meshmotion;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+Mesh<3> box_mesh(int n) {
+  Mesh<3> mesh;
+  const int m = n + 1;
+  mesh.points.resize(3, static_cast<Index>(m) * m * m);
+  const auto id = [m](int i, int j, int k) { return static_cast<Index>(i + m * (j + m * k)); };
+  for (int k = 0; k < m; ++k)
+    for (int j = 0; j < m; ++j)
+      for (int i = 0; i < m; ++i) mesh.points.col(id(i, j, k)) << double(i) / n, double(j) / n, double(k) / n;
+  auto& tets = mesh.block(ElementType::tet4);
+  tets.reserve(6 * static_cast<Index>(n) * n * n);
+  // Kuhn split of each cube along the 0-6 diagonal: six positively oriented tets.
+  const int paths[6][2] = {{1, 3}, {1, 5}, {2, 3}, {2, 6}, {4, 5}, {4, 6}};
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const auto corner = [&](int bits) { return id(i + (bits & 1), j + ((bits >> 1) & 1), k + ((bits >> 2) & 1)); };
+        for (const auto& p : paths) {
+          Index v[4] = {corner(0), corner(p[0]), corner(p[1]), corner(7)};
+          if (signed_measure(mesh, ElementType::tet4, std::span<const Index>(v, 4)) < 0) std::swap(v[1], v[2]);
+          tets.add(std::span<const Index>(v, 4), 1);
+        }
+      }
+  mesh.groups.push_back({3, 1, "volume"});
+  return mesh;
+}
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int n = argc > 1 ? std::atoi(argv[1]) : 100;
+  const auto mesh = box_mesh(n);
+  const auto dir = std::filesystem::temp_directory_path() / "meshmotion_io_bench";
+  std::filesystem::create_directories(dir);
+  std::printf("mesh: %lld nodes, %lld tets\n", static_cast<long long>(mesh.num_nodes()), static_cast<long long>(mesh.num_cells()));
+  std::printf("%-14s %9s %10s %10s %12s %10s %10s %12s\n", "case", "MB", "write s", "write MB/s", "write nodes/s", "read s",
+              "read MB/s", "read nodes/s");
+  struct Case {
+    const char* name;
+    WriteOptions options;
+  };
+  const Case cases[] = {{"msh4.1-binary", {MshVersion::v4_1, true, false}},
+                        {"msh4.1-ascii", {MshVersion::v4_1, false, false}},
+                        {"msh2.2-ascii", {MshVersion::v2_2, false, false}}};
+  double binary_read_seconds = 0;
+  std::vector<std::string> json;
+  for (const auto& c : cases) {
+    const auto file = dir / (std::string(c.name) + ".msh");
+    auto t = Clock::now();
+    write_mesh(file, mesh, c.options);
+    const double write_s = seconds_since(t);
+    const double mb = static_cast<double>(std::filesystem::file_size(file)) / 1e6;
+    t = Clock::now();
+    const auto back = read_mesh_as<3>(file);
+    const double read_s = seconds_since(t);
+    if (back.num_nodes() != mesh.num_nodes() || back.num_cells() != mesh.num_cells()) {
+      std::fprintf(stderr, "io_bench: %s read back a different mesh\n", c.name);
+      return 1;
+    }
+    if (c.options.binary) binary_read_seconds = read_s;
+    const double nodes = static_cast<double>(mesh.num_nodes());
+    std::printf("%-14s %9.1f %10.3f %10.1f %12.3g %10.3f %10.1f %12.3g\n", c.name, mb, write_s, mb / write_s, nodes / write_s,
+                read_s, mb / read_s, nodes / read_s);
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "{\"bench\":\"io\",\"case\":\"%s\",\"nodes\":%lld,\"cells\":%lld,\"mb\":%.3f,\"write_s\":%.4f,\"write_mb_s\":%.1f,"
+                  "\"read_s\":%.4f,\"read_mb_s\":%.1f,\"read_nodes_s\":%.4g}",
+                  c.name, static_cast<long long>(mesh.num_nodes()), static_cast<long long>(mesh.num_cells()), mb, write_s,
+                  mb / write_s, read_s, mb / read_s, nodes / read_s);
+    json.emplace_back(line);
+  }
+  // Baseline: Gmsh reading the same binary file (process start included).
+  const auto binary_file = dir / "msh4.1-binary.msh";
+  if (std::system("gmsh --version > /dev/null 2>&1") == 0) {
+    const std::string command = "gmsh " + binary_file.string() + " -0 -o " + (dir / "gmsh_out.msh").string() + " > /dev/null 2>&1";
+    const auto t = Clock::now();
+    const int rc = std::system(command.c_str());
+    const double gmsh_s = seconds_since(t);
+    if (rc == 0) {
+      std::printf("gmsh: read+rewrite of msh4.1-binary %.3f s; ours (read only) %.3f s; ratio ours/gmsh %.3f\n", gmsh_s,
+                  binary_read_seconds, binary_read_seconds / gmsh_s);
+      char line[256];
+      std::snprintf(line, sizeof line, "{\"bench\":\"io\",\"case\":\"gmsh-baseline\",\"gmsh_s\":%.4f,\"ours_s\":%.4f,\"ratio\":%.4f}",
+                    gmsh_s, binary_read_seconds, binary_read_seconds / gmsh_s);
+      json.emplace_back(line);
+    } else {
+      std::printf("gmsh: failed to read the file (exit %d)\n", rc);
+    }
+  } else {
+    std::printf("gmsh: not installed\n");
+  }
+  for (const auto& j : json) std::printf("%s\n", j.c_str());
+  std::filesystem::remove_all(dir);
+  return 0;
+}
