@@ -295,13 +295,18 @@ class GmshParser {
     node_entity_.push_back(p);
   }
 
-  ElementBlock& block_for(int gmsh_type) {
-    ElementType type{};
+  // The type of a Gmsh element number; `cursor` reports unknown numbers where they were read.
+  template <class Cursor>
+  [[nodiscard]] static ElementType checked_type(int gmsh_type, const Cursor& cursor) {
     try {
-      type = element_type_from_gmsh(gmsh_type);
+      return element_type_from_gmsh(gmsh_type);
     } catch (const InputError&) {
-      text_.fail("unknown element type " + std::to_string(gmsh_type) + " (expected a Gmsh type 1 to 19)");
+      cursor.fail("unknown element type " + std::to_string(gmsh_type) + " (expected a Gmsh type 1 to 19)");
     }
+  }
+
+  ElementBlock& block_for(int gmsh_type) {
+    const ElementType type = checked_type(gmsh_type, text_);
     int& index = block_of_type_[static_cast<std::size_t>(type)];
     if (index < 0) {
       index = static_cast<int>(raw_.blocks.size());
@@ -341,12 +346,7 @@ class GmshParser {
         const std::int64_t num_tags = bin.read<std::int32_t>("number of tags");
         if (n <= 0 || n > count - done) bin.fail("element header announces " + std::to_string(n) + " elements (expected 1 to " + std::to_string(count - done) + ")");
         if (num_tags < 0 || num_tags > 64) bin.fail("element header has " + std::to_string(num_tags) + " tags (expected 0 to 64)");
-        ElementType type{};
-        try {
-          type = element_type_from_gmsh(gmsh_type);
-        } catch (const InputError&) {
-          bin.fail("unknown element type " + std::to_string(gmsh_type) + " (expected a Gmsh type 1 to 19)");
-        }
+        const ElementType type = checked_type(gmsh_type, bin);
         ElementBlock& block = block_for(gmsh_type);
         const std::int64_t per = 1 + num_tags + num_nodes(type);
         bin.require(static_cast<std::uint64_t>(n) * static_cast<std::uint64_t>(per), 4, "element data");
@@ -405,12 +405,7 @@ class GmshParser {
         const int entity = bin.read<std::int32_t>("entity tag");
         const int gmsh_type = bin.read<std::int32_t>("element type");
         const std::uint64_t n = bin.read_size(size_bytes_, "number of elements in block");
-        ElementType type{};
-        try {
-          type = element_type_from_gmsh(gmsh_type);
-        } catch (const InputError&) {
-          bin.fail("unknown element type " + std::to_string(gmsh_type) + " (expected a Gmsh type 1 to 19)");
-        }
+        const ElementType type = checked_type(gmsh_type, bin);
         ElementBlock& block = block_for(gmsh_type);
         const int physical = physical_tag_of(dim, entity);
         const std::uint64_t per = 1 + static_cast<std::uint64_t>(num_nodes(type));
