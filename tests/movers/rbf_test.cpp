@@ -315,3 +315,31 @@ TEST_CASE("support radius heuristic grows with displacement and spacing", "[move
   CHECK(suggest_support_radius(b, d) == Approx(2.5));
   CHECK_THROWS_AS(suggest_support_radius<2>(Points<2>(2, 1), Points<2>(2, 1)), InputError);
 }
+
+#include "meshmotion/core/generators.hpp"
+
+TEST_CASE("step driver: a rotated ellipse O-mesh, wall rotated rigidly, quality reported per step", "[movers]") {
+  OMeshOptions o;
+  o.semi_axis_x = 0.5;
+  o.semi_axis_y = 0.2;
+  o.n_around = 48;
+  o.n_radial = 16;
+  o.first_height = 1e-3;
+  const Mesh<2> mesh = o_mesh(o);
+  BoundarySpec<2> spec;
+  spec.moving("wall", Rotation2D{Vec<2>::Zero(), radians(60.0)}).fixed("farfield");
+  for (const int steps : {1, 3}) {
+    auto mover = make_mover<2>("rbf", MoverParameters{{{"support_radius", "3.0"}}});
+    const StepResult<2> r = run_steps(mover, mesh, spec, StepOptions{steps, Metric::skew});
+    REQUIRE(r.steps.size() == std::size_t(steps));
+    for (const Index v : mesh.group_nodes("wall")) {
+      const Vec<2> expected = Eigen::Rotation2Dd(radians(60.0)) * mesh.points.col(v);
+      CHECK((r.mesh.points.col(v) - expected).norm() < 1e-12);
+    }
+    for (const Index v : mesh.group_nodes("farfield")) CHECK(r.displacements.col(v).norm() == 0.0);
+    REQUIRE(r.steps.back().quality);
+    CHECK(r.steps.back().quality->num_invalid == 0);
+    CHECK(r.steps.back().stats.factorizations == 1);
+  }
+  CHECK_THROWS_AS(make_mover<2>("spring"), InputError);
+}
