@@ -1,4 +1,5 @@
 #include "meshmotion/delaunay.hpp"
+#include "meshmotion/delaunay/detail/spatial_sort.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -442,4 +443,43 @@ TEST_CASE("locate returns barycentric coordinates of the containing simplex", "[
     CHECK(touches_right_edge);
     CHECK_THROWS_AS(dt.locate(Vec<2>(std::nan(""), 0.0)), InputError);
   }
+}
+
+TEST_CASE("Hilbert order visits grid cells by unit steps", "[delaunay]") {
+  // Consecutive keys of a full 2^k grid are face neighbours: the curve is continuous.
+  const int m = 32;
+  std::vector<std::array<int, 2>> at(m * m);
+  for (std::uint32_t x = 0; x < m; ++x) {
+    for (std::uint32_t y = 0; y < m; ++y) {
+      std::uint32_t cell[2] = {x << 11, y << 11};
+      at[detail::hilbert_key<2, 16>(cell) >> 22] = {static_cast<int>(x), static_cast<int>(y)};
+    }
+  }
+  int jumps = 0;
+  for (int k = 1; k < m * m; ++k) {
+    jumps += std::abs(at[k][0] - at[k - 1][0]) + std::abs(at[k][1] - at[k - 1][1]) != 1;
+  }
+  CHECK(jumps == 0);
+  const int q = 8;
+  std::vector<std::array<int, 3>> at3(q * q * q);
+  for (std::uint32_t x = 0; x < q; ++x) {
+    for (std::uint32_t y = 0; y < q; ++y) {
+      for (std::uint32_t z = 0; z < q; ++z) {
+        std::uint32_t cell[3] = {x << 7, y << 7, z << 7};
+        at3[detail::hilbert_key<3, 10>(cell) >> 21] = {static_cast<int>(x), static_cast<int>(y),
+                                                        static_cast<int>(z)};
+      }
+    }
+  }
+  for (int k = 1; k < q * q * q; ++k) {
+    int step = 0;
+    for (int d = 0; d < 3; ++d) step += std::abs(at3[k][d] - at3[k - 1][d]);
+    jumps += step != 1;
+  }
+  CHECK(jumps == 0);
+  // The BRIO order is a permutation.
+  const Points<2> p = random_points<2>(5000, 22);
+  std::vector<Index> order = detail::brio_order<2>(p, 3);
+  std::sort(order.begin(), order.end());
+  for (Index i = 0; i < 5000; ++i) REQUIRE(order[static_cast<std::size_t>(i)] == i);
 }

@@ -84,10 +84,7 @@ class BowyerWatsonKernel {
 
   BowyerWatsonKernel(const double* coordinates, Id n_vertices, std::uint64_t seed)
       : xyz_(coordinates), n_(n_vertices), rng_state_(seed | 1u), representative_(n_vertices) {
-    const std::size_t expected = (Dim == 2 ? 2 : 7) * static_cast<std::size_t>(n_) + 16;
-    vertices_.reserve(corners * expected);
-    neighbours_.reserve(corners * expected);
-    mark_.reserve(expected);
+    cells_.reserve((Dim == 2 ? 2 : 7) * static_cast<std::size_t>(n_) + 16);
     for (Id v = 0; v < n_; ++v) representative_[v] = v;
   }
 
@@ -101,9 +98,7 @@ class BowyerWatsonKernel {
     for (Id v = corners; v < n_; ++v) insert(v);
   }
 
-  [[nodiscard]] Id num_slots() const noexcept {
-    return static_cast<Id>(mark_.size());
-  }
+  [[nodiscard]] Id num_slots() const noexcept { return static_cast<Id>(cells_.size()); }
   [[nodiscard]] bool is_dead(Id s) const noexcept { return vertex(s, 0) < 0; }
   [[nodiscard]] bool is_ghost(Id s) const noexcept {
     for (int i = 0; i < corners; ++i) {
@@ -111,16 +106,19 @@ class BowyerWatsonKernel {
     }
     return false;
   }
-  [[nodiscard]] Id vertex(Id s, int i) const noexcept {
-    return vertices_[static_cast<std::size_t>(s) * corners + i];
-  }
-  [[nodiscard]] Id neighbour(Id s, int i) const noexcept {
-    return neighbours_[static_cast<std::size_t>(s) * corners + i];
-  }
+  [[nodiscard]] Id vertex(Id s, int i) const noexcept { return cells_[s].vertices[i]; }
+  [[nodiscard]] Id neighbour(Id s, int i) const noexcept { return cells_[s].neighbours[i]; }
   /// The vertex that vertex v duplicates (v itself when unique).
   [[nodiscard]] Id representative(Id v) const noexcept { return representative_[v]; }
 
  private:
+  /// A simplex: vertices, neighbour opposite each vertex, and the cavity-search mark, packed
+  /// so that visiting a simplex touches one cache line.
+  struct Cell {
+    std::array<Id, corners> vertices;
+    std::array<Id, corners> neighbours;
+    std::uint32_t mark;
+  };
   struct BoundaryFacet {
     std::array<Id, corners> vertices;  // the new simplex: old one with the point at `facet`
     Id outside;                        // simplex across the facet, not in the cavity
@@ -137,12 +135,8 @@ class BowyerWatsonKernel {
   [[nodiscard]] const double* point(Id v) const noexcept {
     return xyz_ + static_cast<std::size_t>(v) * Dim;
   }
-  Id& vertex_ref(Id s, int i) noexcept {
-    return vertices_[static_cast<std::size_t>(s) * corners + i];
-  }
-  Id& neighbour_ref(Id s, int i) noexcept {
-    return neighbours_[static_cast<std::size_t>(s) * corners + i];
-  }
+  Id& vertex_ref(Id s, int i) noexcept { return cells_[s].vertices[i]; }
+  Id& neighbour_ref(Id s, int i) noexcept { return cells_[s].neighbours[i]; }
 
   std::uint64_t random() noexcept {
     rng_state_ ^= rng_state_ << 13;
@@ -157,14 +151,12 @@ class BowyerWatsonKernel {
       free_.pop_back();
       return s;
     }
-    const auto s = static_cast<Id>(mark_.size());
+    const auto s = static_cast<Id>(cells_.size());
     if (s == std::numeric_limits<Id>::max()) {
       throw InputError("delaunay: too many simplices for 32-bit indices (got " +
                        std::to_string(n_) + " points)");
     }
-    vertices_.resize(vertices_.size() + corners);
-    neighbours_.resize(neighbours_.size() + corners);
-    mark_.push_back(0);
+    cells_.push_back(Cell{{}, {}, 0});
     return s;
   }
 
@@ -243,7 +235,7 @@ class BowyerWatsonKernel {
   [[nodiscard]] Id locate(const double* q) {
     Id s = last_;
     Id previous = -1;
-    const std::size_t max_steps = 64 + 4 * mark_.size();
+    const std::size_t max_steps = 64 + 4 * cells_.size();
     for (std::size_t step = 0; step < max_steps; ++step) {
       if (is_ghost(s)) return s;
       const int start = static_cast<int>(random() % corners);
@@ -304,18 +296,19 @@ class BowyerWatsonKernel {
     cavity_.clear();
     boundary_.clear();
     cavity_.push_back(host);
-    mark_[host] = in_cavity;
+    cells_[host].mark = in_cavity;
     for (std::size_t c = 0; c < cavity_.size(); ++c) {
       const Id s = cavity_[c];
       for (int i = 0; i < corners; ++i) {
         const Id t = neighbour(s, i);
-        if (mark_[t] == in_cavity) continue;
-        if (mark_[t] != rejected && in_conflict(t, q)) {
-          mark_[t] = in_cavity;
+        std::uint32_t& mark = cells_[t].mark;
+        if (mark == in_cavity) continue;
+        if (mark != rejected && in_conflict(t, q)) {
+          mark = in_cavity;
           cavity_.push_back(t);
           continue;
         }
-        mark_[t] = rejected;
+        mark = rejected;
         BoundaryFacet f;
         for (int k = 0; k < corners; ++k) f.vertices[k] = vertex(s, k);
         f.facet = i;
@@ -388,9 +381,7 @@ class BowyerWatsonKernel {
   Id n_;
   std::uint64_t rng_state_;
   std::vector<Id> representative_;
-  std::vector<Id> vertices_;
-  std::vector<Id> neighbours_;
-  std::vector<std::uint32_t> mark_;
+  std::vector<Cell> cells_;
   std::uint32_t epoch_ = 0;
   std::vector<Id> free_;
   Id last_ = 0;

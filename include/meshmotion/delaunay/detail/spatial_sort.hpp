@@ -16,6 +16,24 @@
 
 namespace meshmotion::detail {
 
+/// The bits of x (up to 16 for Dim = 2, 10 for Dim = 3) moved to every Dim-th position.
+template <int Dim>
+[[nodiscard]] constexpr std::uint64_t spread_bits(std::uint32_t x) noexcept {
+  std::uint64_t v = x;
+  if constexpr (Dim == 2) {
+    v = (v | (v << 8)) & 0x00FF00FFull;
+    v = (v | (v << 4)) & 0x0F0F0F0Full;
+    v = (v | (v << 2)) & 0x33333333ull;
+    v = (v | (v << 1)) & 0x55555555ull;
+  } else {
+    v = (v | (v << 16)) & 0x030000FFull;
+    v = (v | (v << 8)) & 0x0300F00Full;
+    v = (v | (v << 4)) & 0x030C30C3ull;
+    v = (v | (v << 2)) & 0x09249249ull;
+  }
+  return v;
+}
+
 /// Position of a grid cell along the Hilbert curve (Skilling, "Programming the Hilbert curve",
 /// AIP Conf. Proc. 707, 2004). `cell` holds Dim coordinates of Bits bits each.
 template <int Dim, int Bits>
@@ -38,10 +56,9 @@ template <int Dim, int Bits>
     if (cell[Dim - 1] & q) t ^= q - 1;
   }
   for (int i = 0; i < Dim; ++i) cell[i] ^= t;
+  // Interleave the bits, cell[0] most significant at each level.
   std::uint64_t key = 0;
-  for (int b = Bits - 1; b >= 0; --b) {
-    for (int i = 0; i < Dim; ++i) key = (key << 1) | ((cell[i] >> b) & 1u);
-  }
+  for (int i = 0; i < Dim; ++i) key |= spread_bits<Dim>(cell[i]) << (Dim - 1 - i);
   return key;
 }
 
