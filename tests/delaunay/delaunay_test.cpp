@@ -214,21 +214,18 @@ void check_locate(const DelaunayTriangulation<Dim>& dt, const Points<Dim>& queri
 
 }  // namespace
 
+template <int Dim>
+void check_random_sorted_and_unsorted(Index n, std::uint64_t seed) {
+  const Points<Dim> p = random_points<Dim>(n, seed);
+  check_delaunay(p, delaunay<Dim>(p), true);
+  DelaunayOptions unsorted;
+  unsorted.spatial_sort = false;
+  check_delaunay(p, delaunay<Dim>(p, unsorted), true);
+}
+
 TEST_CASE("delaunay of random points", "[delaunay]") {
-  SECTION("2D brute force") {
-    const Points<2> p = random_points<2>(600, 1);
-    check_delaunay(p, delaunay<2>(p), true);
-    DelaunayOptions unsorted;
-    unsorted.spatial_sort = false;
-    check_delaunay(p, delaunay<2>(p, unsorted), true);
-  }
-  SECTION("3D brute force") {
-    const Points<3> p = random_points<3>(400, 2);
-    check_delaunay(p, delaunay<3>(p), true);
-    DelaunayOptions unsorted;
-    unsorted.spatial_sort = false;
-    check_delaunay(p, delaunay<3>(p, unsorted), true);
-  }
+  SECTION("2D brute force") { check_random_sorted_and_unsorted<2>(600, 1); }
+  SECTION("3D brute force") { check_random_sorted_and_unsorted<3>(400, 2); }
 }
 
 TEST_CASE("delaunay of 10^5 random points", "[delaunay][slow]") {
@@ -482,4 +479,67 @@ TEST_CASE("Hilbert order visits grid cells by unit steps", "[delaunay]") {
   std::vector<Index> order = detail::brio_order<2>(p, 3);
   std::sort(order.begin(), order.end());
   for (Index i = 0; i < 5000; ++i) REQUIRE(order[static_cast<std::size_t>(i)] == i);
+}
+
+TEST_CASE("graph mapping reproduces affine motions and detects inversion", "[delaunay]") {
+  SECTION("2D") {
+    // Graph: a square frame of boundary points around an inner circle; queries fill the gap.
+    std::vector<Vec<2>> nodes;
+    for (int i = 0; i < 40; ++i) {
+      const double t = 2.0 * std::numbers::pi * i / 40;
+      nodes.emplace_back(0.3 * std::cos(t), 0.3 * std::sin(t));
+      const double s = -1.0 + 2.0 * i / 40;
+      nodes.emplace_back(s, -1.0);
+      nodes.emplace_back(1.0, s);
+      nodes.emplace_back(-s, 1.0);
+      nodes.emplace_back(-1.0, -s);
+    }
+    Points<2> graph_points(2, static_cast<Index>(nodes.size()));
+    for (std::size_t i = 0; i < nodes.size(); ++i) graph_points.col(static_cast<Index>(i)) = nodes[i];
+    const auto graph = delaunay<2>(graph_points);
+    const Points<2> queries = random_points<2>(3000, 23);
+    const GraphMapping<2> mapping(graph, queries);
+    CHECK(mapping.num_queries() == 3000);
+    CHECK(mapping.num_outside() == 0);
+    CHECK((mapping.map(graph_points) - queries).cwiseAbs().maxCoeff() < 1e-14);
+
+    Eigen::Matrix2d a;
+    a << 1.2, 0.3, -0.4, 0.9;
+    const Vec<2> b(0.5, -2.0);
+    const Points<2> moved = (a * graph_points).colwise() + b;
+    const Points<2> expected = (a * queries).colwise() + b;
+    CHECK((mapping.map(moved) - expected).cwiseAbs().maxCoeff() < 1e-13);
+    CHECK(mapping.inverted_simplices(moved).empty());
+    // Linear: displacements map like positions.
+    const Points<2> displacement = moved - graph_points;
+    CHECK((mapping.map(displacement) - (expected - queries)).cwiseAbs().maxCoeff() < 1e-13);
+
+    // A reflection inverts everything; pushing one inner node across the circle inverts some.
+    Points<2> mirrored = graph_points;
+    mirrored.row(0) *= -1.0;
+    CHECK(static_cast<Index>(mapping.inverted_simplices(mirrored).size()) == graph.num_simplices());
+    Points<2> pushed = graph_points;
+    pushed.col(0) = Vec<2>(-0.5, 0.0);
+    CHECK_FALSE(mapping.inverted_simplices(pushed).empty());
+
+    CHECK_THROWS_AS(mapping.map(Points<2>(2, 3)), InputError);
+    Points<2> bad_query = queries.leftCols(5);
+    bad_query(0, 2) = std::nan("");
+    CHECK_THROWS_AS(GraphMapping<2>(graph, bad_query), InputError);
+  }
+  SECTION("3D, queries partly outside the hull") {
+    const Points<3> graph_points = random_points<3>(300, 24);
+    const auto graph = delaunay<3>(graph_points);
+    const Points<3> queries = random_points<3>(2000, 25) * 1.2;
+    const GraphMapping<3> mapping(graph, queries);
+    CHECK(mapping.num_outside() > 0);
+    Eigen::Matrix3d a;
+    a << 1.0, 0.2, 0.0, -0.1, 0.8, 0.3, 0.05, 0.0, 1.1;
+    const Vec<3> b(1.0, 2.0, 3.0);
+    const Points<3> moved = (a * graph_points).colwise() + b;
+    const Points<3> expected = (a * queries).colwise() + b;
+    // Extrapolation outside the hull is affine too.
+    CHECK((mapping.map(moved) - expected).cwiseAbs().maxCoeff() < 1e-12);
+    CHECK(mapping.inverted_simplices(moved).empty());
+  }
 }

@@ -20,6 +20,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cmath>
 
 namespace meshmotion {
@@ -42,17 +43,18 @@ inline constexpr double predicate_epsilon = 0x1p-53;
   return (acx * bcy - acy * bcx).sign();
 }
 
+/// The exact coordinate differences p - q of two 3D points.
+[[nodiscard]] inline std::array<Expansion, 3> differences(const double* p, const double* q) {
+  return {Expansion::difference(p[0], q[0]), Expansion::difference(p[1], q[1]),
+          Expansion::difference(p[2], q[2])};
+}
+
 /// Shewchuk's orient3d determinant det[a - d; b - d; c - d] (the negative of ours).
 [[nodiscard]] inline int orient3d_shewchuk_exact(const double* a, const double* b, const double* c,
                                                  const double* d) {
-  Expansion ad[3];
-  Expansion bd[3];
-  Expansion cd[3];
-  for (int k = 0; k < 3; ++k) {
-    ad[k] = Expansion::difference(a[k], d[k]);
-    bd[k] = Expansion::difference(b[k], d[k]);
-    cd[k] = Expansion::difference(c[k], d[k]);
-  }
+  const auto ad = differences(a, d);
+  const auto bd = differences(b, d);
+  const auto cd = differences(c, d);
   const Expansion det = ad[2] * (bd[0] * cd[1] - cd[0] * bd[1]) +
                         bd[2] * (cd[0] * ad[1] - ad[0] * cd[1]) +
                         cd[2] * (ad[0] * bd[1] - bd[0] * ad[1]);
@@ -79,16 +81,10 @@ inline constexpr double predicate_epsilon = 0x1p-53;
 /// ours).
 [[nodiscard]] inline int insphere_shewchuk_exact(const double* a, const double* b, const double* c,
                                                  const double* d, const double* e) {
-  Expansion ae[3];
-  Expansion be[3];
-  Expansion ce[3];
-  Expansion de[3];
-  for (int k = 0; k < 3; ++k) {
-    ae[k] = Expansion::difference(a[k], e[k]);
-    be[k] = Expansion::difference(b[k], e[k]);
-    ce[k] = Expansion::difference(c[k], e[k]);
-    de[k] = Expansion::difference(d[k], e[k]);
-  }
+  const auto ae = differences(a, e);
+  const auto be = differences(b, e);
+  const auto ce = differences(c, e);
+  const auto de = differences(d, e);
   const Expansion ab = ae[0] * be[1] - be[0] * ae[1];
   const Expansion bc = be[0] * ce[1] - ce[0] * be[1];
   const Expansion cd = ce[0] * de[1] - de[0] * ce[1];
@@ -99,7 +95,9 @@ inline constexpr double predicate_epsilon = 0x1p-53;
   const Expansion bcd = be[2] * cd - ce[2] * bd + de[2] * bc;
   const Expansion cda = ce[2] * da + de[2] * ac + ae[2] * cd;
   const Expansion dab = de[2] * ab + ae[2] * bd + be[2] * da;
-  auto lift = [](const Expansion* v) { return v[0] * v[0] + v[1] * v[1] + v[2] * v[2]; };
+  auto lift = [](const std::array<Expansion, 3>& v) {
+    return v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+  };
   const Expansion det =
       (lift(de) * abc - lift(ce) * dab) + (lift(be) * cda - lift(ae) * bcd);
   return det.sign();
