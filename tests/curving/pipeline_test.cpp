@@ -4,8 +4,16 @@
 
 #include <catch2/catch.hpp>
 
+#include "test_data.hpp"
+
 #include "meshmotion/core/generators.hpp"
+#include "meshmotion/core/shape_functions.hpp"
+#include "meshmotion/curving/blend_regularizer.hpp"
 #include "meshmotion/curving/boundary_layer.hpp"
+#include "meshmotion/curving/curve_mesh.hpp"
+#include "meshmotion/curving/function_graph.hpp"
+#include "meshmotion/curving/geometry.hpp"
+#include "meshmotion/io/mesh_io.hpp"
 
 #include <cmath>
 #include <numbers>
@@ -72,4 +80,220 @@ TEST_CASE("boundary layer: thickness of a generated O-mesh layer is the one buil
     CHECK_THROWS_AS(estimate_boundary_layer(mesh, std::vector<std::string>{"nope"}), InputError);
     CHECK_THROWS_AS(estimate_boundary_layer(mesh, wall_group, {0.5}), InputError);
   }
+}
+
+TEST_CASE("blend mover: a wall translation is blended by the C2 weight of the wall distance", "[curving]") {
+  OMeshOptions o;
+  o.n_around = 32;
+  o.n_radial = 30;
+  o.first_height = 1e-3;
+  o.growth = 1.15;
+  const Mesh<2> mesh = o_mesh(o);
+  BoundarySpec<2> spec;
+  spec.moving("wall", Translation<2>{Vec<2>(1e-3, -2e-3)});
+  spec.fixed("farfield");
+  const ResolvedBoundary<2> boundary = spec.resolve(mesh);
+  const double length = 0.05;
+  BlendMover<2> mover(BlendOptions{length, {}, 3.0});
+  mover.setup(mesh, boundary);
+  const Points<2> u = mover.move(boundary.displacements);
+  const auto s = [&](Index j) { return o.first_height * (std::pow(o.growth, static_cast<double>(j)) - 1.0) / (o.growth - 1.0); };
+  for (Index j = 0; j <= o.n_radial; ++j)
+    for (Index i = 0; i < o.n_around; i += 7) {
+      const Index v = j * o.n_around + i;
+      const double weight = j == o.n_radial ? 0.0 : rbf_value(RbfKernel::wendland2, s(j), length);
+      INFO("ring " << j << " node " << i);
+      CHECK((u.col(v) - weight * Vec<2>(1e-3, -2e-3)).norm() < 1e-15);
+    }
+  CHECK(mover.stats().evaluated_nodes > 0);
+  CHECK(mover.stats().evaluated_nodes < mesh.num_nodes() - 2 * o.n_around);
+  CHECK(mover.move(Points<2>::Zero(2, boundary.size())).isZero(0.0));
+  CHECK_THROWS_AS(mover.move(Points<2>::Zero(2, 3)), InputError);
+}
+
+TEST_CASE("blend mover: one wall's field vanishes on the other wall", "[curving]") {
+  // Two walls: the bottom moves, the top moves too; each one's share dies on the other.
+  Mesh<2> mesh = rectangle_mesh({8, 8, 0.0, 1.0, 0.0, 0.1, RectangleCells::tri3});
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Translation<2>{Vec<2>(0.0, 1e-3)});
+  spec.moving("top", Translation<2>{Vec<2>(0.0, 0.0)});
+  spec.fixed("left").fixed("right");
+  const ResolvedBoundary<2> boundary = spec.resolve(mesh);
+  BlendMover<2> mover(BlendOptions{1.0, {}, 3.0});  // longer than the gap: only damping stops it
+  mover.setup(mesh, boundary);
+  const Points<2> u = mover.move(boundary.displacements);
+  CHECK(mover.blending_lengths().size() == 2);
+  for (Index i = 1; i < 8; ++i) {
+    CHECK(u(1, i) == Approx(1e-3));            // bottom row: its target
+    CHECK(u.col(8 * 9 + i).norm() == 0.0);     // top row: untouched by the bottom's field
+    CHECK(u(1, 4 * 9 + i) > 0.0);              // middle row: in between
+    CHECK(u(1, 4 * 9 + i) < 1e-3);
+  }
+}
+
+namespace {
+
+// Largest distance from the wall facets (line3 in P2, line2 linear) to the circle |x| = r,
+// sampled at 21 points per facet.
+double distance_to_circle(const Mesh<2>& mesh, const std::string& group, double r) {
+  const int tag = mesh.group(group).tag;
+  double worst = 0.0;
+  for (const auto& block : mesh.facets)
+    for (Index e = 0; e < block.size(); ++e) {
+      if (block.tags[static_cast<std::size_t>(e)] != tag) continue;
+      const auto el = block.element(e);
+      Eigen::Matrix<double, 2, Eigen::Dynamic> coords(2, block.nodes_per_element());
+      for (int k = 0; k < block.nodes_per_element(); ++k) coords.col(k) = mesh.points.col(el[static_cast<std::size_t>(k)]);
+      for (int k = 0; k <= 20; ++k) {
+        const Vec<2> x = map_to_physical(block.type, coords, {-1.0 + k / 10.0, 0.0, 0.0});
+        worst = std::max(worst, std::abs(x.norm() - r));
+      }
+    }
+  return worst;
+}
+
+OMeshOptions circle_mesh(Index n_around) {
+  OMeshOptions o;
+  o.n_around = n_around;
+  o.n_radial = 6;
+  o.first_height = 0.02;
+  o.farfield_radius = 3.0;
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE("pipeline: P2 boundary converges to a circle as h^3 or faster, linear as h^2", "[curving]") {
+  const double radius = 0.5;
+  std::vector<double> linear_error, circle_error, spline_error;
+  for (const Index n : {12, 24, 48, 96}) {
+    const Mesh<2> linear = o_mesh(circle_mesh(n));
+    linear_error.push_back(distance_to_circle(linear, "wall", radius));
+    CurveOptions<2> options;
+    options.geometry.emplace("wall", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), radius)));
+    const CurveResult<2> curved = curve_mesh(linear, options);
+    CHECK(curved.invalid() == 0);
+    CHECK(curved.moved_vertices == 0);  // the generator puts the vertices on the circle
+    circle_error.push_back(distance_to_circle(curved.curved, "wall", radius));
+    // Every wall node, high-order ones included, on the circle to round-off.
+    for (const Index v : curved.curved.group_nodes("wall")) CHECK(std::abs(curved.curved.points.col(v).norm() - radius) < 1e-15);
+    // Linear nodes keep their numbers and, off the support, their places.
+    CHECK(curved.num_linear_nodes == linear.num_nodes());
+    CHECK(curved.curved.points.leftCols(n) == linear.points.leftCols(n));
+    spline_error.push_back(distance_to_circle(curve_mesh(linear, CurveOptions<2>{}).curved, "wall", radius));
+  }
+  for (std::size_t k = 1; k < linear_error.size(); ++k) {
+    const double linear_order = std::log2(linear_error[k - 1] / linear_error[k]);
+    const double circle_order = std::log2(circle_error[k - 1] / circle_error[k]);
+    const double spline_order = std::log2(spline_error[k - 1] / spline_error[k]);
+    INFO("refinement " << k << ": linear " << linear_order << ", projected P2 " << circle_order << ", spline P2 "
+                       << spline_order);
+    CHECK(linear_order == Approx(2.0).margin(0.1));
+    CHECK(circle_order >= 2.9);
+    CHECK(spline_order >= 2.9);
+    CHECK(circle_error[k] < linear_error[k]);
+  }
+}
+
+TEST_CASE("pipeline: boundary-layer mesh (aspect ratio >= 1000) needs the regularization", "[curving]") {
+  OMeshOptions o;  // 128 x 64 cells, first cell 1e-5 for a wall spacing of 0.025
+  o.triangles = GENERATE(false, true);
+  const Mesh<2> linear = o_mesh(o);
+  CurveOptions<2> options;
+  options.geometry.emplace("wall", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 0.5)));
+  options.method = "none";
+  const CurveResult<2> snapped = curve_mesh(linear, options);
+  CHECK(snapped.invalid() > 0);
+  CHECK(snapped.moved_nodes == 0);
+  options.strict = true;
+  try {
+    (void)curve_mesh(linear, options);
+    FAIL("strict mode accepted invalid cells");
+  } catch (const InvalidMeshError& e) {
+    CHECK_THAT(e.what(), Catch::Contains(std::to_string(snapped.invalid()) + " of ") && Catch::Contains("worst"));
+  }
+  for (const std::string method : {"rbf", "blend"}) {
+    options.method = method;
+    const CurveResult<2> curved = curve_mesh(linear, options);
+    INFO(method << ": min " << curved.quality.min << ", radius " << curved.support_radius);
+    CHECK(curved.invalid() == 0);
+    CHECK(curved.quality.min > 0.3);
+    CHECK(curved.moved_nodes > 0);
+    REQUIRE(curved.layers.size() == 2);  // the farfield is spline-curved too, and has no layer
+    CHECK(curved.layers[0].group == "wall");
+    CHECK(curved.layers[0].thickness > 100 * o.first_height);
+    CHECK(curved.layers[1].thickness == 0.0);
+    if (method == "rbf") CHECK(curved.support_radius == curved.layers[0].thickness);
+  }
+}
+
+TEST_CASE("pipeline: every element type and mixed meshes curve onto a graph", "[curving]") {
+  const auto wave = [](double x) {
+    const double k = 2.0 * std::numbers::pi;
+    return GraphSample1{0.02 * std::sin(k * x), 0.02 * k * std::cos(k * x), -0.02 * k * k * std::sin(k * x)};
+  };
+  for (const auto cells : {RectangleCells::tri3, RectangleCells::quad4, RectangleCells::tri_quad}) {
+    const Mesh<2> linear = rectangle_mesh({6, 4, 0.0, 1.0, 0.0, 0.5, cells});
+    CurveOptions<2> options;
+    options.geometry.emplace("bottom", BoundaryGeometry<2>::project(GraphProjection2(wave)));
+    const CurveResult<2> curved = curve_mesh(linear, options);
+    INFO("2D cells " << static_cast<int>(cells));
+    CHECK(curved.invalid() == 0);
+    for (const Index v : curved.curved.group_nodes("bottom"))
+      CHECK(std::abs(curved.curved.points(1, v) - wave(curved.curved.points(0, v)).value) < 1e-12);
+  }
+  const auto bump = [](double x, double y) {
+    const double p = std::numbers::pi;
+    GraphSample2 g;
+    g.value = 0.02 * std::sin(p * x) * std::sin(p * y);
+    g.gradient << 0.02 * p * std::cos(p * x) * std::sin(p * y), 0.02 * p * std::sin(p * x) * std::cos(p * y);
+    g.hessian << -p * p * g.value, 0.02 * p * p * std::cos(p * x) * std::cos(p * y),
+        0.02 * p * p * std::cos(p * x) * std::cos(p * y), -p * p * g.value;
+    return g;
+  };
+  for (const auto cells : {BoxCells::hex8, BoxCells::tet4, BoxCells::prism6, BoxCells::pyramid5, BoxCells::hex_prism,
+                           BoxCells::tet_pyramid_prism}) {
+    const Mesh<3> linear = box_mesh({3, 3, 3, 0.0, 1.0, 0.0, 1.0, 0.0, 1.0, cells});
+    CurveOptions<3> options;
+    options.geometry.emplace("bottom", BoundaryGeometry<3>::project(GraphProjection3(bump)));
+    const CurveResult<3> curved = curve_mesh(linear, options);
+    INFO("3D cells " << static_cast<int>(cells));
+    CHECK(curved.invalid() == 0);
+    CHECK(curved.moved_vertices == 4);  // the interior vertices of the bottom face
+    for (const Index v : curved.curved.group_nodes("bottom")) {
+      const Vec<3> x = curved.curved.points.col(v);
+      CHECK(std::abs(x.z() - bump(x.x(), x.y()).value) < 1e-10);
+    }
+  }
+}
+
+TEST_CASE("pipeline: bad options", "[curving]") {
+  const Mesh<2> linear = o_mesh(circle_mesh(12));
+  CurveOptions<2> options;
+  options.method = "magic";
+  CHECK_THROWS_AS(curve_mesh(linear, options), InputError);
+  options.method = "rbf";
+  options.steps = 0;
+  CHECK_THROWS_AS(curve_mesh(linear, options), InputError);
+  options.steps = 1;
+  options.geometry.emplace("nope", BoundaryGeometry<2>::spline());
+  CHECK_THROWS_AS(curve_mesh(linear, options), InputError);
+  const Mesh<3> box = box_mesh({});
+  CHECK_THROWS_AS(curve_mesh(box, CurveOptions<3>{}), InputError);  // nothing to curve in 3D
+  CurveOptions<3> spline3;
+  spline3.geometry.emplace("bottom", BoundaryGeometry<3>::spline());
+  CHECK_THROWS_AS(curve_mesh(box, spline3), InputError);
+}
+
+TEST_CASE("pipeline: 3D sphere with a symmetry plane curves onto the sphere", "[curving]") {
+  MESHMOTION_REQUIRE_DATA(file, "meshopt_sphere_symmetry_linear_tet.msh");
+  const Mesh<3> linear = read_mesh_as<3>(file);
+  CurveOptions<3> options;
+  options.geometry.emplace("7", BoundaryGeometry<3>::project(SphereProjection<3>(Vec<3>::Zero(), 0.5)));
+  options.sliding.push_back("20");
+  const CurveResult<3> curved = curve_mesh(linear, options);
+  INFO("min " << curved.quality.min << ", radius " << curved.support_radius);
+  CHECK(curved.invalid() == 0);
+  for (const Index v : curved.curved.group_nodes("7")) CHECK(std::abs(curved.curved.points.col(v).norm() - 0.5) < 1e-12);
+  for (const Index v : curved.curved.group_nodes("20")) CHECK(std::abs(curved.curved.points(1, v)) < 1e-12);
 }

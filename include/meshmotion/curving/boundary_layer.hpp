@@ -7,7 +7,8 @@
 /// layer makes the interpolant overshoot away from the wall).
 ///
 /// Method: cells whose aspect ratio (longest over shortest vertex edge) is at least
-/// `aspect_ratio_threshold` and that touch a wall seed a flood fill through shared facets
+/// `aspect_ratio_threshold` and that lie on a wall with a long wall edge (stretched along
+/// the wall, not across it) seed a flood fill through shared facets
 /// restricted to such cells. Every vertex reached is measured against the straight wall
 /// facets (exact point-facet distance) and credited to its nearest wall vertex; a wall
 /// vertex's thickness is the largest distance credited to it, a wall's thickness the median
@@ -75,40 +76,33 @@ template <int Dim>
   return shortest > 0.0 ? longest / shortest : std::numeric_limits<double>::infinity();
 }
 
-/// Estimates the boundary-layer thickness of each of `wall_groups` (groups of dimension
-/// Dim - 1) of a linear or quadratic mesh (only vertices are used). Throws InputError for an
-/// empty group list, an unknown group or one that is not a facet group, and a threshold
-/// below 1.
+/// Layer thickness of walls given as straight facet lists (`walls[w]`: the facets of wall
+/// w, P1 or P2; only vertices are used) in a mesh of any cells. WallLayer::group and tag are
+/// left empty. A vertex shared by two walls belongs to the first. Throws InputError for a
+/// threshold below 1 or a facet node out of range.
 template <int Dim>
 [[nodiscard]] BoundaryLayerEstimate estimate_boundary_layer(const Mesh<Dim>& mesh,
-                                                            std::span<const std::string> wall_groups,
+                                                            const std::vector<std::vector<detail::WallFacet>>& walls,
                                                             const BoundaryLayerOptions& options = {}) {
-  if (wall_groups.empty()) throw InputError("estimate_boundary_layer: no wall group given (expected at least one)");
   if (!(options.aspect_ratio_threshold >= 1.0))
     throw InputError("estimate_boundary_layer: aspect_ratio_threshold " + std::to_string(options.aspect_ratio_threshold) +
                      " (expected >= 1)");
   BoundaryLayerEstimate out;
-  std::vector<int> tags;
-  for (const auto& name : wall_groups) {
-    const PhysicalGroup& g = mesh.group(name);
-    if (g.dim != Dim - 1)
-      throw InputError("estimate_boundary_layer: group '" + name + "' has dimension " + std::to_string(g.dim) +
-                       " (expected a wall of dimension " + std::to_string(Dim - 1) + ")");
-    tags.push_back(g.tag);
-    out.walls.push_back({name, g.tag, 0.0, 0.0, 0});
-  }
-  const detail::WallDistance<Dim> wall(mesh.points, detail::wall_facets(mesh, tags));
+  out.walls.resize(walls.size());
+  std::vector<detail::WallFacet> all;
+  for (const auto& w : walls) all.insert(all.end(), w.begin(), w.end());
+  const detail::WallDistance<Dim> wall(mesh.points, std::move(all));
   if (wall.empty()) return out;
   out.wall_nodes = wall.vertices();
   out.node_thickness.assign(out.wall_nodes.size(), 0.0);
   const auto slot = [&](Index v) {
     return static_cast<std::size_t>(std::lower_bound(out.wall_nodes.begin(), out.wall_nodes.end(), v) - out.wall_nodes.begin());
   };
-  // The wall (index into out.walls) of each wall vertex: the first listed group holding it.
+  // The wall (index into out.walls) of each wall vertex: the first listed wall holding it.
   std::vector<std::size_t> owner(out.wall_nodes.size(), out.walls.size());
-  for (std::size_t w = out.walls.size(); w-- > 0;)
-    for (const Index v : mesh.group_nodes(out.walls[w].tag, Dim - 1))
-      if (std::binary_search(out.wall_nodes.begin(), out.wall_nodes.end(), v)) owner[slot(v)] = w;
+  for (std::size_t w = walls.size(); w-- > 0;)
+    for (const auto& f : walls[w])
+      for (int k = 0; k < num_vertices(f.type); ++k) owner[slot(f.nodes[static_cast<std::size_t>(k)])] = w;
 
   std::vector<Index> block_start{0};
   for (const auto& b : mesh.cells) block_start.push_back(block_start.back() + b.size());
@@ -135,11 +129,22 @@ template <int Dim>
   for (const Index v : out.wall_nodes) is_wall[static_cast<std::size_t>(v)] = 1;
   std::vector<char> reached(aspect.size(), 0);
   std::deque<Index> queue;
+  // Seeds: anisotropic cells stretched along the wall (a wall edge at least threshold times
+  // their shortest edge). Cells stretched across it, as the outer cells of an O-mesh at a
+  // farfield, are no boundary layer.
+  const auto stretched_along_wall = [&](ElementType type, std::span<const Index> nodes) {
+    double shortest = std::numeric_limits<double>::infinity(), wall_edge = 0.0;
+    for (const auto& e : edges(type)) {
+      const Index a = nodes[static_cast<std::size_t>(e[0])], b = nodes[static_cast<std::size_t>(e[1])];
+      const double length = (mesh.points.col(a) - mesh.points.col(b)).norm();
+      shortest = std::min(shortest, length);
+      if (is_wall[static_cast<std::size_t>(a)] && is_wall[static_cast<std::size_t>(b)]) wall_edge = std::max(wall_edge, length);
+    }
+    return wall_edge >= options.aspect_ratio_threshold * shortest;
+  };
   for (Index cell = 0; cell < block_start.back(); ++cell) {
     const auto [type, nodes] = cell_nodes(cell);
-    bool touches = false;
-    for (int k = 0; k < num_vertices(type); ++k) touches = touches || is_wall[static_cast<std::size_t>(nodes[static_cast<std::size_t>(k)])];
-    if (touches && anisotropic(cell)) {
+    if (anisotropic(cell) && stretched_along_wall(type, nodes)) {
       reached[static_cast<std::size_t>(cell)] = 1;
       queue.push_back(cell);
     }
@@ -178,6 +183,32 @@ template <int Dim>
     std::nth_element(values.begin(), mid, values.end());
     out.walls[w].thickness = *mid;
     out.walls[w].max_thickness = *std::max_element(values.begin(), values.end());
+  }
+  return out;
+}
+
+/// Estimates the boundary-layer thickness of each of `wall_groups` (groups of dimension
+/// Dim - 1) of a linear or quadratic mesh (only vertices are used). Throws InputError for an
+/// empty group list, an unknown group or one that is not a facet group, and a threshold
+/// below 1.
+template <int Dim>
+[[nodiscard]] BoundaryLayerEstimate estimate_boundary_layer(const Mesh<Dim>& mesh,
+                                                            std::span<const std::string> wall_groups,
+                                                            const BoundaryLayerOptions& options = {}) {
+  if (wall_groups.empty()) throw InputError("estimate_boundary_layer: no wall group given (expected at least one)");
+  std::vector<std::vector<detail::WallFacet>> walls;
+  for (const auto& name : wall_groups) {
+    const PhysicalGroup& g = mesh.group(name);
+    if (g.dim != Dim - 1)
+      throw InputError("estimate_boundary_layer: group '" + name + "' has dimension " + std::to_string(g.dim) +
+                       " (expected a wall of dimension " + std::to_string(Dim - 1) + ")");
+    const int tag = g.tag;
+    walls.push_back(detail::wall_facets(mesh, std::span<const int>(&tag, 1)));
+  }
+  BoundaryLayerEstimate out = estimate_boundary_layer(mesh, walls, options);
+  for (std::size_t w = 0; w < wall_groups.size(); ++w) {
+    out.walls[w].group = wall_groups[w];
+    out.walls[w].tag = mesh.group(wall_groups[w]).tag;
   }
   return out;
 }

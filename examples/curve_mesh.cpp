@@ -1,0 +1,278 @@
+// curve_mesh: a linear mesh in, a certified curved P2 mesh out (thesis chapter 3).
+//
+//   curve_mesh                       # built-in demo: boundary-layer O-mesh around a cylinder
+//   curve_mesh in.su2 -o out.msh --group wall --geometry naca:0012 --svg out.svg
+//   curve_mesh in.msh -o out.msh --group 7 --geometry sphere:0,0,0,0.5 --sliding 20 --json
+//
+// Writes OUTPUT (.msh/.su2), OUTPUT's .vtu beside it (per-cell certified scaled Jacobian),
+// and in 2D an SVG picture coloured by quality when --svg is given (always in the demo).
+// The input file is never modified.
+
+#include "meshmotion/core/detail/json.hpp"
+#include "meshmotion/core/generators.hpp"
+#include "meshmotion/curving/curve_mesh.hpp"
+#include "meshmotion/curving/function_graph.hpp"
+#include "meshmotion/curving/geometry.hpp"
+#include "meshmotion/curving/naca_section.hpp"
+#include "meshmotion/io/mesh_io.hpp"
+#include "meshmotion/io/vtu_writer.hpp"
+#include "meshmotion/quality/svg_picture.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace {
+
+using namespace meshmotion;
+
+struct Arguments {
+  std::string input;
+  std::string output;
+  bool demo = false;
+  std::string method = "rbf";
+  std::string kernel = "wendland2";
+  double support_radius = 0.0;
+  double support_factor = 1.0;
+  double blending_length = 0.0;
+  int steps = 1;
+  std::vector<std::string> geometry;
+  std::vector<std::string> groups;
+  std::vector<std::string> sliding;
+  double corner_angle = 30.0;
+  bool arc_length = false;
+  bool strict = false;
+  bool json = false;
+  std::string svg;
+  std::vector<double> zoom;
+};
+
+std::vector<double> numbers(const std::string& text, const std::string& spec) {
+  std::vector<double> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    try {
+      std::size_t used = 0;
+      out.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw InputError("--geometry " + spec + ": '" + item + "' is not a number");
+    }
+  }
+  return out;
+}
+
+// "spline", "straight", "circle:X,Y,R", "sphere:X,Y,Z,R", "naca:XXXX[,chord,x0,y0]", "bump".
+template <int Dim>
+BoundaryGeometry<Dim> parse_geometry(const std::string& spec) {
+  const auto colon = spec.find(':');
+  const std::string kind = spec.substr(0, colon);
+  const std::string rest = colon == std::string::npos ? "" : spec.substr(colon + 1);
+  const auto expect = [&](const std::vector<double>& v, std::size_t n, const char* form) {
+    if (v.size() != n) throw InputError("--geometry " + spec + ": expected " + form);
+  };
+  if (kind == "spline") return BoundaryGeometry<Dim>::spline();
+  if (kind == "straight") return BoundaryGeometry<Dim>::straight();
+  if (kind == "bump") {
+    if constexpr (Dim == 2) return BoundaryGeometry<Dim>::project(nasa_bump_2d());
+    else return BoundaryGeometry<Dim>::project(nasa_bump_3d());
+  }
+  if constexpr (Dim == 2) {
+    if (kind == "circle") {
+      const auto v = numbers(rest, spec);
+      expect(v, 3, "circle:X,Y,R");
+      return BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>(v[0], v[1]), v[2]));
+    }
+    if (kind == "naca") {
+      const std::string digits = rest.substr(0, rest.find(','));
+      NacaParameters params = naca4(digits);
+      if (rest.size() > digits.size()) {
+        const auto v = numbers(rest.substr(digits.size() + 1), spec);
+        expect(v, 3, "naca:XXXX,CHORD,X0,Y0");
+        params.chord = v[0];
+        params.leading_edge = Vec<2>(v[1], v[2]);
+      }
+      return BoundaryGeometry<2>::project(NacaProjection(params));
+    }
+  } else {
+    if (kind == "sphere") {
+      const auto v = numbers(rest, spec);
+      expect(v, 4, "sphere:X,Y,Z,R");
+      return BoundaryGeometry<3>::project(SphereProjection<3>(Vec<3>(v[0], v[1], v[2]), v[3]));
+    }
+  }
+  throw InputError("--geometry: unknown or wrong-dimension geometry '" + spec +
+                   "' (expected spline, straight, bump, circle:X,Y,R or naca:XXXX[,CHORD,X0,Y0] in 2D, "
+                   "sphere:X,Y,Z,R in 3D)");
+}
+
+template <int Dim>
+CurveOptions<Dim> curve_options(const Arguments& args) {
+  CurveOptions<Dim> options;
+  options.method = args.method;
+  options.kernel = rbf_kernel_from_name(args.kernel);
+  options.support_radius = args.support_radius;
+  options.support_radius_factor = args.support_factor;
+  options.blending_length = args.blending_length;
+  options.steps = args.steps;
+  options.sliding = args.sliding;
+  options.strict = args.strict;
+  options.snap.corner_angle = args.corner_angle;
+  options.snap.midpoint = args.arc_length ? SplineMidpoint::arc_length : SplineMidpoint::parameter;
+  std::vector<std::string> groups = args.groups;
+  if (groups.empty() && !args.geometry.empty()) groups.push_back("wall");
+  if (!args.geometry.empty() && args.geometry.size() != 1 && args.geometry.size() != groups.size())
+    throw InputError("--geometry: " + std::to_string(args.geometry.size()) + " geometries for " +
+                     std::to_string(groups.size()) + " groups (expected one for all, or one per --group)");
+  for (std::size_t g = 0; g < groups.size() && !args.geometry.empty(); ++g)
+    options.geometry.insert_or_assign(groups[g], parse_geometry<Dim>(args.geometry[args.geometry.size() == 1 ? 0 : g]));
+  if (!args.json)
+    options.progress = [start = std::chrono::steady_clock::now()](const std::string& line) {
+      const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::fprintf(stderr, "[%7.3f s] %s\n", t, line.c_str());
+    };
+  return options;
+}
+
+std::filesystem::path with_extension(const std::filesystem::path& file, const char* extension) {
+  std::filesystem::path p = file;
+  return p.replace_extension(extension);
+}
+
+template <int Dim>
+void run(const Mesh<Dim>& linear, const Arguments& args) {
+  const CurveOptions<Dim> options = curve_options<Dim>(args);
+  const CurveResult<Dim> result = curve_mesh(linear, options);
+  const auto values = [&] {
+    std::vector<double> v;
+    for (const auto& c : evaluate_cells(result.curved, Metric::scaled_jacobian)) v.push_back(c.value);
+    return v;
+  }();
+  write_mesh(args.output, result.curved);
+  const std::filesystem::path vtu = with_extension(args.output, ".vtu");
+  VtuFields fields;
+  fields.cell_data.emplace_back("scaled_jacobian",
+                                Eigen::Map<const Eigen::MatrixXd>(values.data(), 1, static_cast<Index>(values.size())));
+  write_vtu(vtu, result.curved, fields);
+  if constexpr (Dim == 2) {
+    if (!args.svg.empty()) {
+      SvgOptions svg;
+      svg.title = "certified scaled Jacobian (" + result.method + ")";
+      if (args.zoom.size() == 4) svg.zoom = std::array<double, 4>{args.zoom[0], args.zoom[1], args.zoom[2], args.zoom[3]};
+      svg.value_min = std::min(0.0, result.quality.min);
+      write_svg(args.svg, result.curved, values, svg);
+    }
+  }
+  const QualityReport& q = result.quality;
+  if (args.json) {
+    detail::JsonWriter w(std::cout);
+    w.begin_object();
+    w.key("input").value(args.demo ? std::string("demo: boundary-layer O-mesh around a cylinder") : args.input);
+    w.key("output").value(args.output).key("vtu").value(vtu.string());
+    w.key("dim").value(Dim).key("nodes").value(result.curved.num_nodes()).key("cells").value(result.curved.num_cells());
+    w.key("method").value(result.method).key("steps").value(args.steps).key("support_radius").value(result.support_radius);
+    w.key("seconds").begin_object();
+    w.key("quadratic").value(result.seconds.quadratic).key("snap").value(result.seconds.snap);
+    w.key("layer").value(result.seconds.layer).key("regularize").value(result.seconds.regularize);
+    w.key("certify").value(result.seconds.certify).key("total").value(result.seconds.total);
+    w.end_object();
+    w.key("solver_iterations").value(result.solver_iterations);
+    w.key("snapped_nodes").value(result.snapped_nodes).key("moved_vertices").value(result.moved_vertices);
+    w.key("moved_nodes").value(result.moved_nodes);
+    w.key("min_scaled_jacobian").value(q.min).key("mean_scaled_jacobian").value(q.mean).key("invalid").value(q.num_invalid);
+    w.key("quality");
+    write_json(w, q);
+    w.end_object();
+    std::cout << "\n";
+    return;
+  }
+  std::printf("curved %lld cells, %lld nodes (%lld linear) with %s", static_cast<long long>(result.curved.num_cells()),
+              static_cast<long long>(result.curved.num_nodes()), static_cast<long long>(result.num_linear_nodes),
+              result.method.c_str());
+  if (result.method == "rbf") std::printf(", support radius %.4g", result.support_radius);
+  std::printf(", %d step(s)\n", args.steps);
+  for (const auto& layer : result.layers)
+    std::printf("  wall '%s': boundary layer %.4g thick (max %.4g)\n", layer.group.c_str(), layer.thickness, layer.max_thickness);
+  std::printf("  boundary: %lld nodes snapped, %lld vertices moved onto the geometry, largest move %.3g\n",
+              static_cast<long long>(result.snapped_nodes), static_cast<long long>(result.moved_vertices),
+              result.max_boundary_displacement);
+  std::printf("  interior nodes moved: %lld, solver iterations: %lld\n", static_cast<long long>(result.moved_nodes),
+              static_cast<long long>(result.solver_iterations));
+  std::printf("  certified scaled Jacobian: min %.4f, mean %.4f, invalid %lld of %lld\n", q.min, q.mean,
+              static_cast<long long>(q.num_invalid), static_cast<long long>(q.num_elements));
+  if (!q.worst.empty())
+    std::printf("  worst cell: %s %lld at (%.4g, %.4g, %.4g): %.4f\n", std::string(name(q.worst[0].type)).c_str(),
+                static_cast<long long>(q.worst[0].file_id), q.worst[0].centroid[0], q.worst[0].centroid[1],
+                q.worst[0].centroid[2], q.worst[0].value);
+  std::printf("  seconds: P2 %.3f, snap %.3f, layer %.3f, regularize %.3f, certify %.3f, total %.3f\n",
+              result.seconds.quadratic, result.seconds.snap, result.seconds.layer, result.seconds.regularize,
+              result.seconds.certify, result.seconds.total);
+  std::printf("wrote %s, %s%s%s\n", args.output.c_str(), vtu.string().c_str(), args.svg.empty() ? "" : ", ",
+              args.svg.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Curve a linear mesh into a certified P2 mesh (spline or CAD boundary, RBF or blending interior)"};
+  Arguments args;
+  app.add_option("input", args.input, "linear mesh (.msh, .su2); none: the built-in demo");
+  app.add_option("-o,--output", args.output, "curved mesh to write (.msh, .su2); a .vtu is written beside it");
+  app.add_flag("--demo", args.demo, "curve the built-in boundary-layer mesh around a cylinder");
+  app.add_option("--method", args.method, "interior regularization: rbf, blend, none")->capture_default_str();
+  app.add_option("--kernel", args.kernel, "RBF kernel (wendland2, wendland0/4/6, tps, gaussian, ...)")->capture_default_str();
+  app.add_option("--support-radius", args.support_radius, "RBF support radius (0: from the boundary-layer thickness)");
+  app.add_option("--support-factor", args.support_factor, "default radius = this x the thickest wall layer")->capture_default_str();
+  app.add_option("--blending-length", args.blending_length, "blend: length (0: each wall's layer thickness)");
+  app.add_option("--steps", args.steps, "regularize in this many increments")->capture_default_str();
+  app.add_option("--geometry", args.geometry,
+                 "true boundary: spline | straight | bump | circle:X,Y,R | naca:XXXX[,CHORD,X0,Y0] | sphere:X,Y,Z,R "
+                 "(one for all --group, or one per group)");
+  app.add_option("--group", args.groups, "groups the --geometry applies to (default: wall)");
+  app.add_option("--sliding", args.sliding, "groups sliding in their plane (symmetry)");
+  app.add_option("--corner-angle", args.corner_angle, "spline corners above this angle (degrees)")->capture_default_str();
+  app.add_flag("--arc-length", args.arc_length, "spline: arc-length midpoint instead of the parameter midpoint");
+  app.add_flag("--strict", args.strict, "fail (exit 2) when invalid cells remain");
+  app.add_flag("--json", args.json, "print one JSON object");
+  app.add_option("--svg", args.svg, "2D: write an SVG picture coloured by quality");
+  app.add_option("--zoom", args.zoom, "SVG zoom box x0,x1,y0,y1")->delimiter(',')->expected(4);
+  CLI11_PARSE(app, argc, argv);
+
+  args.demo = args.demo || args.input.empty();
+  try {
+    if (args.demo) {
+      if (args.output.empty()) args.output = "cylinder_p2.msh";
+      if (args.svg.empty()) args.svg = with_extension(args.output, ".svg").string();
+      if (args.zoom.empty()) args.zoom = {0.47, 0.53, -0.03, 0.03};
+      if (args.geometry.empty()) {
+        args.groups = {"wall"};
+        args.geometry = {"circle:0,0,0.5"};
+      }
+      const Mesh<2> linear = o_mesh({});  // 128 x 64 quads, first cell 1e-5 for a 0.025 wall spacing
+      run(linear, args);
+      return 0;
+    }
+    if (args.output.empty()) throw InputError("curve_mesh: no output file (expected -o OUTPUT)");
+    if (std::filesystem::exists(args.output) && std::filesystem::equivalent(args.input, args.output))
+      throw InputError("curve_mesh: output is the input file (the input is never modified)");
+    std::visit([&](const auto& mesh) { run(mesh, args); }, read_mesh(args.input));
+  } catch (const InvalidMeshError& e) {
+    if (args.json) std::cout << "{\"error\":" << detail::json_string(e.what()) << ",\"invalid\":true}\n";
+    std::cerr << e.what() << "\n";
+    return 2;
+  } catch (const Error& e) {
+    if (args.json) std::cout << "{\"error\":" << detail::json_string(e.what()) << "}\n";
+    std::cerr << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,252 @@
+#pragma once
+/// \file
+/// BlendMover: wall-distance blending, a regularizer for curved boundary-layer meshes that
+/// needs no linear solve (beyond the thesis; issue 5, `--method blend`).
+///
+/// The prescribed (moving) boundary nodes are split into walls: connected sets of facets
+/// whose nodes are all prescribed. Every other node x takes
+///   u(x) = Σ_b φ(d_b / L_b) Π_{c ≠ b} (1 - φ(d_c / L_c)) u_b(p_b(x)),
+/// where p_b(x) is the closest point of wall b (its straight facets in the reference
+/// configuration), u_b the wall's displacement interpolated there by the facet's own P1/P2
+/// shape functions, d_b = |x - p_b(x)|, L_b the wall's blending length and φ Wendland's C2
+/// function φ(r) = (1 - r)^4 (4 r + 1) for r < 1, 0 beyond. φ is flat at the wall, so the
+/// first cells follow the wall almost rigidly and the curvature is extruded through the
+/// layer, as boundary-layer meshes want; the product makes each wall's field vanish on the
+/// other walls. Fixed boundary nodes stay, sliding ones keep the in-plane part of the blend.
+///
+/// Linear in the displacements: setup stores the sparse operator (per node, the weights of
+/// the wall nodes of its closest facets), move is one sparse product. Setup: a k-d tree per
+/// wall and a closest-facet query per node within reach, O(n log m); move: O(nonzeros).
+
+#include "meshmotion/core/element.hpp"
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/shape_functions.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/curving/boundary_layer.hpp"
+#include "meshmotion/curving/detail/wall_distance.hpp"
+#include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/mover.hpp"
+#include "meshmotion/movers/rbf_kernels.hpp"
+#include "meshmotion/solvers/detail/stopwatch.hpp"
+
+#include <Eigen/SparseCore>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+#include <span>
+#include <utility>
+#include <string>
+#include <vector>
+
+namespace meshmotion {
+
+/// Options of BlendMover.
+struct BlendOptions {
+  /// Blending length for every wall; 0 (default): each wall's boundary-layer thickness
+  /// (estimate_boundary_layer), or `fallback_spacings` × its largest facet when it has no
+  /// anisotropic layer.
+  double blending_length = 0.0;
+  BoundaryLayerOptions layer{};
+  double fallback_spacings = 3.0;
+};
+
+/// Wall-distance blending mover (models MeshMover).
+template <int Dim>
+class BlendMover {
+ public:
+  static constexpr int dim = Dim;
+
+  explicit BlendMover(BlendOptions options = {}) : options_(std::move(options)) {}
+
+  /// Builds the blending operator on the reference mesh. `boundary` as ResolvedBoundary.
+  /// Throws InputError for a negative blending length, a boundary node out of range, or
+  /// prescribed nodes that belong to no facet of mesh.facets (a wall must be made of facets).
+  void setup(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) {
+    const detail::Stopwatch clock;
+    if (!(options_.blending_length >= 0.0))
+      throw InputError("BlendMover::setup: negative blending length (got " + std::to_string(options_.blending_length) + ")");
+    const Index n = mesh.num_nodes();
+    const Index m = boundary.size();
+    boundary_ = boundary;
+    slot_.assign(static_cast<std::size_t>(n), -1);
+    for (Index k = 0; k < m; ++k) {
+      const Index v = boundary.nodes[static_cast<std::size_t>(k)];
+      if (v < 0 || v >= n)
+        throw InputError("BlendMover::setup: boundary node " + std::to_string(v) + " out of range (expected 0 to " +
+                         std::to_string(n - 1) + ")");
+      slot_[static_cast<std::size_t>(v)] = k;
+    }
+    const std::vector<std::vector<detail::WallFacet>> walls = split_walls(mesh);
+    lengths_ = wall_lengths(mesh, walls);
+
+    std::vector<detail::WallDistance<Dim>> distance;
+    distance.reserve(walls.size());
+    std::vector<double> reach;  // beyond this nearest-vertex distance no facet is within L
+    for (std::size_t b = 0; b < walls.size(); ++b) {
+      reach.push_back(lengths_[b] + largest_facet(mesh.points, walls[b]));
+      distance.emplace_back(mesh.points, walls[b]);
+    }
+    std::vector<Eigen::Triplet<double, Index>> triplets;
+    std::array<double, 9> shape{};
+    std::vector<detail::WallPoint<Dim>> closest(walls.size());
+    std::vector<double> phi(walls.size());
+    evaluated_ = 0;
+    for (Index v = 0; v < n; ++v) {
+      const Index k = slot_[static_cast<std::size_t>(v)];
+      if (k >= 0 && boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed) {
+        triplets.emplace_back(k, v, 1.0);
+        continue;
+      }
+      if (k >= 0 && boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::fixed) continue;
+      const Vec<Dim> x = mesh.points.col(v);
+      bool any = false;
+      for (std::size_t b = 0; b < walls.size(); ++b) {
+        phi[b] = 0.0;
+        if (distance[b].nearest_vertex(x).second >= reach[b]) continue;
+        closest[b] = distance[b].closest(x);
+        phi[b] = rbf_value(RbfKernel::wendland2, closest[b].distance, lengths_[b]);
+        any = any || phi[b] > 0.0;
+      }
+      if (!any) continue;
+      ++evaluated_;
+      for (std::size_t b = 0; b < walls.size(); ++b) {
+        if (phi[b] == 0.0) continue;
+        double weight = phi[b];
+        for (std::size_t c = 0; c < walls.size(); ++c)
+          if (c != b) weight *= 1.0 - phi[c];
+        const detail::WallFacet& f = distance[b].facets()[static_cast<std::size_t>(closest[b].facet)];
+        shape_functions(f.type, closest[b].xi, std::span<double>(shape.data(), static_cast<std::size_t>(num_nodes(f.type))));
+        for (int j = 0; j < num_nodes(f.type); ++j)
+          if (weight * shape[static_cast<std::size_t>(j)] != 0.0)
+            triplets.emplace_back(slot_[static_cast<std::size_t>(f.nodes[static_cast<std::size_t>(j)])], v,
+                                  weight * shape[static_cast<std::size_t>(j)]);
+      }
+    }
+    operator_.resize(m, n);
+    operator_.setFromTriplets(triplets.begin(), triplets.end());
+    stats_ = MoverStats{};
+    stats_.setup_seconds = clock.seconds();
+    stats_.factorizations = 0;
+    stats_.boundary_nodes = m;
+    stats_.evaluated_nodes = evaluated_;
+    stats_.nonzeros = operator_.nonZeros();
+  }
+
+  /// Displacement of every node (Dim × n_nodes) for boundary displacements `d`
+  /// (Dim × boundary.size(), columns in boundary.nodes order; entries of fixed and sliding
+  /// nodes are ignored). Throws InputError for a wrong shape, a non-finite entry, or a call
+  /// before setup.
+  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
+    Points<Dim> out;
+    move_into(d, out);
+    return out;
+  }
+
+  /// move() into caller storage.
+  void move_into(const Points<Dim>& d, Points<Dim>& out) {
+    const detail::Stopwatch clock;
+    if (d.cols() != operator_.rows() || slot_.empty())
+      throw InputError("BlendMover::move: " + std::to_string(d.cols()) + " displacements (expected " +
+                       std::to_string(operator_.rows()) + ", one per boundary node, after setup)");
+    if (!d.allFinite()) throw InputError("BlendMover::move: non-finite displacement");
+    Points<Dim> given = d;
+    for (Index k = 0; k < boundary_.size(); ++k)
+      if (boundary_.kinds[static_cast<std::size_t>(k)] != BoundaryKind::prescribed) given.col(k).setZero();
+    out.noalias() = given * operator_;
+    for (Index k = 0; k < boundary_.size(); ++k)
+      if (boundary_.kinds[static_cast<std::size_t>(k)] == BoundaryKind::sliding) {
+        const Vec<Dim> normal = boundary_.normals.col(k);
+        auto u = out.col(boundary_.nodes[static_cast<std::size_t>(k)]);
+        u -= normal * normal.dot(u);
+      }
+    ++stats_.moves;
+    stats_.move_seconds = clock.seconds();
+  }
+
+  [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
+  /// Blending length of each wall of the last setup.
+  [[nodiscard]] const std::vector<double>& blending_lengths() const noexcept { return lengths_; }
+
+ private:
+  // Facets (of mesh.facets) whose nodes are all prescribed, grouped into connected walls.
+  [[nodiscard]] std::vector<std::vector<detail::WallFacet>> split_walls(const Mesh<Dim>& mesh) const {
+    std::vector<detail::WallFacet> facets;
+    for (const auto& block : mesh.facets)
+      for (Index e = 0; e < block.size(); ++e) {
+        const auto el = block.element(e);
+        const bool moving = std::all_of(el.begin(), el.end(), [&](Index v) {
+          const Index k = slot_[static_cast<std::size_t>(v)];
+          return k >= 0 && boundary_.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed;
+        });
+        if (!moving) continue;
+        detail::WallFacet f{block.type, {}};
+        std::copy(el.begin(), el.end(), f.nodes.begin());
+        facets.push_back(f);
+      }
+    // Union-find over the boundary slots of the facets' vertices.
+    std::vector<Index> parent(static_cast<std::size_t>(boundary_.size()));
+    std::iota(parent.begin(), parent.end(), Index{0});
+    const auto root = [&](Index a) {
+      while (parent[static_cast<std::size_t>(a)] != a) a = parent[static_cast<std::size_t>(a)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(a)])];
+      return a;
+    };
+    const auto slot = [&](const detail::WallFacet& f, int j) { return slot_[static_cast<std::size_t>(f.nodes[static_cast<std::size_t>(j)])]; };
+    for (const auto& f : facets)
+      for (int j = 1; j < num_nodes(f.type); ++j) parent[static_cast<std::size_t>(root(slot(f, j)))] = root(slot(f, 0));
+    std::vector<Index> wall_of_root(parent.size(), -1);
+    std::vector<std::vector<detail::WallFacet>> walls;
+    for (const auto& f : facets) {
+      Index& w = wall_of_root[static_cast<std::size_t>(root(slot(f, 0)))];
+      if (w < 0) {
+        w = static_cast<Index>(walls.size());
+        walls.emplace_back();
+      }
+      walls[static_cast<std::size_t>(w)].push_back(f);
+    }
+    std::vector<char> covered(parent.size(), 0);
+    for (const auto& f : facets)
+      for (int j = 0; j < num_nodes(f.type); ++j) covered[static_cast<std::size_t>(slot(f, j))] = 1;
+    for (Index k = 0; k < boundary_.size(); ++k)
+      if (boundary_.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed && !covered[static_cast<std::size_t>(k)] &&
+          boundary_.displacements.col(k).squaredNorm() > 0.0)
+        throw InputError("BlendMover::setup: moving boundary node " + std::to_string(boundary_.nodes[static_cast<std::size_t>(k)]) +
+                         " lies on no facet whose nodes all move (expected walls made of mesh.facets)");
+    return walls;
+  }
+
+  [[nodiscard]] static double largest_facet(const Points<Dim>& points, const std::vector<detail::WallFacet>& wall) {
+    double largest = 0.0;
+    for (const auto& f : wall)
+      for (int a = 0; a < num_vertices(f.type); ++a)
+        for (int b = a + 1; b < num_vertices(f.type); ++b)
+          largest = std::max(largest, (points.col(f.nodes[static_cast<std::size_t>(a)]) -
+                                       points.col(f.nodes[static_cast<std::size_t>(b)])).norm());
+    return largest;
+  }
+
+  [[nodiscard]] std::vector<double> wall_lengths(const Mesh<Dim>& mesh, const std::vector<std::vector<detail::WallFacet>>& walls) const {
+    std::vector<double> lengths(walls.size(), options_.blending_length);
+    if (options_.blending_length > 0.0) return lengths;
+    const BoundaryLayerEstimate layer = estimate_boundary_layer(mesh, walls, options_.layer);
+    for (std::size_t b = 0; b < walls.size(); ++b) {
+      lengths[b] = layer.walls[b].thickness;
+      if (!(lengths[b] > 0.0)) lengths[b] = options_.fallback_spacings * largest_facet(mesh.points, walls[b]);
+    }
+    return lengths;
+  }
+
+  BlendOptions options_;
+  ResolvedBoundary<Dim> boundary_;
+  std::vector<Index> slot_;  // node -> boundary index, -1 inside
+  std::vector<double> lengths_;
+  Eigen::SparseMatrix<double, Eigen::ColMajor, Index> operator_;  // boundary × nodes
+  Index evaluated_ = 0;
+  MoverStats stats_;
+};
+
+static_assert(MeshMover<BlendMover<2>> && MeshMover<BlendMover<3>>);
+
+}  // namespace meshmotion

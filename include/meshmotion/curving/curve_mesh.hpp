@@ -1,0 +1,341 @@
+#pragma once
+/// \file
+/// The curving pipeline (thesis chapter 3, issue 5): a linear mesh in, a certified curved
+/// P2 mesh out.
+///
+/// 1. to_quadratic: one node per edge (face, volume) of every element type and mixed meshes;
+///    linear nodes keep their numbers, high-order nodes are appended.
+/// 2. snap_boundary: the facet nodes of every curved group go to the true boundary (2D
+///    spline reconstruction by default; projection callbacks for analytic/CAD geometry, the
+///    only way in 3D). Vertices already on the geometry stay.
+/// 3. Regularization: the boundary displacements of step 2 are propagated into the domain by
+///    a mover (RBF with Wendland C2 by default, the blending regularizer, or any MeshMover):
+///    curved groups are prescribed, other groups fixed or sliding. Only the nodes the mover
+///    gives a nonzero displacement change. The motion may be split into `steps`, each a
+///    fresh setup on the mesh moved so far (thesis table 4.2).
+/// 4. Certification: the certified scaled Jacobian (thesis eq. 3.3) of every cell; strict
+///    mode throws InvalidMeshError when invalid cells remain, default mode reports them.
+///
+/// The default RBF support radius follows the boundary layer (curving/boundary_layer.hpp):
+/// `support_radius_factor` × the thickest layer among the curved walls. docs/curving.md gives
+/// the measured effect of larger radii.
+
+#include "meshmotion/core/element.hpp"
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/topology.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/curving/blend_regularizer.hpp"
+#include "meshmotion/curving/boundary_layer.hpp"
+#include "meshmotion/curving/boundary_snapping.hpp"
+#include "meshmotion/curving/p2_conversion.hpp"
+#include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/mover.hpp"
+#include "meshmotion/movers/rbf.hpp"
+#include "meshmotion/movers/rbf_kernels.hpp"
+#include "meshmotion/movers/support_radius.hpp"
+#include "meshmotion/quality/cell_quality.hpp"
+#include "meshmotion/quality/quality_report.hpp"
+#include "meshmotion/solvers/detail/stopwatch.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <map>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace meshmotion {
+
+/// Options of curve_mesh().
+template <int Dim>
+struct CurveOptions {
+  /// Interior regularization: "rbf" (default), "blend" (curving/blend_regularizer.hpp) or
+  /// "none" (snap the boundary only, to see why the pipeline exists).
+  std::string method = "rbf";
+  RbfKernel kernel = RbfKernel::wendland2;
+  /// RBF support radius; 0: support_radius_factor × the thickest estimated wall layer
+  /// (suggest_support_radius() when no wall has an anisotropic layer).
+  double support_radius = 0.0;
+  double support_radius_factor = 1.0;
+  /// Blending length of method "blend"; 0: each wall's layer thickness.
+  double blending_length = 0.0;
+  /// The regularization in this many increments, each re-based on the moved mesh.
+  int steps = 1;
+  /// Geometry per group name. Groups not listed: spline reconstruction in 2D when
+  /// `spline_by_default`, straight otherwise (always straight in 3D: a projection callback
+  /// is required there, no 3D surface reconstruction exists yet).
+  std::map<std::string, BoundaryGeometry<Dim>, std::less<>> geometry;
+  bool spline_by_default = true;
+  /// Groups that slide in their plane (symmetry); other non-curved groups are fixed.
+  std::vector<std::string> sliding;
+  /// Corners and midpoint rule of the spline; tolerance of "already on the geometry".
+  SnapOptions snap{};
+  BoundaryLayerOptions layer{};
+  ReportOptions report{};
+  /// Throw InvalidMeshError when invalid cells remain (default: report them).
+  bool strict = false;
+  /// Called with a line of text before each stage.
+  std::function<void(const std::string&)> progress{};
+};
+
+/// Wall-clock seconds of each stage.
+struct CurveTimes {
+  double quadratic = 0.0;
+  double snap = 0.0;
+  double layer = 0.0;  ///< boundary-layer estimate for the default radius
+  double regularize = 0.0;
+  double certify = 0.0;
+  double total = 0.0;
+};
+
+/// What curve_mesh() produced and measured.
+template <int Dim>
+struct CurveResult {
+  Mesh<Dim> curved;                 ///< the P2 mesh; nodes 0..num_linear_nodes-1 are the input's
+  Index num_linear_nodes = 0;
+  CurveTimes seconds;
+  std::string method;
+  double support_radius = 0.0;      ///< RBF radius used (0 for other methods)
+  std::vector<WallLayer> layers;    ///< estimated layers of the curved walls (when estimated)
+  Index snapped_nodes = 0;          ///< boundary nodes given a position on the true boundary
+  Index moved_vertices = 0;         ///< linear vertices that were off the geometry
+  double max_boundary_displacement = 0.0;
+  Index moved_nodes = 0;            ///< nodes not on the boundary that the regularization moved
+  Index solver_iterations = 0;      ///< summed over steps
+  std::vector<MoverStats> steps;    ///< per step
+  QualityReport quality;            ///< certified scaled Jacobian
+  [[nodiscard]] Index invalid() const noexcept { return quality.num_invalid; }
+};
+
+namespace detail {
+
+/// Group names and tags of the facet groups and the geometry each gets.
+template <int Dim>
+[[nodiscard]] std::map<int, BoundaryGeometry<Dim>> resolve_geometry(const Mesh<Dim>& mesh, const CurveOptions<Dim>& options) {
+  std::map<int, BoundaryGeometry<Dim>> out;
+  for (const auto& [group, geo] : options.geometry) {
+    const PhysicalGroup& g = mesh.group(group);
+    if (g.dim != Dim - 1)
+      throw InputError("curve_mesh: group '" + group + "' has dimension " + std::to_string(g.dim) + " (expected " +
+                       std::to_string(Dim - 1) + ")");
+    out[g.tag] = geo;
+  }
+  const auto is_sliding = [&](const std::string& n) {
+    return std::find(options.sliding.begin(), options.sliding.end(), n) != options.sliding.end();
+  };
+  for (const auto& g : mesh.groups)
+    if (g.dim == Dim - 1 && !out.count(g.tag))
+      out[g.tag] = (Dim == 2 && options.spline_by_default && !is_sliding(g.name)) ? BoundaryGeometry<Dim>::spline()
+                                                                                  : BoundaryGeometry<Dim>::straight();
+  return out;
+}
+
+/// The boundary the mover sees: snapped nodes prescribed, sliding groups sliding, every
+/// other boundary node (tagged or not) fixed.
+template <int Dim>
+[[nodiscard]] ResolvedBoundary<Dim> curving_boundary(const Mesh<Dim>& mesh, const SnappedBoundary<Dim>& snapped,
+                                                     const std::vector<std::string>& sliding) {
+  std::map<Index, std::pair<BoundaryKind, Vec<Dim>>> entries;  // node -> kind, displacement or normal
+  for (std::size_t k = 0; k < snapped.nodes.size(); ++k)
+    entries.emplace(snapped.nodes[k],
+                    std::pair{BoundaryKind::prescribed, Vec<Dim>(snapped.displacements.col(static_cast<Index>(k)))});
+  if (!sliding.empty()) {
+    BoundarySpec<Dim> spec;
+    for (const auto& g : sliding) spec.sliding(g);
+    const ResolvedBoundary<Dim> slide = spec.resolve(mesh);
+    for (Index k = 0; k < slide.size(); ++k)
+      entries.emplace(slide.nodes[static_cast<std::size_t>(k)], std::pair{slide.kinds[static_cast<std::size_t>(k)], Vec<Dim>(slide.normals.col(k))});
+  }
+  const auto fix = [&](const std::vector<ElementBlock>& blocks) {
+    for (const auto& b : blocks)
+      for (const Index v : b.connectivity) entries.emplace(v, std::pair{BoundaryKind::fixed, Vec<Dim>::Zero()});
+  };
+  fix(mesh.facets);
+  fix(boundary_facets(mesh));
+  ResolvedBoundary<Dim> out;
+  out.displacements.setZero(Dim, static_cast<Index>(entries.size()));
+  out.normals.setZero(Dim, static_cast<Index>(entries.size()));
+  Index k = 0;
+  for (const auto& [node, entry] : entries) {
+    out.nodes.push_back(node);
+    out.kinds.push_back(entry.first);
+    (entry.first == BoundaryKind::sliding ? out.normals : out.displacements).col(k) = entry.second;
+    ++k;
+  }
+  return out;
+}
+
+/// The "none" method: the snapped boundary nodes move, nothing else (models MeshMover).
+template <int Dim>
+class SnapOnlyMover {
+ public:
+  static constexpr int dim = Dim;
+  void setup(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) {
+    num_nodes_ = mesh.num_nodes();
+    boundary_ = boundary;
+  }
+  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
+    Points<Dim> out;
+    move_into(d, out);
+    return out;
+  }
+  void move_into(const Points<Dim>& d, Points<Dim>& out) {
+    out.setZero(Dim, num_nodes_);
+    for (Index k = 0; k < boundary_.size(); ++k)
+      if (boundary_.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed)
+        out.col(boundary_.nodes[static_cast<std::size_t>(k)]) = d.col(k);
+  }
+  [[nodiscard]] MoverStats stats() const { return {}; }
+
+ private:
+  Index num_nodes_ = 0;
+  ResolvedBoundary<Dim> boundary_;
+};
+
+/// Names every facet tag that has no group by its number ("7"), as files without physical
+/// names (Gmsh without $PhysicalNames) are meant to be addressed.
+template <int Dim>
+void name_unnamed_facet_groups(Mesh<Dim>& mesh) {
+  for (const auto& block : mesh.facets)
+    for (const int tag : block.tags) {
+      const bool named = std::any_of(mesh.groups.begin(), mesh.groups.end(),
+                                     [&](const PhysicalGroup& g) { return g.dim == Dim - 1 && g.tag == tag; });
+      if (!named && tag != 0) mesh.groups.push_back({Dim - 1, tag, std::to_string(tag)});
+    }
+}
+
+inline void report_progress(const std::function<void(const std::string&)>& progress, const std::string& line) {
+  if (progress) progress(line);
+}
+
+}  // namespace detail
+
+/// Runs the regularization and certification on a P2 mesh whose boundary is already snapped
+/// (`result.curved` straight, `boundary` from the snapping) with any MeshMover, in
+/// `options.steps` increments. Fills the regularize/certify fields of `result`.
+template <class Mover, int Dim>
+void regularize_and_certify(Mover& mover, const ResolvedBoundary<Dim>& boundary, const CurveOptions<Dim>& options,
+                            CurveResult<Dim>& result) {
+  static_assert(MeshMover<Mover> && Mover::dim == Dim, "regularize_and_certify: Mover must model MeshMover<Dim>");
+  if (options.steps < 1)
+    throw InputError("curve_mesh: steps must be at least 1 (got " + std::to_string(options.steps) + ")");
+  Mesh<Dim>& mesh = result.curved;
+  const detail::Stopwatch clock;
+  ResolvedBoundary<Dim> step = boundary;
+  step.displacements = boundary.displacements / static_cast<double>(options.steps);
+  std::vector<char> moved(static_cast<std::size_t>(mesh.num_nodes()), 0);
+  for (int s = 0; s < options.steps; ++s) {
+    detail::report_progress(options.progress, "regularizing (" + result.method + ", step " + std::to_string(s + 1) + "/" +
+                                                  std::to_string(options.steps) + ")");
+    mover.setup(mesh, step);
+    const Points<Dim> u = mover.move(step.displacements);
+    for (Index v = 0; v < mesh.num_nodes(); ++v)
+      if (u.col(v).squaredNorm() > 0.0) {
+        mesh.points.col(v) += u.col(v);
+        moved[static_cast<std::size_t>(v)] = 1;
+      }
+    result.steps.push_back(mover.stats());
+    result.solver_iterations += mover.stats().iterations;
+  }
+  for (const Index v : boundary.nodes) moved[static_cast<std::size_t>(v)] = 0;
+  result.moved_nodes = static_cast<Index>(std::count(moved.begin(), moved.end(), 1));
+  result.seconds.regularize = clock.seconds();
+
+  detail::report_progress(options.progress, "certifying " + std::to_string(mesh.num_cells()) + " cells (scaled Jacobian)");
+  const detail::Stopwatch certify_clock;
+  result.quality = quality_report(mesh, Metric::scaled_jacobian, options.report);
+  result.seconds.certify = certify_clock.seconds();
+  if (options.strict && result.quality.num_invalid > 0) {
+    const WorstElement& w = result.quality.worst.front();
+    std::ostringstream where;
+    where << "(" << w.centroid[0] << ", " << w.centroid[1] << (Dim == 3 ? ", " + std::to_string(w.centroid[2]) : "") << ")";
+    throw InvalidMeshError("curve_mesh: " + std::to_string(result.quality.num_invalid) + " of " +
+                           std::to_string(result.quality.num_elements) + " cells are invalid after " + result.method +
+                           " regularization (worst: " + std::string(name(w.type)) + " cell " + std::to_string(w.id) +
+                           ", file id " + std::to_string(w.file_id) + ", at " + where.str() +
+                           ", certified scaled Jacobian " + std::to_string(w.value) + "; expected > 0)");
+  }
+}
+
+/// Curves a linear mesh (any element types, 2D or 3D) into a certified P2 mesh; see the file
+/// comment for the stages. The input is not modified. Throws InputError for bad options
+/// (unknown method or group, a spline in 3D, no curved group in 3D, steps < 1), what the
+/// stages throw (SolverError from the RBF factorization), and InvalidMeshError in strict
+/// mode when invalid cells remain (naming their count and the worst one).
+template <int Dim>
+[[nodiscard]] CurveResult<Dim> curve_mesh(const Mesh<Dim>& linear, const CurveOptions<Dim>& options = {}) {
+  const detail::Stopwatch total;
+  if (options.method != "rbf" && options.method != "blend" && options.method != "none")
+    throw InputError("curve_mesh: unknown method '" + options.method + "' (expected rbf, blend or none)");
+  CurveResult<Dim> result;
+  result.method = options.method;
+  detail::report_progress(options.progress, "converting " + std::to_string(linear.num_cells()) + " cells to P2");
+  detail::Stopwatch clock;
+  QuadraticConversion<Dim> conversion = convert_to_quadratic(linear);
+  result.curved = std::move(conversion.mesh);
+  result.num_linear_nodes = conversion.num_linear_nodes;
+  detail::name_unnamed_facet_groups(result.curved);
+  result.seconds.quadratic = clock.seconds();
+
+  const std::map<int, BoundaryGeometry<Dim>> geometry = detail::resolve_geometry(result.curved, options);
+  std::vector<std::string> walls;
+  for (const auto& g : result.curved.groups) {
+    const auto it = geometry.find(g.tag);
+    if (g.dim == Dim - 1 && it != geometry.end() && it->second.kind != BoundaryGeometry<Dim>::Kind::straight)
+      walls.push_back(g.name);
+  }
+  if (Dim == 3 && walls.empty())
+    throw InputError("curve_mesh: no group to curve in 3D (expected a projection callback for at least one group)");
+
+  detail::report_progress(options.progress, "snapping the boundary (" + std::to_string(walls.size()) + " curved groups)");
+  clock = detail::Stopwatch{};
+  const SnappedBoundary<Dim> snapped = snap_boundary(result.curved, geometry, options.snap);
+  result.snapped_nodes = static_cast<Index>(snapped.nodes.size());
+  result.moved_vertices = snapped.moved_vertices;
+  result.max_boundary_displacement = snapped.max_displacement;
+  const ResolvedBoundary<Dim> boundary = detail::curving_boundary(result.curved, snapped, options.sliding);
+  result.seconds.snap = clock.seconds();
+
+  const bool estimate = !walls.empty() && ((options.method == "rbf" && options.support_radius <= 0.0) ||
+                                           (options.method == "blend" && options.blending_length <= 0.0));
+  if (estimate) {
+    detail::report_progress(options.progress, "estimating the boundary layer of the curved walls");
+    clock = detail::Stopwatch{};
+    result.layers = estimate_boundary_layer(result.curved, std::span<const std::string>(walls), options.layer).walls;
+    result.seconds.layer = clock.seconds();
+  }
+  if (options.method == "rbf") {
+    result.support_radius = options.support_radius;
+    if (!(result.support_radius > 0.0)) {
+      double thickest = 0.0;
+      for (const auto& w : result.layers) thickest = std::max(thickest, w.thickness);
+      result.support_radius = options.support_radius_factor * thickest;
+    }
+    if (!(result.support_radius > 0.0)) {
+      Points<Dim> at(Dim, static_cast<Index>(snapped.nodes.size()));
+      for (std::size_t k = 0; k < snapped.nodes.size(); ++k) at.col(static_cast<Index>(k)) = result.curved.points.col(snapped.nodes[k]);
+      result.support_radius = snapped.nodes.size() >= 2 ? suggest_support_radius(at, snapped.displacements) : 1.0;
+    }
+    RbfOptions rbf;
+    rbf.kernel = options.kernel;
+    rbf.support_radius = result.support_radius;
+    RbfMover<Dim> mover(rbf);
+    regularize_and_certify(mover, boundary, options, result);
+  } else if (options.method == "blend") {
+    BlendOptions blend;
+    blend.blending_length = options.blending_length;
+    blend.layer = options.layer;
+    BlendMover<Dim> mover(blend);
+    regularize_and_certify(mover, boundary, options, result);
+  } else {
+    detail::SnapOnlyMover<Dim> mover;
+    regularize_and_certify(mover, boundary, options, result);
+  }
+  result.seconds.total = total.seconds();
+  return result;
+}
+
+}  // namespace meshmotion
