@@ -14,11 +14,19 @@
 #include <functional>
 #include <limits>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 using namespace meshmotion;
 
 namespace {
+
+BoundaryChain chain_of(std::vector<Index> nodes, bool closed) {
+  BoundaryChain chain;
+  chain.nodes = std::move(nodes);
+  chain.closed = closed;
+  return chain;
+}
 
 constexpr double pi = std::numbers::pi;
 
@@ -32,7 +40,7 @@ Sampled closed_curve(const std::function<Vec<2>(double)>& curve,
                      const std::function<double(double)>& parameter, int n) {
   Sampled s;
   s.points.resize(2, n);
-  BoundaryChain chain{{}, true};
+  BoundaryChain chain = chain_of({}, true);
   for (int k = 0; k < n; ++k) {
     s.points.col(k) = curve(parameter(static_cast<double>(k) / n));
     chain.nodes.push_back(k);
@@ -158,7 +166,7 @@ TEST_CASE("square corners stay sharp: each side is reproduced as a straight segm
   const std::vector<Vec<2>> start{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
   const std::vector<Vec<2>> direction{{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
   Points<2> points(2, 20);
-  BoundaryChain chain{{}, true};
+  BoundaryChain chain = chain_of({}, true);
   for (int side = 0; side < 4; ++side)
     for (int k = 0; k < 5; ++k) {
       points.col(side * 5 + k) = start[side] + along[k] * direction[side];
@@ -217,7 +225,7 @@ TEST_CASE("corner detection follows the threshold and the user list", "[curving]
     points.col(k) = points.col(k - 1) + Vec<2>(std::cos(heading), std::sin(heading));
     heading += turns[k - 1] * pi / 180.0;
   }
-  const std::vector<BoundaryChain> chains{{{0, 1, 2, 3, 4}, false}};
+  const std::vector<BoundaryChain> chains{chain_of({0, 1, 2, 3, 4}, false)};
   auto corners_for = [&](double angle, std::vector<Index> listed) {
     BoundarySplineOptions options;
     options.corner_angle = angle;
@@ -269,25 +277,37 @@ TEST_CASE("midpoints converge at fourth order on smooth closed curves", "[curvin
     }
 }
 
-TEST_CASE("centripetal parametrization is the most accurate on graded boundaries",
-          "[curving]") {
-  // An arc with boundary-layer-like geometric grading (growth ratio 1.3) towards both ends.
-  const int n = 25;
+namespace {
+
+/// Largest midpoint error of the spline through the unit-circle points at `angles` (one
+/// open chain).
+double open_arc_error(const std::vector<double>& angles, const BoundarySplineOptions& options) {
+  const auto n = static_cast<Index>(angles.size());
   Points<2> points(2, n);
-  std::vector<double> theta{0.0};
-  for (int k = 1; k < n; ++k) theta.push_back(theta.back() + std::pow(1.3, std::abs(k - n / 2.0)));
   BoundaryChain chain;
-  for (int k = 0; k < n; ++k) {
-    const double angle = pi * theta[k] / theta.back();
-    points.col(k) = Vec<2>(std::cos(angle), std::sin(angle));
+  for (Index k = 0; k < n; ++k) {
+    points.col(k) = Vec<2>(std::cos(angles[k]), std::sin(angles[k]));
     chain.nodes.push_back(k);
   }
   const std::vector<BoundaryChain> chains{chain};
+  return max_midpoint_error(BoundarySpline(points, chains, options),
+                            [](const Vec<2>& p) { return std::abs(p.norm() - 1.0); });
+}
+
+}  // namespace
+
+TEST_CASE("centripetal parametrization is the most accurate on graded boundaries",
+          "[curving]") {
+  // A half circle with boundary-layer-like geometric grading (growth ratio 1.3) towards both
+  // ends.
+  const int n = 25;
+  std::vector<double> angles{0.0};
+  for (int k = 1; k < n; ++k) angles.push_back(angles.back() + std::pow(1.3, std::abs(k - n / 2.0)));
+  for (double& angle : angles) angle *= pi / angles.back();
   auto error = [&](SplineParametrization parametrization) {
     BoundarySplineOptions options;
     options.parametrization = parametrization;
-    return max_midpoint_error(BoundarySpline(points, chains, options),
-                              [](const Vec<2>& p) { return std::abs(p.norm() - 1.0); });
+    return open_arc_error(angles, options);
   };
   const double uniform = error(SplineParametrization::uniform);
   const double chord = error(SplineParametrization::chord_length);
@@ -300,20 +320,12 @@ TEST_CASE("centripetal parametrization is the most accurate on graded boundaries
 }
 
 TEST_CASE("not-a-knot ends are more accurate than natural ends on an open arc", "[curving]") {
-  const int n = 17;
-  Points<2> points(2, n);
-  BoundaryChain chain;
-  for (int k = 0; k < n; ++k) {
-    const double angle = 0.5 * pi * k / (n - 1);
-    points.col(k) = Vec<2>(std::cos(angle), std::sin(angle));
-    chain.nodes.push_back(k);
-  }
-  const std::vector<BoundaryChain> chains{chain};
+  std::vector<double> angles;
+  for (int k = 0; k <= 16; ++k) angles.push_back(0.5 * pi * k / 16.0);
   auto error = [&](SplineEndCondition end) {
     BoundarySplineOptions options;
     options.end_condition = end;
-    return max_midpoint_error(BoundarySpline(points, chains, options),
-                              [](const Vec<2>& p) { return std::abs(p.norm() - 1.0); });
+    return open_arc_error(angles, options);
   };
   const double natural = error(SplineEndCondition::natural);
   const double not_a_knot = error(SplineEndCondition::not_a_knot);
@@ -360,19 +372,19 @@ TEST_CASE("spline rejects bad chains and points", "[curving]") {
   auto build = [&](std::vector<BoundaryChain> chains, BoundarySplineOptions options = {}) {
     return BoundarySpline(points, chains, std::move(options));
   };
-  CHECK_THROWS_AS(build({{{0, 1, 7}, false}}), InputError);
-  CHECK_THROWS_AS(build({{{0}, false}}), InputError);
-  CHECK_THROWS_AS(build({{{0, 1}, true}}), InputError);
-  CHECK_THROWS_AS(build({{{0, 1, 1, 2}, false}}), InputError);
+  CHECK_THROWS_AS(build({chain_of({0, 1, 7}, false)}), InputError);
+  CHECK_THROWS_AS(build({chain_of({0}, false)}), InputError);
+  CHECK_THROWS_AS(build({chain_of({0, 1}, true)}), InputError);
+  CHECK_THROWS_AS(build({chain_of({0, 1, 1, 2}, false)}), InputError);
   BoundarySplineOptions nan_angle;
   nan_angle.corner_angle = std::numeric_limits<double>::quiet_NaN();
-  CHECK_THROWS_AS(build({{{0, 1, 2}, false}}, nan_angle), InputError);
-  const BoundarySpline spline = build({{{0, 1, 2, 3}, true}});
+  CHECK_THROWS_AS(build({chain_of({0, 1, 2}, false)}, nan_angle), InputError);
+  const BoundarySpline spline = build({chain_of({0, 1, 2, 3}, true)});
   CHECK_THROWS_AS(spline.point(4, 0.5), InputError);
   CHECK_THROWS_AS(spline.closest_point(0, Vec<2>(std::nan(""), 0.0)), InputError);
   CHECK_THROWS_AS(spline.arc_length_parameter(0, 1.5), InputError);
   points(1, 2) = std::numeric_limits<double>::infinity();
-  CHECK_THROWS_WITH(build({{{0, 1, 2, 3}, true}}), Catch::Contains("non-finite"));
+  CHECK_THROWS_WITH(build({chain_of({0, 1, 2, 3}, true)}), Catch::Contains("non-finite"));
 }
 
 TEST_CASE("circle, sphere and plane projections are exact", "[curving]") {

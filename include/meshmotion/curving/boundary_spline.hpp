@@ -13,6 +13,7 @@
 /// find_facet (O(log n)).
 
 #include "meshmotion/core/error.hpp"
+#include "meshmotion/core/topology.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/curving/detail/closest_point.hpp"
 #include "meshmotion/curving/detail/tridiagonal.hpp"
@@ -29,25 +30,18 @@
 
 namespace meshmotion {
 
-/// An ordered run of boundary nodes (indices into the point matrix). An open chain of n
-/// nodes has the n - 1 facets (nodes[k], nodes[k+1]); a closed chain lists every node once
-/// and has n facets, the last one (nodes[n-1], nodes[0]).
-struct BoundaryChain {
-  std::vector<Index> nodes;
-  bool closed = false;
-};
-
-/// How the spline parameter advances over a facet.
+/// How the spline parameter advances over a facet. The first enumerator is the default, so
+/// a value-initialized option means the default.
 enum class SplineParametrization {
-  uniform,       ///< one unit per facet (thesis, eqs. B.13/B.14)
-  chord_length,  ///< proportional to the facet's length: straight runs stay linear in t
   centripetal,   ///< proportional to the square root of the facet's length (Lee 1989)
+  chord_length,  ///< proportional to the facet's length: straight runs stay linear in t
+  uniform,       ///< one unit per facet (thesis, eqs. B.13/B.14)
 };
 
-/// End conditions of an open (corner-to-corner) spline.
+/// End conditions of an open (corner-to-corner) spline; the first enumerator is the default.
 enum class SplineEndCondition {
-  natural,     ///< zero second derivative at both ends (thesis eqs. B.11–B.12)
   not_a_knot,  ///< continuous third derivative at the second and last-but-one nodes
+  natural,     ///< zero second derivative at both ends (thesis eqs. B.11–B.12)
 };
 
 /// Options of BoundarySpline.
@@ -165,7 +159,9 @@ class BoundarySpline {
     double distance;
   };
 
-  /// Reconstructs every chain. `points`: 2 × n_nodes coordinates; chains index its columns.
+  /// Reconstructs every chain (BoundaryChain of core/topology.hpp: `nodes` and `closed` are
+  /// used; an open chain of n nodes has n - 1 facets, a closed one n, the last closing the
+  /// loop). `points`: 2 × n_nodes coordinates; chains index its columns.
   /// Facets are numbered chain by chain in chain order (see chain_first_facet).
   /// Throws InputError for an out-of-range node index, a non-finite coordinate, an open chain
   /// of fewer than 2 or a closed one of fewer than 3 nodes, two consecutive nodes at the
