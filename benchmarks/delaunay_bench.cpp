@@ -5,15 +5,15 @@
 // each hinted with the previous answer after a Hilbert sort (the DGM access pattern).
 // Usage: delaunay_bench [n ...]   (default 100000 1000000)
 
-#include "meshmotion/delaunay.hpp"
-#include "meshmotion/delaunay/detail/spatial_sort.hpp"
-
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
+
+#include "meshmotion/delaunay.hpp"
+#include "meshmotion/delaunay/detail/spatial_sort.hpp"
 
 #if __has_include(<CGAL/Delaunay_triangulation_2.h>) && defined(MESHMOTION_BENCH_HAVE_CGAL)
 #define MESHMOTION_BENCH_CGAL 1
@@ -99,8 +99,8 @@ void run(Index n) {
   std::size_t cgal_cells = 0;
   const double cgal = cgal_seconds<Dim>(points, cgal_cells);
   const double ratio = cgal > 0.0 ? ours / cgal : -1.0;
-  std::printf("%3dD %9lld points  %8.3f s  %8.2e points/s  %9lld simplices  locate %7.3f s",
-              Dim, static_cast<long long>(n), ours, static_cast<double>(n) / ours,
+  std::printf("%3dD %9lld points  %8.3f s  %8.2e points/s  %9lld simplices  locate %7.3f s", Dim,
+              static_cast<long long>(n), ours, static_cast<double>(n) / ours,
               static_cast<long long>(dt.num_simplices()), locate);
   if (cgal > 0.0) {
     std::printf("  | CGAL %8.3f s (%zu cells)  ours/CGAL %.2f\n", cgal, cgal_cells, ratio);
@@ -121,8 +121,9 @@ int main(int argc, char** argv) {
   std::vector<Index> sizes;
   for (int a = 1; a < argc; ++a) sizes.push_back(std::atoll(argv[a]));
   if (sizes.empty()) sizes = {100000, 1000000};
-  std::printf("Delaunay of uniform random points in the unit box (no thesis figure; CGAL is the "
-              "reference, target ratio <= 2)\n");
+  std::printf(
+      "Delaunay of uniform random points in the unit box (no thesis figure; CGAL is the "
+      "reference, target ratio <= 2)\n");
   for (Index n : sizes) {
     run<2>(n);
     run<3>(n);

@@ -1,14 +1,14 @@
 #include "meshmotion/delaunay.hpp"
-#include "meshmotion/delaunay/detail/spatial_sort.hpp"
-
-#include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <array>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <numbers>
 #include <random>
 #include <vector>
+
+#include "meshmotion/delaunay/detail/spatial_sort.hpp"
 
 using namespace meshmotion;
 
@@ -464,7 +464,7 @@ TEST_CASE("Hilbert order visits grid cells by unit steps", "[delaunay]") {
       for (std::uint32_t z = 0; z < q; ++z) {
         std::uint32_t cell[3] = {x << 7, y << 7, z << 7};
         at3[detail::hilbert_key<3, 10>(cell) >> 21] = {static_cast<int>(x), static_cast<int>(y),
-                                                        static_cast<int>(z)};
+                                                       static_cast<int>(z)};
       }
     }
   }
@@ -495,7 +495,8 @@ TEST_CASE("graph mapping reproduces affine motions and detects inversion", "[del
       nodes.emplace_back(-1.0, -s);
     }
     Points<2> graph_points(2, static_cast<Index>(nodes.size()));
-    for (std::size_t i = 0; i < nodes.size(); ++i) graph_points.col(static_cast<Index>(i)) = nodes[i];
+    for (std::size_t i = 0; i < nodes.size(); ++i)
+      graph_points.col(static_cast<Index>(i)) = nodes[i];
     const auto graph = delaunay<2>(graph_points);
     const Points<2> queries = random_points<2>(3000, 23);
     const GraphMapping<2> mapping(graph, queries);

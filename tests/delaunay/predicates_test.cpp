@@ -1,7 +1,6 @@
 #include "meshmotion/delaunay/predicates.hpp"
 
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -215,10 +214,41 @@ TEST_CASE("predicates on rectangle and box corners are exactly degenerate", "[de
     const double x0 = u(rng), x1 = u(rng), y0 = u(rng), y1 = u(rng), z0 = u(rng), z1 = u(rng);
     const double a[2] = {x0, y0}, b[2] = {x1, y0}, c[2] = {x1, y1}, d[2] = {x0, y1};
     REQUIRE(incircle(a, b, c, d) == 0);
-    const double p[3] = {x0, y0, z0}, q[3] = {x1, y0, z0}, r[3] = {x0, y1, z0},
-                 s[3] = {x0, y0, z1}, t[3] = {x1, y1, z1};
+    const double p[3] = {x0, y0, z0}, q[3] = {x1, y0, z0}, r[3] = {x0, y1, z0}, s[3] = {x0, y0, z1},
+                 t[3] = {x1, y1, z1};
     REQUIRE(insphere(p, q, r, s, t) == 0);
     const double w[3] = {x1, y1, z0};
     REQUIRE(orient3d(p, q, r, w) == 0);
   }
+}
+
+TEST_CASE("exact stages agree with each other", "[delaunay]") {
+  // The allocation-free stage for exact differences and the general expansion stage must
+  // give the same sign; points near a common sphere/circle make both paths do real work.
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> angle(0.0, 6.283185307179586);
+  std::uniform_int_distribution<int> ulps(-2, 2);
+  int nonzero = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    double p[5][3];
+    for (auto& point : p) {
+      const double t = angle(rng), s = angle(rng);
+      point[0] = 1.5 + 0.4 * std::cos(t) * std::sin(s);
+      point[1] = 1.5 + 0.4 * std::sin(t) * std::sin(s);
+      point[2] = 1.5 + 0.4 * std::cos(s);
+      for (double& x : point) {
+        for (int k = ulps(rng); k != 0; k += k > 0 ? -1 : 1)
+          x = std::nextafter(x, k > 0 ? 9.0 : 0.0);
+      }
+    }
+    const int staged = detail::insphere_exact_differences(p[0], p[1], p[2], p[3], p[4]);
+    REQUIRE(staged != 2);  // coordinates in [1.1, 1.9]: differences are exact (Sterbenz)
+    REQUIRE(staged == detail::insphere_shewchuk_exact(p[0], p[1], p[2], p[3], p[4]));
+    const int o3 = detail::orient3d_exact_differences(p[0], p[1], p[2], p[3]);
+    REQUIRE(o3 == detail::orient3d_shewchuk_exact(p[0], p[1], p[2], p[3]));
+    const int ic = detail::incircle_exact_differences(p[0], p[1], p[2], p[3]);
+    REQUIRE(ic == detail::incircle_exact(p[0], p[1], p[2], p[3]));
+    nonzero += staged != 0;
+  }
+  CHECK(nonzero > 0);
 }

@@ -4,19 +4,19 @@
 /// point set, thesis appendix A (see detail/bowyer_watson_kernel.hpp for the kernel and its
 /// departures from the appendix).
 
-#include "meshmotion/core/error.hpp"
-#include "meshmotion/core/types.hpp"
-#include "meshmotion/delaunay/delaunay_triangulation.hpp"
-#include "meshmotion/delaunay/detail/bowyer_watson_kernel.hpp"
-#include "meshmotion/delaunay/detail/spatial_sort.hpp"
-#include "meshmotion/delaunay/predicates.hpp"
-
 #include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <numeric>
 #include <string>
 #include <vector>
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/delaunay/delaunay_triangulation.hpp"
+#include "meshmotion/delaunay/detail/bowyer_watson_kernel.hpp"
+#include "meshmotion/delaunay/detail/spatial_sort.hpp"
+#include "meshmotion/delaunay/predicates.hpp"
 
 namespace meshmotion {
 
@@ -35,7 +35,8 @@ namespace detail {
 /// Moves to the front of `order` the first Dim + 1 affinely independent points it meets.
 /// Returns false when there are none (all points collinear in 2D / coplanar in 3D).
 template <int Dim>
-[[nodiscard]] bool move_first_simplex_to_front(const Points<Dim>& points, std::vector<Index>& order) {
+[[nodiscard]] bool move_first_simplex_to_front(const Points<Dim>& points,
+                                               std::vector<Index>& order) {
   std::vector<std::size_t> chosen{0};
   auto p = [&](std::size_t k) { return points.col(order[k]).data(); };
   auto independent = [&](std::size_t k) {
@@ -128,7 +129,8 @@ template <int Dim>
   // Coordinates in insertion order: the kernel then reads memory in the order it walks.
   std::vector<double> sorted(static_cast<std::size_t>(n) * Dim);
   for (Index k = 0; k < n; ++k) {
-    for (int d = 0; d < Dim; ++d) sorted[static_cast<std::size_t>(k) * Dim + d] = points(d, order[k]);
+    for (int d = 0; d < Dim; ++d)
+      sorted[static_cast<std::size_t>(k) * Dim + d] = points(d, order[k]);
   }
   detail::BowyerWatsonKernel<Dim> kernel(sorted.data(), static_cast<Id>(n), options.seed);
   kernel.run();

@@ -4,18 +4,17 @@
 /// point location with barycentric coordinates (the query of the Delaunay graph mapping,
 /// thesis section 2.2.1).
 
-#include "meshmotion/core/error.hpp"
-#include "meshmotion/core/types.hpp"
-#include "meshmotion/delaunay/detail/bowyer_watson_kernel.hpp"
-
 #include <Eigen/Core>
-
 #include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/delaunay/detail/bowyer_watson_kernel.hpp"
 
 namespace meshmotion {
 
@@ -210,8 +209,8 @@ class DelaunayTriangulation {
   }
 
   /// Closest point to p on triangle abc (Ericson, Real-Time Collision Detection, 5.1.5).
-  [[nodiscard]] static Vec<3> closest_on_triangle(const Vec<3>& p, const Vec<3>& a,
-                                                  const Vec<3>& b, const Vec<3>& c) {
+  [[nodiscard]] static Vec<3> closest_on_triangle(const Vec<3>& p, const Vec<3>& a, const Vec<3>& b,
+                                                  const Vec<3>& c) {
     const Vec<3> ab = b - a, ac = c - a, ap = p - a;
     const double d1 = ab.dot(ap), d2 = ac.dot(ap);
     if (d1 <= 0.0 && d2 <= 0.0) return a;

@@ -10,16 +10,15 @@
 /// Setup costs one hinted walk per query (queries visited in Hilbert order); mapping costs
 /// (Dim + 1) × Dim multiply-adds per query and allocates nothing in its non-allocating form.
 
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/delaunay/delaunay_triangulation.hpp"
 #include "meshmotion/delaunay/detail/bowyer_watson_kernel.hpp"
 #include "meshmotion/delaunay/detail/spatial_sort.hpp"
-
-#include <Eigen/Core>
-
-#include <string>
-#include <vector>
 
 namespace meshmotion {
 
@@ -59,9 +58,7 @@ class GraphMapping {
   /// Number of queries outside the graph's convex hull (mapped by extrapolation).
   [[nodiscard]] Index num_outside() const noexcept { return num_outside_; }
   /// The graph simplex of query q.
-  [[nodiscard]] Index simplex(Index q) const {
-    return query_simplex_[static_cast<std::size_t>(q)];
-  }
+  [[nodiscard]] Index simplex(Index q) const { return query_simplex_[static_cast<std::size_t>(q)]; }
   /// Barycentric coordinates, (Dim+1) × n_queries, in the order of the simplex's vertices.
   [[nodiscard]] const Eigen::Matrix<double, Dim + 1, Eigen::Dynamic>& barycentric() const noexcept {
     return barycentric_;
@@ -76,7 +73,8 @@ class GraphMapping {
     for (Index q = 0; q < num_queries(); ++q) {
       const Index s = query_simplex_[static_cast<std::size_t>(q)];
       Vec<Dim> x = Vec<Dim>::Zero();
-      for (int j = 0; j < corners; ++j) x += barycentric_(j, q) * graph_values.col(simplices_(j, s));
+      for (int j = 0; j < corners; ++j)
+        x += barycentric_(j, q) * graph_values.col(simplices_(j, s));
       out.col(q) = x;
     }
   }

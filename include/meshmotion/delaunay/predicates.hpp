@@ -16,12 +16,11 @@
 /// - insphere(a, b, c, d, e) > 0 when e lies strictly inside the sphere through a, b, c, d
 ///   and orient3d(a, b, c, d) > 0 (the sign flips for negative orientation).
 
-#include "meshmotion/delaunay/detail/expansion.hpp"
-
 #include <Eigen/Core>
-
 #include <array>
 #include <cmath>
+
+#include "meshmotion/delaunay/detail/expansion.hpp"
 
 namespace meshmotion {
 
@@ -30,9 +29,7 @@ namespace detail {
 /// Half an ulp of 1: the relative rounding error of one double operation.
 inline constexpr double predicate_epsilon = 0x1p-53;
 
-[[nodiscard]] inline int sign_of(double value) noexcept {
-  return (value > 0.0) - (value < 0.0);
-}
+[[nodiscard]] inline int sign_of(double value) noexcept { return (value > 0.0) - (value < 0.0); }
 
 /// Shewchuk's orient2d determinant: > 0 when a, b, c are counterclockwise.
 [[nodiscard]] inline int orient2d_exact(const double* a, const double* b, const double* c) {
@@ -98,8 +95,95 @@ inline constexpr double predicate_epsilon = 0x1p-53;
   auto lift = [](const std::array<Expansion, 3>& v) {
     return v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
   };
-  const Expansion det =
-      (lift(de) * abc - lift(ce) * dab) + (lift(be) * cda - lift(ae) * bcd);
+  const Expansion det = (lift(de) * abc - lift(ce) * dab) + (lift(be) * cda - lift(ae) * bcd);
+  return det.sign();
+}
+
+/// The differences p[k] - q[k] (k < N) when all are exact doubles (true for nearby points
+/// by Sterbenz's lemma, hence for most tests on grids); false otherwise.
+template <int N>
+[[nodiscard]] inline bool exact_differences(const double* p, const double* q, double* out) {
+  for (int k = 0; k < N; ++k) {
+    double tail = 0.0;
+    two_sum(p[k], -q[k], out[k], tail);
+    if (tail != 0.0) return false;
+  }
+  return true;
+}
+
+template <std::size_t A>
+[[nodiscard]] FixedExpansion<A> negated(FixedExpansion<A> e) {
+  for (std::size_t k = 0; k < e.size; ++k) e.terms[k] = -e.terms[k];
+  return e;
+}
+
+/// Shewchuk's insphere determinant, exact, when the differences to e are exact doubles
+/// (his stage B with zero tails): fixed arrays, no allocation. Returns 2 when they are not.
+[[nodiscard]] inline int insphere_exact_differences(const double* a, const double* b,
+                                                    const double* c, const double* d,
+                                                    const double* e) {
+  double ae[3], be[3], ce[3], de[3];
+  if (!exact_differences<3>(a, e, ae) || !exact_differences<3>(b, e, be) ||
+      !exact_differences<3>(c, e, ce) || !exact_differences<3>(d, e, de)) {
+    return 2;
+  }
+  const auto ab = two_by_two(ae[0], be[1], be[0], ae[1]);
+  const auto bc = two_by_two(be[0], ce[1], ce[0], be[1]);
+  const auto cd = two_by_two(ce[0], de[1], de[0], ce[1]);
+  const auto da = two_by_two(de[0], ae[1], ae[0], de[1]);
+  const auto ac = two_by_two(ae[0], ce[1], ce[0], ae[1]);
+  const auto bd = two_by_two(be[0], de[1], de[0], be[1]);
+  const auto abc = scaled(bc, ae[2]) + scaled(ac, -be[2]) + scaled(ab, ce[2]);
+  const auto bcd = scaled(cd, be[2]) + scaled(bd, -ce[2]) + scaled(bc, de[2]);
+  const auto cda = scaled(da, ce[2]) + scaled(ac, de[2]) + scaled(cd, ae[2]);
+  const auto dab = scaled(ab, de[2]) + scaled(bd, ae[2]) + scaled(da, be[2]);
+  auto lift = [](const double* v) {
+    FixedExpansion<2> squares[3];
+    for (int k = 0; k < 3; ++k) {
+      two_product(v[k], v[k], squares[k].terms[1], squares[k].terms[0]);
+      squares[k].size = 2;
+    }
+    return squares[0] + squares[1] + squares[2];
+  };
+  const auto det =
+      (lift(de) * abc + negated(lift(ce)) * dab) + (lift(be) * cda + negated(lift(ae)) * bcd);
+  return det.sign();
+}
+
+/// Shewchuk's orient3d determinant, exact, when the differences to d are exact doubles.
+/// Returns 2 when they are not.
+[[nodiscard]] inline int orient3d_exact_differences(const double* a, const double* b,
+                                                    const double* c, const double* d) {
+  double ad[3], bd[3], cd[3];
+  if (!exact_differences<3>(a, d, ad) || !exact_differences<3>(b, d, bd) ||
+      !exact_differences<3>(c, d, cd)) {
+    return 2;
+  }
+  const auto det = scaled(two_by_two(bd[0], cd[1], cd[0], bd[1]), ad[2]) +
+                   scaled(two_by_two(cd[0], ad[1], ad[0], cd[1]), bd[2]) +
+                   scaled(two_by_two(ad[0], bd[1], bd[0], ad[1]), cd[2]);
+  return det.sign();
+}
+
+/// Shewchuk's incircle determinant, exact, when the differences to d are exact doubles.
+/// Returns 2 when they are not.
+[[nodiscard]] inline int incircle_exact_differences(const double* a, const double* b,
+                                                    const double* c, const double* d) {
+  double ad[2], bd[2], cd[2];
+  if (!exact_differences<2>(a, d, ad) || !exact_differences<2>(b, d, bd) ||
+      !exact_differences<2>(c, d, cd)) {
+    return 2;
+  }
+  auto lift = [](const double* v) {
+    FixedExpansion<2> x, y;
+    two_product(v[0], v[0], x.terms[1], x.terms[0]);
+    two_product(v[1], v[1], y.terms[1], y.terms[0]);
+    x.size = y.size = 2;
+    return x + y;
+  };
+  const auto det = (lift(ad) * two_by_two(bd[0], cd[1], cd[0], bd[1]) +
+                    lift(bd) * two_by_two(cd[0], ad[1], ad[0], cd[1])) +
+                   lift(cd) * two_by_two(ad[0], bd[1], bd[0], ad[1]);
   return det.sign();
 }
 
@@ -128,8 +212,7 @@ inline constexpr double predicate_epsilon = 0x1p-53;
   const double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy;
   const double cdxady = cdx * ady, adxcdy = adx * cdy;
   const double adxbdy = adx * bdy, bdxady = bdx * ady;
-  const double det =
-      adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
+  const double det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
   const double permanent = (std::abs(bdxcdy) + std::abs(cdxbdy)) * std::abs(adz) +
                            (std::abs(cdxady) + std::abs(adxcdy)) * std::abs(bdz) +
                            (std::abs(adxbdy) + std::abs(bdxady)) * std::abs(cdz);
@@ -138,7 +221,8 @@ inline constexpr double predicate_epsilon = 0x1p-53;
   const double errbound = bound * permanent;
   // Shewchuk's determinant is det[a - d; b - d; c - d] = -det[b - a, c - a, d - a].
   if (det > errbound || -det > errbound) return -detail::sign_of(det);
-  return -detail::orient3d_shewchuk_exact(a, b, c, d);
+  const int staged = detail::orient3d_exact_differences(a, b, c, d);
+  return -(staged != 2 ? staged : detail::orient3d_shewchuk_exact(a, b, c, d));
 }
 
 /// +1 when d is strictly inside the circle through a, b, c (counterclockwise), 0 when the four
@@ -153,8 +237,8 @@ inline constexpr double predicate_epsilon = 0x1p-53;
   const double alift = adx * adx + ady * ady;
   const double blift = bdx * bdx + bdy * bdy;
   const double clift = cdx * cdx + cdy * cdy;
-  const double det = alift * (bdxcdy - cdxbdy) + blift * (cdxady - adxcdy) +
-                     clift * (adxbdy - bdxady);
+  const double det =
+      alift * (bdxcdy - cdxbdy) + blift * (cdxady - adxcdy) + clift * (adxbdy - bdxady);
   const double permanent = (std::abs(bdxcdy) + std::abs(cdxbdy)) * alift +
                            (std::abs(cdxady) + std::abs(adxcdy)) * blift +
                            (std::abs(adxbdy) + std::abs(bdxady)) * clift;
@@ -162,7 +246,8 @@ inline constexpr double predicate_epsilon = 0x1p-53;
   constexpr double bound = (10.0 + 96.0 * eps) * eps;
   const double errbound = bound * permanent;
   if (det > errbound || -det > errbound) return detail::sign_of(det);
-  return detail::incircle_exact(a, b, c, d);
+  const int staged = detail::incircle_exact_differences(a, b, c, d);
+  return staged != 2 ? staged : detail::incircle_exact(a, b, c, d);
 }
 
 /// +1 when e is strictly inside the sphere through a, b, c, d with orient3d(a, b, c, d) > 0,
@@ -207,7 +292,8 @@ inline constexpr double predicate_epsilon = 0x1p-53;
   const double errbound = bound * permanent;
   // Shewchuk's insphere is positive inside for his (opposite) orientation convention.
   if (det > errbound || -det > errbound) return -detail::sign_of(det);
-  return -detail::insphere_shewchuk_exact(a, b, c, d, e);
+  const int staged = detail::insphere_exact_differences(a, b, c, d, e);
+  return -(staged != 2 ? staged : detail::insphere_shewchuk_exact(a, b, c, d, e));
 }
 
 /// Eigen overloads of the predicates above.

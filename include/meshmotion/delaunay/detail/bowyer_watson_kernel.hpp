@@ -16,9 +16,6 @@
 /// - Replacing the vertex opposite each cavity boundary facet by the new point keeps the
 ///   positive orientation of every simplex (note 4 of the appendix) without bookkeeping.
 
-#include "meshmotion/core/error.hpp"
-#include "meshmotion/delaunay/predicates.hpp"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -26,6 +23,9 @@
 #include <limits>
 #include <string>
 #include <vector>
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/delaunay/predicates.hpp"
 
 namespace meshmotion::detail {
 
@@ -353,9 +353,9 @@ class BowyerWatsonKernel {
           low = std::min(low, f.vertices[k]);
           high = std::max(high, f.vertices[k]);
         }
-        std::size_t slot =
-            (static_cast<std::size_t>(low) * 0x9E3779B97F4A7C15ull ^ static_cast<std::size_t>(high)) &
-            mask;
+        std::size_t slot = (static_cast<std::size_t>(low) * 0x9E3779B97F4A7C15ull ^
+                            static_cast<std::size_t>(high)) &
+                           mask;
         while (true) {
           RidgeEntry& e = ridges_[slot];
           if (e.simplex < 0) {
