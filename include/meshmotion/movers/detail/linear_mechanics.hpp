@@ -1,0 +1,117 @@
+#pragma once
+/// \file
+/// LinearMechanicsMover: what the linear mechanics movers (lineal and torsional springs,
+/// linear and stiffened elasticity) share — the copied reference mesh, the checks, the
+/// constrained system factorized in setup, and move/move_into/stats. A mover derives from it,
+/// assembles its stiffness matrix in setup and hands it to finish_setup().
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/mesh_like.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/detail/constrained_system.hpp"
+#include "meshmotion/movers/mover.hpp"
+#include "meshmotion/solvers/detail/stopwatch.hpp"
+#include "meshmotion/solvers/linear_solver.hpp"
+
+#include <string>
+#include <vector>
+
+namespace meshmotion::detail {
+
+/// A Mesh<Dim> copy of any MeshLike `mesh`, checked: finite coordinates, at least one cell,
+/// node indices in range, a valid `boundary`. Throws InputError prefixed by `where`.
+template <MeshLike M, int Dim = mesh_dim<M>>
+[[nodiscard]] Mesh<Dim> checked_copy(const M& mesh, const ResolvedBoundary<Dim>& boundary, const std::string& where) {
+  Mesh<Dim> copy = to_mesh(mesh);
+  if (!copy.points.allFinite()) throw InputError(where + "::setup: mesh has a non-finite coordinate");
+  if (copy.num_cells() == 0) throw InputError(where + "::setup: mesh has no cells (expected at least one)");
+  for (const auto& block : copy.cells)
+    for (const Index v : block.connectivity)
+      if (v < 0 || v >= copy.num_nodes())
+        throw InputError(where + "::setup: a " + std::string(name(block.type)) + " cell refers to node " +
+                         std::to_string(v) + " (expected 0 to " + std::to_string(copy.num_nodes() - 1) + ")");
+  check_boundary(where + "::setup", boundary, copy.num_nodes());
+  return copy;
+}
+
+/// Nodes used by some cell (the others have no stiffness and stay put).
+template <int Dim>
+[[nodiscard]] std::vector<bool> cell_nodes(const Mesh<Dim>& mesh) {
+  std::vector<bool> active(static_cast<std::size_t>(mesh.num_nodes()), false);
+  for (const auto& block : mesh.cells)
+    for (const Index v : block.connectivity) active[static_cast<std::size_t>(v)] = true;
+  return active;
+}
+
+template <int Dim>
+class LinearMechanicsMover {
+ public:
+  static constexpr int dim = Dim;
+
+  [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
+
+  /// The assembled stiffness matrix before boundary conditions: (n_nodes · c) square with
+  /// c = 1 (uncoupled springs without sliding nodes) or Dim (node-major dofs, node · Dim + axis).
+  [[nodiscard]] const SparseMatrix& stiffness() const noexcept { return stiffness_; }
+
+  /// Displacement of every node (Dim × n_nodes) for boundary displacements `d` (Dim ×
+  /// boundary.size(), boundary.nodes order; sliding entries ignored). Prescribed and fixed
+  /// nodes get their targets exactly, sliding nodes stay on their planes. Throws InputError
+  /// for a wrong shape, a non-finite value or a missing setup; SolverError when an
+  /// iterative solve does not converge.
+  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
+    Points<Dim> out;
+    move_into(d, out);
+    return out;
+  }
+
+  /// move() into `out` (resized only when its shape differs).
+  void move_into(const Points<Dim>& d, Points<Dim>& out) {
+    const Stopwatch watch;
+    if (!ready_) throw InputError(name_ + "::move: setup() was not called");
+    check_displacements(name_ + "::move", d, boundary_nodes_);
+    system_.solve(d, out);
+    ++stats_.moves;
+    system_.record(stats_);
+    stats_.move_seconds = watch.seconds();
+  }
+
+ protected:
+  explicit LinearMechanicsMover(std::string name) : name_(std::move(name)) {}
+
+  /// Copies the mesh (any MeshLike) and checks it and the boundary; returns the copy.
+  template <MeshLike M>
+  [[nodiscard]] Mesh<Dim> start_setup(const M& mesh, const ResolvedBoundary<Dim>& boundary) {
+    ready_ = false;
+    return checked_copy(mesh, boundary, name_);
+  }
+
+  /// Factorizes the constrained system of K (components dofs per node) and records stats.
+  void finish_setup(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary, SparseMatrix k, int components,
+                    const SolverOptions& solver, const Stopwatch& watch) {
+    stiffness_ = std::move(k);
+    boundary_nodes_ = boundary.nodes;
+    system_.build(components, cell_nodes(mesh), boundary, solver);
+    system_.factorize(stiffness_);
+    stats_ = MoverStats{};
+    stats_.boundary_nodes = boundary.size();
+    stats_.evaluated_nodes = system_.unknowns() / (components == 1 ? 1 : Dim);
+    stats_.nonzeros = system_.nonzeros();
+    stats_.factorizations = system_.report().factorizations;
+    ready_ = true;
+    stats_.setup_seconds = watch.seconds();
+  }
+
+  std::string name_;
+  MoverStats stats_;
+
+ private:
+  SparseMatrix stiffness_;
+  std::vector<Index> boundary_nodes_;
+  ConstrainedSystem<Dim> system_;
+  bool ready_ = false;
+};
+
+}  // namespace meshmotion::detail

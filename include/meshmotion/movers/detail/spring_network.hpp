@@ -1,0 +1,77 @@
+#pragma once
+/// \file
+/// The lineal springs of a mesh (thesis eqs. 2.1–2.2): one spring per edge of a linear cell,
+/// and on quadratic cells one per half edge of the element's natural sub-division (vertex to
+/// edge node, and between high-order nodes half an edge apart, e.g. the four sub-triangles of
+/// a tri6 or the eight sub-hexahedra of a hex27), so every node of any type is connected.
+/// Springs shared by neighbouring cells are counted once.
+
+#include "meshmotion/core/element.hpp"
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/shape_functions.hpp"
+#include "meshmotion/core/types.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+namespace meshmotion::detail {
+
+/// Local node pairs of `type` joined by a spring: pairs whose reference offset is ±1/order
+/// of a reference edge vector (for linear types exactly the edges).
+[[nodiscard]] inline const std::vector<std::array<int, 2>>& spring_pairs(ElementType type) {
+  static const std::array<std::vector<std::array<int, 2>>, num_element_types> table = [] {
+    std::array<std::vector<std::array<int, 2>>, num_element_types> all;
+    for (int t = 0; t < num_element_types; ++t) {
+      const auto type_t = static_cast<ElementType>(t);
+      if (dimension(type_t) < 1) continue;
+      const auto x = reference_nodes(type_t);
+      const double p = order(type_t);
+      const auto offset_matches = [&](int i, int j, const std::array<int, 2>& e) {
+        double plus = 0.0, minus = 0.0;
+        for (std::size_t d = 0; d < 3; ++d) {
+          const double edge = (x[static_cast<std::size_t>(e[1])][d] - x[static_cast<std::size_t>(e[0])][d]) / p;
+          const double offset = x[static_cast<std::size_t>(j)][d] - x[static_cast<std::size_t>(i)][d];
+          plus = std::max(plus, std::abs(offset - edge));
+          minus = std::max(minus, std::abs(offset + edge));
+        }
+        return std::min(plus, minus) < 1e-12;
+      };
+      const int n = num_nodes(type_t);
+      for (int i = 0; i < n; ++i)
+        for (int j = i + 1; j < n; ++j)
+          for (const auto& e : edges(type_t))
+            if (offset_matches(i, j, e)) {
+              all[static_cast<std::size_t>(t)].push_back({i, j});
+              break;
+            }
+    }
+    return all;
+  }();
+  return table[static_cast<std::size_t>(type)];
+}
+
+/// Unique springs (node pairs, smaller index first) of the cells of `mesh`, sorted.
+template <int Dim>
+[[nodiscard]] std::vector<std::array<Index, 2>> mesh_springs(const Mesh<Dim>& mesh) {
+  std::vector<std::array<Index, 2>> springs;
+  Index count = 0;
+  for (const auto& block : mesh.cells) count += block.size() * static_cast<Index>(spring_pairs(block.type).size());
+  springs.reserve(static_cast<std::size_t>(count));
+  for (const auto& block : mesh.cells) {
+    const auto& pairs = spring_pairs(block.type);
+    for (Index e = 0; e < block.size(); ++e) {
+      const auto nodes = block.element(e);
+      for (const auto& [i, j] : pairs) {
+        const Index a = nodes[static_cast<std::size_t>(i)], b = nodes[static_cast<std::size_t>(j)];
+        if (a != b) springs.push_back({std::min(a, b), std::max(a, b)});
+      }
+    }
+  }
+  std::sort(springs.begin(), springs.end());
+  springs.erase(std::unique(springs.begin(), springs.end()), springs.end());
+  return springs;
+}
+
+}  // namespace meshmotion::detail

@@ -1,0 +1,189 @@
+#pragma once
+/// \file
+/// ElasticityMover: linear elasticity mesh motion (thesis section 2.1.2, eqs. 2.3–2.6),
+/// optionally stiffened by the element Jacobian (eqs. 2.7–2.8; Stein, Tezduyar & Benney 2003,
+/// Hartmann & Leicht) and by the distance to the moving walls (the thesis's proposal).
+///
+/// ∇·σ = 0 with σ = 2μ ε + λ tr(ε) I, ε = ½(∇u + ∇uᵀ), u = u_b on Dirichlet boundaries and
+/// u·n = 0 with free tangential motion on sliding ones, discretized by Galerkin FEM with the
+/// mesh's own Lagrange elements (P1 and P2: tri3/6, quad4/8/9, tet4/10, hex8/20/27,
+/// prism6/15/18, pyramid5/13/14, mixed meshes). Stiffening multiplies the integrand at each
+/// quadrature point by
+///     s = (J0 / J_κ)^χ · (d̄ / d_κ)^ψ,
+/// where J_κ = |det J| · |κ̂| (the element's area/volume on affine elements), J0 a reference
+/// (default: the mean cell measure), d_κ the distance from the cell's vertex centroid to the
+/// nearest moving-wall node (k-d tree) and d̄ its mean over the cells. Constant factors (J0,
+/// d̄, Young's modulus) scale K as a whole and do not change the displacements; they only
+/// change the magnitude of the numbers the solver sees. χ = ψ = 0 is plain linear elasticity.
+///
+/// - Linear in the displacements; coupled Dim × N system, SPD after eliminating the Dirichlet
+///   dofs (sliding nodes keep their tangent-plane unknowns, so they stay on their planes).
+/// - Setup caches the factorized reduced system; cost: setup = assembly O(cells · nodes² ·
+///   quadrature points) (OpenMP over cells) + one sparse factorization; move = one solve.
+/// - Solvers: direct Cholesky (default, simplicial_ldlt), CG with Jacobi (as in the thesis,
+///   table 4.2) or incomplete Cholesky; iterations and residual land in stats().
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/mesh_like.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/detail/fem_assembly.hpp"
+#include "meshmotion/movers/detail/linear_mechanics.hpp"
+#include "meshmotion/solvers/detail/stopwatch.hpp"
+#include "meshmotion/solvers/solver_options.hpp"
+#include "meshmotion/spatial/kd_tree.hpp"
+
+#include <atomic>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace meshmotion {
+
+/// Options of ElasticityMover.
+struct ElasticityOptions {
+  double youngs_modulus = 1.0;  ///< E > 0 (scales K only; the thesis uses 1e6)
+  double poisson_ratio = 0.3;   ///< ν in (−1, 0.5) (the thesis uses 0.4)
+  /// χ of eq. 2.8 (thesis table 4.2: 2.75 and 2.9); 0 disables Jacobian stiffening.
+  double stiffening_exponent = 0.0;
+  /// J0 of eq. 2.8 in mesh units of area/volume; ≤ 0 means the mean cell measure.
+  double reference_jacobian = 0.0;
+  /// ψ of the wall-distance stiffening (d̄/d_κ)^ψ; 0 disables it.
+  double distance_exponent = 0.0;
+  /// Solver of the SPD system.
+  SolverOptions solver = {};
+};
+
+/// The (stiffened) linear elasticity mover in Dim dimensions; models MeshMover.
+template <int Dim>
+class ElasticityMover : public detail::LinearMechanicsMover<Dim> {
+ public:
+  explicit ElasticityMover(ElasticityOptions options = {})
+      : detail::LinearMechanicsMover<Dim>("ElasticityMover"), options_(options) {}
+
+  [[nodiscard]] const ElasticityOptions& options() const noexcept { return options_; }
+  /// J0 used by the last setup (0 when χ = 0).
+  [[nodiscard]] double reference_jacobian() const noexcept { return j0_; }
+
+  /// Assembles and factorizes the elasticity system of `mesh` (any MeshLike of dimension Dim)
+  /// with the Dirichlet and sliding nodes of `boundary` (its displacements are not used).
+  /// Throws InputError for E ≤ 0, ν outside (−1, 0.5), a negative or non-finite exponent, a
+  /// degenerate cell when stiffening, a boundary without Dirichlet nodes for distance
+  /// stiffening, or bad mesh/boundary data; SolverError when the factorization fails.
+  template <MeshLike M>
+    requires(mesh_dim<M> == Dim)
+  void setup(const M& mesh, const ResolvedBoundary<Dim>& boundary) {
+    const detail::Stopwatch watch;
+    const detail::Lame lame = detail::lame_parameters(options_.youngs_modulus, options_.poisson_ratio, "ElasticityMover::setup");
+    for (const double exponent : {options_.stiffening_exponent, options_.distance_exponent})
+      if (!(exponent >= 0.0) || !std::isfinite(exponent))
+        throw InputError("ElasticityMover::setup: stiffening exponents must be finite and >= 0 (got " +
+                         std::to_string(exponent) + ")");
+    if (!std::isfinite(options_.reference_jacobian))
+      throw InputError("ElasticityMover::setup: reference_jacobian must be finite");
+    const Mesh<Dim> copy = this->start_setup(mesh, boundary);
+    const double chi = options_.stiffening_exponent;
+    j0_ = chi == 0.0 ? 0.0 : options_.reference_jacobian > 0.0 ? options_.reference_jacobian : mean_cell_measure(copy);
+    const std::vector<double> wall_factor = distance_factors(copy, boundary);
+    std::vector<Index> block_start{0};
+    for (const auto& block : copy.cells) block_start.push_back(block_start.back() + block.size());
+
+    std::atomic<bool> degenerate{false};
+    SparseMatrix stiffness = detail::assemble(copy, copy.num_nodes() * Dim, Dim * Dim, [&](Index b, Index e, auto& out) {
+      const ElementBlock& block = copy.cells[static_cast<std::size_t>(b)];
+      const detail::QuadratureTable& table = detail::quadrature_table(block.type);
+      const double measure = detail::reference_measure(block.type);
+      const double cell_factor = wall_factor.empty() ? 1.0 : wall_factor[static_cast<std::size_t>(block_start[static_cast<std::size_t>(b)] + e)];
+      detail::ElementCoords<Dim> x;
+      detail::gather_coords(copy.points, block, e, x);
+      const int n = table.num_nodes;
+      detail::ElementMatrix<Dim> k = detail::ElementMatrix<Dim>::Zero(n * Dim, n * Dim);
+      detail::ElementGradients<Dim> g;
+      Eigen::Matrix<double, Dim, Dim> jacobian;
+      for (int q = 0; q < table.size(); ++q) {
+        const double det = std::abs(detail::element_geometry<Dim>(table, q, x, g, jacobian));
+        double scale = det * table.weights[static_cast<std::size_t>(q)] * cell_factor;
+        if (chi != 0.0) {
+          if (!(det > 0.0)) {
+            degenerate.store(true, std::memory_order_relaxed);
+            return;
+          }
+          scale *= std::pow(j0_ / (det * measure), chi);
+        }
+        detail::add_elastic_stiffness<Dim>(g, lame.lambda, lame.mu, scale, k);
+      }
+      const auto nodes = block.element(e);
+      for (int a = 0; a < n; ++a)
+        for (int c = 0; c < n; ++c)
+          for (int i = 0; i < Dim; ++i)
+            for (int j = 0; j < Dim; ++j)
+              out.emplace_back(static_cast<int>(nodes[static_cast<std::size_t>(a)] * Dim + i),
+                               static_cast<int>(nodes[static_cast<std::size_t>(c)] * Dim + j), k(a * Dim + i, c * Dim + j));
+    });
+    if (degenerate)
+      throw InputError("ElasticityMover::setup: a cell has a zero Jacobian determinant (degenerate cell), so its "
+                       "stiffening factor (J0/J)^chi is infinite");
+    this->finish_setup(copy, boundary, std::move(stiffness), Dim, options_.solver, watch);
+  }
+
+ private:
+  /// Mean over the cells of their measure Σ_q w_q |det J_q|.
+  [[nodiscard]] static double mean_cell_measure(const Mesh<Dim>& mesh) {
+    double total = 0.0;
+    detail::ElementCoords<Dim> x;
+    detail::ElementGradients<Dim> g;
+    Eigen::Matrix<double, Dim, Dim> jacobian;
+    for (const auto& block : mesh.cells) {
+      const detail::QuadratureTable& table = detail::quadrature_table(block.type);
+      for (Index e = 0; e < block.size(); ++e) {
+        detail::gather_coords(mesh.points, block, e, x);
+        for (int q = 0; q < table.size(); ++q)
+          total += table.weights[static_cast<std::size_t>(q)] * std::abs(detail::element_geometry<Dim>(table, q, x, g, jacobian));
+      }
+    }
+    const double mean = total / static_cast<double>(mesh.num_cells());
+    if (!(mean > 0.0)) throw InputError("ElasticityMover::setup: every cell has zero measure (expected a positive mean)");
+    return mean;
+  }
+
+  /// (d̄/d_κ)^ψ per cell (cell order), empty when ψ = 0. Walls are the prescribed nodes, or
+  /// every Dirichlet node when none is prescribed.
+  [[nodiscard]] std::vector<double> distance_factors(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) const {
+    const double psi = options_.distance_exponent;
+    if (psi == 0.0) return {};
+    std::vector<Index> walls;
+    for (const BoundaryKind wanted : {BoundaryKind::prescribed, BoundaryKind::fixed}) {
+      for (Index k = 0; k < boundary.size(); ++k)
+        if (boundary.kinds[static_cast<std::size_t>(k)] == wanted) walls.push_back(boundary.nodes[static_cast<std::size_t>(k)]);
+      if (!walls.empty()) break;
+    }
+    if (walls.empty())
+      throw InputError("ElasticityMover::setup: distance stiffening needs prescribed or fixed boundary nodes (got none)");
+    Points<Dim> wall_points(Dim, static_cast<Index>(walls.size()));
+    for (std::size_t k = 0; k < walls.size(); ++k) wall_points.col(static_cast<Index>(k)) = mesh.points.col(walls[k]);
+    const KdTree<Dim> tree(wall_points);
+    std::vector<double> distance;
+    distance.reserve(static_cast<std::size_t>(mesh.num_cells()));
+    for (const auto& block : mesh.cells) {
+      const int nv = num_vertices(block.type);
+      for (Index e = 0; e < block.size(); ++e) {
+        const auto nodes = block.element(e);
+        Vec<Dim> centroid = Vec<Dim>::Zero();
+        for (int v = 0; v < nv; ++v) centroid += mesh.points.col(nodes[static_cast<std::size_t>(v)]);
+        centroid /= static_cast<double>(nv);
+        distance.push_back(std::sqrt(tree.nearest(centroid).second));
+      }
+    }
+    double mean = 0.0;
+    for (const double d : distance) mean += d / static_cast<double>(distance.size());
+    // A cell centroid never lies on a wall node unless the cell is degenerate; the floor
+    // keeps such a cell finite.
+    for (double& d : distance) d = std::pow(mean / std::max(d, 1e-12 * mean), psi);
+    return distance;
+  }
+
+  ElasticityOptions options_;
+  double j0_ = 0.0;
+};
+
+}  // namespace meshmotion

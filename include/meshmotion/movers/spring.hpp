@@ -1,0 +1,90 @@
+#pragma once
+/// \file
+/// SpringMover: Batina's lineal spring analogy (thesis section 2.1.1, eqs. 2.1–2.2; J. T.
+/// Batina, AIAA paper 89-0115, 1989). Every edge is a spring of stiffness k_ij = 1/‖r_i − r_j‖
+/// (more generally ‖r_i − r_j‖^−p); node displacements solve Σ_j k_ij (Δr_i − Δr_j) = 0 at
+/// every free node with the boundary displacements imposed.
+///
+/// - Linear in the displacements.
+/// - Uncoupled: one scalar Laplacian-like matrix shared by the Dim coordinate directions
+///   (Dim right-hand sides). Sliding boundaries couple the directions, so with sliding nodes
+///   the matrix is expanded to Dim dofs per node and the sliding nodes keep only their
+///   tangent-plane unknowns (they end exactly on their planes).
+/// - Any element type, 2D and 3D: springs along the cell edges (half edges on quadratic
+///   cells, see detail/spring_network.hpp), each counted once.
+/// - Setup caches the factorized reduced matrix; cost: setup = assembly O(edges) + one sparse
+///   factorization, move = one solve (forward/back substitution, or CG from the last solution).
+/// - Known weakness (thesis): inverts cells for moderate rotations; use it for small motions.
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/mesh_like.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/detail/linear_mechanics.hpp"
+#include "meshmotion/movers/detail/spring_network.hpp"
+#include "meshmotion/solvers/detail/stopwatch.hpp"
+#include "meshmotion/solvers/solver_options.hpp"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace meshmotion {
+
+/// Options of SpringMover.
+struct SpringOptions {
+  /// p in k_ij = ‖r_i − r_j‖^−p; Batina's choice (eq. 2.2) is 1. Must be finite.
+  double length_exponent = 1.0;
+  /// Solver of the (SPD) spring system.
+  SolverOptions solver = {};
+};
+
+/// Batina's lineal spring mover in Dim dimensions; models MeshMover.
+template <int Dim>
+class SpringMover : public detail::LinearMechanicsMover<Dim> {
+ public:
+  explicit SpringMover(SpringOptions options = {})
+      : detail::LinearMechanicsMover<Dim>("SpringMover"), options_(options) {}
+
+  [[nodiscard]] const SpringOptions& options() const noexcept { return options_; }
+
+  /// Assembles and factorizes the spring system of `mesh` (any MeshLike of dimension Dim)
+  /// with the Dirichlet and sliding nodes of `boundary` (its displacements are not used).
+  /// Throws InputError for a non-finite exponent, bad mesh or boundary data, or two distinct
+  /// nodes of one edge at the same position; SolverError when the factorization fails.
+  template <MeshLike M>
+    requires(mesh_dim<M> == Dim)
+  void setup(const M& mesh, const ResolvedBoundary<Dim>& boundary) {
+    const detail::Stopwatch watch;
+    if (!std::isfinite(options_.length_exponent))
+      throw InputError("SpringMover::setup: length_exponent must be finite (got " +
+                       std::to_string(options_.length_exponent) + ")");
+    const Mesh<Dim> copy = this->start_setup(mesh, boundary);
+    const int c = boundary.has_sliding() ? Dim : 1;
+    const auto springs = detail::mesh_springs(copy);
+    std::vector<Eigen::Triplet<double, int>> triplets;
+    triplets.reserve(springs.size() * 4 * static_cast<std::size_t>(c));
+    for (const auto& [a, b] : springs) {
+      const double length = (copy.points.col(a) - copy.points.col(b)).norm();
+      if (!(length > 0.0))
+        throw InputError("SpringMover::setup: nodes " + std::to_string(a) + " and " + std::to_string(b) +
+                         " share an edge but coincide (got length 0, expected > 0)");
+      const double k = std::pow(length, -options_.length_exponent);
+      for (int axis = 0; axis < c; ++axis) {
+        const auto i = static_cast<int>(a * c + axis), j = static_cast<int>(b * c + axis);
+        triplets.emplace_back(i, i, k);
+        triplets.emplace_back(j, j, k);
+        triplets.emplace_back(i, j, -k);
+        triplets.emplace_back(j, i, -k);
+      }
+    }
+    SparseMatrix stiffness(copy.num_nodes() * c, copy.num_nodes() * c);
+    stiffness.setFromTriplets(triplets.begin(), triplets.end());
+    this->finish_setup(copy, boundary, std::move(stiffness), c, options_.solver, watch);
+  }
+
+ private:
+  SpringOptions options_;
+};
+
+}  // namespace meshmotion
