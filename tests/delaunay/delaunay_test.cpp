@@ -1,14 +1,14 @@
 #include "meshmotion/delaunay.hpp"
+#include "meshmotion/delaunay/detail/spatial_sort.hpp"
+
+#include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <array>
-#include <catch2/catch.hpp>
 #include <cmath>
 #include <numbers>
 #include <random>
 #include <vector>
-
-#include "meshmotion/delaunay/detail/spatial_sort.hpp"
 
 using namespace meshmotion;
 
@@ -542,5 +542,57 @@ TEST_CASE("graph mapping reproduces affine motions and detects inversion", "[del
     // Extrapolation outside the hull is affine too.
     CHECK((mapping.map(moved) - expected).cwiseAbs().maxCoeff() < 1e-12);
     CHECK(mapping.inverted_simplices(moved).empty());
+  }
+}
+
+TEST_CASE("delaunay is invariant under power-of-two scaling", "[delaunay]") {
+  // Coordinates near 1e120 would overflow the predicates' products unscaled (and near 1e-120
+  // underflow); an exact power-of-two rescaling keeps the triangulation identical.
+  const Points<3> p = random_points<3>(500, 26);
+  const auto reference = delaunay<3>(p);
+  for (int exponent : {400, -400, 40}) {
+    const Points<3> scaled = p * std::ldexp(1.0, exponent);
+    const auto dt = delaunay<3>(scaled);
+    REQUIRE(dt.num_simplices() == reference.num_simplices());
+    CHECK(dt.simplices() == reference.simplices());
+  }
+  const Points<2> q = random_points<2>(500, 27);
+  const Points<2> huge = q * std::ldexp(1.0, 600);
+  CHECK(delaunay<2>(huge).simplices() == delaunay<2>(q).simplices());
+}
+
+TEST_CASE("delaunay of exactly co-circular and co-spherical lattice points", "[delaunay]") {
+  // Every lattice point of a circle/sphere: all on the hull and all on one circumsphere, so
+  // every in-circle/in-sphere test of a finite simplex is exactly zero.
+  SECTION("circle x^2 + y^2 = 5525 with its centre") {
+    std::vector<Vec<2>> nodes{Vec<2>(0.0, 0.0)};
+    for (int x = -75; x <= 75; ++x) {
+      for (int y = -75; y <= 75; ++y) {
+        if (x * x + y * y == 5525) nodes.emplace_back(x, y);
+      }
+    }
+    REQUIRE(nodes.size() == 49);
+    Points<2> p(2, static_cast<Index>(nodes.size()));
+    for (std::size_t i = 0; i < nodes.size(); ++i) p.col(static_cast<Index>(i)) = nodes[i];
+    const auto dt = delaunay<2>(p);
+    check_delaunay(p, dt, true);
+    CHECK(dt.num_simplices() == 48);
+  }
+  SECTION("sphere x^2 + y^2 + z^2 = 625") {
+    std::vector<Vec<3>> nodes;
+    for (int x = -25; x <= 25; ++x) {
+      for (int y = -25; y <= 25; ++y) {
+        for (int z = -25; z <= 25; ++z) {
+          if (x * x + y * y + z * z == 625) nodes.emplace_back(x, y, z);
+        }
+      }
+    }
+    REQUIRE(nodes.size() > 100);
+    Points<3> p(3, static_cast<Index>(nodes.size()));
+    for (std::size_t i = 0; i < nodes.size(); ++i) p.col(static_cast<Index>(i)) = nodes[i];
+    check_delaunay(p, delaunay<3>(p), true);
+    DelaunayOptions unsorted;
+    unsorted.spatial_sort = false;
+    check_delaunay(p, delaunay<3>(p, unsorted), true);
   }
 }

@@ -1,6 +1,7 @@
 #include "meshmotion/delaunay/predicates.hpp"
 
 #include <catch2/catch.hpp>
+
 #include <cmath>
 #include <cstdint>
 #include <random>

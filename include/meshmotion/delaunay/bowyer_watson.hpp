@@ -4,19 +4,20 @@
 /// point set, thesis appendix A (see detail/bowyer_watson_kernel.hpp for the kernel and its
 /// departures from the appendix).
 
-#include <algorithm>
-#include <cstdint>
-#include <limits>
-#include <numeric>
-#include <string>
-#include <vector>
-
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/delaunay/delaunay_triangulation.hpp"
 #include "meshmotion/delaunay/detail/bowyer_watson_kernel.hpp"
 #include "meshmotion/delaunay/detail/spatial_sort.hpp"
 #include "meshmotion/delaunay/predicates.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <string>
+#include <vector>
 
 namespace meshmotion {
 
@@ -79,6 +80,22 @@ template <int Dim>
   return true;
 }
 
+/// The exponent e such that scaling the points by 2^-e brings the largest coordinate near 1,
+/// or 0 when no scaling is needed (|e| <= 64) or when it would not be exact (a coordinate
+/// would underflow).
+template <int Dim>
+[[nodiscard]] int safe_scale_exponent(const Points<Dim>& points) {
+  const double largest = points.cwiseAbs().maxCoeff();
+  if (largest == 0.0) return 0;
+  const int exponent = std::ilogb(largest);
+  if (exponent >= -64 && exponent <= 64) return 0;
+  for (Index i = 0; i < points.size(); ++i) {
+    const double x = points.data()[i];
+    if (std::ldexp(std::ldexp(x, -exponent), exponent) != x) return 0;
+  }
+  return exponent;
+}
+
 }  // namespace detail
 
 /// Delaunay triangulation (Dim = 2, triangles) or tetrahedralization (Dim = 3) of `points`
@@ -89,7 +106,8 @@ template <int Dim>
 /// hull and are positively oriented. Points with equal coordinates are triangulated once:
 /// the lowest input index of each group is the vertex, and represents the others
 /// (DelaunayTriangulation::representative).
-/// Expected cost O(n log n); about a second per million points in 2D.
+/// Coordinates of any magnitude are handled (an exact power-of-two rescaling guards the
+/// predicates against overflow). Expected cost O(n log n); see benchmarks/delaunay_bench.cpp.
 ///
 /// Throws InputError when a coordinate is not finite, when there are fewer than Dim + 1
 /// distinct points, or when all points are collinear (2D) / coplanar (3D).
@@ -114,14 +132,20 @@ template <int Dim>
                        " has a non-finite coordinate (expected finite coordinates)");
     }
   }
+  // Very large or very small coordinates are scaled by a power of two, which is exact and
+  // keeps every predicate's sign, so that the predicates' products cannot overflow/underflow.
+  const int exponent = detail::safe_scale_exponent(points);
+  Points<Dim> rescaled;
+  if (exponent != 0) rescaled = points.unaryExpr([&](double x) { return std::ldexp(x, -exponent); });
+  const Points<Dim>& work = exponent != 0 ? rescaled : points;
   std::vector<Index> order;
   if (options.spatial_sort) {
-    order = detail::brio_order<Dim>(points, options.seed);
+    order = detail::brio_order<Dim>(work, options.seed);
   } else {
     order.resize(static_cast<std::size_t>(n));
     std::iota(order.begin(), order.end(), Index{0});
   }
-  if (!detail::move_first_simplex_to_front<Dim>(points, order)) {
+  if (!detail::move_first_simplex_to_front<Dim>(work, order)) {
     throw InputError(where + ": all " + std::to_string(n) + " points are " +
                      (Dim == 2 ? "collinear" : "coplanar") + " (expected at least " +
                      std::to_string(Dim + 1) + " affinely independent points)");
@@ -129,8 +153,7 @@ template <int Dim>
   // Coordinates in insertion order: the kernel then reads memory in the order it walks.
   std::vector<double> sorted(static_cast<std::size_t>(n) * Dim);
   for (Index k = 0; k < n; ++k) {
-    for (int d = 0; d < Dim; ++d)
-      sorted[static_cast<std::size_t>(k) * Dim + d] = points(d, order[k]);
+    for (int d = 0; d < Dim; ++d) sorted[static_cast<std::size_t>(k) * Dim + d] = work(d, order[k]);
   }
   detail::BowyerWatsonKernel<Dim> kernel(sorted.data(), static_cast<Id>(n), options.seed);
   kernel.run();

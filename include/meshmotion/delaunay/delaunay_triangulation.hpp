@@ -4,17 +4,18 @@
 /// point location with barycentric coordinates (the query of the Delaunay graph mapping,
 /// thesis section 2.2.1).
 
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/delaunay/detail/bowyer_watson_kernel.hpp"
+
 #include <Eigen/Core>
+
 #include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include "meshmotion/core/error.hpp"
-#include "meshmotion/core/types.hpp"
-#include "meshmotion/delaunay/detail/bowyer_watson_kernel.hpp"
 
 namespace meshmotion {
 
@@ -129,7 +130,8 @@ class DelaunayTriangulation {
   /// Locates q by a visibility walk (exact orientation tests) from `hint` (a simplex index;
   /// -1 or out of range starts from simplex 0). Outside the convex hull, returns the simplex
   /// whose hull facet is nearest to q, flagged `outside`, with extrapolating barycentric
-  /// coordinates. Throws InputError for a non-finite q.
+  /// coordinates. The exact orientation tests assume coordinates of magnitude between about
+  /// 1e-60 and 1e60 (no overflow in their products). Throws InputError for a non-finite q.
   [[nodiscard]] LocateResult<Dim> locate(const Vec<Dim>& q, Index hint = -1) const {
     if (!q.allFinite()) {
       throw InputError("DelaunayTriangulation::locate: point has a non-finite coordinate");

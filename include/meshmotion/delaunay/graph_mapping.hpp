@@ -10,15 +10,16 @@
 /// Setup costs one hinted walk per query (queries visited in Hilbert order); mapping costs
 /// (Dim + 1) × Dim multiply-adds per query and allocates nothing in its non-allocating form.
 
-#include <Eigen/Core>
-#include <string>
-#include <vector>
-
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/delaunay/delaunay_triangulation.hpp"
 #include "meshmotion/delaunay/detail/bowyer_watson_kernel.hpp"
 #include "meshmotion/delaunay/detail/spatial_sort.hpp"
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
 
 namespace meshmotion {
 

@@ -16,11 +16,12 @@
 /// - insphere(a, b, c, d, e) > 0 when e lies strictly inside the sphere through a, b, c, d
 ///   and orient3d(a, b, c, d) > 0 (the sign flips for negative orientation).
 
+#include "meshmotion/delaunay/detail/expansion.hpp"
+
 #include <Eigen/Core>
+
 #include <array>
 #include <cmath>
-
-#include "meshmotion/delaunay/detail/expansion.hpp"
 
 namespace meshmotion {
 

@@ -16,6 +16,9 @@
 /// - Replacing the vertex opposite each cavity boundary facet by the new point keeps the
 ///   positive orientation of every simplex (note 4 of the appendix) without bookkeeping.
 
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/delaunay/predicates.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -23,9 +26,6 @@
 #include <limits>
 #include <string>
 #include <vector>
-
-#include "meshmotion/core/error.hpp"
-#include "meshmotion/delaunay/predicates.hpp"
 
 namespace meshmotion::detail {
 

@@ -6,13 +6,13 @@
 /// randomized expected complexity. The points are normalized to the unit box only to compute
 /// the curve keys (thesis appendix A, "scale entries of pointList to normalize the data").
 
+#include "meshmotion/core/types.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <random>
 #include <vector>
-
-#include "meshmotion/core/types.hpp"
 
 namespace meshmotion::detail {
 
