@@ -7,12 +7,14 @@
 #include "meshmotion/curving/function_graph.hpp"
 #include "meshmotion/curving/geometry.hpp"
 #include "meshmotion/curving/naca_section.hpp"
+#include "meshmotion/curving/surface_reconstruction.hpp"
 
 #include <Eigen/Dense>
 
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <utility>
 #include <vector>
@@ -494,4 +496,203 @@ TEST_CASE("function-graph projections find the closest point of the bump", "[cur
   CHECK_THROWS_AS(bump(Vec<2>(std::nan(""), 0.0)), InputError);
   const GraphProjection2 broken([](double) { return GraphSample1{std::nan(""), 0.0, 0.0}; });
   CHECK_THROWS_AS(broken(Vec<2>(0.0, 1.0)), SolverError);
+}
+
+namespace {
+
+struct TriangleSurface {
+  Points<3> points;
+  std::vector<Index> triangles;
+};
+
+TriangleSurface from_vectors(const std::vector<Vec<3>>& vertices, std::vector<Index> triangles) {
+  TriangleSurface s;
+  s.points.resize(3, static_cast<Index>(vertices.size()));
+  for (std::size_t i = 0; i < vertices.size(); ++i) s.points.col(static_cast<Index>(i)) = vertices[i];
+  s.triangles = std::move(triangles);
+  return s;
+}
+
+/// Unit icosphere: the icosahedron with every triangle split in four `levels` times.
+TriangleSurface icosphere(int levels) {
+  const double g = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Vec<3>> v{{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
+                        {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  for (Vec<3>& x : v) x.normalize();
+  std::vector<Index> t{0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4,
+                       11, 10, 2, 10, 7, 6, 7, 1, 8, 3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8,
+                       3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
+  for (int level = 0; level < levels; ++level) {
+    std::map<std::pair<Index, Index>, Index> middle;
+    auto mid = [&](Index a, Index b) {
+      const auto key = std::minmax(a, b);
+      if (const auto it = middle.find(key); it != middle.end()) return it->second;
+      v.push_back((v[static_cast<std::size_t>(a)] + v[static_cast<std::size_t>(b)]).normalized());
+      return middle[key] = static_cast<Index>(v.size()) - 1;
+    };
+    std::vector<Index> finer;
+    for (std::size_t i = 0; i < t.size(); i += 3) {
+      const Index a = t[i], b = t[i + 1], c = t[i + 2];
+      const Index ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
+      for (Index x : {a, ab, ca, ab, b, bc, ca, bc, c, ab, bc, ca}) finer.push_back(x);
+    }
+    t = std::move(finer);
+  }
+  return from_vectors(v, std::move(t));
+}
+
+/// Quads (i, j) -> (i+1, j+1) of an (nu+1) × (nv+1) grid of `point(i, j)`, two triangles each.
+void add_grid(std::vector<Vec<3>>& v, std::vector<Index>& t, int nu, int nv,
+              const std::function<Vec<3>(int, int)>& point, bool wrap_u) {
+  const auto base = static_cast<Index>(v.size());
+  const int columns = wrap_u ? nu : nu + 1;
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i < columns; ++i) v.push_back(point(i, j));
+  auto id = [&](int i, int j) { return base + j * columns + (i % columns); };
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i)
+      for (Index x : {id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j), id(i + 1, j + 1), id(i, j + 1)})
+        t.push_back(x);
+}
+
+/// Largest |distance(p)| over the reconstructed midpoints of all edges and triangle centres.
+double max_reconstruction_error(const TriangleSurface& s, const SurfaceReconstruction& r,
+                                const std::function<double(const Vec<3>&)>& distance) {
+  double error = 0.0;
+  auto record = [&](double d) { error = std::isnan(d) || std::isnan(error) ? NAN : std::max(error, d); };
+  for (Index t = 0; t < r.num_triangles(); ++t) {
+    for (int k = 0; k < 3; ++k)
+      record(distance(r.edge_midpoint(s.triangles[3 * t + k], s.triangles[3 * t + (k + 1) % 3])));
+    record(distance(r.point(t, Vec<3>::Constant(1.0 / 3.0))));
+  }
+  return error;
+}
+
+}  // namespace
+
+TEST_CASE("surface reconstruction converges at h^3 or faster on a sphere", "[curving]") {
+  auto sphere_distance = [](const Vec<3>& p) { return std::abs(p.norm() - 1.0); };
+  for (int degree : {2, 3}) {
+    std::vector<double> errors;
+    double linear = 0.0;
+    for (int level = 1; level <= 4; ++level) {
+      const TriangleSurface s = icosphere(level);
+      SurfaceReconstructionOptions options;
+      options.degree = degree;
+      const SurfaceReconstruction r(s.points, s.triangles, options);
+      errors.push_back(max_reconstruction_error(s, r, sphere_distance));
+      linear = 0.0;
+      for (std::size_t i = 0; i < s.triangles.size(); i += 3)
+        linear = std::max(linear, sphere_distance(0.5 * (s.points.col(s.triangles[i]) +
+                                                         s.points.col(s.triangles[i + 1]))));
+    }
+    INFO("degree " << degree << ": errors " << errors[0] << " " << errors[1] << " " << errors[2]
+                   << " " << errors[3] << " (straight midpoints " << linear << ")");
+    for (double order : orders(errors)) CHECK(order >= 3.0);
+    CHECK(errors.back() < 0.01 * linear);
+  }
+}
+
+TEST_CASE("surface reconstruction keeps the edges and corners of a cube sharp", "[curving]") {
+  // Cube [-1, 1]^3, 3 × 3 quads per face.
+  std::vector<Vec<3>> v;
+  std::vector<Index> t;
+  const int n = 3;
+  for (int axis = 0; axis < 3; ++axis)
+    for (double side : {-1.0, 1.0})
+      add_grid(v, t, n, n, [&](int i, int j) {
+        Vec<3> p;
+        p[axis] = side;
+        // Orientation does not matter to the reconstruction; the grid is uneven on purpose
+        // (the same spacing in both directions, so faces meet node to node).
+        auto graded = [&](int k) { return -1.0 + 2.0 * std::pow(static_cast<double>(k) / n, 1.3); };
+        p[(axis + 1) % 3] = graded(i);
+        p[(axis + 2) % 3] = graded(j);
+        return p;
+      }, false);
+  // Merge the duplicated nodes along the cube's edges.
+  std::vector<Index> unique_of(v.size());
+  std::vector<Vec<3>> merged;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    unique_of[i] = static_cast<Index>(merged.size());
+    for (std::size_t j = 0; j < merged.size(); ++j)
+      if ((merged[j] - v[i]).norm() < 1e-12) unique_of[i] = static_cast<Index>(j);
+    if (unique_of[i] == static_cast<Index>(merged.size())) merged.push_back(v[i]);
+  }
+  for (Index& x : t) x = unique_of[static_cast<std::size_t>(x)];
+  const TriangleSurface s = from_vectors(merged, t);
+  REQUIRE(s.points.cols() == 6 * 4 + 12 * 2 + 8);  // closed: the faces share their borders
+  auto cube_distance = [](const Vec<3>& p) { return std::abs(p.cwiseAbs().maxCoeff() - 1.0); };
+
+  const SurfaceReconstruction sharp(s.points, s.triangles);
+  // Node 0 of the first face is the corner (-1, -1, -1); node 1 lies on the edge x = z = -1,
+  // node 5 inside the face x = -1.
+  CHECK(sharp.is_ridge(unique_of[0], unique_of[1]));
+  CHECK_FALSE(sharp.is_ridge(unique_of[1], unique_of[5]));
+  CHECK(max_reconstruction_error(s, sharp, cube_distance) < 1e-12);
+  SurfaceReconstructionOptions no_ridges;
+  no_ridges.ridge_angle = 180.0;
+  const SurfaceReconstruction rounded(s.points, s.triangles, no_ridges);
+  CHECK(max_reconstruction_error(s, rounded, cube_distance) > 1e-3);
+}
+
+TEST_CASE("surface reconstruction follows a curved ridge: the rim of a cylinder", "[curving]") {
+  // Unit cylinder side (0 <= z <= 1) with a flat cap at z = 1: the rim is a 90-degree ridge.
+  auto rim_distance = [](const Vec<3>& p) {
+    return std::abs(p.head<2>().norm() - 1.0) + std::abs(p.z() - 1.0);
+  };
+  std::vector<double> errors;
+  for (int m : {16, 32, 64}) {
+    std::vector<Vec<3>> v;
+    std::vector<Index> t;
+    add_grid(v, t, m, 4, [&](int i, int j) {
+      const double angle = 2.0 * pi * i / m;
+      return Vec<3>(std::cos(angle), std::sin(angle), 0.25 * j);
+    }, true);
+    // Cap: the rim (the side's top row) and an inner ring at radius 0.5, plus a centre.
+    const auto rim = static_cast<Index>(4 * m);
+    const auto inner = static_cast<Index>(v.size());
+    for (int i = 0; i < m; ++i) {
+      const double angle = 2.0 * pi * (i + 0.5) / m;
+      v.push_back(Vec<3>(0.5 * std::cos(angle), 0.5 * std::sin(angle), 1.0));
+    }
+    const auto centre = static_cast<Index>(v.size());
+    v.push_back(Vec<3>(0.0, 0.0, 1.0));
+    for (Index i = 0; i < m; ++i) {
+      const Index next = (i + 1) % m;
+      for (Index x : {rim + i, rim + next, inner + i, inner + i, rim + next, inner + next,
+                      inner + i, inner + next, centre})
+        t.push_back(x);
+    }
+    const TriangleSurface s = from_vectors(v, t);
+    const SurfaceReconstruction r(s.points, s.triangles);
+    double error = 0.0;
+    for (Index i = 0; i < m; ++i) {
+      REQUIRE(r.is_ridge(rim + i, rim + (i + 1) % m));
+      error = std::max(error, rim_distance(r.edge_midpoint(rim + i, rim + (i + 1) % m)));
+    }
+    errors.push_back(error);
+  }
+  INFO("rim errors " << errors[0] << " " << errors[1] << " " << errors[2]);
+  for (double order : orders(errors)) CHECK(order >= 3.0);
+}
+
+TEST_CASE("surface reconstruction rejects bad input", "[curving]") {
+  const TriangleSurface s = icosphere(1);
+  SurfaceReconstructionOptions bad_degree;
+  bad_degree.degree = 4;
+  CHECK_THROWS_AS(SurfaceReconstruction(s.points, s.triangles, bad_degree), InputError);
+  std::vector<Index> truncated(s.triangles.begin(), s.triangles.end() - 1);
+  CHECK_THROWS_AS(SurfaceReconstruction(s.points, truncated), InputError);
+  std::vector<Index> out_of_range = s.triangles;
+  out_of_range[4] = s.points.cols();
+  CHECK_THROWS_AS(SurfaceReconstruction(s.points, out_of_range), InputError);
+  std::vector<Index> degenerate = s.triangles;
+  degenerate[1] = degenerate[0];
+  CHECK_THROWS_AS(SurfaceReconstruction(s.points, degenerate), InputError);
+  const SurfaceReconstruction r(s.points, s.triangles);
+  CHECK_THROWS_AS(r.edge_midpoint(s.triangles[0], s.triangles[0]), InputError);
+  // A lone triangle has too few points for any fitting.
+  const std::vector<Index> lone{0, 1, 2};
+  CHECK_THROWS_AS(SurfaceReconstruction(s.points, lone), SolverError);
 }
