@@ -100,14 +100,18 @@ inline constexpr double predicate_epsilon = 0x1p-53;
   return det.sign();
 }
 
-/// The differences p[k] - q[k] (k < N) when all are exact doubles (true for nearby points
-/// by Sterbenz's lemma, hence for most tests on grids); false otherwise.
-template <int N>
-[[nodiscard]] inline bool exact_differences(const double* p, const double* q, double* out) {
-  for (int k = 0; k < N; ++k) {
-    double tail = 0.0;
-    two_sum(p[k], -q[k], out[k], tail);
-    if (tail != 0.0) return false;
+/// The differences points[i][k] - origin[k] (k < N) into out[i] when all are exact doubles
+/// (true for nearby points by Sterbenz's lemma, hence for most tests on grids); false
+/// otherwise.
+template <int N, std::size_t Count>
+[[nodiscard]] inline bool exact_differences(const std::array<const double*, Count>& points,
+                                            const double* origin, double (&out)[Count][N]) {
+  for (std::size_t i = 0; i < Count; ++i) {
+    for (int k = 0; k < N; ++k) {
+      double tail = 0.0;
+      two_sum(points[i][k], -origin[k], out[i][k], tail);
+      if (tail != 0.0) return false;
+    }
   }
   return true;
 }
@@ -123,11 +127,9 @@ template <std::size_t A>
 [[nodiscard]] inline int insphere_exact_differences(const double* a, const double* b,
                                                     const double* c, const double* d,
                                                     const double* e) {
-  double ae[3], be[3], ce[3], de[3];
-  if (!exact_differences<3>(a, e, ae) || !exact_differences<3>(b, e, be) ||
-      !exact_differences<3>(c, e, ce) || !exact_differences<3>(d, e, de)) {
-    return 2;
-  }
+  double to_e[4][3];
+  if (!exact_differences<3, 4>({a, b, c, d}, e, to_e)) return 2;
+  const double *ae = to_e[0], *be = to_e[1], *ce = to_e[2], *de = to_e[3];
   const auto ab = two_by_two(ae[0], be[1], be[0], ae[1]);
   const auto bc = two_by_two(be[0], ce[1], ce[0], be[1]);
   const auto cd = two_by_two(ce[0], de[1], de[0], ce[1]);
@@ -151,41 +153,45 @@ template <std::size_t A>
   return det.sign();
 }
 
+/// The 3×3 determinant with rows (x_i, y_i, last_i), expanded along its last column:
+/// Σ last_i (x_j y_k - x_k y_j) over cyclic (i, j, k), exact.
+template <std::size_t L>
+[[nodiscard]] FixedExpansion<24 * L> last_column_determinant(const double* const (&xy)[3],
+                                                             const FixedExpansion<L> (&last)[3]) {
+  FixedExpansion<8 * L> terms[3];
+  for (int i = 0; i < 3; ++i) {
+    const double* p = xy[(i + 1) % 3];
+    const double* q = xy[(i + 2) % 3];
+    terms[i] = last[i] * two_by_two(p[0], q[1], q[0], p[1]);
+  }
+  return terms[0] + terms[1] + terms[2];
+}
+
 /// Shewchuk's orient3d determinant, exact, when the differences to d are exact doubles.
 /// Returns 2 when they are not.
 [[nodiscard]] inline int orient3d_exact_differences(const double* a, const double* b,
                                                     const double* c, const double* d) {
-  double ad[3], bd[3], cd[3];
-  if (!exact_differences<3>(a, d, ad) || !exact_differences<3>(b, d, bd) ||
-      !exact_differences<3>(c, d, cd)) {
-    return 2;
+  double to_d[3][3];
+  if (!exact_differences<3, 3>({a, b, c}, d, to_d)) return 2;
+  FixedExpansion<1> z[3];
+  for (int i = 0; i < 3; ++i) {
+    z[i].terms[0] = to_d[i][2];
+    z[i].size = to_d[i][2] != 0.0 ? 1 : 0;
   }
-  const auto det = scaled(two_by_two(bd[0], cd[1], cd[0], bd[1]), ad[2]) +
-                   scaled(two_by_two(cd[0], ad[1], ad[0], cd[1]), bd[2]) +
-                   scaled(two_by_two(ad[0], bd[1], bd[0], ad[1]), cd[2]);
-  return det.sign();
+  return last_column_determinant<1>({to_d[0], to_d[1], to_d[2]}, z).sign();
 }
 
 /// Shewchuk's incircle determinant, exact, when the differences to d are exact doubles.
 /// Returns 2 when they are not.
 [[nodiscard]] inline int incircle_exact_differences(const double* a, const double* b,
                                                     const double* c, const double* d) {
-  double ad[2], bd[2], cd[2];
-  if (!exact_differences<2>(a, d, ad) || !exact_differences<2>(b, d, bd) ||
-      !exact_differences<2>(c, d, cd)) {
-    return 2;
+  double to_d[3][2];
+  if (!exact_differences<2, 3>({a, b, c}, d, to_d)) return 2;
+  FixedExpansion<4> lift[3];
+  for (int i = 0; i < 3; ++i) {
+    lift[i] = two_by_two(to_d[i][0], to_d[i][0], to_d[i][1], -to_d[i][1]);  // x^2 + y^2
   }
-  auto lift = [](const double* v) {
-    FixedExpansion<2> x, y;
-    two_product(v[0], v[0], x.terms[1], x.terms[0]);
-    two_product(v[1], v[1], y.terms[1], y.terms[0]);
-    x.size = y.size = 2;
-    return x + y;
-  };
-  const auto det = (lift(ad) * two_by_two(bd[0], cd[1], cd[0], bd[1]) +
-                    lift(bd) * two_by_two(cd[0], ad[1], ad[0], cd[1])) +
-                   lift(cd) * two_by_two(ad[0], bd[1], bd[0], ad[1]);
-  return det.sign();
+  return last_column_determinant<4>({to_d[0], to_d[1], to_d[2]}, lift).sign();
 }
 
 }  // namespace detail
