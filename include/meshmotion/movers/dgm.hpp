@@ -1,0 +1,78 @@
+#pragma once
+/// \file
+/// DgmMover: Delaunay graph mapping (Liu, Qin & Xia, JCP 2006; thesis section 2.2.1).
+///
+/// - The Delaunay graph is triangulated over the boundary nodes (prescribed, fixed and
+///   sliding); every other node keeps its barycentric coordinates in its graph simplex and
+///   is mapped into the moved simplex. Linear in the displacements; reproduces affine
+///   motions exactly for every node inside the graph's convex hull.
+/// - The map is a valid mesh motion only while no graph simplex inverts: move() checks every
+///   simplex (exact orientation test) and throws InvalidMeshError naming one, with the advice
+///   to use more steps; run_steps() rebuilds the graph on the moved mesh at each step.
+/// - Nodes outside the graph's hull: DgmOptions::outside (clamped by default, see OutsideGraph).
+/// - Sliding nodes: interpolated from a graph without them, projected onto their plane.
+/// - Setup caches: the graph's simplices and, per node, its simplex and Dim+1 weights.
+///   Cost: setup = one Bowyer–Watson triangulation of m boundary nodes + one walk per node,
+///   O((m + n) log m) in practice; move = (Dim+1) × Dim multiply-adds per node plus the
+///   inversion test over the graph's O(m) simplices; no linear system.
+
+#include "meshmotion/core/mesh_like.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/delaunay_graph_options.hpp"
+#include "meshmotion/movers/detail/graph_mover_base.hpp"
+#include "meshmotion/movers/mover.hpp"
+
+#include <optional>
+
+namespace meshmotion {
+
+/// Options of DgmMover.
+struct DgmOptions {
+  OutsideGraph outside = OutsideGraph::clamp;
+  /// Refuse (InvalidMeshError) when the moved graph inverts; false maps anyway.
+  bool check_inversion = true;
+};
+
+/// The DGM mover in Dim dimensions; models MeshMover.
+template <int Dim>
+class DgmMover {
+ public:
+  static constexpr int dim = Dim;
+
+  explicit DgmMover(DgmOptions options = {}) : options_(options) {}
+
+  [[nodiscard]] const DgmOptions& options() const noexcept { return options_; }
+  [[nodiscard]] const MoverStats& stats() const noexcept { return base_.stats(); }
+  /// Nodes outside the graph's convex hull at the last setup.
+  [[nodiscard]] Index num_outside() const noexcept { return base_.graph().num_outside(); }
+
+  /// Builds the graph and the barycentric coordinates (see the file comment). `boundary`:
+  /// nodes and kinds (displacements unused). Throws InputError for unsorted, out-of-range or
+  /// non-finite data, or boundary nodes that span no simplex (fewer than Dim+1, collinear).
+  template <MeshLike M>
+    requires(mesh_dim<M> == Dim)
+  void setup(const M& mesh, const ResolvedBoundary<Dim>& boundary) {
+    base_.setup(copy_points(mesh), boundary, {}, std::nullopt, options_.outside);
+  }
+
+  /// Displacement of every node (Dim × n_nodes) for boundary displacements `d`
+  /// (Dim × boundary.size(); sliding entries ignored). Throws InputError for a wrong shape or
+  /// a non-finite value, InvalidMeshError when the moved graph inverts (check_inversion).
+  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
+    Points<Dim> out;
+    move_into(d, out);
+    return out;
+  }
+
+  /// move() into `out` (resized only when its shape differs).
+  void move_into(const Points<Dim>& d, Points<Dim>& out) {
+    base_.move_displacements(d, Points<Dim>(Dim, 0), options_.check_inversion, out);
+  }
+
+ private:
+  DgmOptions options_;
+  detail::GraphMoverBase<Dim> base_{"DgmMover"};
+};
+
+}  // namespace meshmotion
