@@ -136,7 +136,9 @@ template <int Dim>
   // keeps every predicate's sign, so that the predicates' products cannot overflow/underflow.
   const int exponent = detail::safe_scale_exponent(points);
   Points<Dim> rescaled;
-  if (exponent != 0) rescaled = points.unaryExpr([&](double x) { return std::ldexp(x, -exponent); });
+  if (exponent != 0) {
+    rescaled = points.unaryExpr([&](double x) { return std::ldexp(x, -exponent); });
+  }
   const Points<Dim>& work = exponent != 0 ? rescaled : points;
   std::vector<Index> order;
   if (options.spatial_sort) {

@@ -130,8 +130,9 @@ class DelaunayTriangulation {
   /// Locates q by a visibility walk (exact orientation tests) from `hint` (a simplex index;
   /// -1 or out of range starts from simplex 0). Outside the convex hull, returns the simplex
   /// whose hull facet is nearest to q, flagged `outside`, with extrapolating barycentric
-  /// coordinates. The exact orientation tests assume coordinates of magnitude between about
-  /// 1e-60 and 1e60 (no overflow in their products). Throws InputError for a non-finite q.
+  /// coordinates (found by a scan of the hull facets: an outside query costs O(hull size)).
+  /// The exact orientation tests assume coordinates of magnitude between about 1e-60 and 1e60
+  /// (no overflow in their products). Throws InputError for a non-finite q.
   [[nodiscard]] LocateResult<Dim> locate(const Vec<Dim>& q, Index hint = -1) const {
     if (!q.allFinite()) {
       throw InputError("DelaunayTriangulation::locate: point has a non-finite coordinate");
