@@ -1,0 +1,15 @@
+#pragma once
+/// \file
+/// The curving layer: P1 → P2 conversion, boundary reconstruction (2D splines) and analytic
+/// projections, boundary snapping, boundary-layer estimate, the blending regularizer and the
+/// curve_mesh pipeline (docs/curving.md).
+
+#include "meshmotion/curving/blend_regularizer.hpp"
+#include "meshmotion/curving/boundary_layer.hpp"
+#include "meshmotion/curving/boundary_snapping.hpp"
+#include "meshmotion/curving/boundary_spline.hpp"
+#include "meshmotion/curving/curve_mesh.hpp"
+#include "meshmotion/curving/function_graph.hpp"
+#include "meshmotion/curving/geometry.hpp"
+#include "meshmotion/curving/naca_section.hpp"
+#include "meshmotion/curving/p2_conversion.hpp"
