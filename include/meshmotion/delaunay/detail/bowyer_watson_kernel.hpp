@@ -85,6 +85,7 @@ class BowyerWatsonKernel {
   BowyerWatsonKernel(const double* coordinates, Id n_vertices, std::uint64_t seed)
       : xyz_(coordinates), n_(n_vertices), rng_state_(seed | 1u), representative_(n_vertices) {
     cells_.reserve((Dim == 2 ? 2 : 7) * static_cast<std::size_t>(n_) + 16);
+    if constexpr (Dim == 2) vertex_ridges_.resize(static_cast<std::size_t>(n_) + 1);
     for (Id v = 0; v < n_; ++v) representative_[v] = v;
   }
 
@@ -321,16 +322,18 @@ class BowyerWatsonKernel {
   }
 
   /// Joins every cavity boundary facet to the new vertex and links the new simplices to each
-  /// other through the hash of their shared ridges.
+  /// other through their shared ridges (the new facets minus the new vertex).
   void retriangulate(Id v) {
     for (Id s : cavity_) {
       vertex_ref(s, 0) = -1;
       free_.push_back(s);
     }
-    std::size_t table_size = 16;
-    while (table_size < 4 * Dim * boundary_.size()) table_size *= 2;
-    if (ridges_.size() < table_size) ridges_.resize(table_size);
-    const std::size_t mask = table_size - 1;
+    if constexpr (Dim == 3) {
+      std::size_t table_size = 16;
+      while (table_size < 4 * Dim * boundary_.size()) table_size *= 2;
+      if (ridges_.size() < table_size) ridges_.resize(table_size);
+      ridge_mask_ = table_size - 1;
+    }
     Id finite_new = -1;
     for (BoundaryFacet& f : boundary_) {
       f.vertices[f.facet] = v;
@@ -344,37 +347,52 @@ class BowyerWatsonKernel {
       neighbour_ref(s, f.facet) = f.outside;
       neighbour_ref(f.outside, f.outside_facet) = s;
       for (int j = 0; j < corners; ++j) {
-        if (j == f.facet) continue;
-        // The ridge shared with another new simplex: this facet minus the new vertex.
-        Id low = std::numeric_limits<Id>::max();
-        Id high = -1;
-        for (int k = 0; k < corners; ++k) {
-          if (k == j || k == f.facet) continue;
-          low = std::min(low, f.vertices[k]);
-          high = std::max(high, f.vertices[k]);
-        }
-        std::size_t slot = (static_cast<std::size_t>(low) * 0x9E3779B97F4A7C15ull ^
-                            static_cast<std::size_t>(high)) &
-                           mask;
-        while (true) {
-          RidgeEntry& e = ridges_[slot];
-          if (e.simplex < 0) {
-            e = RidgeEntry{low, high, s, j};
-            touched_.push_back(slot);
-            break;
-          }
-          if (e.low == low && e.high == high) {
-            neighbour_ref(s, j) = e.simplex;
-            neighbour_ref(e.simplex, e.facet) = s;
-            break;
-          }
-          slot = (slot + 1) & mask;
-        }
+        if (j != f.facet) link_ridge(s, j, f);
       }
     }
-    for (std::size_t slot : touched_) ridges_[slot] = RidgeEntry{};
-    touched_.clear();
+    if constexpr (Dim == 3) {
+      for (std::size_t slot : touched_) ridges_[slot] = RidgeEntry{};
+      touched_.clear();
+    }
     last_ = finite_new;
+  }
+
+  /// Links the facet opposite vertex j of new simplex s to the other new simplex sharing its
+  /// ridge, or records it for that simplex.
+  void link_ridge(Id s, int j, const BoundaryFacet& f) {
+    RidgeEntry* entry = nullptr;
+    if constexpr (Dim == 2) {
+      // The ridge is one vertex: a vertex-indexed table stamped by insertion (in `low`).
+      entry = &vertex_ridges_[f.vertices[3 - j - f.facet]];
+      if (entry->low != static_cast<Id>(epoch_)) {
+        *entry = RidgeEntry{static_cast<Id>(epoch_), 0, s, j};
+        return;
+      }
+    } else {
+      // The ridge is an edge: a small open-addressing hash table, cleared after each insertion.
+      Id low = std::numeric_limits<Id>::max();
+      Id high = -1;
+      for (int k = 0; k < corners; ++k) {
+        if (k == j || k == f.facet) continue;
+        low = std::min(low, f.vertices[k]);
+        high = std::max(high, f.vertices[k]);
+      }
+      std::size_t slot =
+          (static_cast<std::size_t>(low) * 0x9E3779B97F4A7C15ull ^ static_cast<std::size_t>(high)) &
+          ridge_mask_;
+      while (ridges_[slot].simplex >= 0 &&
+             (ridges_[slot].low != low || ridges_[slot].high != high)) {
+        slot = (slot + 1) & ridge_mask_;
+      }
+      entry = &ridges_[slot];
+      if (entry->simplex < 0) {
+        *entry = RidgeEntry{low, high, s, j};
+        touched_.push_back(slot);
+        return;
+      }
+    }
+    neighbour_ref(s, j) = entry->simplex;
+    neighbour_ref(entry->simplex, entry->facet) = s;
   }
 
   const double* xyz_;
@@ -387,7 +405,9 @@ class BowyerWatsonKernel {
   Id last_ = 0;
   std::vector<Id> cavity_;
   std::vector<BoundaryFacet> boundary_;
-  std::vector<RidgeEntry> ridges_;
+  std::vector<RidgeEntry> ridges_;         // 3D
+  std::size_t ridge_mask_ = 0;             // 3D: ridges_ size - 1 for this insertion
+  std::vector<RidgeEntry> vertex_ridges_;  // 2D: per vertex, `low` holds the insertion stamp
   std::vector<std::size_t> touched_;
 };
 
