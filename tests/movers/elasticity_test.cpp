@@ -1,12 +1,13 @@
 // Mechanics movers: lineal and torsional springs, linear and stiffened elasticity, neo-Hookean.
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/curving/p2_conversion.hpp"
+#include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/detail/fem_assembly.hpp"
+#include "meshmotion/movers/motion.hpp"
 #include "meshmotion/movers/elasticity.hpp"
 #include "meshmotion/movers/nonlinear_elasticity.hpp"
 #include "meshmotion/movers/spring.hpp"
 #include "meshmotion/movers/torsion_spring.hpp"
-#include "meshmotion/quality/cell_quality.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -136,4 +137,313 @@ TEST_CASE("linear elasticity reproduces affine motions on every P1 and P2 elemen
         check_affine_patch(with_order(linear, order, complete), 1e-9);
       }
   }
+}
+
+namespace {
+
+/// A rectangle whose top moves by (0.1, −0.05), left and right fixed, bottom sliding (y = 0).
+BoundarySpec<2> shear_spec() {
+  BoundarySpec<2> spec;
+  spec.moving("top", Translation<2>{Vec<2>(0.1, -0.05)});
+  spec.fixed("left");
+  spec.fixed("right");
+  spec.sliding("bottom");
+  return spec;
+}
+
+/// A square body in a ring of triangles (thin wall cells), groups "wall" and "farfield".
+Mesh<2> ring(double first_height = 0.02) {
+  OMeshOptions o;
+  o.body = OMeshBody::square;
+  o.semi_axis_x = 0.5;
+  o.n_around = 32;
+  o.n_radial = 14;
+  o.first_height = first_height;
+  o.farfield_radius = 4.0;
+  o.triangles = true;
+  return o_mesh(o);
+}
+
+template <class Mover, int Dim>
+Points<Dim> run(Mover mover, const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& b) {
+  mover.setup(mesh, b);
+  return mover.move(b.displacements);
+}
+
+template <int Dim>
+double symmetry_defect(const SparseMatrix& k) {
+  return SparseMatrix(k - SparseMatrix(k.transpose())).norm() / k.norm();
+}
+
+/// L2 norm of (u_h − u) over the mesh with a degree-8 rule.
+template <class F>
+double l2_error(const Mesh<2>& mesh, const Points<2>& u, F&& exact) {
+  double sum = 0.0;
+  for (const auto& block : mesh.cells) {
+    const auto table = detail::make_quadrature_table(block.type, 8);
+    const int n = table.num_nodes;
+    detail::ElementCoords<2> x, ue;
+    detail::ElementGradients<2> g;
+    Eigen::Matrix2d jac;
+    for (Index e = 0; e < block.size(); ++e) {
+      detail::gather_coords(mesh.points, block, e, x);
+      detail::gather_coords(u, block, e, ue);
+      for (int q = 0; q < table.size(); ++q) {
+        const double w = std::abs(detail::element_geometry<2>(table, q, x, g, jac)) * table.weights[static_cast<std::size_t>(q)];
+        Vec<2> xq = Vec<2>::Zero(), uq = Vec<2>::Zero();
+        for (int i = 0; i < n; ++i) {
+          const double v = table.values[static_cast<std::size_t>(q * n + i)];
+          xq += v * x.col(i);
+          uq += v * ue.col(i);
+        }
+        sum += w * (uq - exact(xq)).squaredNorm();
+      }
+    }
+  }
+  return std::sqrt(sum);
+}
+
+}  // namespace
+
+TEST_CASE("springs and torsion springs reproduce a uniform translation", "[movers]") {
+  const Vec<2> t2(0.03, -0.02);
+  const auto shift2 = [&](const Vec<2>&) -> Vec<2> { return t2; };
+  for (const auto cells : {RectangleCells::tri3, RectangleCells::quad4, RectangleCells::tri_quad}) {
+    Mesh<2> mesh = rectangle(cells);
+    perturb_interior(mesh, 0.05);
+    const auto b = prescribed_boundary(mesh, shift2);
+    CHECK(max_error(mesh, run(SpringMover<2>(), mesh, b), shift2) < 1e-12);
+    CHECK(max_error(mesh, run(TorsionSpringMover<2>(), mesh, b), shift2) < 1e-12);
+    const Mesh<2> p2 = to_quadratic(mesh);
+    CHECK(max_error(p2, run(SpringMover<2>(), p2, prescribed_boundary(p2, shift2)), shift2) < 1e-12);
+  }
+  const Vec<3> t3(0.03, -0.02, 0.01);
+  const auto shift3 = [&](const Vec<3>&) -> Vec<3> { return t3; };
+  for (const auto cells : {BoxCells::tet4, BoxCells::hex8, BoxCells::tet_pyramid_prism}) {
+    Mesh<3> mesh = box(cells);
+    perturb_interior(mesh, 0.04);
+    const auto b = prescribed_boundary(mesh, shift3);
+    CHECK(max_error(mesh, run(SpringMover<3>(), mesh, b), shift3) < 1e-12);
+    if (cells == BoxCells::tet4) CHECK(max_error(mesh, run(TorsionSpringMover<3>(), mesh, b), shift3) < 1e-12);
+  }
+}
+
+TEST_CASE("spring, torsion and elasticity stiffness matrices are symmetric", "[movers]") {
+  Mesh<2> mesh = rectangle(RectangleCells::tri_quad, 5);
+  perturb_interior(mesh, 0.06);
+  const auto b = prescribed_boundary(mesh, [](const Vec<2>& x) -> Vec<2> { return 0.1 * x; });
+  SpringMover<2> spring;
+  spring.setup(mesh, b);
+  TorsionSpringMover<2> torsion;
+  torsion.setup(mesh, b);
+  ElasticityMover<2> stiffened(ElasticityOptions{1.0, 0.3, 2.0, 0.0, 1.0, {}});
+  stiffened.setup(mesh, b);
+  const Mesh<2> p2 = to_quadratic(mesh);
+  ElasticityMover<2> quadratic;
+  quadratic.setup(p2, prescribed_boundary(p2, [](const Vec<2>& x) -> Vec<2> { return 0.1 * x; }));
+  CHECK(symmetry_defect<2>(spring.stiffness()) < 1e-14);
+  CHECK(symmetry_defect<2>(torsion.stiffness()) < 1e-14);
+  CHECK(symmetry_defect<2>(stiffened.stiffness()) < 1e-14);
+  CHECK(symmetry_defect<2>(quadratic.stiffness()) < 1e-14);
+  // The lineal spring matrix annihilates constants (a translation stores no energy).
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(spring.stiffness().rows());
+  CHECK((spring.stiffness() * ones).norm() < 1e-12 * spring.stiffness().norm());
+}
+
+TEST_CASE("Jacobian stiffening: chi = 0 is linear elasticity, J0 only scales, chi > 0 stiffens small cells", "[movers]") {
+  const Mesh<2> mesh = ring(0.01);
+  BoundarySpec<2> spec;
+  spec.moving("wall", Translation<2>{Vec<2>(0.3, 0.1)});
+  spec.fixed("farfield");
+  const auto b = spec.resolve(mesh);
+  const Points<2> plain = run(ElasticityMover<2>(), mesh, b);
+  ElasticityOptions zero;
+  zero.reference_jacobian = 123.0;  // ignored when chi = 0
+  CHECK((run(ElasticityMover<2>(zero), mesh, b) - plain).norm() <= 1e-12 * plain.norm());
+  ElasticityOptions chi2;
+  chi2.stiffening_exponent = 2.0;
+  const Points<2> stiff = run(ElasticityMover<2>(chi2), mesh, b);
+  chi2.reference_jacobian = 1e-3;
+  CHECK((run(ElasticityMover<2>(chi2), mesh, b) - stiff).norm() <= 1e-8 * stiff.norm());
+  ElasticityOptions wall;
+  wall.distance_exponent = 2.0;
+  const Points<2> by_distance = run(ElasticityMover<2>(wall), mesh, b);
+  // Stiff small cells near the wall move more rigidly: the first layer off the wall follows
+  // the wall's translation more closely.
+  const std::vector<Index> wall_nodes = mesh.group_nodes("wall");
+  const Vec<2> t(0.3, 0.1);
+  const auto first_layer_defect = [&](const Points<2>& u) {
+    double worst = 0.0;
+    for (Index i = 0; i < mesh.num_nodes(); ++i) {
+      if (std::binary_search(wall_nodes.begin(), wall_nodes.end(), i)) continue;
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const Index w : wall_nodes) nearest = std::min(nearest, (mesh.points.col(i) - mesh.points.col(w)).norm());
+      if (nearest < 0.015) worst = std::max(worst, (u.col(i) - t).norm());
+    }
+    return worst;
+  };
+  CHECK(first_layer_defect(stiff) < 0.5 * first_layer_defect(plain));
+  CHECK(first_layer_defect(by_distance) < first_layer_defect(plain));
+  for (const auto* u : {&plain, &stiff, &by_distance})
+    for (Index k = 0; k < b.size(); ++k) CHECK((u->col(b.nodes[static_cast<std::size_t>(k)]) - b.displacements.col(k)).norm() == 0.0);
+}
+
+TEST_CASE("linear elasticity converges at order p + 1 in L2 for P1 and P2", "[movers]") {
+  // u = ∇φ with φ = eˣ sin y harmonic solves the Navier–Cauchy equations μΔu + (λ+μ)∇(∇·u) = 0
+  // for every λ, μ (∇·u = Δφ = 0 and Δu = ∇Δφ = 0), so the mover itself (no body force)
+  // approximates a smooth non-polynomial solution from its boundary values.
+  const auto exact = [](const Vec<2>& x) -> Vec<2> { return {std::exp(x(0)) * std::sin(x(1)), std::exp(x(0)) * std::cos(x(1))}; };
+  for (const auto cells : {RectangleCells::tri3, RectangleCells::quad4})
+    for (const int order : {1, 2}) {
+      std::vector<double> errors;
+      for (const Index n : {4, 8, 16}) {
+        const Mesh<2> mesh = with_order(rectangle(cells, n), order);
+        const auto b = prescribed_boundary(mesh, exact);
+        errors.push_back(l2_error(mesh, run(ElasticityMover<2>(ElasticityOptions{1.0, 0.4}), mesh, b), exact));
+      }
+      for (std::size_t k = 1; k < errors.size(); ++k) {
+        const double rate = std::log2(errors[k - 1] / errors[k]);
+        INFO("cells " << static_cast<int>(cells) << " P" << order << " rate " << rate);
+        CHECK(rate > order + 1 - 0.2);
+      }
+    }
+}
+
+TEST_CASE("sliding boundaries stay in their plane and move tangentially", "[movers]") {
+  const Mesh<2> mesh = rectangle(RectangleCells::tri3, 6);
+  const auto b = shear_spec().resolve(mesh);
+  const auto check = [&](const Points<2>& u) {
+    double tangential = 0.0;
+    for (Index k = 0; k < b.size(); ++k) {
+      const Index v = b.nodes[static_cast<std::size_t>(k)];
+      if (b.kinds[static_cast<std::size_t>(k)] == BoundaryKind::sliding) {
+        CHECK(std::abs(u(1, v)) < 1e-14);
+        tangential = std::max(tangential, std::abs(u(0, v)));
+      } else {
+        CHECK((u.col(v) - b.displacements.col(k)).norm() == 0.0);
+      }
+    }
+    CHECK(tangential > 1e-3);
+  };
+  check(run(SpringMover<2>(), mesh, b));
+  check(run(TorsionSpringMover<2>(), mesh, b));
+  check(run(ElasticityMover<2>(), mesh, b));
+  check(run(NonlinearElasticityMover<2>(), mesh, b));
+  const Mesh<3> cube = box(BoxCells::tet4);
+  BoundarySpec<3> spec;
+  spec.moving("top", Translation<3>{Vec<3>(0.1, 0.05, -0.05)});
+  spec.sliding("bottom");
+  spec.fixed("left");
+  const auto b3 = spec.resolve(cube);
+  const Points<3> u = run(ElasticityMover<3>(), cube, b3);
+  for (Index k = 0; k < b3.size(); ++k)
+    if (b3.kinds[static_cast<std::size_t>(k)] == BoundaryKind::sliding) CHECK(std::abs(u(2, b3.nodes[static_cast<std::size_t>(k)])) < 1e-14);
+}
+
+TEST_CASE("iterative solvers agree with the direct solve and report iterations", "[movers]") {
+  Mesh<2> mesh = rectangle(RectangleCells::tri3, 8);
+  perturb_interior(mesh, 0.03);
+  const auto b = shear_spec().resolve(mesh);
+  const Points<2> direct = run(ElasticityMover<2>(), mesh, b);
+  for (const auto kind : {SolverKind::cg_jacobi, SolverKind::cg_incomplete_cholesky, SolverKind::simplicial_llt}) {
+    ElasticityOptions o;
+    o.solver.kind = kind;
+    ElasticityMover<2> mover(o);
+    mover.setup(mesh, b);
+    const Points<2> u = mover.move(b.displacements);
+    CHECK((u - direct).norm() < 1e-9 * direct.norm());
+    CHECK((mover.stats().iterations > 0) == is_iterative(kind));
+    CHECK(mover.stats().factorizations == 1);
+  }
+}
+
+TEST_CASE("repeated moves equal a fresh setup, superpose, and reuse the factorization", "[movers]") {
+  Mesh<2> mesh = rectangle(RectangleCells::quad4, 6);
+  perturb_interior(mesh, 0.05);
+  const auto b1 = prescribed_boundary(mesh, [](const Vec<2>& x) -> Vec<2> { return {0.05 * std::sin(3 * x(1)), 0.02 * x(0) * x(0)}; });
+  const auto b2 = prescribed_boundary(mesh, [](const Vec<2>& x) -> Vec<2> { return {-0.01 * x(1), 0.04 * std::cos(2 * x(0))}; });
+  const auto check = [&](auto mover) {
+    mover.setup(mesh, b1);
+    const Points<2> first = mover.move(b1.displacements);
+    const Points<2> second = mover.move(b2.displacements);
+    Points<2> into(2, 3);
+    mover.move_into(Points<2>(b1.displacements + 2.0 * b2.displacements), into);
+    CHECK(mover.stats().moves == 3);
+    CHECK(mover.stats().factorizations == 1);
+    CHECK((into - (first + 2.0 * second)).norm() < 1e-12 * into.norm());
+    decltype(mover) fresh(mover.options());
+    fresh.setup(mesh, b2);
+    CHECK((fresh.move(b2.displacements) - second).norm() < 1e-13 * second.norm());
+  };
+  check(SpringMover<2>());
+  check(TorsionSpringMover<2>());
+  check(ElasticityMover<2>(ElasticityOptions{1.0, 0.3, 1.5, 0.0, 0.0, {}}));
+  NonlinearElasticityMover<2> nle;
+  nle.setup(mesh, b1);
+  const Points<2> once = nle.move(b1.displacements);
+  (void)nle.move(b2.displacements);
+  CHECK((nle.move(b1.displacements) - once).norm() == 0.0);
+}
+
+TEST_CASE("neo-Hookean elasticity: linear for small motions, valid where linear elasticity inverts", "[movers]") {
+  Mesh<2> mesh = rectangle(RectangleCells::tri_quad, 6);
+  perturb_interior(mesh, 0.04);
+  const auto small = prescribed_boundary(mesh, [](const Vec<2>& x) -> Vec<2> { return 1e-5 * Vec<2>(std::sin(3 * x(1)), x(0) * x(0)); });
+  const Points<2> linear = run(ElasticityMover<2>(ElasticityOptions{1.0, 0.3}), mesh, small);
+  const Points<2> nonlinear = run(NonlinearElasticityMover<2>(NonlinearElasticityOptions{1.0, 0.3}), mesh, small);
+  CHECK((linear - nonlinear).norm() < 1e-4 * linear.norm());
+
+  // A square body turned 90 degrees inside a ring of thin cells.
+  const Mesh<2> r = ring();
+  BoundarySpec<2> spec;
+  spec.moving("wall", Rotation2D{Vec<2>::Zero(), radians(90.0)});
+  spec.fixed("farfield");
+  const auto b = spec.resolve(r);
+  const Points<2> le = run(ElasticityMover<2>(), r, b);
+  CHECK(min_signed_jacobian(r, Points<2>(r.points + le)) < 0.0);
+  NonlinearElasticityOptions o;
+  o.load_steps = 3;
+  NonlinearElasticityMover<2> nle(o);
+  nle.setup(r, b);
+  const Points<2> u = nle.move(b.displacements);
+  CHECK(min_signed_jacobian(r, Points<2>(r.points + u)) > 0.0);
+  for (Index k = 0; k < b.size(); ++k) CHECK((u.col(b.nodes[static_cast<std::size_t>(k)]) - b.displacements.col(k)).norm() == 0.0);
+  CHECK(nle.stats().iterations > 1);
+}
+
+TEST_CASE("mechanics movers reject bad input with clear errors", "[movers]") {
+  const Mesh<2> mesh = rectangle(RectangleCells::tri3, 3);
+  const auto b = prescribed_boundary(mesh, [](const Vec<2>&) -> Vec<2> { return {0.1, 0.0}; });
+  const auto setup_throws = [&](auto mover, const char* text) {
+    CHECK_THROWS_AS(mover.setup(mesh, b), InputError);
+    CHECK_THROWS_WITH(mover.setup(mesh, b), Catch::Contains(text));
+  };
+  setup_throws(ElasticityMover<2>(ElasticityOptions{0.0, 0.3}), "Young's modulus");
+  setup_throws(ElasticityMover<2>(ElasticityOptions{1.0, 0.5}), "Poisson ratio");
+  setup_throws(ElasticityMover<2>(ElasticityOptions{1.0, 0.3, -1.0}), "exponents");
+  setup_throws(NonlinearElasticityMover<2>(NonlinearElasticityOptions{1.0, 0.3, 0}), "load_steps");
+  setup_throws(SpringMover<2>(SpringOptions{std::nan("")}), "length_exponent");
+  setup_throws(TorsionSpringMover<2>(TorsionSpringOptions{-1.0}), "torsion_weight");
+
+  ElasticityMover<2> le;
+  CHECK_THROWS_WITH(le.move(b.displacements), Catch::Contains("setup() was not called"));
+  ResolvedBoundary<2> out_of_range = b;
+  out_of_range.nodes.back() = mesh.num_nodes();
+  CHECK_THROWS_WITH(le.setup(mesh, out_of_range), Catch::Contains("out of range"));
+  ResolvedBoundary<2> empty;
+  CHECK_THROWS_WITH(le.setup(mesh, empty), Catch::Contains("no nodes"));
+  le.setup(mesh, b);
+  CHECK_THROWS_WITH(le.move(Points<2>::Zero(2, 1)), Catch::Contains("displacement columns"));
+  Points<2> nan = b.displacements;
+  nan(0, 0) = std::nan("");
+  CHECK_THROWS_WITH(le.move(nan), Catch::Contains("not finite"));
+
+  TorsionSpringMover<2> torsion;
+  const Mesh<2> p2 = to_quadratic(mesh);
+  CHECK_THROWS_WITH(torsion.setup(p2, prescribed_boundary(p2, [](const Vec<2>&) -> Vec<2> { return {0.1, 0.0}; })),
+                    Catch::Contains("tri6 cells are not supported"));
+  Mesh<2> flat = mesh;
+  flat.points.row(1).setZero();  // every cell degenerate
+  ElasticityMover<2> stiffened(ElasticityOptions{1.0, 0.3, 2.0});
+  CHECK_THROWS_AS(stiffened.setup(flat, b), InputError);
 }

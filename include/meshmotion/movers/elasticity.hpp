@@ -112,13 +112,7 @@ class ElasticityMover : public detail::LinearMechanicsMover<Dim> {
         }
         detail::add_elastic_stiffness<Dim>(g, lame.lambda, lame.mu, scale, k);
       }
-      const auto nodes = block.element(e);
-      for (int a = 0; a < n; ++a)
-        for (int c = 0; c < n; ++c)
-          for (int i = 0; i < Dim; ++i)
-            for (int j = 0; j < Dim; ++j)
-              out.emplace_back(static_cast<int>(nodes[static_cast<std::size_t>(a)] * Dim + i),
-                               static_cast<int>(nodes[static_cast<std::size_t>(c)] * Dim + j), k(a * Dim + i, c * Dim + j));
+      detail::scatter_element_matrix<Dim>(block.element(e), k, out);
     });
     if (degenerate)
       throw InputError("ElasticityMover::setup: a cell has a zero Jacobian determinant (degenerate cell), so its "

@@ -14,7 +14,9 @@
 /// - Not linear in the displacements; for small ones it agrees with linear elasticity (the
 ///   tangent at u = 0 is the linear-elastic stiffness with the same λ, μ).
 /// - Setup caches the reference mesh, the unknown numbering (Dirichlet elimination, sliding
-///   tangent planes) and the symbolic analysis of the tangent; every move starts from the
+///   tangent planes), the factorized reference (linear-elastic) stiffness used as a fallback
+///   descent direction when the Newton direction fails the line search, and the symbolic
+///   analysis of the tangent; every move starts from the
 ///   reference configuration and re-assembles and factorizes the tangent once per Newton
 ///   iteration (cost per move: iterations × (assembly + factorization)), so it is a robust
 ///   reference for large deformations and curving rather than a per-time-step mover.
@@ -82,6 +84,13 @@ class NonlinearElasticityMover {
     boundary_nodes_ = boundary.nodes;
     kinds_ = boundary.kinds;
     system_.build(Dim, detail::cell_nodes(mesh_), boundary, options_.solver);
+    reference_.build(Dim, detail::cell_nodes(mesh_), boundary, options_.solver);
+    {
+      SparseMatrix stiffness;
+      Eigen::MatrixXd unused(mesh_.num_nodes() * Dim, 1);
+      evaluate(Points<Dim>::Zero(Dim, mesh_.num_nodes()), &unused, &stiffness);
+      reference_.factorize(stiffness);
+    }
     diameter_ = (mesh_.points.rowwise().maxCoeff() - mesh_.points.rowwise().minCoeff()).norm();
     stats_ = MoverStats{};
     stats_.boundary_nodes = boundary.size();
@@ -125,20 +134,17 @@ class NonlinearElasticityMover {
         system_.factorize(tangent);
         system_.solve(increment, step, &force);
         ++stats_.factorizations;
-        double alpha = 1.0;
-        while (true) {
-          trial = out + alpha * step;
-          const Evaluation e = evaluate(trial, nullptr, nullptr);
-          if (e.valid && (!boundary_done || e.energy <= energy + 1e-12 * std::abs(energy))) {
-            energy = e.energy;
-            break;
-          }
-          alpha *= 0.5;
-          if (alpha < options_.min_step)
-            throw SolverError("NonlinearElasticityMover::move: the line search found no step keeping every element valid "
-                              "(load step " + std::to_string(s) + " of " + std::to_string(options_.load_steps) +
-                              "; try more load_steps)");
+        double alpha = line_search(out, step, boundary_done, energy, trial);
+        if (alpha < options_.min_step) {
+          // The tangent can be indefinite far from the reference; the reference (linear
+          // elastic, SPD) stiffness always gives a descent direction for the energy.
+          reference_.solve(increment, step, &force);
+          alpha = line_search(out, step, boundary_done, energy, trial);
         }
+        if (alpha < options_.min_step)
+          throw SolverError("NonlinearElasticityMover::move: the line search found no step keeping every element valid "
+                            "(load step " + std::to_string(s) + " of " + std::to_string(options_.load_steps) +
+                            "; try more load_steps)");
         out = trial;
         applied += alpha * increment;
         if (alpha == 1.0) applied = target;  // exact boundary values once the increment is complete
@@ -163,6 +169,22 @@ class NonlinearElasticityMover {
     bool valid = true;
     double energy = 0.0;
   };
+
+  /// Backtracking from u along `step`: the largest α = 2^−k ≥ min_step with every element
+  /// valid and, when the boundary is in place, no energy increase; updates `energy` and
+  /// `trial` = u + α step. Returns α, or 0 when none is found.
+  double line_search(const Points<Dim>& u, const Points<Dim>& step, bool boundary_done, double& energy,
+                     Points<Dim>& trial) const {
+    for (double alpha = 1.0; alpha >= options_.min_step; alpha *= 0.5) {
+      trial = u + alpha * step;
+      const Evaluation e = evaluate(trial, nullptr, nullptr);
+      if (e.valid && (!boundary_done || e.energy <= energy + 1e-12 * std::abs(energy))) {
+        energy = e.energy;
+        return alpha;
+      }
+    }
+    return 0.0;
+  }
 
   /// Energy of displacement u; with `force`, also −(internal force) (n·Dim × 1) and the
   /// tangent stiffness (n·Dim square). Invalid (det F ≤ 0 somewhere) gives valid = false.
@@ -235,13 +257,7 @@ class NonlinearElasticityMover {
                     c * ((i == kk ? dot : 0.0) + shear * m(a, kk) * m(bb, i) + lambda * m(a, i) * m(bb, kk));
           }
       }
-      const auto nodes = block.element(e);
-      for (int a = 0; a < nn; ++a)
-        for (int bb = 0; bb < nn; ++bb)
-          for (int i = 0; i < Dim; ++i)
-            for (int kk = 0; kk < Dim; ++kk)
-              out.emplace_back(static_cast<int>(nodes[static_cast<std::size_t>(a)] * Dim + i),
-                               static_cast<int>(nodes[static_cast<std::size_t>(bb)] * Dim + kk), k(a * Dim + i, bb * Dim + kk));
+      detail::scatter_element_matrix<Dim>(block.element(e), k, out);
     });
     result.valid = result.valid && valid.load();
     return result;
@@ -253,6 +269,7 @@ class NonlinearElasticityMover {
   std::vector<Index> boundary_nodes_;
   std::vector<BoundaryKind> kinds_;
   detail::ConstrainedSystem<Dim> system_;
+  detail::ConstrainedSystem<Dim> reference_;  ///< factorized linear-elastic stiffness (fallback direction)
   detail::Lame lame_{0.0, 0.0};
   double diameter_ = 0.0;
   bool ready_ = false;

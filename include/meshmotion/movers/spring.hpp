@@ -61,23 +61,7 @@ class SpringMover : public detail::LinearMechanicsMover<Dim> {
                        std::to_string(options_.length_exponent) + ")");
     const Mesh<Dim> copy = this->start_setup(mesh, boundary);
     const int c = boundary.has_sliding() ? Dim : 1;
-    const auto springs = detail::mesh_springs(copy);
-    std::vector<Eigen::Triplet<double, int>> triplets;
-    triplets.reserve(springs.size() * 4 * static_cast<std::size_t>(c));
-    for (const auto& [a, b] : springs) {
-      const double length = (copy.points.col(a) - copy.points.col(b)).norm();
-      if (!(length > 0.0))
-        throw InputError("SpringMover::setup: nodes " + std::to_string(a) + " and " + std::to_string(b) +
-                         " share an edge but coincide (got length 0, expected > 0)");
-      const double k = std::pow(length, -options_.length_exponent);
-      for (int axis = 0; axis < c; ++axis) {
-        const auto i = static_cast<int>(a * c + axis), j = static_cast<int>(b * c + axis);
-        triplets.emplace_back(i, i, k);
-        triplets.emplace_back(j, j, k);
-        triplets.emplace_back(i, j, -k);
-        triplets.emplace_back(j, i, -k);
-      }
-    }
+    const auto triplets = detail::lineal_spring_triplets(copy, c, options_.length_exponent, "SpringMover::setup");
     SparseMatrix stiffness(copy.num_nodes() * c, copy.num_nodes() * c);
     stiffness.setFromTriplets(triplets.begin(), triplets.end());
     this->finish_setup(copy, boundary, std::move(stiffness), c, options_.solver, watch);

@@ -93,23 +93,8 @@ class TorsionSpringMover : public detail::LinearMechanicsMover<Dim> {
         throw InputError("TorsionSpringMover::setup: " + std::string(name(block.type)) +
                          " cells are not supported (expected tri3 or quad4 in 2D, tet4 in 3D)");
     const Index size = copy.num_nodes() * Dim;
-    // Lineal springs, once per edge.
-    const auto springs = detail::mesh_springs(copy);
-    std::vector<Eigen::Triplet<double, int>> lineal;
-    lineal.reserve(springs.size() * 4 * Dim);
-    for (const auto& [a, b] : springs) {
-      const double length = (copy.points.col(a) - copy.points.col(b)).norm();
-      if (!(length > 0.0))
-        throw InputError("TorsionSpringMover::setup: nodes " + std::to_string(a) + " and " + std::to_string(b) +
-                         " share an edge but coincide");
-      for (int axis = 0; axis < Dim; ++axis) {
-        const auto i = static_cast<int>(a * Dim + axis), j = static_cast<int>(b * Dim + axis);
-        lineal.emplace_back(i, i, 1.0 / length);
-        lineal.emplace_back(j, j, 1.0 / length);
-        lineal.emplace_back(i, j, -1.0 / length);
-        lineal.emplace_back(j, i, -1.0 / length);
-      }
-    }
+    // Lineal springs, once per edge (Batina's, the same in each direction).
+    const auto lineal = detail::lineal_spring_triplets(copy, Dim, 1.0, "TorsionSpringMover::setup");
     SparseMatrix stiffness(size, size);
     stiffness.setFromTriplets(lineal.begin(), lineal.end());
     // Torsional springs per cell corner; a degenerate corner is reported after the loop.

@@ -238,6 +238,19 @@ double element_geometry(const QuadratureTable& table, int q, const ElementCoords
   }
 }
 
+/// Appends the element matrix k (node-major, Dim dofs per node) of a cell with global
+/// `nodes` as triplets.
+template <int Dim, class Triplets>
+void scatter_element_matrix(std::span<const Index> nodes, const ElementMatrix<Dim>& k, Triplets& out) {
+  const auto n = static_cast<int>(nodes.size());
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b)
+      for (int i = 0; i < Dim; ++i)
+        for (int j = 0; j < Dim; ++j)
+          out.emplace_back(static_cast<int>(nodes[static_cast<std::size_t>(a)] * Dim + i),
+                           static_cast<int>(nodes[static_cast<std::size_t>(b)] * Dim + j), k(a * Dim + i, b * Dim + j));
+}
+
 /// Lamé parameters of an isotropic material.
 struct Lame {
   double lambda;

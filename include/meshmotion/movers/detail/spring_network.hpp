@@ -7,6 +7,7 @@
 /// Springs shared by neighbouring cells are counted once.
 
 #include "meshmotion/core/element.hpp"
+#include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/shape_functions.hpp"
 #include "meshmotion/core/types.hpp"
@@ -14,7 +15,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <string>
 #include <vector>
+
+#include <Eigen/SparseCore>
 
 namespace meshmotion::detail {
 
@@ -72,6 +76,32 @@ template <int Dim>
   std::sort(springs.begin(), springs.end());
   springs.erase(std::unique(springs.begin(), springs.end()), springs.end());
   return springs;
+}
+
+/// Triplets of the lineal springs of `mesh` (k = ‖r_i − r_j‖^−exponent, the same spring in
+/// each of `components` directions, node-major dofs). Throws InputError, prefixed by `where`,
+/// when a spring joins two distinct nodes at the same position.
+template <int Dim>
+[[nodiscard]] std::vector<Eigen::Triplet<double, int>> lineal_spring_triplets(const Mesh<Dim>& mesh, int components,
+                                                                              double exponent, const std::string& where) {
+  const auto springs = mesh_springs(mesh);
+  std::vector<Eigen::Triplet<double, int>> triplets;
+  triplets.reserve(springs.size() * 4 * static_cast<std::size_t>(components));
+  for (const auto& [a, b] : springs) {
+    const double length = (mesh.points.col(a) - mesh.points.col(b)).norm();
+    if (!(length > 0.0))
+      throw InputError(where + ": nodes " + std::to_string(a) + " and " + std::to_string(b) +
+                       " share an edge but coincide (got length 0, expected > 0)");
+    const double k = std::pow(length, -exponent);
+    for (int axis = 0; axis < components; ++axis) {
+      const auto i = static_cast<int>(a * components + axis), j = static_cast<int>(b * components + axis);
+      triplets.emplace_back(i, i, k);
+      triplets.emplace_back(j, j, k);
+      triplets.emplace_back(i, j, -k);
+      triplets.emplace_back(j, i, -k);
+    }
+  }
+  return triplets;
 }
 
 }  // namespace meshmotion::detail
