@@ -3,6 +3,7 @@
 /// Everything meshmotion offers. Each layer header (and each header below it) also compiles alone.
 
 #include "meshmotion/core.hpp"
+#include "meshmotion/curving.hpp"
 #include "meshmotion/delaunay.hpp"
 #include "meshmotion/io.hpp"
 #include "meshmotion/movers.hpp"
