@@ -71,7 +71,8 @@ std::vector<double> numbers(const std::string& text, const std::string& spec) {
   return out;
 }
 
-// "spline", "straight", "circle:X,Y,R", "sphere:X,Y,Z,R", "naca:XXXX[,chord,x0,y0]", "bump".
+// "spline" (2D) / "reconstruct" (3D triangles): from the linear mesh; "straight";
+// "circle:X,Y,R", "sphere:X,Y,Z,R", "naca:XXXX[,chord,x0,y0]", "bump".
 template <int Dim>
 BoundaryGeometry<Dim> parse_geometry(const std::string& spec) {
   const auto colon = spec.find(':');
@@ -80,7 +81,7 @@ BoundaryGeometry<Dim> parse_geometry(const std::string& spec) {
   const auto expect = [&](const std::vector<double>& v, std::size_t n, const char* form) {
     if (v.size() != n) throw InputError("--geometry " + spec + ": expected " + form);
   };
-  if (kind == "spline") return BoundaryGeometry<Dim>::spline();
+  if (kind == "spline" || kind == "reconstruct") return BoundaryGeometry<Dim>::spline();
   if (kind == "straight") return BoundaryGeometry<Dim>::straight();
   if (kind == "bump") {
     if constexpr (Dim == 2) return BoundaryGeometry<Dim>::project(nasa_bump_2d());
@@ -220,6 +221,14 @@ void run(const Mesh<Dim>& linear, const Arguments& args) {
               args.svg.c_str());
 }
 
+void print_error_json(const char* what, bool invalid) {
+  detail::JsonWriter w(std::cout);
+  w.begin_object().key("error").value(what);
+  if (invalid) w.key("invalid").value(true);
+  w.end_object();
+  std::cout << "\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -235,7 +244,7 @@ int main(int argc, char** argv) {
   app.add_option("--blending-length", args.blending_length, "blend: length (0: each wall's layer thickness)");
   app.add_option("--steps", args.steps, "regularize in this many increments")->capture_default_str();
   app.add_option("--geometry", args.geometry,
-                 "true boundary: spline | straight | bump | circle:X,Y,R | naca:XXXX[,CHORD,X0,Y0] | sphere:X,Y,Z,R "
+                 "true boundary: spline | reconstruct | straight | bump | circle:X,Y,R | naca:XXXX[,CHORD,X0,Y0] | sphere:X,Y,Z,R "
                  "(one for all --group, or one per group)");
   app.add_option("--group", args.groups, "groups the --geometry applies to (default: wall)");
   app.add_option("--sliding", args.sliding, "groups sliding in their plane (symmetry)");
@@ -266,11 +275,11 @@ int main(int argc, char** argv) {
       throw InputError("curve_mesh: output is the input file (the input is never modified)");
     std::visit([&](const auto& mesh) { run(mesh, args); }, read_mesh(args.input));
   } catch (const InvalidMeshError& e) {
-    if (args.json) std::cout << "{\"error\":" << detail::json_string(e.what()) << ",\"invalid\":true}\n";
+    if (args.json) print_error_json(e.what(), true);
     std::cerr << e.what() << "\n";
     return 2;
   } catch (const Error& e) {
-    if (args.json) std::cout << "{\"error\":" << detail::json_string(e.what()) << "}\n";
+    if (args.json) print_error_json(e.what(), false);
     std::cerr << e.what() << "\n";
     return 1;
   }
