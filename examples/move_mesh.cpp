@@ -88,6 +88,15 @@ int run(const Arguments& a, Mesh<Dim> mesh) {
 
   MoverParameters parameters;
   parameters.values["kernel"] = a.kernel;
+  // DGRBF2 rotates about the centre (and axis) of the rigid motion given here.
+  const auto joined = [](const std::vector<double>& v) {
+    std::ostringstream text;
+    text.precision(17);
+    for (std::size_t k = 0; k < v.size(); ++k) text << (k ? "," : "") << v[k];
+    return text.str();
+  };
+  if (!a.center.empty()) parameters.values["center"] = joined(a.center);
+  if (!a.axis.empty()) parameters.values["axis"] = joined(a.axis);
   if (a.support_radius) {
     parameters.values["support_radius"] = std::to_string(*a.support_radius);
   } else {
@@ -142,7 +151,7 @@ int main(int argc, char** argv) {
   translate->excludes(file);
   app.add_option("--fixed", a.fixed, "Fixed groups");
   app.add_option("--sliding", a.sliding, "Groups sliding in their plane");
-  app.add_option("--method", a.method, "Mover (rbf)");
+  app.add_option("--method", a.method, "Mover: rbf|dgm|idgm|dgrbf|dgrbf2 (and the registry's others)");
   app.add_option("--kernel", a.kernel, "RBF kernel: wendland0|wendland2|wendland4|wendland6|tps|gaussian|multiquadric|inverse_multiquadric");
   app.add_option("--support-radius", a.support_radius, "RBF support radius (default: heuristic from the boundary)");
   app.add_option("--steps", a.steps, "Number of steps")->check(CLI::PositiveNumber);
