@@ -1,13 +1,23 @@
 #pragma once
 /// \file
 /// The movers layer: the mover contract, boundary specification, rigid motions, the step
-/// driver and the movers themselves.
+/// driver and the movers themselves (interpolation: RBF, DGM, DGRBF, DGRBF2, improved DGM;
+/// mechanics: lineal and torsional springs, linear, stiffened and neo-Hookean elasticity).
 
 #include "meshmotion/movers/any_mover.hpp"
 #include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/delaunay_graph_options.hpp"
+#include "meshmotion/movers/dgm.hpp"
+#include "meshmotion/movers/dgrbf.hpp"
+#include "meshmotion/movers/dgrbf2.hpp"
+#include "meshmotion/movers/elasticity.hpp"
+#include "meshmotion/movers/improved_dgm.hpp"
 #include "meshmotion/movers/motion.hpp"
 #include "meshmotion/movers/mover.hpp"
+#include "meshmotion/movers/nonlinear_elasticity.hpp"
 #include "meshmotion/movers/rbf.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
+#include "meshmotion/movers/spring.hpp"
 #include "meshmotion/movers/step_driver.hpp"
 #include "meshmotion/movers/support_radius.hpp"
+#include "meshmotion/movers/torsion_spring.hpp"
