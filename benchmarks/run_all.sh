@@ -1,0 +1,104 @@
+#!/usr/bin/env bash
+# Configure with benchmarks on, build every benchmark, run them all and collect their JSON lines
+# into one file. Default sizes finish in a few minutes each on a 2-core machine; --full runs the
+# sizes the issues ask for (>= 1M elements/nodes: much longer).
+#
+#   benchmarks/run_all.sh [--full] [--build-dir DIR] [--out FILE] [--jobs N] [--no-build]
+#
+# The output file holds, per benchmark, a {"benchmark_run": ...} line (program, arguments, load
+# average before it, exit code, wall seconds) followed by that program's own JSON lines. The
+# readable tables go to the terminal and to FILE.log.
+set -uo pipefail
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+source_dir="$(dirname "$here")"
+build_dir="$source_dir/build-bench"
+full=0
+build=1
+jobs=1
+out=""
+
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --full) full=1 ;;
+    --no-build) build=0 ;;
+    --build-dir) build_dir="$2"; shift ;;
+    --out) out="$2"; shift ;;
+    --jobs) jobs="$2"; shift ;;
+    -h|--help) sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "run_all.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
+  esac
+  shift
+done
+
+build_dir="$(mkdir -p "$build_dir" && cd "$build_dir" && pwd)"
+[[ -n "$out" ]] || out="$build_dir/benchmark_results_$(date -u +%Y%m%dT%H%M%SZ)$([[ $full == 1 ]] && echo _full).jsonl"
+log="$out.log"
+: > "$out"
+: > "$log"
+
+# name and arguments per benchmark: quick sizes, then full sizes.
+declare -A quick_args=(
+  [io_bench]="60"
+  [quality_bench]="--quick"
+  [delaunay_bench]="100000"
+  [rbf_bench]="64"
+  [interpolation_bench]=""
+  [elasticity_bench]="--quick"
+  [curving_bench]=""
+)
+declare -A full_args=(
+  [io_bench]="100"
+  [quality_bench]=""
+  [delaunay_bench]="100000 1000000"
+  [rbf_bench]="126"
+  [interpolation_bench]=""
+  [elasticity_bench]=""
+  [curving_bench]=""
+)
+order=(io_bench quality_bench delaunay_bench rbf_bench interpolation_bench elasticity_bench curving_bench)
+
+# curving_bench joins only once it is committed (it may be work in progress in the tree).
+benches=()
+for name in "${order[@]}"; do
+  src="$here/$name.cpp"
+  [[ -f "$src" ]] || continue
+  if [[ "$name" == curving_bench ]] && [[ -z "$(git -C "$source_dir" log --oneline -1 -- "benchmarks/$name.cpp" 2>/dev/null)" ]]; then
+    echo "run_all.sh: skipping $name (not committed yet)" | tee -a "$log"
+    continue
+  fi
+  benches+=("$name")
+done
+
+{
+  echo "# $(date -u +%FT%TZ)  nproc=$(nproc)  $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //')"
+  echo "# $(c++ --version | head -1)  mode=$([[ $full == 1 ]] && echo full || echo quick)"
+} | tee -a "$log"
+
+if [[ $build == 1 ]]; then
+  cmake -S "$source_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DMESHMOTION_BUILD_BENCHMARKS=ON \
+    >> "$log" 2>&1 || { echo "run_all.sh: configure failed, see $log" >&2; exit 1; }
+  cmake --build "$build_dir" --target "${benches[@]}" -j"$jobs" >> "$log" 2>&1 \
+    || { echo "run_all.sh: build failed, see $log" >&2; exit 1; }
+fi
+
+status=0
+for name in "${benches[@]}"; do
+  if [[ $full == 1 ]]; then args="${full_args[$name]}"; else args="${quick_args[$name]}"; fi
+  load="$(cut -d' ' -f1-3 /proc/loadavg)"
+  echo "== $name $args   (load average $load)" | tee -a "$log"
+  start=$(date +%s.%N)
+  # shellcheck disable=SC2086  # args is a word list on purpose
+  "$build_dir/benchmarks/$name" $args > "$build_dir/$name.out" 2>&1
+  rc=$?
+  seconds=$(echo "$(date +%s.%N) - $start" | bc)
+  tee -a "$log" < "$build_dir/$name.out" | grep -v '^{'
+  printf '{"benchmark_run":"%s","arguments":"%s","load_average":"%s","exit_code":%d,"wall_seconds":%.1f}\n' \
+    "$name" "$args" "$load" "$rc" "$seconds" >> "$out"
+  grep '^{' "$build_dir/$name.out" >> "$out"
+  [[ $rc == 0 ]] || { echo "run_all.sh: $name exited with $rc" | tee -a "$log" >&2; status=1; }
+done
+
+echo "JSON lines: $out" | tee -a "$log"
+echo "tables:     $log"
+exit $status
