@@ -282,7 +282,7 @@ TEST_CASE("pipeline: bad options", "[curving]") {
   CHECK_THROWS_AS(curve_mesh(box, CurveOptions<3>{}), InputError);  // nothing to curve in 3D
   CurveOptions<3> spline3;
   spline3.geometry.emplace("bottom", BoundaryGeometry<3>::spline());
-  CHECK_THROWS_AS(curve_mesh(box, spline3), InputError);
+  CHECK_THROWS_AS(curve_mesh(box, spline3), InputError);  // reconstruction needs triangles
 }
 
 TEST_CASE("pipeline: 3D sphere with a symmetry plane curves onto the sphere", "[curving]") {
@@ -296,4 +296,30 @@ TEST_CASE("pipeline: 3D sphere with a symmetry plane curves onto the sphere", "[
   CHECK(curved.invalid() == 0);
   for (const Index v : curved.curved.group_nodes("7")) CHECK(std::abs(curved.curved.points.col(v).norm() - 0.5) < 1e-12);
   for (const Index v : curved.curved.group_nodes("20")) CHECK(std::abs(curved.curved.points(1, v)) < 1e-12);
+}
+
+TEST_CASE("pipeline: 3D sphere reconstructed from the linear mesh alone", "[curving]") {
+  MESHMOTION_REQUIRE_DATA(file, "meshopt_sphere_symmetry_linear_tet.msh");
+  const Mesh<3> linear = read_mesh_as<3>(file);
+  CurveOptions<3> options;
+  options.geometry.emplace("7", BoundaryGeometry<3>::spline());
+  options.sliding.push_back("20");
+  const CurveResult<3> curved = curve_mesh(linear, options);
+  CHECK(curved.invalid() == 0);
+  CHECK(curved.moved_vertices == 0);
+  // Edge nodes: far closer to the sphere than the straight midpoints were.
+  const CurveResult<3> straight = curve_mesh(linear, [&] {
+    CurveOptions<3> o;
+    o.geometry.emplace("7", BoundaryGeometry<3>::project([](const Vec<3>& x) { return x; }));
+    o.method = "none";
+    return o;
+  }());
+  double reconstructed_error = 0.0, straight_error = 0.0;
+  for (const Index v : curved.curved.group_nodes("7")) {
+    reconstructed_error = std::max(reconstructed_error, std::abs(curved.curved.points.col(v).norm() - 0.5));
+    straight_error = std::max(straight_error, std::abs(straight.curved.points.col(v).norm() - 0.5));
+  }
+  INFO("straight midpoints " << straight_error << ", reconstructed " << reconstructed_error);
+  CHECK(straight_error > 1e-3);
+  CHECK(reconstructed_error < 0.2 * straight_error);
 }

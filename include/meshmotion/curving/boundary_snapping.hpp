@@ -6,6 +6,9 @@
 /// - from the linear mesh alone in 2D: a C² cubic spline through the group's vertices
 ///   (BoundarySpline; corners by angle or list), each edge node going to its facet's
 ///   parameter midpoint (thesis) or arc-length midpoint; vertices stay; or
+/// - from the linear mesh alone in 3D: the WALF surface reconstruction of the group's
+///   triangles (SurfaceReconstruction, ridges sharp above the corner angle), each edge node
+///   going to the reconstructed edge midpoint; vertices stay; or
 /// - from a closest-point projection (analytic or CAD geometry, any dimension): vertices
 ///   off the geometry are projected, then every edge (face) node goes to the projection of
 ///   the straight midpoint (centre) of its projected vertices, which places it where the
@@ -21,6 +24,7 @@
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/curving/boundary_spline.hpp"
 #include "meshmotion/curving/geometry.hpp"
+#include "meshmotion/curving/surface_reconstruction.hpp"
 
 #include <algorithm>
 #include <map>
@@ -42,7 +46,7 @@ template <int Dim>
 struct BoundaryGeometry {
   enum class Kind {
     straight,    ///< keep the straight facets (flat walls, farfields that need no curving)
-    spline,      ///< 2D only: cubic spline through the group's vertices
+    spline,      ///< reconstructed from the linear mesh: 2D cubic spline, 3D WALF surface (triangles)
     projection,  ///< closest-point callback onto the true boundary
   };
   Kind kind = Kind::straight;
@@ -72,10 +76,42 @@ struct SnappedBoundary {
   double max_displacement = 0.0;
 };
 
+namespace detail {
+
+/// 3D reconstruction of group `tag`: every edge node of its (tri6) facets to the
+/// reconstructed edge midpoint; the vertices stay and join the wall.
+template <class Claim>
+void snap_to_reconstruction(const Mesh<3>& mesh, int tag, const SnapOptions& options, Claim&& claim) {
+  std::vector<Index> triangles;
+  for (const auto& block : mesh.facets)
+    for (Index e = 0; e < block.size(); ++e) {
+      if (block.tags[static_cast<std::size_t>(e)] != tag) continue;
+      if (shape(block.type) != Shape::triangle)
+        throw InputError("snap_boundary: surface reconstruction of group tag " + std::to_string(tag) + " needs triangle facets (got " +
+                         std::string(name(block.type)) + "; give a projection callback)");
+      const auto el = block.element(e);
+      triangles.insert(triangles.end(), el.begin(), el.begin() + 3);
+    }
+  if (triangles.empty()) return;
+  const SurfaceReconstruction surface(mesh.points, triangles, SurfaceReconstructionOptions{3, options.corner_angle});
+  for (const auto& block : mesh.facets)
+    for (Index e = 0; e < block.size(); ++e) {
+      if (block.tags[static_cast<std::size_t>(e)] != tag) continue;
+      const auto el = block.element(e);
+      for (int k = 0; k < 3; ++k) claim(el[static_cast<std::size_t>(k)], Vec<3>(mesh.points.col(el[static_cast<std::size_t>(k)])));
+      const auto local_edges = edges(block.type);
+      for (std::size_t k = 0; k < local_edges.size(); ++k)
+        claim(el[3 + k], surface.edge_midpoint(el[static_cast<std::size_t>(local_edges[k][0])], el[static_cast<std::size_t>(local_edges[k][1])]));
+    }
+}
+
+}  // namespace detail
+
 /// Snaps the facet nodes of the groups in `geometry` (group tag → geometry) of a P2 mesh.
 /// A node shared by two curved groups takes the first group's (lowest tag) position. Throws
-/// InputError for a linear mesh, a spline asked in 3D or a projection without a callback,
-/// and what BoundarySpline and the projections throw (degenerate chains, non-finite points).
+/// InputError for a linear mesh, a 3D reconstruction of quadrilateral facets or a projection
+/// without a callback, and what BoundarySpline, SurfaceReconstruction and the projections
+/// throw (degenerate chains, too few neighbours, non-finite points).
 template <int Dim>
 [[nodiscard]] SnappedBoundary<Dim> snap_boundary(const Mesh<Dim>& mesh, const std::map<int, BoundaryGeometry<Dim>>& geometry,
                                                  const SnapOptions& options = {}) {
@@ -93,9 +129,8 @@ template <int Dim>
     using Kind = typename BoundaryGeometry<Dim>::Kind;
     if (geo.kind == Kind::straight) continue;
     if (geo.kind == Kind::spline) {
-      if constexpr (Dim != 2) {
-        throw InputError("snap_boundary: spline reconstruction is 2D only (group tag " + std::to_string(tag) +
-                         "; give a projection callback in 3D)");
+      if constexpr (Dim == 3) {
+        detail::snap_to_reconstruction(mesh, tag, options, claim);
       } else {
         const std::vector<BoundaryChain> chains = boundary_chains(mesh, tag);
         if (chains.empty()) continue;

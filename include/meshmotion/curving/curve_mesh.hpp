@@ -29,9 +29,9 @@
 #include "meshmotion/curving/boundary_layer.hpp"
 #include "meshmotion/curving/boundary_snapping.hpp"
 #include "meshmotion/curving/p2_conversion.hpp"
+#include "meshmotion/movers/any_mover.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/mover.hpp"
-#include "meshmotion/movers/rbf.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
 #include "meshmotion/movers/support_radius.hpp"
 #include "meshmotion/quality/cell_quality.hpp"
@@ -40,6 +40,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <map>
 #include <sstream>
@@ -52,11 +53,16 @@ namespace meshmotion {
 /// Options of curve_mesh().
 template <int Dim>
 struct CurveOptions {
-  /// Interior regularization: "rbf" (default), "blend" (curving/blend_regularizer.hpp) or
-  /// "none" (snap the boundary only, to see why the pipeline exists).
+  /// Interior regularization: "rbf" (default), "blend" (curving/blend_regularizer.hpp),
+  /// "none" (snap the boundary only, to see why the pipeline exists) or any other method of
+  /// mover_registry() (movers/any_mover.hpp), which gets `kernel`, the support radius and
+  /// `parameters`.
   std::string method = "rbf";
+  /// Extra textual parameters of registry movers (keys they document).
+  MoverParameters parameters{};
   RbfKernel kernel = RbfKernel::wendland2;
-  /// RBF support radius; 0: support_radius_factor × the thickest estimated wall layer
+  /// RBF support radius (given to every registry mover as "support_radius"); 0:
+  /// support_radius_factor × the thickest estimated wall layer
   /// (suggest_support_radius() when no wall has an anisotropic layer).
   double support_radius = 0.0;
   double support_radius_factor = 1.0;
@@ -65,8 +71,8 @@ struct CurveOptions {
   /// The regularization in this many increments, each re-based on the moved mesh.
   int steps = 1;
   /// Geometry per group name. Groups not listed: spline reconstruction in 2D when
-  /// `spline_by_default`, straight otherwise (always straight in 3D: a projection callback
-  /// is required there, no 3D surface reconstruction exists yet).
+  /// `spline_by_default`, straight otherwise, and straight in 3D (give a projection callback,
+  /// or BoundaryGeometry::spline() for the WALF surface reconstruction of triangle facets).
   std::map<std::string, BoundaryGeometry<Dim>, std::less<>> geometry;
   bool spline_by_default = true;
   /// Groups that slide in their plane (symmetry); other non-curved groups are fixed.
@@ -98,7 +104,7 @@ struct CurveResult {
   Index num_linear_nodes = 0;
   CurveTimes seconds;
   std::string method;
-  double support_radius = 0.0;      ///< RBF radius used (0 for other methods)
+  double support_radius = 0.0;      ///< support radius given to the mover (0 for blend and none)
   std::vector<WallLayer> layers;    ///< estimated layers of the curved walls (when estimated)
   Index snapped_nodes = 0;          ///< boundary nodes given a position on the true boundary
   Index moved_vertices = 0;         ///< linear vertices that were off the geometry
@@ -207,6 +213,13 @@ void name_unnamed_facet_groups(Mesh<Dim>& mesh) {
     }
 }
 
+/// A double as text that reads back to the same value (for MoverParameters).
+[[nodiscard]] inline std::string exact_decimal(double x) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g", x);
+  return buffer;
+}
+
 inline void report_progress(const std::function<void(const std::string&)>& progress, const std::string& line) {
   if (progress) progress(line);
 }
@@ -268,8 +281,11 @@ void regularize_and_certify(Mover& mover, const ResolvedBoundary<Dim>& boundary,
 template <int Dim>
 [[nodiscard]] CurveResult<Dim> curve_mesh(const Mesh<Dim>& linear, const CurveOptions<Dim>& options = {}) {
   const detail::Stopwatch total;
-  if (options.method != "rbf" && options.method != "blend" && options.method != "none")
-    throw InputError("curve_mesh: unknown method '" + options.method + "' (expected rbf, blend or none)");
+  if (options.method != "blend" && options.method != "none" && !mover_registry<Dim>().contains(options.method)) {
+    std::string known = "blend, none";
+    for (const auto& [key, factory] : mover_registry<Dim>()) known += ", " + key;
+    throw InputError("curve_mesh: unknown method '" + options.method + "' (expected one of " + known + ")");
+  }
   CurveResult<Dim> result;
   result.method = options.method;
   detail::report_progress(options.progress, "converting " + std::to_string(linear.num_cells()) + " cells to P2");
@@ -288,7 +304,8 @@ template <int Dim>
       walls.push_back(g.name);
   }
   if (Dim == 3 && walls.empty())
-    throw InputError("curve_mesh: no group to curve in 3D (expected a projection callback for at least one group)");
+    throw InputError("curve_mesh: no group to curve in 3D (expected a projection callback or a surface reconstruction "
+                     "for at least one group)");
 
   detail::report_progress(options.progress, "snapping the boundary (" + std::to_string(walls.size()) + " curved groups)");
   clock = detail::Stopwatch{};
@@ -299,15 +316,24 @@ template <int Dim>
   const ResolvedBoundary<Dim> boundary = detail::curving_boundary(result.curved, snapped, options.sliding);
   result.seconds.snap = clock.seconds();
 
-  const bool estimate = !walls.empty() && ((options.method == "rbf" && options.support_radius <= 0.0) ||
-                                           (options.method == "blend" && options.blending_length <= 0.0));
+  const bool estimate = !walls.empty() && options.method != "none" &&
+                        (options.method == "blend" ? options.blending_length <= 0.0 : options.support_radius <= 0.0);
   if (estimate) {
     detail::report_progress(options.progress, "estimating the boundary layer of the curved walls");
     clock = detail::Stopwatch{};
     result.layers = estimate_boundary_layer(result.curved, std::span<const std::string>(walls), options.layer).walls;
     result.seconds.layer = clock.seconds();
   }
-  if (options.method == "rbf") {
+  if (options.method == "blend") {
+    BlendOptions blend;
+    blend.blending_length = options.blending_length;
+    blend.layer = options.layer;
+    BlendMover<Dim> mover(blend);
+    regularize_and_certify(mover, boundary, options, result);
+  } else if (options.method == "none") {
+    detail::SnapOnlyMover<Dim> mover;
+    regularize_and_certify(mover, boundary, options, result);
+  } else {
     result.support_radius = options.support_radius;
     if (!(result.support_radius > 0.0)) {
       double thickest = 0.0;
@@ -319,19 +345,10 @@ template <int Dim>
       for (std::size_t k = 0; k < snapped.nodes.size(); ++k) at.col(static_cast<Index>(k)) = result.curved.points.col(snapped.nodes[k]);
       result.support_radius = snapped.nodes.size() >= 2 ? suggest_support_radius(at, snapped.displacements) : 1.0;
     }
-    RbfOptions rbf;
-    rbf.kernel = options.kernel;
-    rbf.support_radius = result.support_radius;
-    RbfMover<Dim> mover(rbf);
-    regularize_and_certify(mover, boundary, options, result);
-  } else if (options.method == "blend") {
-    BlendOptions blend;
-    blend.blending_length = options.blending_length;
-    blend.layer = options.layer;
-    BlendMover<Dim> mover(blend);
-    regularize_and_certify(mover, boundary, options, result);
-  } else {
-    detail::SnapOnlyMover<Dim> mover;
+    MoverParameters parameters = options.parameters;
+    parameters.values.try_emplace("kernel", std::string(name(options.kernel)));
+    parameters.values.try_emplace("support_radius", detail::exact_decimal(result.support_radius));
+    AnyMover<Dim> mover = make_mover<Dim>(options.method, parameters);
     regularize_and_certify(mover, boundary, options, result);
   }
   result.seconds.total = total.seconds();
