@@ -56,7 +56,7 @@ declare -A full_args=(
   [elasticity_bench]=""
   [curving_bench]=""
 )
-order=(io_bench quality_bench delaunay_bench rbf_bench interpolation_bench elasticity_bench curving_bench)
+order=(io_bench quality_bench rbf_bench interpolation_bench elasticity_bench delaunay_bench curving_bench)
 
 # curving_bench joins only once it is committed (it may be work in progress in the tree).
 benches=()
