@@ -5,3 +5,9 @@ if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
     -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Werror)
   # Eigen and nanoflann are system headers (-isystem), so these flags judge our code only.
 endif()
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+  # GCC 12 reports maybe-uninitialized inside inlined Eigen factorizations at -O1 (false
+  # positives at the inlining site, outside Eigen's system-header shelter): keep it visible,
+  # not fatal.
+  target_compile_options(meshmotion_warnings INTERFACE -Wno-error=maybe-uninitialized)
+endif()
