@@ -87,14 +87,19 @@ for name in "${benches[@]}"; do
   if [[ $full == 1 ]]; then args="${full_args[$name]}"; else args="${quick_args[$name]}"; fi
   load="$(cut -d' ' -f1-3 /proc/loadavg)"
   echo "== $name $args   (load average $load)" | tee -a "$log"
-  start=$(date +%s.%N)
+  if [[ ! -x "$build_dir/benchmarks/$name" ]]; then
+    echo "run_all.sh: $build_dir/benchmarks/$name is not built" | tee -a "$log" >&2
+    status=1
+    continue
+  fi
+  start=$(date +%s%N)
   # shellcheck disable=SC2086  # args is a word list on purpose
   "$build_dir/benchmarks/$name" $args > "$build_dir/$name.out" 2>&1
   rc=$?
-  seconds=$(echo "$(date +%s.%N) - $start" | bc)
+  milliseconds=$(( ($(date +%s%N) - start) / 1000000 ))
   tee -a "$log" < "$build_dir/$name.out" | grep -v '^{'
-  printf '{"benchmark_run":"%s","arguments":"%s","load_average":"%s","exit_code":%d,"wall_seconds":%.1f}\n' \
-    "$name" "$args" "$load" "$rc" "$seconds" >> "$out"
+  printf '{"benchmark_run":"%s","arguments":"%s","load_average":"%s","exit_code":%d,"wall_seconds":%d.%03d}\n' \
+    "$name" "$args" "$load" "$rc" $((milliseconds / 1000)) $((milliseconds % 1000)) >> "$out"
   grep '^{' "$build_dir/$name.out" >> "$out"
   [[ $rc == 0 ]] || { echo "run_all.sh: $name exited with $rc" | tee -a "$log" >&2; status=1; }
 done
