@@ -1,4 +1,6 @@
+#include "meshmotion/core/generators.hpp"
 #include "meshmotion/core/shape_functions.hpp"
+#include "meshmotion/curving/p2_conversion.hpp"
 #include "meshmotion/io.hpp"
 #include "meshmotion/quality.hpp"
 
@@ -435,4 +437,43 @@ TEST_CASE("scaled Jacobian agrees with a live gmsh run", "[quality]") {
     REQUIRE(!ratio.empty());
     check_against(read_mesh_as<2>(quality_data(c.file)), ratio, invalid);
   }
+}
+
+namespace {
+// Counts the occurrences of `needle` in `text`.
+std::size_t occurrences(const std::string& text, const std::string& needle) {
+  std::size_t n = 0;
+  for (auto at = text.find(needle); at != std::string::npos; at = text.find(needle, at + needle.size())) ++n;
+  return n;
+}
+}  // namespace
+
+TEST_CASE("SVG picture: well-formed, one path per cell in the zoom box, curved P2 edges", "[quality]") {
+  Mesh<2> mesh = rectangle_mesh({.nx = 4, .ny = 2, .x_min = 0.0, .x_max = 4.0, .y_min = 0.0, .y_max = 2.0});
+  const std::vector<double> values(static_cast<std::size_t>(mesh.num_cells()), 0.5);
+  SvgOptions options;
+  options.title = "a <long> title & more, so the header is longer than any fixed buffer";
+
+  const std::string whole = svg_picture(mesh, values, options);
+  CHECK(whole.rfind("<svg xmlns=\"http://www.w3.org/2000/svg\"", 0) == 0);
+  CHECK(whole.find("stroke-width=\"0.4\">\n") != std::string::npos);  // header complete
+  CHECK(whole.size() > 6);
+  CHECK(whole.substr(whole.size() - 7) == "</svg>\n");
+  CHECK(occurrences(whole, "<path ") == static_cast<std::size_t>(mesh.num_cells()));
+  CHECK(occurrences(whole, "&lt;long>") == 1);
+  CHECK(occurrences(whole, "&amp;") == 1);
+  CHECK(occurrences(whole, "<") == occurrences(whole, ">") - 1);  // the escaped title keeps one '>'
+
+  // Zoom on the left square column: the other cells are not drawn.
+  options.zoom = std::array<double, 4>{0.1, 0.9, 0.1, 1.9};
+  CHECK(occurrences(svg_picture(mesh, values, options), "<path ") == 2);
+
+  // Quadratic cells are drawn with quadratic Bézier edges, straight cells with lines.
+  CHECK(occurrences(whole, " Q") == 0);
+  options.zoom.reset();
+  const std::string curved = svg_picture(to_quadratic(mesh), values, options);
+  CHECK(occurrences(curved, " Q") == 4 * static_cast<std::size_t>(mesh.num_cells()));
+
+  options.zoom = std::array<double, 4>{1.0, 1.0, 0.0, 1.0};
+  CHECK_THROWS_AS(svg_picture(mesh, values, options), InputError);
 }

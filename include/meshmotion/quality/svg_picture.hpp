@@ -34,6 +34,17 @@ struct SvgOptions {
 
 namespace detail {
 
+/// Appends printf-style text of any length: a picture is never silently truncated.
+template <class... Args>
+void append_format(std::string& out, const char* format, Args... args) {
+  const int n = std::snprintf(nullptr, 0, format, args...);
+  if (n <= 0) return;
+  const std::size_t old = out.size();
+  out.resize(old + static_cast<std::size_t>(n) + 1);
+  std::snprintf(out.data() + old, static_cast<std::size_t>(n) + 1, format, args...);
+  out.resize(old + static_cast<std::size_t>(n));
+}
+
 // A perceptually ordered scale (dark blue → teal → yellow), close to viridis.
 inline std::string colour(double t) {
   static constexpr std::array<std::array<double, 3>, 5> stops{{
@@ -73,13 +84,11 @@ inline std::string colour(double t) {
   const auto px = [&](double x) { return (x - box[0]) / (box[1] - box[0]) * w; };
   const auto py = [&](double y) { return (box[3] - y) / (box[3] - box[2]) * h; };
   std::string out;
-  char buf[256];
-  std::snprintf(buf, sizeof buf,
+  detail::append_format(out,
                 "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\">\n"
                 "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n<clipPath id=\"box\"><rect width=\"%.0f\" "
                 "height=\"%.0f\"/></clipPath>\n<g clip-path=\"url(#box)\" stroke=\"%s\" stroke-width=\"0.4\">\n",
                 w + bar, h, w + bar, h, w, h, options.draw_edges ? "black" : "none");
-  out += buf;
   const double span = options.value_max - options.value_min;
   Index cell = 0;
   for (const auto& block : mesh.cells) {
@@ -97,18 +106,16 @@ inline std::string colour(double t) {
       const double v = values[static_cast<std::size_t>(cell)];
       const std::string fill = v <= 0 || !std::isfinite(v) ? std::string("#ff00ff")
                                                            : detail::colour(span > 0 ? (v - options.value_min) / span : 1.0);
-      std::snprintf(buf, sizeof buf, "<path fill=\"%s\" d=\"M%.3f %.3f", fill.c_str(), px(p(0).x()), py(p(0).y()));
-      out += buf;
+      detail::append_format(out, "<path fill=\"%s\" d=\"M%.3f %.3f", fill.c_str(), px(p(0).x()), py(p(0).y()));
       for (int k = 0; k < nv; ++k) {
         const auto b = p((k + 1) % nv);
         if (curved) {
           // The quadratic through a, m (at t = 1/2) and b has control point 2m - (a + b)/2.
           const Eigen::Vector2d c = 2.0 * p(nv + k) - 0.5 * (p(k) + b);
-          std::snprintf(buf, sizeof buf, " Q%.3f %.3f %.3f %.3f", px(c.x()), py(c.y()), px(b.x()), py(b.y()));
+          detail::append_format(out, " Q%.3f %.3f %.3f %.3f", px(c.x()), py(c.y()), px(b.x()), py(b.y()));
         } else {
-          std::snprintf(buf, sizeof buf, " L%.3f %.3f", px(b.x()), py(b.y()));
+          detail::append_format(out, " L%.3f %.3f", px(b.x()), py(b.y()));
         }
-        out += buf;
       }
       out += "Z\"/>\n";
     }
@@ -117,19 +124,17 @@ inline std::string colour(double t) {
   // Colour bar: 20 steps from value_max (top) to value_min (bottom).
   const double bx = w + 15, bh = std::min(h - 40, 400.0), by = 25;
   for (int k = 0; k < 20; ++k) {
-    std::snprintf(buf, sizeof buf, "<rect x=\"%.1f\" y=\"%.2f\" width=\"20\" height=\"%.2f\" fill=\"%s\"/>\n", bx,
-                  by + k * bh / 20, bh / 20 + 0.5, detail::colour(1.0 - (k + 0.5) / 20).c_str());
-    out += buf;
+    detail::append_format(out, "<rect x=\"%.1f\" y=\"%.2f\" width=\"20\" height=\"%.2f\" fill=\"%s\"/>\n", bx,
+                          by + k * bh / 20, bh / 20 + 0.5, detail::colour(1.0 - (k + 0.5) / 20).c_str());
   }
   for (int k = 0; k <= 4; ++k) {
-    std::snprintf(buf, sizeof buf, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" font-family=\"sans-serif\">%.3g</text>\n",
-                  bx + 24, by + bh * (1.0 - k / 4.0) + 4, options.value_min + span * k / 4.0);
-    out += buf;
+    detail::append_format(out, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" font-family=\"sans-serif\">%.3g</text>\n",
+                          bx + 24, by + bh * (1.0 - k / 4.0) + 4, options.value_min + span * k / 4.0);
   }
   std::string title;
   for (const char ch : options.title) title += ch == '<' ? std::string("&lt;") : ch == '&' ? std::string("&amp;") : std::string(1, ch);
-  std::snprintf(buf, sizeof buf, "<text x=\"%.1f\" y=\"15\" font-size=\"11\" font-family=\"sans-serif\">", bx);
-  out += buf + title + "</text>\n</svg>\n";
+  detail::append_format(out, "<text x=\"%.1f\" y=\"15\" font-size=\"11\" font-family=\"sans-serif\">", bx);
+  out += title + "</text>\n</svg>\n";
   return out;
 }
 
