@@ -74,16 +74,21 @@ void header() {
               "seconds", "/rbf", "iters", "thesis");
 }
 
+Row start_row(const std::string& part, const std::string& method, const std::string& label, const std::string& thesis) {
+  Row r;
+  r.part = part;
+  r.method = method;
+  r.parameters = label;
+  r.thesis = thesis;
+  return r;
+}
+
 Row curve(const Mesh<2>& linear, const std::string& method, const MoverParameters& parameters, const std::string& label,
           const std::string& thesis) {
   CurveOptions<2> o;
   o.method = method;
   o.parameters = parameters;
-  Row r;
-  r.part = "tab4.2";
-  r.method = method;
-  r.parameters = label;
-  r.thesis = thesis;
+  Row r = start_row("tab4.2", method, label, thesis);
   try {
     const CurveResult<2> c = curve_mesh(linear, o);
     r.min_quality = c.quality.min;
@@ -99,11 +104,7 @@ Row curve(const Mesh<2>& linear, const std::string& method, const MoverParameter
 
 Row flap(const Mesh<2>& mesh, const BoundarySpec<2>& spec, const GroupNodes& groups, const std::string& method,
          const MoverParameters& parameters, int steps, const std::string& label, const std::string& thesis) {
-  Row r;
-  r.part = "fig4.1-5";
-  r.method = method;
-  r.parameters = label;
-  r.thesis = thesis;
+  Row r = start_row("fig4.1-5", method, label, thesis);
   try {
     AnyMover<2> mover = make_mover<2>(method, parameters);
     const auto start = std::chrono::steady_clock::now();
