@@ -341,5 +341,5 @@ TEST_CASE("step driver: a rotated ellipse O-mesh, wall rotated rigidly, quality 
     CHECK(r.steps.back().quality->num_invalid == 0);
     CHECK(r.steps.back().stats.factorizations == 1);
   }
-  CHECK_THROWS_AS(make_mover<2>("spring"), InputError);
+  CHECK_THROWS_AS(make_mover<2>("no_such_method"), InputError);
 }
