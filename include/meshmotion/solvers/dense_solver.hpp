@@ -11,6 +11,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -52,9 +53,9 @@ class DenseSolver {
     matrix_ = a;
     bool ok = true;
     switch (kind_) {
-      case DenseSolverKind::llt: llt_.compute(matrix_); ok = llt_.info() == Eigen::Success; break;
-      case DenseSolverKind::ldlt: ldlt_.compute(matrix_); ok = ldlt_.info() == Eigen::Success; break;
-      case DenseSolverKind::partial_piv_lu: lu_.compute(matrix_); break;
+      case DenseSolverKind::llt: ok = llt_.emplace(matrix_).info() == Eigen::Success; break;
+      case DenseSolverKind::ldlt: ok = ldlt_.emplace(matrix_).info() == Eigen::Success; break;
+      case DenseSolverKind::partial_piv_lu: lu_.emplace(matrix_); break;
     }
     ++report_.factorizations;
     ++report_.analyses;
@@ -71,10 +72,11 @@ class DenseSolver {
     if (b.rows() != size())
       throw InputError("DenseSolver::solve: right-hand side has " + std::to_string(b.rows()) + " rows (expected " +
                        std::to_string(size()) + ")");
+    if (!llt_ && !ldlt_ && !lu_) throw InputError("DenseSolver::solve: no matrix factorized (call compute first)");
     switch (kind_) {
-      case DenseSolverKind::llt: x = llt_.solve(b); break;
-      case DenseSolverKind::ldlt: x = ldlt_.solve(b); break;
-      case DenseSolverKind::partial_piv_lu: x = lu_.solve(b); break;
+      case DenseSolverKind::llt: x = llt_->solve(b); break;
+      case DenseSolverKind::ldlt: x = ldlt_->solve(b); break;
+      case DenseSolverKind::partial_piv_lu: x = lu_->solve(b); break;
     }
     const double norm_b = b.norm();
     const double residual = (matrix_ * x - b).norm() / (norm_b > 0.0 ? norm_b : 1.0);
@@ -96,9 +98,11 @@ class DenseSolver {
   DenseSolverKind kind_;
   SolverReport report_;
   Eigen::MatrixXd matrix_;
-  Eigen::LLT<Eigen::MatrixXd> llt_;
-  Eigen::LDLT<Eigen::MatrixXd> ldlt_;
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+  // Created by compute() only: Eigen leaves a default-constructed factorization's status
+  // uninitialized, and moving a solver would read it.
+  std::optional<Eigen::LLT<Eigen::MatrixXd>> llt_;
+  std::optional<Eigen::LDLT<Eigen::MatrixXd>> ldlt_;
+  std::optional<Eigen::PartialPivLU<Eigen::MatrixXd>> lu_;
 };
 
 }  // namespace meshmotion
