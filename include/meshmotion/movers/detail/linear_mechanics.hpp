@@ -89,11 +89,14 @@ class LinearMechanicsMover {
   }
 
   /// Factorizes the constrained system of K (components dofs per node) and records stats.
+  /// `free_nodes` (optional, one flag per node) limits the unknowns to the flagged nodes that
+  /// are not Dirichlet nodes: the others keep zero displacement (by default every node of a
+  /// cell is free).
   void finish_setup(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary, SparseMatrix k, int components,
-                    const SolverOptions& solver, const Stopwatch& watch) {
+                    const SolverOptions& solver, const Stopwatch& watch, const std::vector<bool>* free_nodes = nullptr) {
     stiffness_ = std::move(k);
     boundary_nodes_ = boundary.nodes;
-    system_.build(components, cell_nodes(mesh), boundary, solver);
+    system_.build(components, free_nodes != nullptr ? *free_nodes : cell_nodes(mesh), boundary, solver);
     system_.factorize(stiffness_);
     stats_ = MoverStats{};
     stats_.boundary_nodes = boundary.size();
