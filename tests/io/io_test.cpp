@@ -9,10 +9,16 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cctype>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 using namespace meshmotion;
@@ -362,7 +368,7 @@ TEST_CASE("VTU output: Lagrange cell types, point and cell data, facets on reque
   VtuFields fields;
   fields.point_data.emplace_back("displacement", Eigen::MatrixXd::Ones(3, mesh.num_nodes()));
   fields.cell_data.emplace_back("quality", Eigen::MatrixXd::Constant(1, mesh.num_cells(), 0.5));
-  const auto text = format_vtu(mesh, fields);
+  const auto text = format_vtu(mesh, fields, VtuOptions{false, VtuEncoding::ascii});
   CHECK(text.find("NumberOfCells=\"7\"") != std::string::npos);
   const auto types_at = text.find("Name=\"types\"");
   const auto types = text.substr(types_at, text.find("</DataArray>", types_at) - types_at);
@@ -378,6 +384,79 @@ TEST_CASE("VTU output: Lagrange cell types, point and cell data, facets on reque
   const auto out = test::scratch_path("mesh.vtu");
   write_mesh(out, mesh);
   CHECK(fs::file_size(out) > 0);
+}
+
+namespace {
+
+std::vector<unsigned char> decode_base64(std::string_view text) {
+  const std::string_view alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  REQUIRE(text.size() % 4 == 0);
+  std::vector<unsigned char> bytes;
+  for (std::size_t i = 0; i < text.size(); i += 4) {
+    unsigned bits = 0;
+    int num_bytes = 3;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const char c = text[i + k];
+      if (c == '=') --num_bytes;
+      bits = (bits << 6) | (c == '=' ? 0u : static_cast<unsigned>(alphabet.find(c)));
+    }
+    for (int k = 0; k < num_bytes; ++k) bytes.push_back(static_cast<unsigned char>((bits >> (16 - 8 * k)) & 0xffu));
+  }
+  return bytes;
+}
+
+/// The decoded payload of DataArray `name` (header and data were encoded separately).
+template <class T>
+std::vector<T> binary_array(const std::string& text, const std::string& name) {
+  const auto at = text.find(name);
+  REQUIRE(at != std::string::npos);
+  const auto begin = text.find('>', at) + 1;
+  const auto end = text.find("</DataArray>", begin);
+  std::string body = text.substr(begin, end - begin);
+  body.erase(std::remove_if(body.begin(), body.end(), [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; }),
+             body.end());
+  // The UInt64 byte count is 8 bytes: 12 characters including its '=' padding.
+  const auto header = decode_base64(body.substr(0, 12));
+  std::uint64_t num_bytes = 0;
+  std::memcpy(&num_bytes, header.data(), sizeof(num_bytes));
+  const auto payload = decode_base64(body.substr(12));
+  REQUIRE(payload.size() >= num_bytes);
+  std::vector<T> values(num_bytes / sizeof(T));
+  std::memcpy(values.data(), payload.data(), values.size() * sizeof(T));
+  return values;
+}
+
+}  // namespace
+
+TEST_CASE("VTU binary output decodes to the exact coordinates, connectivity and fields", "[io]") {
+  auto mesh = all_types_mesh<3>(2);
+  mesh.points.array() += 0.1;  // values with no short decimal form
+  VtuFields fields;
+  Eigen::MatrixXd displacement = mesh.points * 0.5;
+  fields.point_data.emplace_back("displacement", displacement);
+  const auto text = format_vtu(mesh, fields);
+  CHECK(text.find("format=\"ascii\"") == std::string::npos);
+  const auto points = binary_array<double>(text, "NumberOfComponents=\"3\" format");
+  REQUIRE(points.size() == static_cast<std::size_t>(3 * mesh.num_nodes()));
+  for (Index i = 0; i < mesh.num_nodes(); ++i)
+    for (int d = 0; d < 3; ++d) CHECK(points[static_cast<std::size_t>(3 * i + d)] == mesh.points(d, i));
+  const auto shown = binary_array<double>(text, "Name=\"displacement\"");
+  REQUIRE(shown.size() == static_cast<std::size_t>(displacement.size()));
+  CHECK(Eigen::Map<const Eigen::MatrixXd>(shown.data(), 3, mesh.num_nodes()) == displacement);
+  const auto types = binary_array<std::uint8_t>(text, "Name=\"types\"");
+  const auto offsets = binary_array<std::int64_t>(text, "Name=\"offsets\"");
+  REQUIRE(types.size() == static_cast<std::size_t>(mesh.num_cells()));
+  REQUIRE(offsets.size() == types.size());
+  // The ASCII writer is the reference for the same arrays.
+  const auto ascii = format_vtu(mesh, fields, VtuOptions{false, VtuEncoding::ascii});
+  const auto ascii_types_at = ascii.find("Name=\"types\"");
+  std::istringstream ascii_types(ascii.substr(ascii.find('>', ascii_types_at) + 1));
+  for (const auto t : types) {
+    int expected = -1;
+    ascii_types >> expected;
+    CHECK(int{t} == expected);
+  }
+  CHECK(offsets.back() == static_cast<std::int64_t>(binary_array<std::int64_t>(text, "Name=\"connectivity\"").size()));
 }
 
 TEST_CASE("mesh summary counts groups, edges and orientation", "[io]") {
