@@ -1,0 +1,131 @@
+#!/usr/bin/env bash
+# Mesh motion vs OpenFOAM: the SU2 deforming bump (`interface` rises by 0.05 sin²) and the
+# rotating ellipse O-mesh (30° and 60°) moved by OpenFOAM's moveMesh (dynamicMotionSolverFvMesh,
+# displacementLaplacian, inverseDistance diffusivity from the moving patch) and by our RBF,
+# elasticity and spring movers; every result judged by our quality layer.
+# Installs Debian's `openfoam` with apt-get when moveMesh is absent; a missing peer is reported.
+#
+#   benchmarks/openfoam_peer.sh [BUILD_DIR=build] [WORK_DIR=/tmp/meshmotion_openfoam_peer]
+set -u
+build=${1:-build}
+work=${2:-/tmp/meshmotion_openfoam_peer}
+bench="$build/benchmarks/motion_peer_bench"
+if [[ ! -x "$bench" ]]; then
+  echo "openfoam_peer: $bench not built (configure with -DMESHMOTION_BUILD_BENCHMARKS=ON, build target motion_peer_bench)" >&2
+  exit 1
+fi
+
+if ! command -v moveMesh >/dev/null 2>&1; then
+  echo "openfoam_peer: moveMesh not found; installing Debian's openfoam with apt-get"
+  if [[ $(id -u) -eq 0 ]] && command -v apt-get >/dev/null 2>&1; then
+    (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq openfoam) >"$work.apt.log" 2>&1 ||
+      echo "openfoam_peer: apt-get install openfoam failed (log: $work.apt.log)"
+  else
+    echo "openfoam_peer: cannot install (needs root and apt-get)"
+  fi
+fi
+# Debian installs the applications in /usr/bin; its bashrc sets WM_PROJECT_DIR and the library
+# paths (it reads unset variables, hence set +u around it).
+if [[ -f /usr/share/openfoam/etc/bashrc ]]; then
+  set +u
+  # shellcheck disable=SC1091
+  source /usr/share/openfoam/etc/bashrc >/dev/null 2>&1
+  set -u
+fi
+have_foam=0
+command -v moveMesh >/dev/null 2>&1 && have_foam=1
+echo "openfoam_peer: OpenFOAM $( ((have_foam)) && dpkg-query -W -f='${Version}' openfoam 2>/dev/null || echo MISSING)," \
+  "load $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) cores"
+
+# The case dictionaries shared by every case; the mesh and 0/pointDisplacement come from
+# motion_peer_bench foam-export.
+write_dicts() {
+  local dir=$1 patch=$2
+  mkdir -p "$dir/system" "$dir/constant"
+  local header='FoamFile { version 2.0; format ascii; class dictionary; object'
+  cat >"$dir/system/controlDict" <<EOF
+$header controlDict; }
+application     moveMesh;
+startFrom       startTime;
+startTime       0;
+stopAt          endTime;
+endTime         1;
+deltaT          1;
+writeControl    timeStep;
+writeInterval   1;
+writeFormat     ascii;
+writePrecision  17;
+writeCompression off;
+timeFormat      general;
+timePrecision   6;
+runTimeModifiable false;
+EOF
+  cat >"$dir/system/fvSchemes" <<EOF
+$header fvSchemes; }
+ddtSchemes { default steadyState; }
+gradSchemes { default Gauss linear; }
+divSchemes { default none; }
+laplacianSchemes { default Gauss linear corrected; }
+interpolationSchemes { default linear; }
+snGradSchemes { default corrected; }
+EOF
+  cat >"$dir/system/fvSolution" <<EOF
+$header fvSolution; }
+solvers
+{
+    cellDisplacement
+    {
+        solver          GAMG;
+        smoother        GaussSeidel;
+        tolerance       1e-08;
+        relTol          0;
+        maxIter         1000;
+        // inverseDistance makes the diffusivity ~1e5 at the 1e-5 wall cells of the O-mesh, and
+        // OpenFOAM's normalised residual then reads ~1e-15 after one sweep although the far
+        // field is not converged; 20 sweeps give the converged field (100 and 400 change nothing).
+        minIter         20;
+    }
+}
+EOF
+  cat >"$dir/constant/dynamicMeshDict" <<EOF
+$header dynamicMeshDict; }
+dynamicFvMesh   dynamicMotionSolverFvMesh;
+motionSolverLibs ("libfvMotionSolvers.so");
+motionSolver    displacementLaplacian;
+displacementLaplacianCoeffs
+{
+    diffusivity inverseDistance ($patch);
+}
+EOF
+}
+
+run_case() {
+  local case=$1 patch=$2
+  local dir="$work/${case//:/_}"
+  rm -rf "$dir"
+  "$bench" foam-export "$case" "$dir" || return 1
+  write_dicts "$dir" "$patch"
+  local seconds=0 note="OpenFOAM not installed"
+  if ((have_foam)); then
+    local start end
+    start=$(date +%s.%N)
+    if moveMesh -case "$dir" >"$dir/log.moveMesh" 2>&1; then
+      end=$(date +%s.%N)
+      seconds=$(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.4f", b - a }')
+      local iterations
+      iterations=$(grep -o 'No Iterations [0-9]*' "$dir/log.moveMesh" | awk '{ s += $3 } END { print s + 0 }')
+      local cpu
+      cpu=$(grep -o 'ExecutionTime = [0-9.e+-]*' "$dir/log.moveMesh" | tail -1 | awk '{ printf "%.2f", $3 }')
+      note="moveMesh wall time; its ExecutionTime $cpu s; $iterations GAMG iterations (x+y)"
+    else
+      note="moveMesh failed, see $dir/log.moveMesh"
+      tail -5 "$dir/log.moveMesh"
+    fi
+  fi
+  "$bench" foam-judge "$case" "$dir" "$seconds" "$note"
+}
+
+mkdir -p "$work"
+run_case bump interface
+run_case ellipse:128:30 wall
+run_case ellipse:128:60 wall
