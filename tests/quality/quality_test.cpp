@@ -463,6 +463,13 @@ TEST_CASE("SVG picture: well-formed, one path per cell in the zoom box, curved P
   CHECK(occurrences(whole, "&lt;long>") == 1);
   CHECK(occurrences(whole, "&amp;") == 1);
   CHECK(occurrences(whole, "<") == occurrences(whole, ">") - 1);  // the escaped title keeps one '>'
+  // The title has a band above the picture (4000 × 2000 box at width 1000: 500 px high).
+  CHECK(whole.find("height=\"522\"") != std::string::npos);
+  CHECK(whole.find("<g transform=\"translate(0 22)\">") < whole.find("<path "));
+  CHECK(whole.find("<text x=\"5\" y=\"15\"") > whole.rfind("</g>"));
+  options.title.clear();
+  CHECK(svg_picture(mesh, values, options).find("height=\"500\"") != std::string::npos);
+  options.title = "restored";
 
   // Zoom on the left square column: the other cells are not drawn.
   options.zoom = std::array<double, 4>{0.1, 0.9, 0.1, 1.9};

@@ -28,7 +28,7 @@ struct SvgOptions {
   int width = 1000;                           ///< picture width in pixels (height follows the aspect ratio)
   double value_min = 0.0;                     ///< value at the bottom of the colour scale
   double value_max = 1.0;                     ///< value at the top of the colour scale
-  std::string title;                          ///< shown above the colour bar
+  std::string title;                          ///< shown in a band above the picture
   bool draw_edges = true;
 };
 
@@ -81,14 +81,18 @@ inline std::string colour(double t) {
                      ", y " + std::to_string(box[2]) + ".." + std::to_string(box[3]) + ")");
   const double w = options.width, h = std::clamp(w * (box[3] - box[2]) / (box[1] - box[0]), 50.0, 4.0 * w);
   const double bar = 90;
+  // The title gets a band of its own above the picture: in the colour-bar column a long one
+  // ran off the right edge.
+  const double band = options.title.empty() ? 0.0 : 22.0;
   const auto px = [&](double x) { return (x - box[0]) / (box[1] - box[0]) * w; };
   const auto py = [&](double y) { return (box[3] - y) / (box[3] - box[2]) * h; };
   std::string out;
   detail::append_format(out,
                 "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\">\n"
-                "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n<clipPath id=\"box\"><rect width=\"%.0f\" "
-                "height=\"%.0f\"/></clipPath>\n<g clip-path=\"url(#box)\" stroke=\"%s\" stroke-width=\"0.4\">\n",
-                w + bar, h, w + bar, h, w, h, options.draw_edges ? "black" : "none");
+                "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n<g transform=\"translate(0 %.0f)\">\n"
+                "<clipPath id=\"box\"><rect width=\"%.0f\" height=\"%.0f\"/></clipPath>\n"
+                "<g clip-path=\"url(#box)\" stroke=\"%s\" stroke-width=\"0.4\">\n",
+                w + bar, h + band, w + bar, h + band, band, w, h, options.draw_edges ? "black" : "none");
   const double span = options.value_max - options.value_min;
   Index cell = 0;
   for (const auto& block : mesh.cells) {
@@ -131,10 +135,13 @@ inline std::string colour(double t) {
     detail::append_format(out, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" font-family=\"sans-serif\">%.3g</text>\n",
                           bx + 24, by + bh * (1.0 - k / 4.0) + 4, options.value_min + span * k / 4.0);
   }
-  std::string title;
-  for (const char ch : options.title) title += ch == '<' ? std::string("&lt;") : ch == '&' ? std::string("&amp;") : std::string(1, ch);
-  detail::append_format(out, "<text x=\"%.1f\" y=\"15\" font-size=\"11\" font-family=\"sans-serif\">", bx);
-  out += title + "</text>\n</svg>\n";
+  out += "</g>\n";
+  if (!options.title.empty()) {
+    out += "<text x=\"5\" y=\"15\" font-size=\"12\" font-family=\"sans-serif\">";
+    for (const char ch : options.title) out += ch == '<' ? std::string("&lt;") : ch == '&' ? std::string("&amp;") : std::string(1, ch);
+    out += "</text>\n";
+  }
+  out += "</svg>\n";
   return out;
 }
 
