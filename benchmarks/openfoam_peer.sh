@@ -7,6 +7,9 @@
 #
 #   benchmarks/openfoam_peer.sh [BUILD_DIR=build] [WORK_DIR=/tmp/meshmotion_openfoam_peer]
 set -u
+# One thread for every tool (ours, Eigen, OpenBLAS under SciPy; OpenFOAM runs serial): on a
+# shared, loaded machine OpenMP threads that wait on each other make timings meaningless.
+export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1} OPENBLAS_NUM_THREADS=${OPENBLAS_NUM_THREADS:-1}
 build=${1:-build}
 work=${2:-/tmp/meshmotion_openfoam_peer}
 bench="$build/benchmarks/motion_peer_bench"
@@ -35,7 +38,7 @@ fi
 have_foam=0
 command -v moveMesh >/dev/null 2>&1 && have_foam=1
 echo "openfoam_peer: OpenFOAM $( ((have_foam)) && dpkg-query -W -f='${Version}' openfoam 2>/dev/null || echo MISSING)," \
-  "load $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) cores"
+  "threads $OMP_NUM_THREADS, load $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) cores"
 
 # The case dictionaries shared by every case; the mesh and 0/pointDisplacement come from
 # motion_peer_bench foam-export.
@@ -116,7 +119,15 @@ run_case() {
       iterations=$(grep -o 'No Iterations [0-9]*' "$dir/log.moveMesh" | awk '{ s += $3 } END { print s + 0 }')
       local cpu
       cpu=$(grep -o 'ExecutionTime = [0-9.e+-]*' "$dir/log.moveMesh" | tail -1 | awk '{ printf "%.2f", $3 }')
-      note="moveMesh wall time; its ExecutionTime $cpu s; $iterations GAMG iterations (x+y)"
+      # The same run without the motion step (endTime 0): start-up, reading and set-up only.
+      sed -i 's/^endTime .*/endTime         0;/' "$dir/system/controlDict"
+      start=$(date +%s.%N)
+      moveMesh -case "$dir" >"$dir/log.startup" 2>&1
+      end=$(date +%s.%N)
+      sed -i 's/^endTime .*/endTime         1;/' "$dir/system/controlDict"
+      local startup
+      startup=$(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.2f", b - a }')
+      note="moveMesh wall time; its ExecutionTime $cpu s; start-up only $startup s; $iterations GAMG iterations (x+y)"
     else
       note="moveMesh failed, see $dir/log.moveMesh"
       tail -5 "$dir/log.moveMesh"
