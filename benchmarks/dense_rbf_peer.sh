@@ -35,7 +35,7 @@ fi
 have_scipy=0
 "$python" -c 'import scipy.interpolate' >/dev/null 2>&1 && have_scipy=1
 echo "dense_rbf_peer: SciPy $( ((have_scipy)) && "$python" -c 'import scipy; print(scipy.__version__)' || echo MISSING)," \
-  "threads $OMP_NUM_THREADS, load $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) cores"
+  "threads $OMP_NUM_THREADS, load $(cut -d' ' -f1-3 /proc/loadavg), $(nproc --all) cores"
 
 # Fits RBFInterpolator to the exported centres and values, evaluates it at every node and
 # writes the displacements and the fit + evaluation seconds (file reading excluded).

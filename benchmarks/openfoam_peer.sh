@@ -38,7 +38,7 @@ fi
 have_foam=0
 command -v moveMesh >/dev/null 2>&1 && have_foam=1
 echo "openfoam_peer: OpenFOAM $( ((have_foam)) && dpkg-query -W -f='${Version}' openfoam 2>/dev/null || echo MISSING)," \
-  "threads $OMP_NUM_THREADS, load $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) cores"
+  "threads $OMP_NUM_THREADS, load $(cut -d' ' -f1-3 /proc/loadavg), $(nproc --all) cores"
 
 # The case dictionaries shared by every case; the mesh and 0/pointDisplacement come from
 # motion_peer_bench foam-export.
