@@ -158,9 +158,8 @@ class BlendMover {
     out.noalias() = given * operator_;
     for (Index k = 0; k < boundary_.size(); ++k)
       if (boundary_.kinds[static_cast<std::size_t>(k)] == BoundaryKind::sliding) {
-        const Vec<Dim> normal = boundary_.normals.col(k);
         auto u = out.col(boundary_.nodes[static_cast<std::size_t>(k)]);
-        u -= normal * normal.dot(u);
+        u = boundary_.project(k, u);
       }
     ++stats_.moves;
     stats_.move_seconds = clock.seconds();

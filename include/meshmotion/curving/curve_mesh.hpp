@@ -144,31 +144,43 @@ template <int Dim>
 template <int Dim>
 [[nodiscard]] ResolvedBoundary<Dim> curving_boundary(const Mesh<Dim>& mesh, const SnappedBoundary<Dim>& snapped,
                                                      const std::vector<std::string>& sliding) {
-  std::map<Index, std::pair<BoundaryKind, Vec<Dim>>> entries;  // node -> kind, displacement or normal
+  struct Entry {
+    BoundaryKind kind;
+    Vec<Dim> displacement = Vec<Dim>::Zero();
+    Vec<Dim> normal = Vec<Dim>::Zero();
+    Vec<Dim> direction = Vec<Dim>::Zero();  // line of a node on two sliding planes
+  };
+  std::map<Index, Entry> entries;
   for (std::size_t k = 0; k < snapped.nodes.size(); ++k)
     entries.emplace(snapped.nodes[k],
-                    std::pair{BoundaryKind::prescribed, Vec<Dim>(snapped.displacements.col(static_cast<Index>(k)))});
+                    Entry{BoundaryKind::prescribed, Vec<Dim>(snapped.displacements.col(static_cast<Index>(k)))});
   if (!sliding.empty()) {
     BoundarySpec<Dim> spec;
     for (const auto& g : sliding) spec.sliding(g);
     const ResolvedBoundary<Dim> slide = spec.resolve(mesh);
     for (Index k = 0; k < slide.size(); ++k)
-      entries.emplace(slide.nodes[static_cast<std::size_t>(k)], std::pair{slide.kinds[static_cast<std::size_t>(k)], Vec<Dim>(slide.normals.col(k))});
+      entries.emplace(slide.nodes[static_cast<std::size_t>(k)],
+                      Entry{slide.kinds[static_cast<std::size_t>(k)], Vec<Dim>::Zero(), Vec<Dim>(slide.normals.col(k)),
+                            Vec<Dim>(slide.directions.col(k))});
   }
   const auto fix = [&](const std::vector<ElementBlock>& blocks) {
     for (const auto& b : blocks)
-      for (const Index v : b.connectivity) entries.emplace(v, std::pair{BoundaryKind::fixed, Vec<Dim>::Zero()});
+      for (const Index v : b.connectivity) entries.emplace(v, Entry{BoundaryKind::fixed});
   };
   fix(mesh.facets);
   fix(boundary_facets(mesh));
   ResolvedBoundary<Dim> out;
-  out.displacements.setZero(Dim, static_cast<Index>(entries.size()));
-  out.normals.setZero(Dim, static_cast<Index>(entries.size()));
+  const auto size = static_cast<Index>(entries.size());
+  out.displacements.setZero(Dim, size);
+  out.normals.setZero(Dim, size);
+  out.directions.setZero(Dim, size);
   Index k = 0;
   for (const auto& [node, entry] : entries) {
     out.nodes.push_back(node);
-    out.kinds.push_back(entry.first);
-    (entry.first == BoundaryKind::sliding ? out.normals : out.displacements).col(k) = entry.second;
+    out.kinds.push_back(entry.kind);
+    out.displacements.col(k) = entry.displacement;
+    out.normals.col(k) = entry.normal;
+    out.directions.col(k) = entry.direction;
     ++k;
   }
   return out;

@@ -2,7 +2,7 @@
 /// \file
 /// Boundary specification for the movers: named groups (Gmsh physical groups, SU2 markers)
 /// each prescribed (a per-node displacement array or a rigid Motion), fixed, or sliding in a
-/// plane; resolved against a mesh into the node lists and target displacements a mover's
+/// plane (or, where two sliding planes meet in 3D, along their line); resolved against a mesh into the node lists and target displacements a mover's
 /// setup/move take.
 ///
 /// \code
@@ -37,23 +37,73 @@ enum class BoundaryKind {
   sliding,     ///< free to move in a plane, zero displacement along its normal
 };
 
+/// An orthonormal basis of the plane normal to the unit vector n (Dim × (Dim − 1)).
+template <int Dim>
+[[nodiscard]] Eigen::Matrix<double, Dim, Dim - 1> plane_basis(const Vec<Dim>& n) {
+  Eigen::Matrix<double, Dim, Dim - 1> t;
+  if constexpr (Dim == 2) {
+    t.col(0) = Vec<2>(-n(1), n(0));
+  } else {
+    // Start from the axis least aligned with n.
+    Eigen::Index axis = 0;
+    n.cwiseAbs().minCoeff(&axis);
+    Vec<3> e = Vec<3>::Zero();
+    e(axis) = 1.0;
+    t.col(0) = (e - n.dot(e) * n).normalized();
+    t.col(1) = n.cross(Vec<3>(t.col(0)));
+  }
+  return t;
+}
+
 /// A boundary resolved to nodes: what a mover's setup and move take.
 ///
 /// `nodes` are sorted, unique mesh node indices; `displacements` (Dim × nodes.size()) are
 /// their targets (zero for fixed and sliding nodes); `kinds[k]` tells how node nodes[k]
-/// moves; `normals` (Dim × nodes.size()) holds the unit plane normal of sliding nodes (zero
-/// columns elsewhere). A node in several groups takes the strongest condition: prescribed
-/// over fixed over sliding; a node sliding in two different planes is fixed.
+/// moves. A sliding node moves in a plane or, in 3D, along a line:
+/// - `normals` (Dim × nodes.size()) holds the unit normal of a plane the node stays in
+///   (zero columns for other kinds);
+/// - `directions` (Dim × nodes.size(), or empty when no node slides along a line) holds the
+///   unit direction of the line of a node on two non-parallel sliding planes (the edge where
+///   two symmetry planes meet moves along it); zero columns for nodes sliding in a plane.
+///
+/// A node in several groups takes the strongest condition: prescribed over fixed over
+/// sliding. Sliding in parallel planes stays a plane; two non-parallel planes leave their
+/// line of intersection in 3D and a point (fixed) in 2D; a third plane not containing that
+/// line fixes the node.
 template <int Dim>
 struct ResolvedBoundary {
+  using Basis = Eigen::Matrix<double, Dim, Eigen::Dynamic, 0, Dim, Dim - 1>;
+
   std::vector<Index> nodes;
   std::vector<BoundaryKind> kinds;
   Points<Dim> displacements;
   Points<Dim> normals;
+  Points<Dim> directions;
 
   [[nodiscard]] Index size() const noexcept { return static_cast<Index>(nodes.size()); }
   [[nodiscard]] bool has_sliding() const {
     return std::find(kinds.begin(), kinds.end(), BoundaryKind::sliding) != kinds.end();
+  }
+  /// True when entry k slides along a line (directions.col(k) is set).
+  [[nodiscard]] bool slides_on_line(Index k) const {
+    return directions.cols() > k && directions.col(k).squaredNorm() > 0.0;
+  }
+  /// Orthonormal basis (Dim × 1 for a line, Dim × (Dim − 1) for a plane) of the directions
+  /// sliding entry k may move in. Precondition: kinds[k] is sliding.
+  [[nodiscard]] Basis sliding_basis(Index k) const {
+    if (slides_on_line(k)) return Basis(directions.col(k));
+    return Basis(plane_basis<Dim>(Vec<Dim>(normals.col(k))));
+  }
+  /// The part of u that entry k may take: u projected on its line or plane when it slides,
+  /// u itself otherwise.
+  [[nodiscard]] Vec<Dim> project(Index k, const Vec<Dim>& u) const {
+    if (kinds[static_cast<std::size_t>(k)] != BoundaryKind::sliding) return u;
+    if (slides_on_line(k)) {
+      const Vec<Dim> t = directions.col(k);
+      return t.dot(u) * t;
+    }
+    const Vec<Dim> n = normals.col(k);
+    return u - n.dot(u) * n;
   }
 };
 
@@ -127,12 +177,14 @@ class BoundarySpec {
     const auto m = static_cast<Index>(entries.size());
     out.displacements.setZero(Dim, m);
     out.normals.setZero(Dim, m);
+    out.directions.setZero(Dim, m);
     Index k = 0;
     for (const auto& [node, e] : entries) {
       out.nodes.push_back(node);
       out.kinds.push_back(e.kind);
       out.displacements.col(k) = e.displacement;
       out.normals.col(k) = e.normal;
+      out.directions.col(k) = e.direction;
       ++k;
     }
     return out;
@@ -150,7 +202,28 @@ class BoundarySpec {
     BoundaryKind kind;
     Vec<Dim> displacement;
     Vec<Dim> normal;
+    Vec<Dim> direction = Vec<Dim>::Zero();  ///< line of a node on two sliding planes (3D)
   };
+
+  /// Sine of the angle below which two plane normals count as parallel (and a line as lying
+  /// in a plane).
+  static constexpr double parallel_tolerance = 1e-5;
+
+  /// Adds the sliding plane `normal` to a sliding entry: parallel planes keep the plane, two
+  /// planes leave their line (3D) or a point (2D), a plane not containing the line fixes it.
+  static void intersect(Entry& e, const Vec<Dim>& normal) {
+    const Entry fixed{BoundaryKind::fixed, Vec<Dim>::Zero(), Vec<Dim>::Zero()};
+    if (e.direction.squaredNorm() > 0.0) {
+      if (std::abs(e.direction.dot(normal)) > parallel_tolerance) e = fixed;
+      return;
+    }
+    if constexpr (Dim == 3) {
+      const Vec<3> line = e.normal.cross(normal);
+      if (line.norm() > parallel_tolerance) e.direction = line.normalized();
+    } else {
+      if (std::abs(e.normal(0) * normal(1) - e.normal(1) * normal(0)) > parallel_tolerance) e = fixed;
+    }
+  }
 
   static Vec<Dim> plane_normal(const Group& g, const std::vector<Index>& list, const Points<Dim>& points) {
     if (g.normal) {
@@ -211,7 +284,7 @@ class BoundarySpec {
           throw InputError("BoundarySpec::resolve: node " + std::to_string(list[k]) +
                            " gets two different displacements (group '" + g.name + "' conflicts with an earlier group)");
       } else if (g.kind == BoundaryKind::sliding && e.kind == BoundaryKind::sliding) {
-        if (std::abs(std::abs(e.normal.dot(normal)) - 1.0) > 1e-10) e = Entry{BoundaryKind::fixed, Vec<Dim>::Zero(), Vec<Dim>::Zero()};
+        intersect(e, normal);
       } else if (static_cast<int>(g.kind) < static_cast<int>(e.kind)) {
         e = incoming;
       }

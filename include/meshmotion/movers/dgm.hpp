@@ -21,6 +21,7 @@
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/delaunay_graph_options.hpp"
 #include "meshmotion/movers/detail/graph_mover_base.hpp"
+#include "meshmotion/movers/detail/mover_support.hpp"
 #include "meshmotion/movers/mover.hpp"
 
 #include <optional>
@@ -36,7 +37,7 @@ struct DgmOptions {
 
 /// The DGM mover in Dim dimensions; models MeshMover.
 template <int Dim>
-class DgmMover {
+class DgmMover : public detail::MoveFromMoveInto<DgmMover<Dim>, Dim> {
  public:
   static constexpr int dim = Dim;
 
@@ -59,13 +60,8 @@ class DgmMover {
   /// Displacement of every node (Dim × n_nodes) for boundary displacements `d`
   /// (Dim × boundary.size(); sliding entries ignored). Throws InputError for a wrong shape or
   /// a non-finite value, InvalidMeshError when the moved graph inverts (check_inversion).
-  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
-    Points<Dim> out;
-    move_into(d, out);
-    return out;
-  }
-
-  /// move() into `out` (resized only when its shape differs).
+  /// move() (inherited) returns the same; move_into writes into `out`, resized only when its
+  /// shape differs.
   void move_into(const Points<Dim>& d, Points<Dim>& out) {
     base_.move_displacements(d, Points<Dim>(Dim, 0), options_.check_inversion, out);
   }

@@ -19,6 +19,7 @@
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/delaunay_graph_options.hpp"
 #include "meshmotion/movers/detail/graph_mover_base.hpp"
+#include "meshmotion/movers/detail/mover_support.hpp"
 #include "meshmotion/movers/mover.hpp"
 
 namespace meshmotion {
@@ -31,7 +32,7 @@ struct DgrbfOptions {
 
 /// The DGRBF mover in Dim dimensions; models MeshMover.
 template <int Dim>
-class DgrbfMover {
+class DgrbfMover : public detail::MoveFromMoveInto<DgrbfMover<Dim>, Dim> {
  public:
   static constexpr int dim = Dim;
 
@@ -53,13 +54,8 @@ class DgrbfMover {
 
   /// Displacement of every node (Dim × n_nodes) for `d` (Dim × boundary.size()). Throws
   /// InputError for a wrong shape or a non-finite value.
-  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
-    Points<Dim> out;
-    move_into(d, out);
-    return out;
-  }
-
-  /// move() into `out` (resized only when its shape differs).
+  /// move() (inherited) returns the same; move_into writes into `out`, resized only when its
+  /// shape differs.
   void move_into(const Points<Dim>& d, Points<Dim>& out) {
     base_.move_displacements(d, Points<Dim>(Dim, 0), false, out);
   }

@@ -25,6 +25,7 @@
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/delaunay_graph_options.hpp"
 #include "meshmotion/movers/detail/graph_mover_base.hpp"
+#include "meshmotion/movers/detail/mover_support.hpp"
 #include "meshmotion/movers/motion.hpp"
 #include "meshmotion/movers/mover.hpp"
 
@@ -65,7 +66,7 @@ struct Dgrbf2Options {
 
 /// The DGRBF2 mover in Dim dimensions; models MeshMover.
 template <int Dim>
-class Dgrbf2Mover {
+class Dgrbf2Mover : public detail::MoveFromMoveInto<Dgrbf2Mover<Dim>, Dim> {
  public:
   static constexpr int dim = Dim;
   /// Interpolated per node: angle and translation (2D), rotation vector and translation (3D).
@@ -95,19 +96,15 @@ class Dgrbf2Mover {
 
   /// Displacement of every node (Dim × n_nodes) for `d` (Dim × boundary.size()). Throws
   /// InputError for a wrong shape or a non-finite value.
-  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
-    Points<Dim> out;
-    move_into(d, out);
-    return out;
-  }
-
-  /// move() into `out` (resized only when its shape differs).
+  /// move() (inherited) returns the same; move_into writes into `out`, resized only when its
+  /// shape differs.
   void move_into(const Points<Dim>& d, Points<Dim>& out) {
-    base_.check_displacements(d);
-    choose_centre(d);
-    base_.template move<rows>(
-        d, Points<Dim>(Dim, 0), [this](const Points<Dim>& p, const Points<Dim>& u) { return encode(p, u); },
-        [this](const Vec<Dim>& x, const Value& v) { return decode(x, v); }, false, out);
+    base_.timed_move(d, [&] {
+      choose_centre(d);
+      base_.template interpolate<rows>(
+          d, Points<Dim>(Dim, 0), [this](const Points<Dim>& p, const Points<Dim>& u) { return encode(p, u); },
+          [this](const Vec<Dim>& x, const Value& v) { return decode(x, v); }, false, out);
+    });
   }
 
  private:

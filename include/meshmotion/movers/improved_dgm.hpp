@@ -26,6 +26,7 @@
 #include "meshmotion/core/topology.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/detail/mover_support.hpp"
 #include "meshmotion/movers/dgm.hpp"
 #include "meshmotion/movers/detail/graph_mover_base.hpp"
 #include "meshmotion/movers/mover.hpp"
@@ -60,7 +61,7 @@ struct ImprovedDgmOptions {
 
 /// The improved DGM mover in Dim dimensions; models MeshMover.
 template <int Dim>
-class ImprovedDgmMover {
+class ImprovedDgmMover : public detail::MoveFromMoveInto<ImprovedDgmMover<Dim>, Dim> {
  public:
   static constexpr int dim = Dim;
 
@@ -119,23 +120,16 @@ class ImprovedDgmMover {
   /// Displacement of every node (Dim × n_nodes) for `d` (Dim × boundary.size()). Throws
   /// InputError for a wrong shape or non-finite value, InvalidMeshError when the moved graph
   /// inverts (DgmOptions::check_inversion).
-  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
-    Points<Dim> out;
-    move_into(d, out);
-    return out;
-  }
-
-  /// move() into `out` (resized only when its shape differs).
+  /// move() (inherited) returns the same; move_into writes into `out`, resized only when its
+  /// shape differs.
   void move_into(const Points<Dim>& d, Points<Dim>& out) {
-    const detail::Stopwatch watch;
-    base_.check_displacements(d);
-    rbf_.move_into(d, stage_);
-    base_.move_displacements(d, Points<Dim>(stage_.rightCols(static_cast<Index>(layer_.size()))),
-                             options_.dgm.check_inversion, out);
-    stats_.moves = base_.stats().moves;
-    stats_.iterations = rbf_.stats().iterations;
-    stats_.residual = rbf_.stats().residual;
-    stats_.move_seconds = watch.seconds();
+    detail::timed_move<Dim>("ImprovedDgmMover::move", base_.ready(), d, base_.boundary().nodes, stats_, [&] {
+      rbf_.move_into(d, stage_);
+      base_.interpolate_displacements(d, Points<Dim>(stage_.rightCols(static_cast<Index>(layer_.size()))),
+                                      options_.dgm.check_inversion, out);
+      stats_.iterations = rbf_.stats().iterations;
+      stats_.residual = rbf_.stats().residual;
+    });
   }
 
  private:

@@ -30,6 +30,7 @@
 #include "meshmotion/movers/detail/constrained_system.hpp"
 #include "meshmotion/movers/detail/fem_assembly.hpp"
 #include "meshmotion/movers/detail/linear_mechanics.hpp"
+#include "meshmotion/movers/detail/mover_support.hpp"
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 #include "meshmotion/solvers/solver_options.hpp"
@@ -57,7 +58,7 @@ struct NonlinearElasticityOptions {
 
 /// The neo-Hookean mover in Dim dimensions; models MeshMover.
 template <int Dim>
-class NonlinearElasticityMover {
+class NonlinearElasticityMover : public detail::MoveFromMoveInto<NonlinearElasticityMover<Dim>, Dim> {
  public:
   static constexpr int dim = Dim;
 
@@ -103,28 +104,31 @@ class NonlinearElasticityMover {
   /// boundary.size()); every quadrature point keeps det F > 0. Throws InputError for a wrong
   /// shape, non-finite values or a missing setup; SolverError when Newton does not converge
   /// or the line search cannot keep the elements valid (try more load_steps).
-  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
-    Points<Dim> out;
-    move_into(d, out);
-    return out;
+  /// move() (inherited) returns the same; move_into writes into `out`, resized only when its
+  /// shape differs.
+  void move_into(const Points<Dim>& d, Points<Dim>& out) {
+    detail::timed_move<Dim>("NonlinearElasticityMover::move", ready_, d, boundary_nodes_, stats_, [&] { newton(d, out); });
   }
 
-  /// move() into `out` (resized only when its shape differs).
-  void move_into(const Points<Dim>& d, Points<Dim>& out) {
-    const detail::Stopwatch watch;
-    if (!ready_) throw InputError("NonlinearElasticityMover::move: setup() was not called");
-    detail::check_displacements("NonlinearElasticityMover::move", d, boundary_nodes_);
+ private:
+  struct Evaluation {
+    bool valid = true;
+    double energy = 0.0;
+  };
+
+  /// The load-stepped Newton solve of move_into (inputs checked).
+  void newton(const Points<Dim>& d, Points<Dim>& out) {
     const Index n = mesh_.num_nodes();
     out.setZero(Dim, n);
     Points<Dim> applied = Points<Dim>::Zero(Dim, d.cols());
     Points<Dim> step, trial;
     Eigen::MatrixXd force(n * Dim, 1);
-    Index newton = 0;
+    Index iterations = 0;
     double energy = evaluate(out, nullptr, nullptr).energy;
     for (int s = 1; s <= options_.load_steps; ++s) {
       const Points<Dim> target = d * (static_cast<double>(s) / options_.load_steps);
       bool converged = false;
-      for (int it = 0; it < options_.max_newton_iterations && !converged; ++it, ++newton) {
+      for (int it = 0; it < options_.max_newton_iterations && !converged; ++it, ++iterations) {
         Points<Dim> increment = target - applied;
         for (Index k = 0; k < increment.cols(); ++k)
           if (kinds_[static_cast<std::size_t>(k)] == BoundaryKind::sliding) increment.col(k).setZero();
@@ -158,17 +162,9 @@ class NonlinearElasticityMover {
     // Boundary nodes get their targets exactly (sliding ones keep their computed position).
     for (Index k = 0; k < d.cols(); ++k)
       if (kinds_[static_cast<std::size_t>(k)] != BoundaryKind::sliding) out.col(boundary_nodes_[static_cast<std::size_t>(k)]) = d.col(k);
-    ++stats_.moves;
-    stats_.iterations = newton;
+    stats_.iterations = iterations;
     stats_.residual = 0.0;
-    stats_.move_seconds = watch.seconds();
   }
-
- private:
-  struct Evaluation {
-    bool valid = true;
-    double energy = 0.0;
-  };
 
   /// Backtracking from u along `step`: the largest α = 2^−k ≥ min_step with every element
   /// valid and, when the boundary is in place, no energy increase; updates `energy` and

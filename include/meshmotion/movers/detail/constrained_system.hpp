@@ -2,89 +2,35 @@
 /// \file
 /// ConstrainedSystem: the symmetric stiffness system K u = 0 of the mechanics movers with
 /// Dirichlet nodes (prescribed and fixed) eliminated and sliding nodes reduced to their
-/// tangent-plane unknowns, factorized once; each solve maps boundary displacements to the
+/// tangent unknowns (Dim − 1 on a plane, 1 on a line), factorized once; each solve maps boundary displacements to the
 /// displacement of every node.
 ///
 /// With u = P x + S d (P: free unknowns → dofs, sliding nodes through an orthonormal basis of
-/// their plane; S: Dirichlet values → dofs) the reduced system is (Pᵀ K P) x = −(Pᵀ K S) d,
-/// so sliding nodes stay exactly on their planes. K has `components` dofs per node: 1 for
+/// their plane or line, ResolvedBoundary::sliding_basis; S: Dirichlet values → dofs) the reduced system is (Pᵀ K P) x = −(Pᵀ K S) d,
+/// so sliding nodes stay exactly on their planes (and lines). K has `components` dofs per node: 1 for
 /// the uncoupled lineal-spring Laplacian (solved with Dim right-hand sides), Dim for
 /// coupled systems (node-major: node * Dim + axis).
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/detail/mover_support.hpp"
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/solvers/linear_solver.hpp"
 
 #include <Eigen/SparseCore>
 
-#include <cmath>
 #include <string>
 #include <vector>
 
 namespace meshmotion::detail {
-
-/// Throws InputError when `b` is not a valid resolved boundary for n nodes.
-template <int Dim>
-void check_boundary(const std::string& where, const ResolvedBoundary<Dim>& b, Index n) {
-  const Index m = b.size();
-  if (static_cast<Index>(b.kinds.size()) != m || b.normals.cols() != m || b.displacements.cols() != m)
-    throw InputError(where + ": boundary has " + std::to_string(m) + " nodes but " + std::to_string(b.kinds.size()) +
-                     " kinds, " + std::to_string(b.normals.cols()) + " normals and " +
-                     std::to_string(b.displacements.cols()) + " displacements (expected one each)");
-  if (m == 0) throw InputError(where + ": the boundary has no nodes (expected at least one)");
-  for (Index k = 0; k < m; ++k) {
-    const Index v = b.nodes[static_cast<std::size_t>(k)];
-    if (v < 0 || v >= n)
-      throw InputError(where + ": boundary node " + std::to_string(v) + " is out of range (expected 0 to " +
-                       std::to_string(n - 1) + ")");
-    if (k > 0 && v <= b.nodes[static_cast<std::size_t>(k - 1)])
-      throw InputError(where + ": boundary nodes must be sorted and unique (node " + std::to_string(v) + " follows " +
-                       std::to_string(b.nodes[static_cast<std::size_t>(k - 1)]) + ")");
-    if (b.kinds[static_cast<std::size_t>(k)] == BoundaryKind::sliding && std::abs(b.normals.col(k).norm() - 1.0) > 1e-8)
-      throw InputError(where + ": sliding node " + std::to_string(v) + " needs a unit normal (got length " +
-                       std::to_string(b.normals.col(k).norm()) + ")");
-  }
-}
-
-/// Throws InputError unless d is finite and Dim × m.
-template <int Dim>
-void check_displacements(const std::string& where, const Points<Dim>& d, const std::vector<Index>& nodes) {
-  const auto m = static_cast<Index>(nodes.size());
-  if (d.cols() != m)
-    throw InputError(where + ": got " + std::to_string(d.cols()) + " displacement columns (expected " +
-                     std::to_string(m) + ", one per boundary node)");
-  for (Index b = 0; b < m; ++b)
-    if (!d.col(b).allFinite())
-      throw InputError(where + ": displacement of node " + std::to_string(nodes[static_cast<std::size_t>(b)]) +
-                       " is not finite");
-}
-
-/// An orthonormal basis of the plane normal to the unit vector n (Dim × (Dim − 1)).
-template <int Dim>
-[[nodiscard]] Eigen::Matrix<double, Dim, Dim - 1> tangent_basis(const Vec<Dim>& n) {
-  Eigen::Matrix<double, Dim, Dim - 1> t;
-  if constexpr (Dim == 2) {
-    t.col(0) = Vec<2>(-n(1), n(0));
-  } else {
-    // Start from the axis least aligned with n.
-    Eigen::Index axis = 0;
-    n.cwiseAbs().minCoeff(&axis);
-    Vec<3> e = Vec<3>::Zero();
-    e(axis) = 1.0;
-    t.col(0) = (e - n.dot(e) * n).normalized();
-    t.col(1) = n.cross(Vec<3>(t.col(0)));
-  }
-  return t;
-}
 
 template <int Dim>
 class ConstrainedSystem {
  public:
   /// Numbers the unknowns: `active[i]` is false for nodes that no element touches (they do
   /// not move); Dirichlet nodes of `b` are eliminated, sliding ones (components == Dim only)
-  /// keep their tangent-plane unknowns. Creates the solver.
+  /// keep their tangent unknowns. Creates the solver.
   void build(int components, const std::vector<bool>& active, const ResolvedBoundary<Dim>& b,
              const SolverOptions& solver_options) {
     components_ = components;
@@ -104,8 +50,8 @@ class ConstrainedSystem {
         for (Index a = 0; a < c; ++a) p_entries.emplace_back(static_cast<int>(i * c + a), static_cast<int>(reduced++), 1.0);
       } else if (b.kinds[static_cast<std::size_t>(k)] == BoundaryKind::sliding) {
         if (c != Dim) throw InputError("ConstrainedSystem: sliding nodes need a coupled system");
-        const auto t = tangent_basis<Dim>(b.normals.col(k));
-        for (Index j = 0; j < Dim - 1; ++j, ++reduced)
+        const auto t = b.sliding_basis(k);
+        for (Index j = 0; j < t.cols(); ++j, ++reduced)
           for (Index a = 0; a < Dim; ++a)
             if (t(a, j) != 0.0) p_entries.emplace_back(static_cast<int>(i * c + a), static_cast<int>(reduced), t(a, j));
       } else {

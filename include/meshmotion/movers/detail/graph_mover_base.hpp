@@ -8,13 +8,15 @@
 ///
 /// Sliding nodes (exact, as in the RBF mover): a first graph without them interpolates their
 /// displacement from the prescribed/fixed/extra nodes; its component along the plane normal is
-/// removed; the projected values then join the full graph.
+/// removed (or, on a line, only its component along the line kept); the projected values
+/// then join the full graph.
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/delaunay_graph_options.hpp"
 #include "meshmotion/movers/detail/graph_interpolation.hpp"
+#include "meshmotion/movers/detail/mover_support.hpp"
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 
@@ -41,7 +43,7 @@ class GraphMoverBase {
     points_ = std::move(points);
     const Index n = points_.cols();
     if (!points_.allFinite()) throw InputError(who_ + "::setup: mesh has a non-finite coordinate");
-    check_boundary(boundary, n);
+    check_boundary<Dim>(who_ + "::setup", boundary, n, false);
     boundary_ = boundary;
     std::vector<char> role(static_cast<std::size_t>(n), 0);
     for (const Index v : boundary.nodes) role[static_cast<std::size_t>(v)] = 1;
@@ -76,6 +78,7 @@ class GraphMoverBase {
     stats_.setup_seconds = watch.seconds();
   }
 
+  [[nodiscard]] bool ready() const noexcept { return ready_; }
   [[nodiscard]] const Points<Dim>& points() const noexcept { return points_; }
   [[nodiscard]] const ResolvedBoundary<Dim>& boundary() const noexcept { return boundary_; }
   [[nodiscard]] const std::vector<Index>& graph_nodes() const noexcept { return graph_nodes_; }
@@ -83,16 +86,11 @@ class GraphMoverBase {
   [[nodiscard]] MoverStats& stats() noexcept { return stats_; }
   [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
 
-  /// Throws InputError unless setup ran and `d` is finite and Dim × boundary.size().
-  void check_displacements(const Points<Dim>& d) const {
-    if (!ready_) throw InputError(who_ + "::move: setup() was not called");
-    if (d.cols() != boundary_.size())
-      throw InputError(who_ + "::move: got " + std::to_string(d.cols()) + " displacement columns (expected " +
-                       std::to_string(boundary_.size()) + ", one per boundary node)");
-    for (Index b = 0; b < d.cols(); ++b)
-      if (!d.col(b).allFinite())
-        throw InputError(who_ + "::move: displacement of node " + std::to_string(boundary_.nodes[static_cast<std::size_t>(b)]) +
-                         " is not finite");
+  /// timed_move for the mover using this base: checks `d` (Dim × boundary.size(), finite,
+  /// after setup), runs body(), counts and times the move in stats().
+  template <class Body>
+  void timed_move(const Points<Dim>& d, Body&& body) {
+    detail::timed_move<Dim>(who_ + "::move", ready_, d, boundary_.nodes, stats_, std::forward<Body>(body));
   }
 
   /// The move. `d`: Dim × boundary.size(); `extra_displacements`: Dim × extra.size().
@@ -103,8 +101,28 @@ class GraphMoverBase {
   template <int Rows, class Encode, class Decode>
   void move(const Points<Dim>& d, const Points<Dim>& extra_displacements, Encode&& encode, Decode&& decode,
             bool check_inversion, Points<Dim>& out) {
-    const Stopwatch watch;
-    check_displacements(d);
+    timed_move(d, [&] { interpolate<Rows>(d, extra_displacements, encode, decode, check_inversion, out); });
+  }
+
+  /// move() interpolating the displacements themselves (DGM, DGRBF).
+  void move_displacements(const Points<Dim>& d, const Points<Dim>& extra_displacements, bool check_inversion,
+                          Points<Dim>& out) {
+    timed_move(d, [&] { interpolate_displacements(d, extra_displacements, check_inversion, out); });
+  }
+
+  /// move_displacements() without its checks and timing (the improved DGM times its whole move).
+  void interpolate_displacements(const Points<Dim>& d, const Points<Dim>& extra_displacements, bool check_inversion,
+                                 Points<Dim>& out) {
+    interpolate<Dim>(
+        d, extra_displacements, [](const Points<Dim>&, const Points<Dim>& u) -> const Points<Dim>& { return u; },
+        [](const Vec<Dim>&, const Vec<Dim>& u) { return u; }, check_inversion, out);
+  }
+
+  /// The interpolation of move() without its checks and timing (for movers that time a
+  /// larger move themselves).
+  template <int Rows, class Encode, class Decode>
+  void interpolate(const Points<Dim>& d, const Points<Dim>& extra_displacements, Encode&& encode, Decode&& decode,
+                   bool check_inversion, Points<Dim>& out) {
     const auto m = boundary_.size();
     const auto n_graph = static_cast<Index>(graph_nodes_.size());
     Points<Dim> graph_displacement(Dim, n_graph);
@@ -121,11 +139,9 @@ class GraphMoverBase {
       sliding_graph_.interpolate(Eigen::Matrix<double, Rows, Eigen::Dynamic>(encode(at, moved)), values);
       for (std::size_t s = 0; s < sliding_.size(); ++s) {
         const Index g = sliding_[s];
-        const Vec<Dim> normal = boundary_.normals.col(g);
-        Vec<Dim> u = decode(Vec<Dim>(points_.col(graph_nodes_[static_cast<std::size_t>(g)])),
-                            Eigen::Matrix<double, Rows, 1>(values.col(static_cast<Index>(s))));
-        u -= normal.dot(u) * normal;
-        graph_displacement.col(g) = u;
+        graph_displacement.col(g) =
+            boundary_.project(g, decode(Vec<Dim>(points_.col(graph_nodes_[static_cast<std::size_t>(g)])),
+                                        Eigen::Matrix<double, Rows, 1>(values.col(static_cast<Index>(s)))));
       }
     }
     const Points<Dim> graph_points = gather(graph_nodes_);
@@ -141,16 +157,6 @@ class GraphMoverBase {
       out.col(node) = decode(Vec<Dim>(points_.col(node)), Eigen::Matrix<double, Rows, 1>(values.col(k)));
     }
     for (Index g = 0; g < n_graph; ++g) out.col(graph_nodes_[static_cast<std::size_t>(g)]) = graph_displacement.col(g);
-    ++stats_.moves;
-    stats_.move_seconds = watch.seconds();
-  }
-
-  /// move() interpolating the displacements themselves (DGM, DGRBF, improved DGM).
-  void move_displacements(const Points<Dim>& d, const Points<Dim>& extra_displacements, bool check_inversion,
-                          Points<Dim>& out) {
-    move<Dim>(
-        d, extra_displacements, [](const Points<Dim>&, const Points<Dim>& u) -> const Points<Dim>& { return u; },
-        [](const Vec<Dim>&, const Vec<Dim>& u) { return u; }, check_inversion, out);
   }
 
  private:
@@ -158,25 +164,6 @@ class GraphMoverBase {
     Points<Dim> p(Dim, static_cast<Index>(nodes.size()));
     for (std::size_t k = 0; k < nodes.size(); ++k) p.col(static_cast<Index>(k)) = points_.col(nodes[k]);
     return p;
-  }
-
-  void check_boundary(const ResolvedBoundary<Dim>& b, Index n) const {
-    const Index m = b.size();
-    if (static_cast<Index>(b.kinds.size()) != m || b.normals.cols() != m)
-      throw InputError(who_ + "::setup: boundary has " + std::to_string(m) + " nodes but " + std::to_string(b.kinds.size()) +
-                       " kinds and " + std::to_string(b.normals.cols()) + " normals (expected one each)");
-    for (Index k = 0; k < m; ++k) {
-      const Index v = b.nodes[static_cast<std::size_t>(k)];
-      if (v < 0 || v >= n)
-        throw InputError(who_ + "::setup: boundary node " + std::to_string(v) + " is out of range (expected 0 to " +
-                         std::to_string(n - 1) + ")");
-      if (k > 0 && v <= b.nodes[static_cast<std::size_t>(k - 1)])
-        throw InputError(who_ + "::setup: boundary nodes must be sorted and unique (node " + std::to_string(v) + " follows " +
-                         std::to_string(b.nodes[static_cast<std::size_t>(k - 1)]) + ")");
-      if (b.kinds[static_cast<std::size_t>(k)] == BoundaryKind::sliding && std::abs(b.normals.col(k).norm() - 1.0) > 1e-8)
-        throw InputError(who_ + "::setup: sliding node " + std::to_string(v) + " needs a unit normal (got length " +
-                         std::to_string(b.normals.col(k).norm()) + ")");
-    }
   }
 
   /// Throws InvalidMeshError when a graph simplex inverts at the moved graph positions.

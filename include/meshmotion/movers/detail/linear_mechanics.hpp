@@ -11,6 +11,7 @@
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/detail/constrained_system.hpp"
+#include "meshmotion/movers/detail/mover_support.hpp"
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 #include "meshmotion/solvers/linear_solver.hpp"
@@ -69,13 +70,10 @@ class LinearMechanicsMover {
 
   /// move() into `out` (resized only when its shape differs).
   void move_into(const Points<Dim>& d, Points<Dim>& out) {
-    const Stopwatch watch;
-    if (!ready_) throw InputError(name_ + "::move: setup() was not called");
-    check_displacements(name_ + "::move", d, boundary_nodes_);
-    system_.solve(d, out);
-    ++stats_.moves;
-    system_.record(stats_);
-    stats_.move_seconds = watch.seconds();
+    timed_move<Dim>(name_ + "::move", ready_, d, boundary_nodes_, stats_, [&] {
+      system_.solve(d, out);
+      system_.record(stats_);
+    });
   }
 
  protected:

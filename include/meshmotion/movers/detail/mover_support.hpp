@@ -1,0 +1,96 @@
+#pragma once
+/// \file
+/// What every mover does around its own work: validate the resolved boundary given to setup,
+/// validate the displacements given to move, and count and time each move in its stats.
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/mover.hpp"
+#include "meshmotion/solvers/detail/stopwatch.hpp"
+
+#include <cmath>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace meshmotion::detail {
+
+/// Throws InputError (messages start with `where`) unless `b` is a valid resolved boundary
+/// for n nodes: one kind, normal (and displacement, when `with_displacements`) per node; at
+/// least one node; sorted unique indices in [0, n); unit normals on sliding nodes; line
+/// directions (when given) unit, perpendicular to the normal and on sliding nodes only.
+template <int Dim>
+void check_boundary(std::string_view where, const ResolvedBoundary<Dim>& b, Index n, bool with_displacements = true) {
+  const std::string w(where);
+  const Index m = b.size();
+  if (static_cast<Index>(b.kinds.size()) != m || b.normals.cols() != m ||
+      (with_displacements && b.displacements.cols() != m) || (b.directions.cols() != 0 && b.directions.cols() != m))
+    throw InputError(w + ": boundary has " + std::to_string(m) + " nodes but " + std::to_string(b.kinds.size()) +
+                     " kinds, " + std::to_string(b.normals.cols()) + " normals, " +
+                     std::to_string(b.displacements.cols()) + " displacements and " +
+                     std::to_string(b.directions.cols()) + " line directions (expected one each; directions may be empty)");
+  if (m == 0) throw InputError(w + ": the boundary has no nodes (expected at least one)");
+  for (Index k = 0; k < m; ++k) {
+    const Index v = b.nodes[static_cast<std::size_t>(k)];
+    if (v < 0 || v >= n)
+      throw InputError(w + ": boundary node " + std::to_string(v) + " is out of range (expected 0 to " +
+                       std::to_string(n - 1) + ")");
+    if (k > 0 && v <= b.nodes[static_cast<std::size_t>(k - 1)])
+      throw InputError(w + ": boundary nodes must be sorted and unique (node " + std::to_string(v) + " follows " +
+                       std::to_string(b.nodes[static_cast<std::size_t>(k - 1)]) + ")");
+    const bool sliding = b.kinds[static_cast<std::size_t>(k)] == BoundaryKind::sliding;
+    if (sliding && !(std::abs(b.normals.col(k).norm() - 1.0) <= 1e-8))
+      throw InputError(w + ": sliding node " + std::to_string(v) + " needs a unit normal (got length " +
+                       std::to_string(b.normals.col(k).norm()) + ")");
+    if (b.slides_on_line(k)) {
+      const Vec<Dim> t = b.directions.col(k);
+      if (!sliding || !(std::abs(t.norm() - 1.0) <= 1e-8) || !(std::abs(t.dot(b.normals.col(k))) <= 1e-8))
+        throw InputError(w + ": node " + std::to_string(v) +
+                         " has a line direction but is not sliding, or the direction is not a unit vector "
+                         "perpendicular to its normal (got length " + std::to_string(t.norm()) + ")");
+    }
+  }
+}
+
+/// Throws InputError unless d is finite and Dim × nodes.size().
+template <int Dim>
+void check_displacements(std::string_view where, const Points<Dim>& d, const std::vector<Index>& nodes) {
+  const auto m = static_cast<Index>(nodes.size());
+  if (d.cols() != m)
+    throw InputError(std::string(where) + ": got " + std::to_string(d.cols()) + " displacement columns (expected " +
+                     std::to_string(m) + ", one per boundary node)");
+  for (Index b = 0; b < m; ++b)
+    if (!d.col(b).allFinite())
+      throw InputError(std::string(where) + ": displacement of node " + std::to_string(nodes[static_cast<std::size_t>(b)]) +
+                       " is not finite");
+}
+
+/// One move: throws InputError unless `ready` (setup ran) and `d` fits `nodes`
+/// (check_displacements), runs body(), then counts the move and records its time in `stats`.
+template <int Dim, class Body>
+void timed_move(std::string_view where, bool ready, const Points<Dim>& d, const std::vector<Index>& nodes,
+                MoverStats& stats, Body&& body) {
+  const Stopwatch watch;
+  if (!ready) throw InputError(std::string(where) + ": setup() was not called");
+  check_displacements<Dim>(where, d, nodes);
+  std::forward<Body>(body)();
+  ++stats.moves;
+  stats.move_seconds = watch.seconds();
+}
+
+/// CRTP base giving a mover the allocating `move(d)` from its `move_into(d, out)`.
+template <class Derived, int Dim>
+class MoveFromMoveInto {
+ public:
+  /// Displacement of every node (Dim × n_nodes) for boundary displacements `d`
+  /// (Dim × boundary.size()); see the mover's move_into for what it throws.
+  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
+    Points<Dim> out;
+    static_cast<Derived&>(*this).move_into(d, out);
+    return out;
+  }
+};
+
+}  // namespace meshmotion::detail
