@@ -250,6 +250,77 @@ TEST_CASE("spring, torsion and elasticity stiffness matrices are symmetric", "[m
   CHECK((spring.stiffness() * ones).norm() < 1e-12 * spring.stiffness().norm());
 }
 
+namespace {
+
+/// ‖K r‖ / (‖K‖ ‖r‖) for the infinitesimal rotation r(x) = ω × x (about z in 2D).
+template <int Dim>
+double rotation_energy(const SparseMatrix& k, const Points<Dim>& x) {
+  Eigen::VectorXd r(k.rows());
+  const Vec<3> omega(0.3, -0.2, 1.0);
+  for (Index i = 0; i < x.cols(); ++i) {
+    Vec<3> p = Vec<3>::Zero();
+    p.head<Dim>() = x.col(i);
+    const Vec<3> v = Dim == 2 ? Vec<3>(Vec<3>::UnitZ().cross(p)) : Vec<3>(omega.cross(p));
+    for (int d = 0; d < Dim; ++d) r(i * Dim + d) = v(d);
+  }
+  return (k * r).norm() / (k.norm() * r.norm());
+}
+
+/// Stiffness of vertex 3's normal motion in the tetrahedron (0,0,0), (1,0,0), (0,1,0),
+/// (0.3, 0.3, h), the other vertices fixed.
+double apex_stiffness(double h, bool vertex_facet) {
+  Mesh<3> tet;
+  tet.points.resize(3, 4);
+  tet.points << 0, 1, 0, 0.3, 0, 0, 1, 0.3, 0, 0, 0, h;
+  ElementBlock block;
+  block.type = ElementType::tet4;
+  block.connectivity = {0, 1, 2, 3};
+  block.tags = {0};
+  tet.cells.push_back(block);
+  ResolvedBoundary<3> fixed;
+  fixed.nodes = {0, 1, 2};
+  fixed.kinds.assign(3, BoundaryKind::fixed);
+  fixed.displacements.setZero(3, 3);
+  fixed.normals.setZero(3, 3);
+  TorsionSpringOptions o;
+  o.vertex_facet_springs = vertex_facet;
+  TorsionSpringMover<3> mover(o);
+  mover.setup(tet, fixed);
+  return mover.stiffness().coeff(11, 11);
+}
+
+}  // namespace
+
+TEST_CASE("torsion springs: Farhat's coupled lineal springs and the torsion store no energy in a rigid rotation", "[movers]") {
+  Mesh<2> flat = rectangle(RectangleCells::tri_quad, 5);
+  perturb_interior(flat, 0.06);
+  Mesh<3> solid = box(BoxCells::tet4, 3);
+  perturb_interior(solid, 0.05);
+  const auto b2 = prescribed_boundary(flat, [](const Vec<2>&) -> Vec<2> { return Vec<2>::Zero(); });
+  const auto b3 = prescribed_boundary(solid, [](const Vec<3>&) -> Vec<3> { return Vec<3>::Zero(); });
+  TorsionSpringMover<2> t2;
+  t2.setup(flat, b2);
+  TorsionSpringMover<3> t3;
+  t3.setup(solid, b3);
+  CHECK(rotation_energy<2>(t2.stiffness(), flat.points) < 1e-12);
+  CHECK(rotation_energy<3>(t3.stiffness(), solid.points) < 1e-12);
+  CHECK(symmetry_defect<3>(t3.stiffness()) < 1e-14);
+  // Batina's uncoupled springs resist rotations (the check above can fail).
+  TorsionSpringOptions batina;
+  batina.coupled_lineal = false;
+  TorsionSpringMover<3> uncoupled(batina);
+  uncoupled.setup(solid, b3);
+  CHECK(rotation_energy<3>(uncoupled.stiffness(), solid.points) > 1e-5);
+}
+
+TEST_CASE("3D torsion: vertex-facet springs stiffen a vertex approaching its opposite face", "[movers]") {
+  // Dihedral springs grow like 1/h²; face-corner springs see the flattening only at second
+  // order, so their normal stiffness vanishes like h².
+  CHECK(apex_stiffness(0.01, true) > 50.0 * apex_stiffness(0.1, true));
+  CHECK(apex_stiffness(0.01, false) < apex_stiffness(0.1, false));
+  CHECK(apex_stiffness(0.01, true) > 1e3 * apex_stiffness(0.01, false));
+}
+
 TEST_CASE("Jacobian stiffening: chi = 0 is linear elasticity, J0 only scales, chi > 0 stiffens small cells", "[movers]") {
   const Mesh<2> mesh = ring(0.01);
   BoundarySpec<2> spec;
@@ -355,6 +426,117 @@ TEST_CASE("iterative solvers agree with the direct solve and report iterations",
     CHECK((mover.stats().iterations > 0) == is_iterative(kind));
     CHECK(mover.stats().factorizations == 1);
   }
+}
+
+namespace {
+
+/// Curving of a cylinder's P2 boundary-layer mesh: wall nodes go onto the circle r = 0.5
+/// (vertices are on it; mid-edge nodes move out by the sagitta, ~1e-3, a thousand times the
+/// first cell height 1e-6), farfield nodes onto r = 20.
+struct GradedCurving {
+  Mesh<2> mesh;
+  ResolvedBoundary<2> boundary;
+};
+
+GradedCurving graded_curving() {
+  OMeshOptions o;
+  o.n_around = 40;
+  o.n_radial = 24;
+  o.first_height = 1e-6;
+  o.farfield_radius = 20.0;
+  GradedCurving c;
+  c.mesh = to_quadratic(o_mesh(o));
+  c.boundary = prescribed_boundary(c.mesh, [](const Vec<2>& x) -> Vec<2> {
+    const double r = x.norm();
+    return ((r < 1.0 ? 0.5 : 20.0) / r - 1.0) * x;
+  });
+  return c;
+}
+
+/// The Dirichlet-reduced system K_ff u_f = −K_fb d solved by `solver` on K as assembled (no
+/// scaling): what ElasticityMover did before it balanced the rows.
+Points<2> unscaled_solve(const SparseMatrix& k, const ResolvedBoundary<2>& b, Index n, SolverOptions solver) {
+  std::vector<Index> slot(static_cast<std::size_t>(2 * n), -1);
+  Eigen::VectorXd known = Eigen::VectorXd::Zero(2 * n);
+  for (Index j = 0; j < b.size(); ++j)
+    for (int a = 0; a < 2; ++a) known(2 * b.nodes[static_cast<std::size_t>(j)] + a) = b.displacements(a, j);
+  std::vector<bool> is_known(static_cast<std::size_t>(2 * n), false);
+  for (const Index v : b.nodes) is_known[static_cast<std::size_t>(2 * v)] = is_known[static_cast<std::size_t>(2 * v + 1)] = true;
+  Index free = 0;
+  for (Index i = 0; i < 2 * n; ++i)
+    if (!is_known[static_cast<std::size_t>(i)]) slot[static_cast<std::size_t>(i)] = free++;
+  std::vector<Eigen::Triplet<double, int>> entries;
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(free);
+  for (Index j = 0; j < k.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(k, j); it; ++it) {
+      const Index row = slot[static_cast<std::size_t>(it.row())], col = slot[static_cast<std::size_t>(j)];
+      if (row < 0) continue;
+      if (col >= 0)
+        entries.emplace_back(static_cast<int>(row), static_cast<int>(col), it.value());
+      else
+        rhs(row) -= it.value() * known(j);
+    }
+  SparseMatrix reduced(free, free);
+  reduced.setFromTriplets(entries.begin(), entries.end());
+  LinearSolver linear(solver);
+  linear.compute(reduced);
+  const Eigen::MatrixXd x = linear.solve(rhs);
+  Points<2> u(2, n);
+  for (Index i = 0; i < 2 * n; ++i)
+    u(i % 2, i / 2) = is_known[static_cast<std::size_t>(i)] ? known(i) : x(slot[static_cast<std::size_t>(i)], 0);
+  return u;
+}
+
+}  // namespace
+
+TEST_CASE("stiffened elasticity on a graded boundary layer: CG agrees with the direct solve", "[movers][slow]") {
+  const GradedCurving c = graded_curving();
+  const double largest = c.boundary.displacements.colwise().norm().maxCoeff();
+  ElasticityOptions o;
+  o.youngs_modulus = 1e6;
+  o.poisson_ratio = 0.4;
+  o.stiffening_exponent = 2.75;
+  ElasticityMover<2> direct(o);
+  direct.setup(c.mesh, c.boundary);
+  const Points<2> exact = direct.move(c.boundary.displacements);
+  CHECK(min_signed_jacobian(c.mesh, Points<2>(c.mesh.points + exact)) > 0.0);
+  // The thesis's solver settings (table 4.2): CG with Jacobi at 1e-6. On the raw system the
+  // stiffest rows (~1e20 times the softest) make the relative residual blind to the rest.
+  SolverOptions thesis{SolverKind::cg_jacobi, 1e-6};
+  const Points<2> unscaled = unscaled_solve(direct.stiffness(), c.boundary, c.mesh.num_nodes(), thesis);
+  CHECK((unscaled - exact).cwiseAbs().maxCoeff() > 0.1 * largest);
+  for (const auto kind : {SolverKind::cg_jacobi, SolverKind::cg_incomplete_cholesky}) {
+    o.solver = {kind, 1e-6};
+    ElasticityMover<2> iterative(o);
+    iterative.setup(c.mesh, c.boundary);
+    const Points<2> u = iterative.move(c.boundary.displacements);
+    CHECK((u - exact).cwiseAbs().maxCoeff() < 1e-3 * largest);
+    CHECK(min_signed_jacobian(c.mesh, Points<2>(c.mesh.points + u)) > 0.0);
+  }
+}
+
+TEST_CASE("stiffened elasticity with an active radius: zero beyond it, the full solution near the walls", "[movers][slow]") {
+  const GradedCurving c = graded_curving();
+  ElasticityOptions o;
+  o.stiffening_exponent = 2.0;
+  ElasticityMover<2> full(o);
+  full.setup(c.mesh, c.boundary);
+  const Points<2> u_full = full.move(c.boundary.displacements);
+  o.active_radius = 0.3;
+  ElasticityMover<2> limited(o);
+  limited.setup(c.mesh, c.boundary);
+  const Points<2> u = limited.move(c.boundary.displacements);
+  CHECK(limited.stats().evaluated_nodes < full.stats().evaluated_nodes);
+  const double largest = c.boundary.displacements.colwise().norm().maxCoeff();
+  double near_error = 0.0, far = 0.0;
+  for (Index v = 0; v < c.mesh.num_nodes(); ++v) {
+    const double r = c.mesh.points.col(v).norm();
+    if (r > 0.5 + 0.3 + 1e-9 && r < 10.0) far = std::max(far, u.col(v).norm());
+    if (r < 0.5 + 0.02) near_error = std::max(near_error, (u.col(v) - u_full.col(v)).norm());
+  }
+  CHECK(far == 0.0);
+  CHECK(near_error < 0.05 * largest);
+  CHECK(min_signed_jacobian(c.mesh, Points<2>(c.mesh.points + u)) > 0.0);
 }
 
 TEST_CASE("repeated moves equal a fresh setup, superpose, and reuse the factorization", "[movers]") {

@@ -128,7 +128,8 @@ template <int Dim>
 }
 
 /// Elasticity options from "youngs_modulus", "poisson_ratio", "stiffening_exponent",
-/// "reference_jacobian", "distance_exponent", "solver", "tolerance".
+/// "reference_jacobian", "distance_exponent", "active_radius" (or "active_radius_factor" ×
+/// "support_radius"), "solver", "tolerance".
 [[nodiscard]] inline ElasticityOptions elasticity_parameters(const MoverParameters& p, double default_exponent) {
   ElasticityOptions o;
   o.youngs_modulus = p.get("youngs_modulus", o.youngs_modulus);
@@ -136,6 +137,11 @@ template <int Dim>
   o.stiffening_exponent = p.get("stiffening_exponent", default_exponent);
   o.reference_jacobian = p.get("reference_jacobian", o.reference_jacobian);
   o.distance_exponent = p.get("distance_exponent", o.distance_exponent);
+  o.active_radius = p.get("active_radius", o.active_radius);
+  // A radius relative to the "support_radius" every caller of the registry may pass (the
+  // curving pipeline: its wall-layer estimate).
+  if (!p.values.contains("active_radius") && p.values.contains("active_radius_factor"))
+    o.active_radius = p.get("active_radius_factor", 0.0) * p.get("support_radius", 0.0);
   o.solver = mechanics_solver(p);
   return o;
 }
@@ -178,7 +184,9 @@ mover_registry() {
        }},
       // Mechanics movers: "solver" (SolverKind name) and "tolerance"; le/sle/nle take
       // "youngs_modulus", "poisson_ratio"; le/sle "stiffening_exponent" (sle default 2.75, the
-      // thesis's table 4.2), "reference_jacobian", "distance_exponent"; nle "load_steps".
+      // thesis's table 4.2), "reference_jacobian", "distance_exponent", "active_radius" (or "active_radius_factor" ×
+      // "support_radius"); nle "load_steps",
+      // "newton_iterations", "newton_tolerance".
       {"spring", [](const MoverParameters& p) {
          SpringOptions o;
          o.solver = detail::mechanics_solver(p);
@@ -197,6 +205,8 @@ mover_registry() {
          o.youngs_modulus = p.get("youngs_modulus", o.youngs_modulus);
          o.poisson_ratio = p.get("poisson_ratio", o.poisson_ratio);
          o.load_steps = static_cast<int>(p.get("load_steps", double(o.load_steps)));
+         o.max_newton_iterations = static_cast<int>(p.get("newton_iterations", double(o.max_newton_iterations)));
+         o.tolerance = p.get("newton_tolerance", o.tolerance);
          o.solver = detail::mechanics_solver(p);
          return AnyMover<Dim>(NonlinearElasticityMover<Dim>(o));
        }},

@@ -50,8 +50,16 @@ struct ElasticityOptions {
   double reference_jacobian = 0.0;
   /// ψ of the wall-distance stiffening (d̄/d_κ)^ψ; 0 disables it.
   double distance_exponent = 0.0;
-  /// Solver of the SPD system.
+  /// Solver of the SPD system. ElasticityMover always solves the diagonally scaled system
+  /// (solver.diagonal_scaling is switched on): stiffening spreads the rows of K over many
+  /// orders of magnitude, and an iterative solver's relative residual only means something
+  /// on the balanced system.
   SolverOptions solver = {};
+  /// Solve only near the moving walls: nodes farther than this from every prescribed
+  /// boundary node keep zero displacement (a homogeneous Dirichlet condition there, like the
+  /// compact support of an RBF); cells without a free node are not assembled, and sliding
+  /// nodes beyond the radius are held fixed. ≤ 0 (default): the whole mesh.
+  double active_radius = 0.0;
 };
 
 /// The (stiffened) linear elasticity mover in Dim dimensions; models MeshMover.
@@ -68,8 +76,9 @@ class ElasticityMover : public detail::LinearMechanicsMover<Dim> {
   /// Assembles and factorizes the elasticity system of `mesh` (any MeshLike of dimension Dim)
   /// with the Dirichlet and sliding nodes of `boundary` (its displacements are not used).
   /// Throws InputError for E ≤ 0, ν outside (−1, 0.5), a negative or non-finite exponent, a
-  /// degenerate cell when stiffening, a boundary without Dirichlet nodes for distance
-  /// stiffening, or bad mesh/boundary data; SolverError when the factorization fails.
+  /// degenerate cell when stiffening, a non-finite active_radius, a boundary without
+  /// Dirichlet nodes for distance stiffening or active_radius, or bad mesh/boundary data;
+  /// SolverError when the factorization fails.
   template <MeshLike M>
     requires(mesh_dim<M> == Dim)
   void setup(const M& mesh, const ResolvedBoundary<Dim>& boundary) {
@@ -79,9 +88,13 @@ class ElasticityMover : public detail::LinearMechanicsMover<Dim> {
       if (!(exponent >= 0.0) || !std::isfinite(exponent))
         throw InputError("ElasticityMover::setup: stiffening exponents must be finite and >= 0 (got " +
                          std::to_string(exponent) + ")");
-    if (!std::isfinite(options_.reference_jacobian))
-      throw InputError("ElasticityMover::setup: reference_jacobian must be finite");
+    if (!std::isfinite(options_.reference_jacobian) || !std::isfinite(options_.active_radius))
+      throw InputError("ElasticityMover::setup: reference_jacobian and active_radius must be finite");
     const Mesh<Dim> copy = this->start_setup(mesh, boundary);
+    const std::vector<bool> unknown = free_nodes(copy, boundary);
+    ResolvedBoundary<Dim> limited;
+    if (!unknown.empty()) limited = hold_far_sliding_nodes(boundary, unknown);
+    const ResolvedBoundary<Dim>& used = unknown.empty() ? boundary : limited;
     const double chi = options_.stiffening_exponent;
     j0_ = chi == 0.0 ? 0.0 : options_.reference_jacobian > 0.0 ? options_.reference_jacobian : mean_cell_measure(copy);
     const std::vector<double> wall_factor = distance_factors(copy, boundary);
@@ -94,6 +107,11 @@ class ElasticityMover : public detail::LinearMechanicsMover<Dim> {
       const detail::QuadratureTable& table = detail::quadrature_table(block.type);
       const double measure = detail::reference_measure(block.type);
       const double cell_factor = wall_factor.empty() ? 1.0 : wall_factor[static_cast<std::size_t>(block_start[static_cast<std::size_t>(b)] + e)];
+      if (!unknown.empty()) {
+        bool touches_free = false;
+        for (const Index v : block.element(e)) touches_free = touches_free || unknown[static_cast<std::size_t>(v)];
+        if (!touches_free) return;
+      }
       detail::ElementCoords<Dim> x;
       detail::gather_coords(copy.points, block, e, x);
       const int n = table.num_nodes;
@@ -117,7 +135,9 @@ class ElasticityMover : public detail::LinearMechanicsMover<Dim> {
     if (degenerate)
       throw InputError("ElasticityMover::setup: a cell has a zero Jacobian determinant (degenerate cell), so its "
                        "stiffening factor (J0/J)^chi is infinite");
-    this->finish_setup(copy, boundary, std::move(stiffness), Dim, options_.solver, watch);
+    SolverOptions solver = options_.solver;
+    solver.diagonal_scaling = true;
+    this->finish_setup(copy, used, std::move(stiffness), Dim, solver, watch, unknown.empty() ? nullptr : &unknown);
   }
 
  private:
@@ -140,11 +160,36 @@ class ElasticityMover : public detail::LinearMechanicsMover<Dim> {
     return mean;
   }
 
-  /// (d̄/d_κ)^ψ per cell (cell order), empty when ψ = 0. Walls are the prescribed nodes, or
-  /// every Dirichlet node when none is prescribed.
-  [[nodiscard]] std::vector<double> distance_factors(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) const {
-    const double psi = options_.distance_exponent;
-    if (psi == 0.0) return {};
+  /// Nodes within active_radius of a prescribed node (of a fixed one when none is
+  /// prescribed), as flags; empty when active_radius ≤ 0.
+  [[nodiscard]] std::vector<bool> free_nodes(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) const {
+    if (!(options_.active_radius > 0.0)) return {};
+    const std::vector<double> distance = wall_distances(mesh, boundary, mesh.points);
+    const std::vector<bool> in_cells = detail::cell_nodes(mesh);
+    std::vector<bool> unknown(distance.size(), false);
+    for (std::size_t v = 0; v < distance.size(); ++v) unknown[v] = in_cells[v] && distance[v] <= options_.active_radius;
+    return unknown;
+  }
+
+  /// `boundary` with its sliding nodes outside the free region turned fixed (they have no
+  /// stiffness left to slide with).
+  [[nodiscard]] static ResolvedBoundary<Dim> hold_far_sliding_nodes(const ResolvedBoundary<Dim>& boundary,
+                                                                    const std::vector<bool>& unknown) {
+    ResolvedBoundary<Dim> out = boundary;
+    for (Index k = 0; k < out.size(); ++k) {
+      auto& kind = out.kinds[static_cast<std::size_t>(k)];
+      if (kind == BoundaryKind::sliding && !unknown[static_cast<std::size_t>(out.nodes[static_cast<std::size_t>(k)])]) {
+        kind = BoundaryKind::fixed;
+        out.displacements.col(k).setZero();
+      }
+    }
+    return out;
+  }
+
+  /// Distance from each column of `queries` to the nearest wall node: the prescribed nodes,
+  /// or every fixed node when none is prescribed. Throws InputError when there are neither.
+  [[nodiscard]] static std::vector<double> wall_distances(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary,
+                                                          const Points<Dim>& queries) {
     std::vector<Index> walls;
     for (const BoundaryKind wanted : {BoundaryKind::prescribed, BoundaryKind::fixed}) {
       for (Index k = 0; k < boundary.size(); ++k)
@@ -152,22 +197,33 @@ class ElasticityMover : public detail::LinearMechanicsMover<Dim> {
       if (!walls.empty()) break;
     }
     if (walls.empty())
-      throw InputError("ElasticityMover::setup: distance stiffening needs prescribed or fixed boundary nodes (got none)");
+      throw InputError("ElasticityMover::setup: distance stiffening and active_radius need prescribed or fixed boundary "
+                       "nodes (got none)");
     Points<Dim> wall_points(Dim, static_cast<Index>(walls.size()));
     for (std::size_t k = 0; k < walls.size(); ++k) wall_points.col(static_cast<Index>(k)) = mesh.points.col(walls[k]);
     const KdTree<Dim> tree(wall_points);
-    std::vector<double> distance;
-    distance.reserve(static_cast<std::size_t>(mesh.num_cells()));
+    std::vector<double> distance(static_cast<std::size_t>(queries.cols()));
+    for (Index i = 0; i < queries.cols(); ++i) distance[static_cast<std::size_t>(i)] = std::sqrt(tree.nearest(Vec<Dim>(queries.col(i))).second);
+    return distance;
+  }
+
+  /// (d̄/d_κ)^ψ per cell (cell order), empty when ψ = 0, with d_κ the distance from the
+  /// cell's vertex centroid to the nearest wall node (see wall_distances).
+  [[nodiscard]] std::vector<double> distance_factors(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) const {
+    const double psi = options_.distance_exponent;
+    if (psi == 0.0) return {};
+    Points<Dim> centroids(Dim, mesh.num_cells());
+    Index at = 0;
     for (const auto& block : mesh.cells) {
       const int nv = num_vertices(block.type);
-      for (Index e = 0; e < block.size(); ++e) {
+      for (Index e = 0; e < block.size(); ++e, ++at) {
         const auto nodes = block.element(e);
         Vec<Dim> centroid = Vec<Dim>::Zero();
         for (int v = 0; v < nv; ++v) centroid += mesh.points.col(nodes[static_cast<std::size_t>(v)]);
-        centroid /= static_cast<double>(nv);
-        distance.push_back(std::sqrt(tree.nearest(centroid).second));
+        centroids.col(at) = centroid / static_cast<double>(nv);
       }
     }
+    std::vector<double> distance = wall_distances(mesh, boundary, centroids);
     double mean = 0.0;
     for (const double d : distance) mean += d / static_cast<double>(distance.size());
     // A cell centroid never lies on a wall node unless the cell is degenerate; the floor

@@ -16,6 +16,7 @@
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -36,6 +37,8 @@ class SparseBackend {
   virtual bool factorize(const SparseMatrix& a) = 0;
   /// Solves for one column; returns false when the solver reports failure.
   virtual bool solve(const Eigen::VectorXd& b, Eigen::VectorXd& x, Index& iterations) = 0;
+  /// Changes the relative-residual target of an iterative solver (direct ones ignore it).
+  virtual void set_tolerance(double /*tolerance*/) {}
 };
 
 template <class EigenSolver>
@@ -75,6 +78,7 @@ class IterativeBackend final : public SparseBackend {
     iterations = solver_.iterations();
     return solver_.info() == Eigen::Success;
   }
+  void set_tolerance(double tolerance) override { solver_.setTolerance(tolerance); }
 
  private:
   EigenSolver solver_;
@@ -111,7 +115,8 @@ inline std::unique_ptr<SparseBackend> make_backend(const SolverOptions& o) {
 /// Usage: `compute(A)` (analysis when the pattern is new, then factorization), then
 /// `solve(B)` as often as needed. A later `compute(A2)` with the same sparsity pattern skips
 /// the symbolic analysis. The solver keeps a copy of A (iterative solvers and residual
-/// checks need it).
+/// checks need it). With SolverOptions::diagonal_scaling it keeps and solves the scaled
+/// matrix D^-1/2 A D^-1/2 and maps right-hand sides and solutions (callers see A's x).
 class LinearSolver {
  public:
   explicit LinearSolver(SolverOptions options = {}) : options_(options) {}
@@ -135,6 +140,7 @@ class LinearSolver {
     const bool same_pattern = backend_ && same_pattern_as(a);
     matrix_ = a;
     matrix_.makeCompressed();
+    if (options_.diagonal_scaling) scale_matrix();
     if (!same_pattern) {
       backend_ = detail::make_backend(options_);
       fallback_.reset();
@@ -166,11 +172,17 @@ class LinearSolver {
     if (x.rows() != b.rows() || x.cols() != b.cols()) x.setZero(b.rows(), b.cols());
     report_.iterations = 0;
     report_.residual = 0.0;
+    const bool scaled = options_.diagonal_scaling;
     for (Index c = 0; c < b.cols(); ++c) {
       rhs_ = b.col(c);
       column_ = x.col(c);
+      if (scaled) {
+        rhs_.array() *= scale_.array();
+        column_.array() /= scale_.array();
+      }
       Index iterations = 0;
       bool ok = backend_->solve(rhs_, column_, iterations);
+      if (ok && scaled && is_iterative(options_.kind)) ok = tighten_scaled_solve(iterations);
       double residual = relative_residual();
       report_.iterations = std::max(report_.iterations, iterations);
       const double limit = is_iterative(options_.kind) ? 10.0 * options_.tolerance : 1e-6;
@@ -188,6 +200,7 @@ class LinearSolver {
                             std::to_string(residual) + ")");
       }
       report_.residual = std::max(report_.residual, residual);
+      if (scaled) column_.array() *= scale_.array();
       x.col(c) = column_;
     }
     report_.seconds += watch.seconds();
@@ -208,6 +221,43 @@ class LinearSolver {
     for (Index k = 0; k < a.nonZeros(); ++k)
       if (a.innerIndexPtr()[k] != matrix_.innerIndexPtr()[k]) return false;
     return true;
+  }
+
+  /// Under diagonal_scaling the Krylov solver's own test, ||r̃|| ≤ tol ||b̃|| on the scaled
+  /// system, is still dominated by the rows with the largest right-hand side (the stiffest
+  /// cells); errors where the matrix is soft go unseen. In displacement units the residual is
+  /// D^-1 r = S r̃ (the Jacobi correction of each unknown), so the solve is continued, with a
+  /// tighter target and warm-started, until ||S r̃|| ≤ tol ||S b̃|| as well (at most 12
+  /// restarts). Returns false when the iterative solver fails on the way.
+  bool tighten_scaled_solve(Index& iterations) {
+    const double target = options_.tolerance;
+    const double norm_b = (scale_.array() * rhs_.array()).matrix().norm();
+    double tolerance = target;
+    bool ok = true;
+    for (int round = 0; ok && round < 12 && norm_b > 0.0; ++round) {
+      const double ratio = (scale_.array() * (matrix_ * column_ - rhs_).array()).matrix().norm() / norm_b;
+      if (ratio <= target) break;
+      tolerance = std::max(tolerance * 0.5 * target / ratio, 1e-16);
+      backend_->set_tolerance(tolerance);
+      Index more = 0;
+      ok = backend_->solve(rhs_, column_, more);
+      iterations += more;
+    }
+    backend_->set_tolerance(target);
+    return ok;
+  }
+
+  /// Replaces matrix_ by S A S with S = diag(A)^-1/2, kept in scale_.
+  void scale_matrix() {
+    scale_ = matrix_.diagonal();
+    for (Index i = 0; i < scale_.size(); ++i) {
+      if (!(scale_[i] > 0.0))
+        throw InputError("LinearSolver::compute: diagonal_scaling needs a positive diagonal (got " +
+                         std::to_string(scale_[i]) + " in row " + std::to_string(i) + ")");
+      scale_[i] = 1.0 / std::sqrt(scale_[i]);
+    }
+    for (Index j = 0; j < matrix_.outerSize(); ++j)
+      for (SparseMatrix::InnerIterator it(matrix_, j); it; ++it) it.valueRef() *= scale_[it.row()] * scale_[j];
   }
 
   [[nodiscard]] double relative_residual() const {
@@ -231,6 +281,7 @@ class LinearSolver {
   SparseMatrix matrix_;
   std::unique_ptr<detail::SparseBackend> backend_;
   std::unique_ptr<detail::SparseBackend> fallback_;
+  Eigen::VectorXd scale_;  ///< diag(A)^-1/2 under diagonal_scaling
   Eigen::VectorXd rhs_;
   Eigen::VectorXd column_;
 };

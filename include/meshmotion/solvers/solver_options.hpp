@@ -48,13 +48,22 @@ struct SolverOptions {
   /// When an iterative solver does not converge, solve again with SparseLU instead of
   /// throwing (the report's fell_back says so).
   bool fallback_to_direct = false;
+  /// Solve the symmetrically scaled system (D^-1/2 A D^-1/2) y = D^-1/2 b, x = D^-1/2 y,
+  /// D = diag(A) (needs a positive diagonal). The tolerance and the reported residual then
+  /// refer to the scaled system, whose rows are balanced: when the rows of A span many
+  /// orders of magnitude (stiffened elasticity), ||A x − b|| / ||b|| is dominated by the
+  /// stiffest rows and says nothing about the others. CG with the Jacobi preconditioner
+  /// makes the same iterates either way; only its stopping test changes. Iterative solvers
+  /// then also meet the tolerance in D^-1-scaled (displacement) units, ||D^-1 r|| ≤ tol
+  /// ||D^-1 b||, restarting warm with a tighter target when their own test stops short.
+  bool diagonal_scaling = false;
 };
 
 /// What a solver did, accumulated since it was created (seconds, factorizations) or for the
 /// latest solve (iterations, residual).
 struct SolverReport {
   Index iterations = 0;      ///< largest iteration count over the right-hand sides of the last solve
-  double residual = 0.0;     ///< largest relative residual ||A x - b|| / ||b|| of the last solve
+  double residual = 0.0;     ///< largest relative residual ||A x - b|| / ||b|| of the last solve (of the scaled system under diagonal_scaling)
   double seconds = 0.0;      ///< total time in analysis, factorization and solves
   Index analyses = 0;        ///< symbolic analyses (sparsity pattern) performed
   Index factorizations = 0;  ///< numeric factorizations (or preconditioner builds) performed

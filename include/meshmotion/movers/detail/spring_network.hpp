@@ -78,30 +78,45 @@ template <int Dim>
   return springs;
 }
 
-/// Triplets of the lineal springs of `mesh` (k = ‖r_i − r_j‖^−exponent, the same spring in
-/// each of `components` directions, node-major dofs). Throws InputError, prefixed by `where`,
-/// when a spring joins two distinct nodes at the same position.
+/// Triplets of the springs of `mesh`, k = ‖r_b − r_a‖^−exponent, on node-major dofs with
+/// `components` per node. Uncoupled (Batina): the same spring k in each direction. Coupled
+/// (the truss springs of Farhat et al. 1998; components must be Dim): the spring resists only
+/// the change of its length, so its blocks are ±k e eᵀ with e the unit direction a → b, and it
+/// stores no energy in an infinitesimal rigid rotation. Throws InputError, prefixed by
+/// `where`, when a spring joins two distinct nodes at the same position.
 template <int Dim>
-[[nodiscard]] std::vector<Eigen::Triplet<double, int>> lineal_spring_triplets(const Mesh<Dim>& mesh, int components,
-                                                                              double exponent, const std::string& where) {
+[[nodiscard]] std::vector<Eigen::Triplet<double, int>> spring_triplets(const Mesh<Dim>& mesh, int components, double exponent,
+                                                                       bool coupled, const std::string& where) {
   const auto springs = mesh_springs(mesh);
   std::vector<Eigen::Triplet<double, int>> triplets;
-  triplets.reserve(springs.size() * 4 * static_cast<std::size_t>(components));
+  const auto c = static_cast<std::size_t>(components);
+  triplets.reserve(springs.size() * 4 * (coupled ? c * c : c));
   for (const auto& [a, b] : springs) {
-    const double length = (mesh.points.col(a) - mesh.points.col(b)).norm();
+    const Vec<Dim> d = mesh.points.col(b) - mesh.points.col(a);
+    const double length = d.norm();
     if (!(length > 0.0))
       throw InputError(where + ": nodes " + std::to_string(a) + " and " + std::to_string(b) +
                        " share an edge but coincide (got length 0, expected > 0)");
     const double k = std::pow(length, -exponent);
-    for (int axis = 0; axis < components; ++axis) {
-      const auto i = static_cast<int>(a * components + axis), j = static_cast<int>(b * components + axis);
-      triplets.emplace_back(i, i, k);
-      triplets.emplace_back(j, j, k);
-      triplets.emplace_back(i, j, -k);
-      triplets.emplace_back(j, i, -k);
-    }
+    for (int i = 0; i < components; ++i)
+      for (int j = coupled ? 0 : i; j < (coupled ? components : i + 1); ++j) {
+        const double kij = coupled ? k * d(i) * d(j) / (length * length) : k;
+        const auto ai = static_cast<int>(a * components + i), aj = static_cast<int>(a * components + j);
+        const auto bi = static_cast<int>(b * components + i), bj = static_cast<int>(b * components + j);
+        triplets.emplace_back(ai, aj, kij);
+        triplets.emplace_back(bi, bj, kij);
+        triplets.emplace_back(ai, bj, -kij);
+        triplets.emplace_back(bi, aj, -kij);
+      }
   }
   return triplets;
+}
+
+/// Batina's uncoupled lineal springs (spring_triplets with coupled = false).
+template <int Dim>
+[[nodiscard]] std::vector<Eigen::Triplet<double, int>> lineal_spring_triplets(const Mesh<Dim>& mesh, int components,
+                                                                              double exponent, const std::string& where) {
+  return spring_triplets(mesh, components, exponent, false, where);
 }
 
 }  // namespace meshmotion::detail
