@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# Configure with benchmarks on, build every benchmark, run them all and collect their JSON lines
-# into one file. Default sizes finish in a few minutes each on a 2-core machine; --full runs the
-# sizes the issues ask for (>= 1M elements/nodes: much longer).
+# Configure with benchmarks on, build every benchmark, run them all, then the peer comparisons
+# (OpenFOAM, dense RBF; Gmsh runs inside curving_bench), collect their JSON lines into one file
+# and draw the SVG plots beside it. Default sizes finish in a few minutes each on a 2-core
+# machine; --full runs the sizes the issues ask for (>= 1M elements/nodes: much longer).
 #
-#   benchmarks/run_all.sh [--full] [--build-dir DIR] [--out FILE] [--jobs N] [--no-build]
+#   benchmarks/run_all.sh [--full] [--build-dir DIR] [--out FILE] [--jobs N] [--no-build] [--no-peers]
 #
 # The output file holds, per benchmark, a {"benchmark_run": ...} line (program, arguments, load
 # average before it, exit code, wall seconds) followed by that program's own JSON lines. The
@@ -15,6 +16,7 @@ source_dir="$(dirname "$here")"
 build_dir="$source_dir/build-bench"
 full=0
 build=1
+peers=1
 jobs=1
 out=""
 
@@ -22,10 +24,11 @@ while [[ $# -gt 0 ]]; do
   case "$1" in
     --full) full=1 ;;
     --no-build) build=0 ;;
+    --no-peers) peers=0 ;;
     --build-dir) build_dir="$2"; shift ;;
     --out) out="$2"; shift ;;
     --jobs) jobs="$2"; shift ;;
-    -h|--help) sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "run_all.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
   shift
@@ -46,6 +49,7 @@ declare -A quick_args=(
   [interpolation_bench]=""
   [elasticity_bench]="--quick"
   [curving_bench]=""
+  [bump3d_bench]="0 1"
 )
 declare -A full_args=(
   [io_bench]="100"
@@ -55,20 +59,19 @@ declare -A full_args=(
   [interpolation_bench]=""
   [elasticity_bench]=""
   [curving_bench]=""
+  [bump3d_bench]="0 1 2"
 )
-order=(io_bench quality_bench rbf_bench interpolation_bench elasticity_bench delaunay_bench curving_bench)
+order=(io_bench quality_bench rbf_bench interpolation_bench elasticity_bench delaunay_bench curving_bench bump3d_bench)
+# Peer scripts: they take the build folder and a work folder, install their peer with apt-get
+# when it is absent, and report it missing when that fails.
+peer_scripts=(openfoam_peer dense_rbf_peer)
 
-# curving_bench joins only once it is committed (it may be work in progress in the tree).
 benches=()
 for name in "${order[@]}"; do
-  src="$here/$name.cpp"
-  [[ -f "$src" ]] || continue
-  if [[ "$name" == curving_bench ]] && [[ -z "$(git -C "$source_dir" log --oneline -1 -- "benchmarks/$name.cpp" 2>/dev/null)" ]]; then
-    echo "run_all.sh: skipping $name (not committed yet)" | tee -a "$log"
-    continue
-  fi
-  benches+=("$name")
+  [[ -f "$here/$name.cpp" ]] && benches+=("$name")
 done
+targets=("${benches[@]}")
+[[ $peers == 1 ]] && targets+=(motion_peer_bench)
 
 {
   echo "# $(date -u +%FT%TZ)  nproc=$(nproc)  $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //')"
@@ -78,23 +81,21 @@ done
 if [[ $build == 1 ]]; then
   cmake -S "$source_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DMESHMOTION_BUILD_BENCHMARKS=ON \
     >> "$log" 2>&1 || { echo "run_all.sh: configure failed, see $log" >&2; exit 1; }
-  cmake --build "$build_dir" --target "${benches[@]}" -j"$jobs" >> "$log" 2>&1 \
+  cmake --build "$build_dir" --target "${targets[@]}" -j"$jobs" >> "$log" 2>&1 \
     || { echo "run_all.sh: build failed, see $log" >&2; exit 1; }
 fi
 
 status=0
-for name in "${benches[@]}"; do
-  if [[ $full == 1 ]]; then args="${full_args[$name]}"; else args="${quick_args[$name]}"; fi
+# run NAME COMMAND...: runs one benchmark, its tables to the terminal and the log, its JSON
+# lines (after a benchmark_run line) to the results file.
+run() {
+  local name="$1" args="${*:3}"
+  shift
+  local load start rc milliseconds
   load="$(cut -d' ' -f1-3 /proc/loadavg)"
   echo "== $name $args   (load average $load)" | tee -a "$log"
-  if [[ ! -x "$build_dir/benchmarks/$name" ]]; then
-    echo "run_all.sh: $build_dir/benchmarks/$name is not built" | tee -a "$log" >&2
-    status=1
-    continue
-  fi
   start=$(date +%s%N)
-  # shellcheck disable=SC2086  # args is a word list on purpose
-  "$build_dir/benchmarks/$name" $args > "$build_dir/$name.out" 2>&1
+  "$@" > "$build_dir/$name.out" 2>&1
   rc=$?
   milliseconds=$(( ($(date +%s%N) - start) / 1000000 ))
   tee -a "$log" < "$build_dir/$name.out" | grep -v '^{'
@@ -102,8 +103,25 @@ for name in "${benches[@]}"; do
     "$name" "$args" "$load" "$rc" $((milliseconds / 1000)) $((milliseconds % 1000)) >> "$out"
   grep '^{' "$build_dir/$name.out" >> "$out"
   [[ $rc == 0 ]] || { echo "run_all.sh: $name exited with $rc" | tee -a "$log" >&2; status=1; }
-done
+}
 
+for name in "${benches[@]}"; do
+  if [[ $full == 1 ]]; then args="${full_args[$name]}"; else args="${quick_args[$name]}"; fi
+  if [[ ! -x "$build_dir/benchmarks/$name" ]]; then
+    echo "run_all.sh: $build_dir/benchmarks/$name is not built" | tee -a "$log" >&2
+    status=1
+    continue
+  fi
+  # shellcheck disable=SC2086  # args is a word list on purpose
+  run "$name" "$build_dir/benchmarks/$name" $args
+done
+if [[ $peers == 1 ]]; then
+  for name in "${peer_scripts[@]}"; do
+    run "$name" "$here/$name.sh" "$build_dir" "$build_dir/$name"
+  done
+fi
+
+python3 "$here/plot_results.py" "$out" --out-dir "$build_dir/plots" | tee -a "$log"
 echo "JSON lines: $out" | tee -a "$log"
 echo "tables:     $log"
 exit $status
