@@ -343,3 +343,130 @@ TEST_CASE("step driver: a rotated ellipse O-mesh, wall rotated rigidly, quality 
   }
   CHECK_THROWS_AS(make_mover<2>("no_such_method"), InputError);
 }
+
+TEST_CASE("sliding groups: two planes meet in a line (3D), a point (2D); parallel planes stay a plane", "[movers]") {
+  const Grid<3> g3 = grid<3>(3);
+  BoundarySpec<3> spec3;
+  spec3.sliding("x0").sliding("y0").sliding("x1", Vec<3>(-2.0, 0.0, 0.0)).sliding("z0");
+  const auto b3 = spec3.resolve(g3.mesh.points, g3.groups);
+  Index lines = 0, planes = 0, fixed = 0;
+  for (Index k = 0; k < b3.size(); ++k) {
+    const Vec<3> x = g3.mesh.points.col(b3.nodes[static_cast<std::size_t>(k)]);
+    const bool on_x = x(0) == 0.0 || x(0) == 1.0, on_y = x(1) == 0.0, on_z = x(2) == 0.0;
+    const int on = on_x + on_y + on_z;
+    if (b3.kinds[static_cast<std::size_t>(k)] == BoundaryKind::fixed) {
+      ++fixed;
+      CHECK(on == 3);  // a corner on three planes
+    } else if (b3.slides_on_line(k)) {
+      ++lines;
+      CHECK(on == 2);
+      const Vec<3> expected = !on_x ? Vec<3>::UnitX() : !on_y ? Vec<3>::UnitY() : Vec<3>::UnitZ();
+      CHECK(std::abs(std::abs(b3.directions.col(k).dot(expected)) - 1.0) < 1e-14);
+      const Vec<3> u(0.3, -0.2, 0.5);
+      CHECK((b3.project(k, u) - expected.dot(u) * expected).norm() < 1e-15);
+      CHECK(b3.sliding_basis(k).cols() == 1);
+    } else {
+      ++planes;
+      CHECK(on == 1);
+      CHECK(b3.sliding_basis(k).cols() == 2);
+    }
+  }
+  CHECK(fixed == 2);              // (0,0,0) and (1,0,0); the parallel planes x0 and x1 never meet
+  CHECK(lines == 4 * 3 + 2);      // z edges x0∩y0, x1∩y0 and y edges x0∩z0, x1∩z0 (3 each), x edge y0∩z0 (2)
+  CHECK(planes == b3.size() - 16);
+
+  // A line node meeting a third plane that contains the line stays on the line.
+  BoundarySpec<3> same;
+  same.sliding("x0").sliding("y0").sliding("x0", Vec<3>(1.0, 0.0, 0.0));
+  const auto b_same = same.resolve(g3.mesh.points, g3.groups);
+  Index same_lines = 0;
+  for (Index k = 0; k < b_same.size(); ++k) same_lines += b_same.slides_on_line(k);
+  CHECK(same_lines == 4);
+
+  // 2D: two non-parallel lines leave a point; parallel lines stay a line.
+  const Grid<2> g2 = grid<2>(4);
+  BoundarySpec<2> spec2;
+  spec2.sliding("x0").sliding("y0").sliding("x1");
+  const auto b2 = spec2.resolve(g2.mesh.points, g2.groups);
+  for (Index k = 0; k < b2.size(); ++k) {
+    const Vec<2> x = g2.mesh.points.col(b2.nodes[static_cast<std::size_t>(k)]);
+    const bool corner = x(1) == 0.0 && (x(0) == 0.0 || x(0) == 1.0);
+    CHECK((b2.kinds[static_cast<std::size_t>(k)] == BoundaryKind::fixed) == corner);
+    CHECK(!b2.slides_on_line(k));
+  }
+}
+
+TEST_CASE("edge of two symmetry planes: RBF and elasticity move its nodes along the line", "[movers]") {
+  BoxOptions o;
+  o.nx = o.ny = o.nz = 4;
+  o.cells = BoxCells::tet4;
+  const Mesh<3> box = box_mesh(o);
+  BoundarySpec<3> spec;
+  spec.moving("top", Translation<3>{Vec<3>(0.1, 0.08, 0.12)}).fixed("bottom").sliding("left").sliding("front");
+  const ResolvedBoundary<3> b = spec.resolve(box);
+  const auto check = [&](const Points<3>& u, const char* who) {
+    INFO(who);
+    Index on_line = 0;
+    double along = 0.0;
+    for (Index k = 0; k < b.size(); ++k) {
+      if (b.kinds[static_cast<std::size_t>(k)] != BoundaryKind::sliding) continue;
+      const Index v = b.nodes[static_cast<std::size_t>(k)];
+      const Vec<3> moved = box.points.col(v) + u.col(v);
+      if (box.points(0, v) == 0.0) CHECK(std::abs(moved(0)) < 1e-12);
+      if (box.points(1, v) == 0.0) CHECK(std::abs(moved(1)) < 1e-12);
+      if (b.slides_on_line(k)) {
+        ++on_line;
+        along = std::max(along, std::abs(u(2, v)));
+      } else {
+        CHECK(u.col(v).norm() > 1e-4);  // plane nodes slide too
+      }
+    }
+    CHECK(on_line == 3);    // the z edge between the fixed bottom and the moving top
+    CHECK(along > 0.02);    // and they do move along it
+  };
+  RbfOptions options;
+  options.support_radius = 1.5;
+  RbfMover<3> rbf(options);
+  rbf.setup(box, b);
+  check(rbf.move(b.displacements), "rbf");
+  ElasticityMover<3> elasticity;
+  elasticity.setup(box, b);
+  check(elasticity.move(b.displacements), "linear elasticity");
+}
+
+TEST_CASE("global kernels: the cached evaluation matrix gives the uncached result", "[movers]") {
+  const Grid<2> g = grid<2>(12);
+  BoundarySpec<2> spec;
+  spec.moving("x0", Translation<2>{Vec<2>(0.05, 0.02)}).fixed("x1").sliding("y0").sliding("y1");
+  const auto boundary = spec.resolve(g.mesh.points, g.groups);
+  for (const RbfKernel kernel : {RbfKernel::thin_plate_spline, RbfKernel::gaussian, RbfKernel::multiquadric,
+                                 RbfKernel::inverse_multiquadric}) {
+    INFO(name(kernel));
+    RbfOptions options;
+    options.kernel = kernel;
+    // Shape scales of about the grid spacing keep the dense systems well conditioned.
+    options.support_radius = kernel == RbfKernel::thin_plate_spline ? 1.0 : 0.1;
+    options.polynomial = kernel == RbfKernel::thin_plate_spline;
+    RbfMover<2> cached(options);
+    cached.setup(g.mesh, boundary);
+    CHECK(cached.evaluation_cached());
+    options.max_evaluation_cache_bytes = 0;
+    RbfMover<2> direct(options);
+    direct.setup(g.mesh, boundary);
+    CHECK_FALSE(direct.evaluation_cached());
+    CHECK(cached.stats().nonzeros == direct.stats().nonzeros + cached.stats().evaluated_nodes * cached.stats().boundary_nodes);
+    // Repeated moves on the cached mover equal a fresh setup + move without the cache.
+    Points<2> u;
+    for (unsigned seed = 1; seed <= 3; ++seed) {
+      const Points<2> d = random_displacements<2>(boundary.size(), seed);
+      cached.move_into(d, u);
+      RbfMover<2> fresh(options);
+      fresh.setup(g.mesh, boundary);
+      CHECK((u - fresh.move(d)).cwiseAbs().maxCoeff() < 1e-13);
+    }
+    CHECK(cached.stats().moves == 3);
+    CHECK(cached.stats().factorizations == 2);  // the sliding walls' two systems, once
+    const Points<2> v = random_displacements<2>(g.mesh.num_nodes(), 9);
+    CHECK((cached.derivative_reverse(v) - direct.derivative_reverse(v)).cwiseAbs().maxCoeff() < 1e-12);
+  }
+}

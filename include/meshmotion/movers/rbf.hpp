@@ -12,10 +12,14 @@
 /// - Cost: setup O(m log m + n log m) queries plus one sparse factorization (m boundary
 ///   nodes, n nodes); move = one solve with the cached factorization + one sparse
 ///   mat-vec E α (parallel). Global kernels: dense O(m³) setup, O(n m) per move.
+/// - Global kernels: the dense evaluation matrix (evaluated nodes × centres) is cached in
+///   setup when it fits RbfOptions::max_evaluation_cache_bytes, making a move one dense
+///   matrix product (evaluation_cached() tells); otherwise each move re-evaluates the kernel.
 /// - Sliding boundaries (exact): the interpolant over the prescribed and fixed nodes gives
-///   the sliding nodes a displacement, its normal component is removed, and the projected
-///   values join the constraints of a second interpolant over all nodes; both systems are
-///   factorized once in setup, so sliding nodes end exactly on their planes.
+///   the sliding nodes a displacement, which is projected on each node's plane or line
+///   (ResolvedBoundary::project), and the projected values join the constraints of a second
+///   interpolant over all nodes; both systems are factorized once in setup, so sliding nodes
+///   end exactly on their planes and lines.
 /// - Optional linear polynomial augmentation reproduces affine motions exactly.
 /// - derivative_forward / derivative_reverse give J w and Jᵀ v for J = ∂(node displacements)
 ///   / ∂(boundary displacements), reusing the factorizations (shape optimization).
@@ -25,6 +29,7 @@
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/detail/coincident_nodes.hpp"
+#include "meshmotion/movers/detail/mover_support.hpp"
 #include "meshmotion/movers/detail/rbf_system.hpp"
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
@@ -32,6 +37,7 @@
 #include "meshmotion/solvers/solver_options.hpp"
 
 #include <cmath>
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -53,11 +59,16 @@ struct RbfOptions {
   Index max_dense_centres = 4000;
   /// Boundary nodes closer than this fraction of the boundary's bounding-box diagonal are one node.
   double coincidence_tolerance = 1e-10;
+  /// Global kernels: setup stores the dense evaluation matrix (evaluated nodes × centres, 8
+  /// bytes an entry) when it takes at most this many bytes, so a move is one dense matrix
+  /// product instead of n × m kernel evaluations; larger matrices are recomputed every move.
+  /// 0 never caches. Compact kernels always keep their (sparse) operator.
+  std::size_t max_evaluation_cache_bytes = std::size_t{256} << 20;
 };
 
 /// The RBF mover in Dim dimensions; models MeshMover.
 template <int Dim>
-class RbfMover {
+class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
  public:
   static constexpr int dim = Dim;
   using Coefficients = Eigen::MatrixXd;
@@ -66,6 +77,9 @@ class RbfMover {
 
   [[nodiscard]] const RbfOptions& options() const noexcept { return options_; }
   [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
+  /// True when the last setup stored the dense evaluation matrix of a global kernel (see
+  /// RbfOptions::max_evaluation_cache_bytes); compact kernels always keep a sparse operator.
+  [[nodiscard]] bool evaluation_cached() const noexcept { return dense_operator_.size() > 0; }
 
   /// Reference-configuration work (see the file comment). `mesh`: any MeshLike of dimension
   /// Dim; `boundary`: nodes and kinds (its displacements are not used here).
@@ -81,9 +95,10 @@ class RbfMover {
     points_ = copy_points(mesh);
     const Index n = points_.cols();
     if (!points_.allFinite()) throw InputError("RbfMover::setup: mesh has a non-finite coordinate");
-    check_boundary(boundary, n);
+    detail::check_boundary<Dim>("RbfMover::setup", boundary, n, false);
     boundary_nodes_ = boundary.nodes;
     kinds_ = boundary.kinds;
+    dense_operator_.resize(0, 0);
     const Index m = boundary.size();
 
     // Merge coincident boundary nodes into centres; constrained centres first, sliding after.
@@ -118,10 +133,14 @@ class RbfMover {
         source_[static_cast<std::size_t>(centre_of_[static_cast<std::size_t>(b)])] = b;
     const auto k = static_cast<Index>(source_.size());
     Points<Dim> centres(Dim, k);
-    normals_.setZero(Dim, k);
+    projectors_.clear();
     for (Index c = 0; c < k; ++c) {
-      centres.col(c) = positions.col(source_[static_cast<std::size_t>(c)]);
-      if (c >= n_constrained_) normals_.col(c) = boundary.normals.col(source_[static_cast<std::size_t>(c)]);
+      const Index b = source_[static_cast<std::size_t>(c)];
+      centres.col(c) = positions.col(b);
+      if (c < n_constrained_) continue;
+      Projector p;
+      for (int a = 0; a < Dim; ++a) p.col(a) = boundary.project(b, Vec<Dim>::Unit(a));
+      projectors_.push_back(p);
     }
 
     const detail::RbfKernelSettings kernel{options_.kernel, options_.support_radius, options_.polynomial};
@@ -147,24 +166,24 @@ class RbfMover {
       if (!is_boundary[static_cast<std::size_t>(i)]) interior_.push_back(i);
     evaluated_.clear();
     if (is_compact(options_.kernel)) {
-      auto rows = detail::compact_kernel_rows(points_, interior_, all_.tree(), k, kernel);
-      // Keep only rows with weights, so skipped nodes cost nothing per move.
-      std::vector<Index> keep;
-      for (Index r = 0; r < rows.rows(); ++r)
-        if (rows.outerIndexPtr()[r + 1] > rows.outerIndexPtr()[r]) keep.push_back(r);
-      operator_.resize(static_cast<Index>(keep.size()), k);
-      operator_.reserve(rows.nonZeros());
-      for (const Index r : keep) {
-        evaluated_.push_back(interior_[static_cast<std::size_t>(r)]);
-        operator_.startVec(static_cast<Index>(evaluated_.size()) - 1);
-        for (typename Operator::InnerIterator it(rows, r); it; ++it)
-          operator_.insertBack(static_cast<Index>(evaluated_.size()) - 1, it.col()) = it.value();
-      }
-      operator_.finalize();
+      // Only rows with weights are kept, so skipped nodes cost nothing per move; the operator
+      // is only multiplied, so its rows need no sorting.
+      std::vector<Index> kept;
+      operator_ = detail::compact_kernel_rows(points_, interior_, all_.tree(), k, kernel, false, &kept);
+      evaluated_.reserve(kept.size());
+      for (const Index r : kept) evaluated_.push_back(interior_[static_cast<std::size_t>(r)]);
       stats_.nonzeros += operator_.nonZeros();
     } else {
       evaluated_ = interior_;
       operator_.resize(0, 0);
+      const auto bytes = static_cast<double>(evaluated_.size()) * static_cast<double>(k) * sizeof(double);
+      if (bytes <= static_cast<double>(options_.max_evaluation_cache_bytes) && !evaluated_.empty()) {
+        dense_operator_.resize(static_cast<Index>(evaluated_.size()), k);
+        const auto n_eval = static_cast<Index>(evaluated_.size());
+#pragma omp parallel for schedule(static)
+        for (Index r = 0; r < n_eval; ++r) dense_operator_.row(r) = kernel_row(points_.col(evaluated_[static_cast<std::size_t>(r)]));
+        stats_.nonzeros += dense_operator_.size();
+      }
     }
     stats_.evaluated_nodes = options_.polynomial ? static_cast<Index>(interior_.size()) : static_cast<Index>(evaluated_.size());
     stats_.factorizations = all_.report().factorizations + (k > n_constrained_ ? constrained_.report().factorizations : 0);
@@ -177,30 +196,24 @@ class RbfMover {
   /// get their targets exactly (sliding ones their projected displacement). Throws
   /// InputError for a wrong shape, a non-finite value, or coincident nodes given different
   /// displacements (naming them); SolverError when an iterative solve fails.
-  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
-    Points<Dim> out;
-    move_into(d, out);
-    return out;
-  }
-
-  /// move() into `out` (resized only when its shape differs).
+  /// move() (inherited) returns the same; move_into writes into `out`, resized only when its
+  /// shape differs.
   void move_into(const Points<Dim>& d, Points<Dim>& out) {
-    const detail::Stopwatch watch;
-    check_displacements(d, "move");
-    apply(d, out);
-    ++stats_.moves;
-    const SolverReport& r = all_.report();
-    stats_.iterations = r.iterations;
-    stats_.residual = r.residual;
-    stats_.fell_back = r.fell_back;
-    stats_.move_seconds = watch.seconds();
+    detail::timed_move<Dim>("RbfMover::move", ready_, d, boundary_nodes_, stats_, [&] {
+      apply(d, out);
+      const SolverReport& r = all_.report();
+      stats_.iterations = r.iterations;
+      stats_.residual = r.residual;
+      stats_.fell_back = r.fell_back;
+    });
   }
 
   /// Forward derivative J w: the displacement change of every node (Dim × n_nodes) for a
   /// boundary displacement change w (Dim × boundary.size()). The mover is linear in the
   /// displacements, so this is move(w); coincident nodes must agree in w too.
   [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w) {
-    check_displacements(w, "derivative_forward");
+    require_ready("derivative_forward");
+    detail::check_displacements<Dim>("RbfMover::derivative_forward", w, boundary_nodes_);
     Points<Dim> out;
     apply(w, out);
     return out;
@@ -256,48 +269,14 @@ class RbfMover {
     if (!ready_) throw InputError(std::string("RbfMover::") + where + ": setup() was not called");
   }
 
-  static void check_boundary(const ResolvedBoundary<Dim>& b, Index n) {
-    const Index m = b.size();
-    if (static_cast<Index>(b.kinds.size()) != m || b.normals.cols() != m)
-      throw InputError("RbfMover::setup: boundary has " + std::to_string(m) + " nodes but " +
-                       std::to_string(b.kinds.size()) + " kinds and " + std::to_string(b.normals.cols()) + " normals");
-    for (Index k = 0; k < m; ++k) {
-      const Index v = b.nodes[static_cast<std::size_t>(k)];
-      if (v < 0 || v >= n)
-        throw InputError("RbfMover::setup: boundary node " + std::to_string(v) + " is out of range (expected 0 to " +
-                         std::to_string(n - 1) + ")");
-      if (k > 0 && v <= b.nodes[static_cast<std::size_t>(k - 1)])
-        throw InputError("RbfMover::setup: boundary nodes must be sorted and unique (node " + std::to_string(v) +
-                         " follows " + std::to_string(b.nodes[static_cast<std::size_t>(k - 1)]) + ")");
-      if (b.kinds[static_cast<std::size_t>(k)] == BoundaryKind::sliding && std::abs(b.normals.col(k).norm() - 1.0) > 1e-8)
-        throw InputError("RbfMover::setup: sliding node " + std::to_string(v) + " needs a unit normal (got length " +
-                         std::to_string(b.normals.col(k).norm()) + ")");
-    }
-    if (m == 0) throw InputError("RbfMover::setup: the boundary has no nodes (expected at least one)");
-  }
-
-  void check_displacements(const Points<Dim>& d, const char* where) const {
-    require_ready(where);
-    const auto m = static_cast<Index>(boundary_nodes_.size());
-    if (d.cols() != m)
-      throw InputError(std::string("RbfMover::") + where + ": got " + std::to_string(d.cols()) +
-                       " displacement columns (expected " + std::to_string(m) + ", one per boundary node)");
-    for (Index b = 0; b < m; ++b)
-      if (!d.col(b).allFinite())
-        throw InputError(std::string("RbfMover::") + where + ": displacement of node " +
-                         std::to_string(boundary_nodes_[static_cast<std::size_t>(b)]) + " is not finite");
-  }
-
   /// Operator rows (kernel weights) of centres `rows` of `at` against the system's centres.
   [[nodiscard]] static Operator build_operator(const Points<Dim>& at, const std::vector<Index>& rows,
                                                const detail::RbfSystem<Dim>& system) {
     if (is_compact(system.kernel().kernel))
-      return detail::compact_kernel_rows(at, rows, system.tree(), system.size(), system.kernel());
+      return detail::compact_kernel_rows(at, rows, system.tree(), system.size(), system.kernel(), false);
     Eigen::MatrixXd dense(static_cast<Index>(rows.size()), system.size());
     for (Index r = 0; r < dense.rows(); ++r)
-      for (Index c = 0; c < system.size(); ++c)
-        dense(r, c) = rbf_value(system.kernel().kernel, (at.col(rows[static_cast<std::size_t>(r)]) - system.centres().col(c)).norm(),
-                                system.kernel().radius);
+      dense.row(r) = kernel_row(system, at.col(rows[static_cast<std::size_t>(r)]));
     return dense.sparseView();
   }
 
@@ -310,12 +289,21 @@ class RbfMover {
     return out;
   }
 
+  /// Projects row r of s (sliding centre n_constrained_ + r) on its plane or line; the
+  /// projectors are symmetric, so this is also its own transpose.
   void project_rows(Eigen::MatrixXd& s) const {
-    for (Index r = 0; r < s.rows(); ++r) {
-      const Vec<Dim> normal = normals_.col(n_constrained_ + r);
-      s.row(r) -= normal.dot(s.row(r).transpose()) * normal.transpose();
-    }
+    for (Index r = 0; r < s.rows(); ++r) s.row(r) = (projectors_[static_cast<std::size_t>(r)] * s.row(r).transpose()).transpose();
   }
+
+  /// φ(|x − c_j|) for every centre c_j of `system` (a row).
+  [[nodiscard]] static Eigen::RowVectorXd kernel_row(const detail::RbfSystem<Dim>& system, const Vec<Dim>& x) {
+    const Points<Dim>& centres = system.centres();
+    Eigen::RowVectorXd row(centres.cols());
+    for (Index c = 0; c < centres.cols(); ++c)
+      row(c) = rbf_value(system.kernel().kernel, (x - centres.col(c)).norm(), system.kernel().radius);
+    return row;
+  }
+  [[nodiscard]] Eigen::RowVectorXd kernel_row(const Vec<Dim>& x) const { return kernel_row(all_, x); }
 
   /// The linear map boundary displacements → node displacements.
   void apply(const Points<Dim>& d, Points<Dim>& out) {
@@ -358,20 +346,18 @@ class RbfMover {
 
   void evaluate_interior(Points<Dim>& out) {
     const auto n_eval = static_cast<Index>(evaluated_.size());
-    if (is_compact(options_.kernel)) {
-      evaluated_values_.noalias() = operator_ * alpha_;
+    if (is_compact(options_.kernel) || evaluation_cached()) {
+      if (is_compact(options_.kernel))
+        evaluated_values_.noalias() = operator_ * alpha_;
+      else
+        evaluated_values_.noalias() = dense_operator_ * alpha_;
 #pragma omp parallel for schedule(static)
       for (Index r = 0; r < n_eval; ++r) out.col(evaluated_[static_cast<std::size_t>(r)]) = evaluated_values_.row(r).transpose();
     } else {
-      const Points<Dim>& centres = all_centres();
 #pragma omp parallel for schedule(static)
       for (Index r = 0; r < n_eval; ++r) {
         const Index node = evaluated_[static_cast<std::size_t>(r)];
-        Vec<Dim> sum = Vec<Dim>::Zero();
-        for (Index c = 0; c < centres.cols(); ++c)
-          sum += rbf_value(options_.kernel, (points_.col(node) - centres.col(c)).norm(), options_.support_radius) *
-                 alpha_.row(c).transpose();
-        out.col(node) = sum;
+        out.col(node) = (kernel_row(points_.col(node)) * alpha_).transpose();
       }
     }
     if (!options_.polynomial) return;
@@ -390,12 +376,12 @@ class RbfMover {
     for (std::size_t r = 0; r < evaluated_.size(); ++r) v_eval.row(static_cast<Index>(r)) = v.col(evaluated_[r]).transpose();
     if (is_compact(options_.kernel)) {
       alpha_bar = operator_.transpose() * v_eval;
+    } else if (evaluation_cached()) {
+      alpha_bar = dense_operator_.transpose() * v_eval;
     } else {
       alpha_bar.setZero(k, Dim);
       for (std::size_t r = 0; r < evaluated_.size(); ++r)
-        for (Index c = 0; c < k; ++c)
-          alpha_bar.row(c) += rbf_value(options_.kernel, (points_.col(evaluated_[r]) - all_centres().col(c)).norm(),
-                                        options_.support_radius) * v_eval.row(static_cast<Index>(r));
+        alpha_bar += kernel_row(points_.col(evaluated_[r])).transpose() * v_eval.row(static_cast<Index>(r));
     }
     Eigen::MatrixXd v_interior(static_cast<Index>(interior_.size()), Dim);
     for (std::size_t r = 0; r < interior_.size(); ++r) v_interior.row(static_cast<Index>(r)) = v.col(interior_[r]).transpose();
@@ -411,7 +397,8 @@ class RbfMover {
   std::vector<Index> centre_of_;            ///< boundary entry → centre
   std::vector<Index> source_;               ///< centre → boundary entry giving its value
   Index n_constrained_ = 0;                 ///< centres 0..n_constrained_-1 are prescribed/fixed
-  Points<Dim> normals_;                     ///< unit normals of sliding centres
+  using Projector = Eigen::Matrix<double, Dim, Dim>;
+  std::vector<Projector> projectors_;       ///< onto the plane or line of each sliding centre
   detail::RbfSystem<Dim> all_;              ///< over every centre
   detail::RbfSystem<Dim> constrained_;      ///< over constrained centres (sliding boundaries only)
   std::vector<Index> sliding_rows_;         ///< sliding centres
@@ -419,6 +406,7 @@ class RbfMover {
   std::vector<Index> interior_;             ///< non-boundary nodes
   std::vector<Index> evaluated_;            ///< interior nodes with kernel weights
   Operator operator_;                       ///< evaluated_ × centres (compact kernels)
+  Eigen::MatrixXd dense_operator_;          ///< evaluated_ × centres (global kernels, when cached)
   Eigen::MatrixXd values_, alpha_, evaluated_values_;
   Poly beta_ = Poly::Zero();
 };

@@ -17,7 +17,9 @@
 
 #include <Eigen/LU>
 
+
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -31,38 +33,63 @@ struct RbfKernelSettings {
 };
 
 /// Rows of φ(|x_i - c_j|) for the points x_i (columns of `points` listed in `rows`) against
-/// the centres in `tree`, compact kernels only: a row-major sparse matrix (rows.size() × n_centres).
-/// Rows with no centre inside the support are empty. Parallel over rows.
+/// the centres in `tree`, compact kernels only: a row-major sparse matrix (rows.size() ×
+/// n_centres; with `kept`, only the rows with some centre inside the support, their positions
+/// in `rows` written to *kept). With `sorted` false the column indices of a row are in k-d
+/// tree order: enough for products and for a storage-order conversion (which sorts), not for
+/// coefficient access. Parallel over ranges of rows, each queried into one buffer that is
+/// copied once into the matrix.
 template <int Dim>
 [[nodiscard]] Eigen::SparseMatrix<double, Eigen::RowMajor, int> compact_kernel_rows(
     const Points<Dim>& points, const std::vector<Index>& rows, const KdTree<Dim>& tree, Index n_centres,
-    const RbfKernelSettings& k) {
+    const RbfKernelSettings& k, bool sorted = true, std::vector<Index>* kept = nullptr) {
   const auto n = static_cast<Index>(rows.size());
-  std::vector<std::vector<Neighbor>> found(static_cast<std::size_t>(n));
+  std::vector<int> count(static_cast<std::size_t>(n));
+  // Contiguous row ranges, more of them than threads so that dynamic scheduling balances
+  // rows with many and with no neighbours; each range's pairs go to one buffer, in row order.
+  const Index chunks = std::clamp<Index>(n / 256, 1, 64);
+  std::vector<std::vector<Neighbor>> found(static_cast<std::size_t>(chunks));
 #pragma omp parallel
   {
     std::vector<Neighbor> buffer;
-#pragma omp for schedule(dynamic, 256)
-    for (Index r = 0; r < n; ++r) {
-      tree.radius_search(points.col(rows[static_cast<std::size_t>(r)]), k.radius, buffer);
-      std::sort(buffer.begin(), buffer.end());
-      found[static_cast<std::size_t>(r)] = buffer;
+#pragma omp for schedule(dynamic, 1)
+    for (Index c = 0; c < chunks; ++c) {
+      std::vector<Neighbor>& pairs = found[static_cast<std::size_t>(c)];
+      for (Index r = n * c / chunks; r < n * (c + 1) / chunks; ++r) {
+        tree.radius_search(points.col(rows[static_cast<std::size_t>(r)]), k.radius, buffer);
+        if (sorted) std::sort(buffer.begin(), buffer.end());
+        count[static_cast<std::size_t>(r)] = static_cast<int>(buffer.size());
+        pairs.insert(pairs.end(), buffer.begin(), buffer.end());
+      }
     }
   }
-  Eigen::SparseMatrix<double, Eigen::RowMajor, int> m(n, n_centres);
-  Index nnz = 0;
-  for (const auto& f : found) nnz += static_cast<Index>(f.size());
-  m.resizeNonZeros(nnz);
-  auto* outer = m.outerIndexPtr();
-  outer[0] = 0;
-  for (Index r = 0; r < n; ++r) outer[r + 1] = outer[r] + static_cast<int>(found[static_cast<std::size_t>(r)].size());
-#pragma omp parallel for schedule(dynamic, 256)
+  // Row offsets (skipping empty rows when asked) and where each range's pairs start.
+  std::vector<int> outer;
+  outer.reserve(static_cast<std::size_t>(n) + 1);
+  outer.push_back(0);
+  if (kept != nullptr) kept->clear();
   for (Index r = 0; r < n; ++r) {
-    Index pos = outer[r];
-    for (const auto& [j, d2] : found[static_cast<std::size_t>(r)]) {
-      m.innerIndexPtr()[pos] = static_cast<int>(j);
-      m.valuePtr()[pos] = rbf_value(k.kernel, std::sqrt(d2), k.radius);
-      ++pos;
+    const int c = count[static_cast<std::size_t>(r)];
+    if (kept != nullptr) {
+      if (c == 0) continue;
+      kept->push_back(r);
+    }
+    outer.push_back(outer.back() + c);
+  }
+  const auto n_out = static_cast<Index>(outer.size()) - 1;
+  Eigen::SparseMatrix<double, Eigen::RowMajor, int> m(n_out, n_centres);
+  m.resizeNonZeros(outer.back());
+  std::copy(outer.begin(), outer.end(), m.outerIndexPtr());
+  std::vector<Index> start(found.size() + 1, 0);
+  for (std::size_t c = 0; c < found.size(); ++c) start[c + 1] = start[c] + static_cast<Index>(found[c].size());
+#pragma omp parallel for schedule(dynamic, 1)
+  for (Index c = 0; c < chunks; ++c) {
+    const auto& pairs = found[static_cast<std::size_t>(c)];
+    int* inner = m.innerIndexPtr() + start[static_cast<std::size_t>(c)];
+    double* value = m.valuePtr() + start[static_cast<std::size_t>(c)];
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      inner[i] = static_cast<int>(pairs[i].first);
+      value[i] = rbf_value(k.kernel, std::sqrt(pairs[i].second), k.radius);
     }
   }
   return m;
