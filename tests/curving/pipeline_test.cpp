@@ -15,9 +15,11 @@
 #include "meshmotion/curving/geometry.hpp"
 #include "meshmotion/io/mesh_io.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace meshmotion;
@@ -163,7 +165,7 @@ OMeshOptions circle_mesh(Index n_around) {
 
 }  // namespace
 
-TEST_CASE("pipeline: P2 boundary converges to a circle as h^3 or faster, linear as h^2", "[curving]") {
+TEST_CASE("pipeline: P2 boundary converges to a circle as h^3 or faster, linear as h^2", "[curving][slow]") {
   const double radius = 0.5;
   std::vector<double> linear_error, circle_error, spline_error;
   for (const Index n : {12, 24, 48, 96}) {
@@ -227,7 +229,7 @@ TEST_CASE("pipeline: boundary-layer mesh (aspect ratio >= 1000) needs the regula
   }
 }
 
-TEST_CASE("pipeline: every element type and mixed meshes curve onto a graph", "[curving]") {
+TEST_CASE("pipeline: every element type and mixed meshes curve onto a graph", "[curving][slow]") {
   const auto wave = [](double x) {
     const double k = 2.0 * std::numbers::pi;
     return GraphSample1{0.02 * std::sin(k * x), 0.02 * k * std::cos(k * x), -0.02 * k * k * std::sin(k * x)};
@@ -323,4 +325,81 @@ TEST_CASE("pipeline: 3D sphere reconstructed from the linear mesh alone", "[curv
   INFO("straight midpoints " << straight_error << ", reconstructed " << reconstructed_error);
   CHECK(straight_error > 1e-3);
   CHECK(reconstructed_error < 0.5 * straight_error);
+}
+
+TEST_CASE("bump_channel_3d: the TMR 3D bump-in-channel grid family", "[curving]") {
+  const Mesh<3> coarse = bump_channel_3d(0);
+  const Mesh<3> medium = bump_channel_3d(1);
+  // (spanwise × streamwise × normal) 5×45×21 and 9×89×41; the coarse P2 mesh has the medium
+  // grid's 32,841 points (thesis table 4.3).
+  CHECK(coarse.num_nodes() == 5 * 45 * 21);
+  CHECK(coarse.num_cells() == 4 * 44 * 20);
+  CHECK(medium.num_nodes() == 9 * 89 * 41);
+  CHECK(convert_to_quadratic(coarse).mesh.num_nodes() == 32841);
+  // Nested: the coarse grid is every other line of the medium one.
+  for (Index k = 0; k <= 20; ++k)
+    for (Index j = 0; j <= 4; ++j)
+      for (Index i = 0; i <= 44; ++i)
+        REQUIRE((coarse.points.col(i + 45 * (j + 5 * k)) - medium.points.col(2 * i + 89 * (2 * j + 9 * 2 * k))).norm() < 1e-14);
+  // Groups and their facet counts (spanwise 4, streamwise 12 + 20 + 12, normal 20 cells).
+  const std::vector<std::pair<std::string, Index>> groups{{"bump", 4 * 20}, {"symmetry_lower", 4 * 24}, {"inflow", 4 * 20},
+                                                          {"outflow", 4 * 20}, {"top", 4 * 44},       {"side_y0", 44 * 20},
+                                                          {"side_y1", 44 * 20}};
+  for (const auto& [name, count] : groups) {
+    const int tag = coarse.group(name).tag;
+    Index found = 0;
+    for (const auto& block : coarse.facets)
+      found += static_cast<Index>(std::count(block.tags.begin(), block.tags.end(), tag));
+    INFO(name);
+    CHECK(found == count);
+  }
+  // Every hexahedron valid, wall cells stretched as in RANS grids.
+  const QualityReport q = quality_report(coarse, Metric::scaled_jacobian);
+  CHECK(q.num_invalid == 0);
+  CHECK(q.min > 0.0);
+  double first_height = 1.0;
+  for (const Index v : coarse.group_nodes("side_y0"))
+    if (coarse.points(0, v) < -20.0 && coarse.points(2, v) > 0.0) first_height = std::min(first_height, coarse.points(2, v));
+  CHECK(first_height == Approx(2.5e-5).epsilon(0.05));
+  // Wall nodes on the shifted bump z = h(x - 0.3 sin^4(pi y)), the viscous wall over 0 <= x0 <= 1.5.
+  double highest = 0.0;
+  for (const Index v : coarse.group_nodes("bump")) {
+    const Vec<3> x = coarse.points.col(v);
+    CHECK(std::abs(x.z() - nasa_bump_3d_height(x.x(), x.y()).value) < 1e-15);
+    CHECK(x.x() - bump_channel_shift(x.y()) >= -1e-15);
+    CHECK(x.x() - bump_channel_shift(x.y()) <= 1.5 + 1e-15);
+    highest = std::max(highest, x.z());
+  }
+  CHECK(highest > 0.04);
+  for (const Index v : coarse.group_nodes("symmetry_lower")) CHECK(coarse.points(2, v) == 0.0);
+  for (const Index v : coarse.group_nodes("inflow")) CHECK(coarse.points(0, v) == -25.0);
+  for (const Index v : coarse.group_nodes("side_y1")) CHECK(coarse.points(1, v) == 0.0);
+  CHECK_THROWS_AS(bump_channel_3d(-1), InputError);
+  CHECK_THROWS_AS(bump_channel_3d(5), InputError);
+}
+
+TEST_CASE("pipeline: the coarse 3D bump-in-channel curves onto the analytic bump", "[curving][slow]") {
+  const Mesh<3> linear = bump_channel_3d(0);
+  CurveOptions<3> options;
+  options.geometry.emplace("bump", BoundaryGeometry<3>::project(nasa_bump_3d()));
+  options.sliding = {"side_y0", "side_y1"};
+  options.support_radius = 0.06;  // thesis table 4.3
+  const CurveResult<3> curved = curve_mesh(linear, options);
+  INFO("min " << curved.quality.min << ", mean " << curved.quality.mean);
+  CHECK(curved.curved.num_nodes() == 32841);
+  CHECK(curved.invalid() == 0);
+  CHECK(curved.moved_vertices == 0);  // the generator's wall vertices are on the bump
+  CHECK(curved.moved_nodes > 0);
+  CHECK(curved.max_boundary_displacement > 1e-3);  // the straight hex faces were off the bump
+  const std::vector<Index> wall = curved.curved.group_nodes("bump");
+  CHECK(wall.size() == 9 * 41);
+  for (const Index v : wall) {
+    const Vec<3> x = curved.curved.points.col(v);
+    CHECK(std::abs(x.z() - nasa_bump_3d_height(x.x(), x.y()).value) < 1e-15);
+  }
+  for (const Index v : curved.curved.group_nodes("side_y0")) CHECK(std::abs(curved.curved.points(1, v) + 1.0) < 1e-14);
+  for (const Index v : curved.curved.group_nodes("side_y1")) CHECK(std::abs(curved.curved.points(1, v)) < 1e-14);
+  // Snapping alone leaves the thin wall cells invalid: the regularization is what saves them.
+  options.method = "none";
+  CHECK(curve_mesh(linear, options).invalid() > 0);
 }

@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 
+#include "meshmotion/core/generators.hpp"
 #include "meshmotion/curving/boundary_spline.hpp"
 #include "meshmotion/curving/function_graph.hpp"
 #include "meshmotion/curving/geometry.hpp"
@@ -464,6 +465,24 @@ TEST_CASE("NACA projection lands on the section at its closest point", "[curving
   CHECK_THROWS_AS(NacaProjection(naca4("0012"))(Vec<2>(std::nan(""), 0.0)), InputError);
 }
 
+TEST_CASE("3D bump-in-channel wall: derivatives match differences, profile matches the generator", "[curving]") {
+  const double h = 1e-5;
+  for (int k = 0; k < 40; ++k) {
+    const double x = 0.25 + 1.2 * k / 39.0, y = -0.97 * std::fmod(0.37 * k, 1.0);
+    const GraphSample2 g = nasa_bump_3d_height(x, y);
+    const auto value = [](double a, double b) { return nasa_bump_3d_height(a, b).value; };
+    const auto gradient = [](double a, double b) { return nasa_bump_3d_height(a, b).gradient; };
+    INFO("x " << x << ", y " << y);
+    CHECK(g.value == Approx(bump_channel_height(x - bump_channel_shift(y))).epsilon(1e-13));
+    CHECK(g.gradient.x() == Approx((value(x + h, y) - value(x - h, y)) / (2 * h)).margin(1e-8));
+    CHECK(g.gradient.y() == Approx((value(x, y + h) - value(x, y - h)) / (2 * h)).margin(1e-8));
+    const Eigen::Matrix2d hessian = (Eigen::Matrix2d() << (gradient(x + h, y) - gradient(x - h, y)) / (2 * h),
+                                     (gradient(x, y + h) - gradient(x, y - h)) / (2 * h)).finished();
+    CHECK((g.hessian - hessian).norm() < 1e-6);
+    CHECK(g.hessian(0, 1) == g.hessian(1, 0));
+  }
+}
+
 TEST_CASE("function-graph projections find the closest point of the bump", "[curving]") {
   const GraphProjection2 bump = nasa_bump_2d();
   const GraphProjection3 bump3 = nasa_bump_3d();
@@ -477,10 +496,24 @@ TEST_CASE("function-graph projections find the closest point of the bump", "[cur
       sampled = std::min(sampled, (Vec<2>(x, nasa_bump_height(x).value) - p).norm());
     }
     CHECK((q - p).norm() <= sampled + 1e-9);
-    // The extruded 3D bump gives the same point in every spanwise plane.
-    const Vec<3> q3 = bump3(Vec<3>(p.x(), -0.3 * k, p.y()));
+    // The side planes of the 3D bump (y = 0, -1) are unshifted symmetry planes: the 2D point.
+    const double side = k % 2 == 0 ? 0.0 : -1.0;
+    const Vec<3> q3 = bump3(Vec<3>(p.x(), side, p.y()));
     CHECK((Vec<2>(q3.x(), q3.z()) - q).norm() < 1e-10);
-    CHECK(q3.y() == -0.3 * k);
+    CHECK(std::abs(q3.y() - side) < 1e-14);
+    // Inside the span the profile is shifted by 0.3 sin^4(pi y): on the wall, and no sample
+    // of the wall around the point is closer.
+    const double y = -0.04 - 0.92 * k / 29.0;
+    const Vec<3> p3(p.x() + 0.3 * std::pow(std::sin(std::numbers::pi * y), 4), y, p.y());
+    const Vec<3> r = bump3(p3);
+    CHECK(std::abs(r.z() - nasa_bump_3d_height(r.x(), r.y()).value) < 1e-15);
+    double sampled3 = std::numeric_limits<double>::infinity();
+    for (int a = 0; a <= 300; ++a)
+      for (int b = 0; b <= 300; ++b) {
+        const double sx = p3.x() - 0.15 + 0.3 * a / 300.0, sy = p3.y() - 0.15 + 0.3 * b / 300.0;
+        sampled3 = std::min(sampled3, (Vec<3>(sx, sy, nasa_bump_3d_height(sx, sy).value) - p3).norm());
+      }
+    CHECK((r - p3).norm() <= sampled3 + 1e-12);
   }
   // A smooth 3D graph with curvature in both directions: the stationarity condition holds.
   const GraphProjection3 dome([](double x, double y) {

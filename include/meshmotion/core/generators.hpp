@@ -1,8 +1,9 @@
 #pragma once
 /// \file
 /// Built-in meshes: structured rectangles and boxes of every linear element type (and mixed
-/// ones), and a boundary-layer O-mesh around an ellipse (a cylinder) or a square inside a
-/// circular farfield. Every generator returns positively oriented cells and the boundary
+/// ones), a boundary-layer O-mesh around an ellipse (a cylinder) or a square inside a
+/// circular farfield, and the NASA Turbulence Modeling Resource 3D bump-in-channel hex grid.
+/// Every generator returns positively oriented cells and the boundary
 /// facets tagged with named groups.
 
 #include "meshmotion/core/element.hpp"
@@ -313,6 +314,132 @@ inline void add_positive_tet(ElementBlock& block, const Points<3>& p, std::array
   detail::add_boundary_groups(mesh, {"wall", "farfield"}, [&](std::span<const Index> nodes) {
     return nodes[0] < n ? 1 : 2;
   });
+  return mesh;
+}
+
+
+/// Height of the NASA Turbulence Modeling Resource bump-in-channel wall at streamwise
+/// station x0: 0.05 sin^4(pi x0 / 0.9 - pi / 3) for 0.3 <= x0 <= 1.2, 0 elsewhere.
+[[nodiscard]] inline double bump_channel_height(double x0) {
+  if (x0 <= 0.3 || x0 >= 1.2) return 0.0;
+  const double s = std::sin(std::numbers::pi * x0 / 0.9 - std::numbers::pi / 3.0);
+  return 0.05 * s * s * s * s;
+}
+
+/// Spanwise shift of the 3D bump-in-channel: a station x0 sits at x = x0 + 0.3 sin^4(pi y),
+/// y in [-1, 0], so the wall is z = bump_channel_height(x - bump_channel_shift(y)).
+[[nodiscard]] inline double bump_channel_shift(double y) {
+  const double s = std::sin(std::numbers::pi * y);
+  return 0.3 * s * s * s * s;
+}
+
+/// The NASA Turbulence Modeling Resource 3D bump-in-channel grid family (thesis section
+/// 4.2.2, table 4.3), structured hexahedra: level L has (4·2^L + 1) × (44·2^L + 1) ×
+/// (20·2^L + 1) nodes (spanwise × streamwise × normal): 5×45×21, 9×89×41, 17×177×81,
+/// 33×353×161 for L = 0..3; the P2 mesh of level L has the node count of level L + 1
+/// (thesis: 32,841, 243,729, 1,875,489 for the P2 meshes of L = 0, 1, 2). Coarser levels
+/// are every other line of finer ones.
+///
+/// Geometry: streamwise stations x0 in [-25, 26.5] (12·2^L cells upstream of the viscous
+/// wall, 20·2^L on it, x0 in [0, 1.5], clustered towards its ends by a tanh map, and 12·2^L
+/// downstream, growing geometrically and C^1 with the wall spacing); interior stations are
+/// shifted spanwise to x = x0 + bump_channel_shift(y), the inflow and outflow ends are not.
+/// y uniform in [-1, 0]; from the wall z = bump_channel_height(x0) to the top z = 5, the
+/// normal spacing grows geometrically from about 2.5e-5 (L = 0; halved per level, growth
+/// ratio e^(12 / (20·2^L))), so wall cells have aspect ratios of 10^3–10^4 as in RANS grids.
+/// Wall nodes lie on the bump; facets between them are straight.
+///
+/// Nodes are numbered i + nx1 (j + ny1 k) (i streamwise, j spanwise, k normal; nx1, ny1 the
+/// node counts along them). Groups (facet tags 1–7): "bump" (the viscous wall, 0 <= x0 <=
+/// 1.5), "symmetry_lower" (the rest of z = 0), "inflow" (x = -25), "outflow" (x = 26.5),
+/// "top" (z = 5), "side_y0" (y = -1), "side_y1" (y = 0). Throws InputError for a level
+/// outside 0..4.
+[[nodiscard]] inline Mesh<3> bump_channel_3d(int level) {
+  if (level < 0 || level > 4)
+    throw InputError("bump_channel_3d: level " + std::to_string(level) + " is out of range (expected 0 to 4)");
+  const Index scale = Index{1} << level;
+  const Index n_up = 12 * scale, n_wall = 20 * scale, nx = 2 * n_up + n_wall, ny = 4 * scale, nz = 20 * scale;
+  constexpr double upstream = 25.0, wall_length = 1.5, top = 5.0, cluster = 3.0, normal_growth = 12.0;
+  // Wall section x0 = L/2 (1 + tanh(c (t - 1/2)) / tanh(c / 2)), t in [0, 1]; its end slope
+  // per cell sets the first cell of the geometric farfield sections x0 = -a (e^(b u) - 1)
+  // (u in [0, 1] over n_up cells), b solved so both spacings agree at the wall's ends.
+  const double tanh_half = std::tanh(cluster / 2.0);
+  const double end_slope = 0.5 * wall_length * cluster * (1.0 - tanh_half * tanh_half) / tanh_half;
+  const double target = end_slope * static_cast<double>(n_up) / static_cast<double>(n_wall);
+  double lo = 1e-6, hi = 60.0;  // upstream * b / (e^b - 1) falls from `upstream` to 0
+  for (int it = 0; it < 200; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (upstream * mid / std::expm1(mid) > target ? lo : hi) = mid;
+  }
+  const double b = 0.5 * (lo + hi), a = upstream / std::expm1(b);
+  std::vector<double> x0(static_cast<std::size_t>(nx + 1));
+  for (Index i = 0; i <= nx; ++i) {
+    double x;
+    if (i <= n_up) {
+      x = -a * std::expm1(b * static_cast<double>(n_up - i) / static_cast<double>(n_up));
+    } else if (i <= n_up + n_wall) {
+      const double t = static_cast<double>(i - n_up) / static_cast<double>(n_wall);
+      x = 0.5 * wall_length * (1.0 + std::tanh(cluster * (t - 0.5)) / tanh_half);
+    } else {
+      x = wall_length + a * std::expm1(b * static_cast<double>(i - n_up - n_wall) / static_cast<double>(n_up));
+    }
+    x0[static_cast<std::size_t>(i)] = x;
+  }
+  x0.front() = -upstream;  // exact ends and wall borders, whatever the rounding above
+  x0[static_cast<std::size_t>(n_up)] = 0.0;
+  x0[static_cast<std::size_t>(n_up + n_wall)] = wall_length;
+  x0.back() = wall_length + upstream;
+
+  const Index nx1 = nx + 1, ny1 = ny + 1;
+  const auto node = [&](Index i, Index j, Index k) { return i + nx1 * (j + ny1 * k); };
+  Mesh<3> mesh;
+  mesh.points.resize(3, nx1 * ny1 * (nz + 1));
+  const double normal_total = std::expm1(normal_growth);
+  for (Index k = 0; k <= nz; ++k) {
+    const double eta = k == nz ? 1.0 : std::expm1(normal_growth * static_cast<double>(k) / static_cast<double>(nz)) / normal_total;
+    for (Index j = 0; j <= ny; ++j) {
+      const double y = -1.0 + static_cast<double>(j) / static_cast<double>(ny);
+      const double shift = bump_channel_shift(y);
+      for (Index i = 0; i <= nx; ++i) {
+        const double station = x0[static_cast<std::size_t>(i)];
+        const double wall = bump_channel_height(station);
+        const double x = (i == 0 || i == nx) ? station : station + shift;
+        mesh.points.col(node(i, j, k)) << x, y, k == 0 ? wall : wall + (top - wall) * eta;
+      }
+    }
+  }
+  ElementBlock& hexes = mesh.block(ElementType::hex8);
+  hexes.reserve(nx * ny * nz);
+  for (Index k = 0; k < nz; ++k)
+    for (Index j = 0; j < ny; ++j)
+      for (Index i = 0; i < nx; ++i)
+        hexes.add(std::array<Index, 8>{node(i, j, k), node(i + 1, j, k), node(i + 1, j + 1, k), node(i, j + 1, k),
+                                       node(i, j, k + 1), node(i + 1, j, k + 1), node(i + 1, j + 1, k + 1),
+                                       node(i, j + 1, k + 1)});
+  detail::add_boundary_groups(
+      mesh, {"bump", "symmetry_lower", "inflow", "outflow", "top", "side_y0", "side_y1"},
+      [&](std::span<const Index> nodes) {
+        // Grid index of a node along each axis; a boundary facet holds one of them constant.
+        const auto all = [&](auto&& index, Index value) {
+          for (const Index v : nodes)
+            if (index(v) != value) return false;
+          return true;
+        };
+        const auto i_of = [&](Index v) { return v % nx1; };
+        const auto j_of = [&](Index v) { return (v / nx1) % ny1; };
+        const auto k_of = [&](Index v) { return v / (nx1 * ny1); };
+        if (all(k_of, 0)) {
+          for (const Index v : nodes)
+            if (i_of(v) < n_up || i_of(v) > n_up + n_wall) return 2;
+          return 1;
+        }
+        if (all(k_of, nz)) return 5;
+        if (all(i_of, 0)) return 3;
+        if (all(i_of, nx)) return 4;
+        if (all(j_of, 0)) return 6;
+        if (all(j_of, ny)) return 7;
+        throw InvalidMeshError("bump_channel_3d: a boundary facet lies on no side of the channel");
+      });
   return mesh;
 }
 

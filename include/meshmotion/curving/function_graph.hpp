@@ -139,16 +139,25 @@ class GraphProjection3 {
 /// The 2D bump-in-channel wall y = h(x) (see nasa_bump_height).
 [[nodiscard]] inline GraphProjection2 nasa_bump_2d() { return GraphProjection2(nasa_bump_height); }
 
-/// A 3D bump wall z = h(x), the 2D bump-in-channel profile extruded along y. The resource's
-/// "3D bump-in-channel" case shifts the profile in x along the span; that shift is not
-/// reproduced here (see docs/curving_boundary.md): use GraphProjection3 with it if needed.
-[[nodiscard]] inline GraphProjection3 nasa_bump_3d() {
-  return GraphProjection3([](double x, double) {
-    const GraphSample1 h = nasa_bump_height(x);
-    GraphSample2 g{h.value, {h.slope, 0.0}, Eigen::Matrix2d::Zero()};
-    g.hessian(0, 0) = h.curvature;
-    return g;
-  });
+/// The NASA Turbulence Modeling Resource 3D bump-in-channel wall (thesis section 4.2.2): the
+/// 2D profile h (nasa_bump_height) shifted streamwise along the span,
+/// z = f(x, y) = h(x - s(y)), s(y) = 0.3 sin^4(pi y) (y in [-1, 0], s = s' = 0 on both sides,
+/// so the side planes are symmetry planes of the wall). The wall of bump_channel_3d().
+[[nodiscard]] inline GraphSample2 nasa_bump_3d_height(double x, double y) {
+  constexpr double pi = std::numbers::pi;
+  const double sn = std::sin(pi * y), cs = std::cos(pi * y);
+  const double shift = 0.3 * sn * sn * sn * sn;
+  const double shift1 = 1.2 * pi * sn * sn * sn * cs;
+  const double shift2 = 1.2 * pi * pi * (3.0 * sn * sn * cs * cs - sn * sn * sn * sn);
+  const GraphSample1 h = nasa_bump_height(x - shift);
+  GraphSample2 g{h.value, {h.slope, -h.slope * shift1}, Eigen::Matrix2d::Zero()};
+  g.hessian << h.curvature, -h.curvature * shift1, -h.curvature * shift1,
+      h.curvature * shift1 * shift1 - h.slope * shift2;
+  return g;
 }
+
+/// Closest-point projection onto the 3D bump-in-channel wall (nasa_bump_3d_height), for the
+/// "bump" and "symmetry_lower" groups of bump_channel_3d().
+[[nodiscard]] inline GraphProjection3 nasa_bump_3d() { return GraphProjection3(nasa_bump_3d_height); }
 
 }  // namespace meshmotion
