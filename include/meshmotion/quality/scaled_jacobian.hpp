@@ -35,6 +35,7 @@ namespace meshmotion {
 struct ScaledJacobianOptions {
   bool certify = true;        ///< false: sampled extremes only (fast screening)
   bool sharp = true;          ///< refine both bounds to `tolerance`; false: stop once validity is decided
+  bool sharp_max = true;      ///< with `sharp`: refine the upper bound too (false when only the minimum is used)
   double tolerance = 1e-4;    ///< wanted gap between Bézier bound and sampled extreme (scaled units)
   int max_depth = 10;         ///< deepest subdivision level
   int max_leaves = 4096;      ///< subdomains per element at most (the bound stays a bound when hit)
@@ -118,7 +119,7 @@ inline void certify(const JacobianSpace& s, const LatticeVector& values, const S
     r.certified_max = upper_max;
     const bool decided = lower_min > 0 || upper_min <= 0;
     const bool min_sharp = upper_min - lower_min <= opt.tolerance;
-    const bool max_sharp = upper_max - lower_max <= opt.tolerance;
+    const bool max_sharp = !opt.sharp_max || upper_max - lower_max <= opt.tolerance;
     if (opt.sharp ? (min_sharp && max_sharp) : decided) break;
     const std::size_t pick = (opt.sharp && min_sharp) ? worst_max : worst_min;
     if (leaves[pick].depth >= opt.max_depth ||
