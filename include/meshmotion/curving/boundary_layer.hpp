@@ -2,17 +2,21 @@
 /// \file
 /// Boundary-layer thickness of each wall, estimated from the mesh alone: the layer is the
 /// region of anisotropic cells connected to the wall, and its thickness the wall distance
-/// where those cells stop being anisotropic. The curving pipeline derives its default RBF
+/// where those cells stop being thin across the wall. The curving pipeline derives its default RBF
 /// support radius and blending length from it (issue 5: a radius much larger than the
 /// layer makes the interpolant overshoot away from the wall).
 ///
 /// Method: cells whose aspect ratio (longest over shortest vertex edge) is at least
 /// `aspect_ratio_threshold` and that lie on a wall with a long wall edge (stretched along
-/// the wall, not across it) seed a flood fill through shared facets
-/// restricted to such cells. Every vertex reached is measured against the straight wall
-/// facets (exact point-facet distance) and credited to its nearest wall vertex; a wall
-/// vertex's thickness is the largest distance credited to it, a wall's thickness the median
-/// over its vertices (robust to the wake of a trailing edge, which is anisotropic too).
+/// the wall, not across it) seed a flood fill through shared facets restricted to cells
+/// thin across the wall: longest vertex edge at least the threshold times the cell's extent
+/// in wall distance (largest minus smallest distance of its vertices). Cells stretched
+/// across the wall, or in a spanwise or streamwise direction far from it (the outer cells of
+/// a channel grid, anisotropic everywhere), are no boundary layer. Every vertex reached is
+/// measured against the straight wall facets (exact point-facet distance) and credited to
+/// its nearest wall vertex; a wall vertex's thickness is the largest distance credited to
+/// it, a wall's thickness the median over its vertices (robust to the wake of a trailing
+/// edge, which is anisotropic too).
 /// Cost: linear in the cells of the layer, plus a k-d tree query per vertex reached.
 
 #include "meshmotion/core/element.hpp"
@@ -125,6 +129,28 @@ template <int Dim>
     return a >= options.aspect_ratio_threshold;
   };
 
+  // Wall distance of each vertex, computed when first needed (negative: not yet).
+  std::vector<double> distance(static_cast<std::size_t>(mesh.num_nodes()), -1.0);
+  const auto wall_distance = [&](Index v) {
+    double& d = distance[static_cast<std::size_t>(v)];
+    if (d < 0.0) d = wall.closest(Vec<Dim>(mesh.points.col(v))).distance;
+    return d;
+  };
+  const auto thin_across_wall = [&](Index cell) {
+    const auto [type, nodes] = cell_nodes(cell);
+    double nearest = std::numeric_limits<double>::infinity(), farthest = 0.0;
+    for (int k = 0; k < num_vertices(type); ++k) {
+      const double d = wall_distance(nodes[static_cast<std::size_t>(k)]);
+      nearest = std::min(nearest, d);
+      farthest = std::max(farthest, d);
+    }
+    double longest = 0.0;
+    for (const auto& e : edges(type))
+      longest = std::max(longest, (mesh.points.col(nodes[static_cast<std::size_t>(e[1])]) -
+                                   mesh.points.col(nodes[static_cast<std::size_t>(e[0])])).norm());
+    return longest >= options.aspect_ratio_threshold * (farthest - nearest);
+  };
+
   std::vector<char> is_wall(static_cast<std::size_t>(mesh.num_nodes()), 0);
   for (const Index v : out.wall_nodes) is_wall[static_cast<std::size_t>(v)] = 1;
   std::vector<char> reached(aspect.size(), 0);
@@ -163,13 +189,13 @@ template <int Dim>
       credited = std::min(credited, owner[s]);
       if (measured[static_cast<std::size_t>(v)] || is_wall[static_cast<std::size_t>(v)]) continue;
       measured[static_cast<std::size_t>(v)] = 1;
-      out.node_thickness[s] = std::max(out.node_thickness[s], wall.closest(p).distance);
+      out.node_thickness[s] = std::max(out.node_thickness[s], wall_distance(v));
     }
     if (credited < out.walls.size()) ++out.walls[credited].layer_cells;
     const auto [b, e] = locate(cell);
     for (const Index f : topo.element_facets.of(b, e))
       for (const Index next : topo.elements[static_cast<std::size_t>(f)])
-        if (next >= 0 && !reached[static_cast<std::size_t>(next)] && anisotropic(next)) {
+        if (next >= 0 && !reached[static_cast<std::size_t>(next)] && thin_across_wall(next)) {
           reached[static_cast<std::size_t>(next)] = 1;
           queue.push_back(next);
         }
