@@ -18,6 +18,8 @@
 #include "meshmotion/io/vtu_writer.hpp"
 #include "meshmotion/quality/svg_picture.hpp"
 
+#include "mechanics_arguments.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <chrono>
@@ -53,6 +55,7 @@ struct Arguments {
   bool json = false;
   std::string svg;
   std::vector<double> zoom;
+  examples::MechanicsArguments mechanics;
 };
 
 std::vector<double> numbers(const std::string& text, const std::string& spec) {
@@ -125,6 +128,7 @@ CurveOptions<Dim> curve_options(const Arguments& args) {
   options.support_radius_factor = args.support_factor;
   options.blending_length = args.blending_length;
   options.steps = args.steps;
+  examples::add_mechanics_parameters(args.mechanics, options.parameters);
   options.sliding = args.sliding;
   options.strict = args.strict;
   options.snap.corner_angle = args.corner_angle;
@@ -237,7 +241,7 @@ int main(int argc, char** argv) {
   app.add_option("input", args.input, "linear mesh (.msh, .su2); none: the built-in demo");
   app.add_option("-o,--output", args.output, "curved mesh to write (.msh, .su2); a .vtu is written beside it");
   app.add_flag("--demo", args.demo, "curve the built-in boundary-layer mesh around a cylinder");
-  app.add_option("--method", args.method, "interior regularization: rbf, blend, none")->capture_default_str();
+  app.add_option("--method", args.method, "interior regularization: rbf, blend, none, or a mover (sle, le, nle, torsion, spring, ...)")->capture_default_str();
   app.add_option("--kernel", args.kernel, "RBF kernel (wendland2, wendland0/4/6, tps, gaussian, ...)")->capture_default_str();
   app.add_option("--support-radius", args.support_radius, "RBF support radius (0: from the boundary-layer thickness)");
   app.add_option("--support-factor", args.support_factor, "default radius = this x the thickest wall layer")->capture_default_str();
@@ -249,6 +253,7 @@ int main(int argc, char** argv) {
   app.add_option("--group", args.groups, "groups the --geometry applies to (default: wall)");
   app.add_option("--sliding", args.sliding, "groups sliding in their plane (symmetry)");
   app.add_option("--corner-angle", args.corner_angle, "spline corners above this angle (degrees)")->capture_default_str();
+  examples::add_mechanics_options(app, args.mechanics);
   app.add_flag("--arc-length", args.arc_length, "spline: arc-length midpoint instead of the parameter midpoint");
   app.add_flag("--strict", args.strict, "fail (exit 2) when invalid cells remain");
   app.add_flag("--json", args.json, "print one JSON object");

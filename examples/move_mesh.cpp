@@ -8,6 +8,8 @@
 #include "meshmotion/movers.hpp"
 #include "meshmotion/quality.hpp"
 
+#include "mechanics_arguments.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <chrono>
@@ -26,6 +28,7 @@ struct Arguments {
   std::vector<double> center, axis, translate;
   int steps = 1;
   bool json = false;
+  examples::MechanicsArguments mechanics;
 };
 
 template <int Dim>
@@ -97,6 +100,7 @@ int run(const Arguments& a, Mesh<Dim> mesh) {
   };
   if (!a.center.empty()) parameters.values["center"] = joined(a.center);
   if (!a.axis.empty()) parameters.values["axis"] = joined(a.axis);
+  examples::add_mechanics_parameters(a.mechanics, parameters);
   if (a.support_radius) {
     parameters.values["support_radius"] = std::to_string(*a.support_radius);
   } else {
@@ -151,10 +155,11 @@ int main(int argc, char** argv) {
   translate->excludes(file);
   app.add_option("--fixed", a.fixed, "Fixed groups");
   app.add_option("--sliding", a.sliding, "Groups sliding in their plane");
-  app.add_option("--method", a.method, "Mover: rbf|dgm|idgm|dgrbf|dgrbf2 (and the registry's others)");
+  app.add_option("--method", a.method, "Mover: rbf|dgm|idgm|dgrbf|dgrbf2|spring|torsion|le|sle|nle");
   app.add_option("--kernel", a.kernel, "RBF kernel: wendland0|wendland2|wendland4|wendland6|tps|gaussian|multiquadric|inverse_multiquadric");
   app.add_option("--support-radius", a.support_radius, "RBF support radius (default: heuristic from the boundary)");
   app.add_option("--steps", a.steps, "Number of steps")->check(CLI::PositiveNumber);
+  examples::add_mechanics_options(app, a.mechanics);
   app.add_flag("--json", a.json, "Print one JSON object");
   CLI11_PARSE(app, argc, argv);
   try {

@@ -108,6 +108,20 @@ smoke_test(NAME mesh_info.moved.json REQUIRES examples_moved_mesh
            KEYS file,mesh/nodes,mesh/cells
            COMMAND mesh_info "${smoke_dir}/moved.msh" --json)
 
+# The mechanics knobs reach the mover: stiffened elasticity as curve_mesh's regularizer and
+# as move_mesh's mover, and a bad Poisson ratio is refused.
+smoke_test(NAME curve_mesh.sle.json
+           KEYS output,min_scaled_jacobian,invalid,seconds/total
+           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_sle.msh" --method sle --stiffening-exponent 2
+                   --poisson-ratio 0.4 --youngs-modulus 1e6 --solver simplicial_llt --json)
+smoke_test(NAME move_mesh.sle.json REQUIRES examples_demo_mesh
+           KEYS output,after/min,after/invalid
+           COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_sle.msh" --group wall --rotate 2
+                   --fixed farfield --method sle --stiffening-exponent 1.5 --poisson-ratio 0.35 --json)
+smoke_test(NAME curve_mesh.bad_poisson_ratio.json EXPECT_RC 1
+           KEYS error
+           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_bad.msh" --method sle --poisson-ratio 0.7 --json)
+
 # Bad input: a clear error, in JSON too, and a non-zero exit.
 smoke_test(NAME mesh_info.missing_file.json EXPECT_RC 1
            KEYS error
