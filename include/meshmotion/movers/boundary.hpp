@@ -107,6 +107,35 @@ struct ResolvedBoundary {
   }
 };
 
+/// One node's condition, as BoundarySpec (and other builders of a ResolvedBoundary) collect them.
+template <int Dim>
+struct BoundaryEntry {
+  BoundaryKind kind = BoundaryKind::fixed;
+  Vec<Dim> displacement = Vec<Dim>::Zero();
+  Vec<Dim> normal = Vec<Dim>::Zero();
+  Vec<Dim> direction = Vec<Dim>::Zero();  ///< line of a node on two sliding planes (3D)
+};
+
+/// The ResolvedBoundary of conditions by node (the map keeps the nodes sorted).
+template <int Dim>
+[[nodiscard]] ResolvedBoundary<Dim> make_resolved_boundary(const std::map<Index, BoundaryEntry<Dim>>& entries) {
+  ResolvedBoundary<Dim> out;
+  const auto m = static_cast<Index>(entries.size());
+  out.displacements.setZero(Dim, m);
+  out.normals.setZero(Dim, m);
+  out.directions.setZero(Dim, m);
+  Index k = 0;
+  for (const auto& [node, e] : entries) {
+    out.nodes.push_back(node);
+    out.kinds.push_back(e.kind);
+    out.displacements.col(k) = e.displacement;
+    out.normals.col(k) = e.normal;
+    out.directions.col(k) = e.direction;
+    ++k;
+  }
+  return out;
+}
+
 /// Node lists by group name, for meshes without named groups (any MeshLike).
 using GroupNodes = std::map<std::string, std::vector<Index>, std::less<>>;
 
@@ -173,21 +202,7 @@ class BoundarySpec {
       list.erase(std::unique(list.begin(), list.end()), list.end());
       add_group(g, list, points, to, from, entries);
     }
-    ResolvedBoundary<Dim> out;
-    const auto m = static_cast<Index>(entries.size());
-    out.displacements.setZero(Dim, m);
-    out.normals.setZero(Dim, m);
-    out.directions.setZero(Dim, m);
-    Index k = 0;
-    for (const auto& [node, e] : entries) {
-      out.nodes.push_back(node);
-      out.kinds.push_back(e.kind);
-      out.displacements.col(k) = e.displacement;
-      out.normals.col(k) = e.normal;
-      out.directions.col(k) = e.direction;
-      ++k;
-    }
-    return out;
+    return make_resolved_boundary(entries);
   }
 
  private:
@@ -198,12 +213,7 @@ class BoundarySpec {
     Points<Dim> displacements;
     std::optional<Vec<Dim>> normal;
   };
-  struct Entry {
-    BoundaryKind kind;
-    Vec<Dim> displacement;
-    Vec<Dim> normal;
-    Vec<Dim> direction = Vec<Dim>::Zero();  ///< line of a node on two sliding planes (3D)
-  };
+  using Entry = BoundaryEntry<Dim>;
 
   /// Sine of the angle below which two plane normals count as parallel (and a line as lying
   /// in a plane).
