@@ -175,6 +175,9 @@ void print_peer_header() {
 }
 
 void print_peer_row(const std::string& name, const PeerRow& r, double reference_cpu) {
+  std::string note = r.note;  // JSON-safe: messages may quote names
+  std::replace(note.begin(), note.end(), '"', '\'');
+  std::replace(note.begin(), note.end(), '\\', '/');
   const double ratio = reference_cpu > 0.0 ? r.cpu / reference_cpu : 0.0;
   std::printf("%-13s %-11s %-36s %8.3f %8.3f %7.2f %8.4f %8.4f %7lld %8.4f %8.4f %7ld %9.2e  %s\n", name.c_str(),
               r.tool.c_str(), r.method.c_str(), r.cpu, r.wall, ratio, r.ours.min, r.ours.mean,
@@ -187,7 +190,7 @@ void print_peer_row(const std::string& name, const PeerRow& r, double reference_
       "\"note\":\"%s\"}\n",
       name.c_str(), r.tool.c_str(), r.method.c_str(), r.cpu, r.wall, ratio, r.ours.min, r.ours.mean,
       static_cast<long long>(r.ours.num_invalid), r.gmsh.worst, r.gmsh.average, r.gmsh.invalid, r.geometry_error,
-      r.note.c_str());
+      note.c_str());
   std::fflush(stdout);
 }
 
