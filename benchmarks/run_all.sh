@@ -48,7 +48,7 @@ declare -A quick_args=(
   [rbf_bench]="64"
   [interpolation_bench]=""
   [elasticity_bench]="--quick"
-  [curving_bench]=""
+  [curving_bench]="--quick"
   [bump3d_bench]="0 1"
 )
 declare -A full_args=(
