@@ -147,12 +147,7 @@ template <int Dim>
 template <int Dim>
 [[nodiscard]] ResolvedBoundary<Dim> curving_boundary(const Mesh<Dim>& mesh, const SnappedBoundary<Dim>& snapped,
                                                      const std::vector<std::string>& sliding) {
-  struct Entry {
-    BoundaryKind kind;
-    Vec<Dim> displacement = Vec<Dim>::Zero();
-    Vec<Dim> normal = Vec<Dim>::Zero();
-    Vec<Dim> direction = Vec<Dim>::Zero();  // line of a node on two sliding planes
-  };
+  using Entry = BoundaryEntry<Dim>;
   std::map<Index, Entry> entries;
   for (std::size_t k = 0; k < snapped.nodes.size(); ++k)
     entries.emplace(snapped.nodes[k],
@@ -172,21 +167,7 @@ template <int Dim>
   };
   fix(mesh.facets);
   fix(boundary_facets(mesh));
-  ResolvedBoundary<Dim> out;
-  const auto size = static_cast<Index>(entries.size());
-  out.displacements.setZero(Dim, size);
-  out.normals.setZero(Dim, size);
-  out.directions.setZero(Dim, size);
-  Index k = 0;
-  for (const auto& [node, entry] : entries) {
-    out.nodes.push_back(node);
-    out.kinds.push_back(entry.kind);
-    out.displacements.col(k) = entry.displacement;
-    out.normals.col(k) = entry.normal;
-    out.directions.col(k) = entry.direction;
-    ++k;
-  }
-  return out;
+  return make_resolved_boundary(entries);
 }
 
 /// The "none" method: the snapped boundary nodes move, nothing else (models MeshMover).
