@@ -434,6 +434,32 @@ TEST_CASE("edge of two symmetry planes: RBF and elasticity move its nodes along 
   check(elasticity.move(b.displacements), "linear elasticity");
 }
 
+TEST_CASE("a compact support covering the mesh is evaluated dense, with the sparse result", "[movers]") {
+  const Grid<2> g = grid<2>(12);
+  BoundarySpec<2> spec;
+  spec.moving("x0", Rotation2D{Vec<2>(0.5, 0.5), 0.3}).fixed("x1").sliding("y0").sliding("y1");
+  const auto boundary = spec.resolve(g.mesh.points, g.groups);
+  RbfOptions options;
+  options.support_radius = 5.0;  // the unit square lies inside every support
+  RbfMover<2> dense(options);
+  dense.setup(g.mesh, boundary);
+  CHECK(dense.evaluation_cached());
+  options.max_evaluation_cache_bytes = 0;
+  RbfMover<2> sparse(options);
+  sparse.setup(g.mesh, boundary);
+  CHECK_FALSE(sparse.evaluation_cached());
+  const Points<2> d = boundary.displacements;
+  CHECK((dense.move(d) - sparse.move(d)).cwiseAbs().maxCoeff() < 1e-12);
+  const Points<2> v = random_displacements<2>(g.mesh.num_nodes(), 4);
+  CHECK((dense.derivative_reverse(v) - sparse.derivative_reverse(v)).cwiseAbs().maxCoeff() < 1e-12);
+  // A support of a few cells stays sparse whatever the budget.
+  options.max_evaluation_cache_bytes = std::size_t{1} << 30;
+  options.support_radius = 0.25;
+  RbfMover<2> local(options);
+  local.setup(g.mesh, boundary);
+  CHECK_FALSE(local.evaluation_cached());
+}
+
 TEST_CASE("global kernels: the cached evaluation matrix gives the uncached result", "[movers]") {
   const Grid<2> g = grid<2>(12);
   BoundarySpec<2> spec;

@@ -15,6 +15,8 @@
 /// - Global kernels: the dense evaluation matrix (evaluated nodes × centres) is cached in
 ///   setup when it fits RbfOptions::max_evaluation_cache_bytes, making a move one dense
 ///   matrix product (evaluation_cached() tells); otherwise each move re-evaluates the kernel.
+///   A compact kernel whose support reaches more than half of the centres from a sample of
+///   nodes gets the same dense matrix when it fits (its sparse operator would be full).
 /// - Sliding boundaries (exact): the interpolant over the prescribed and fixed nodes gives
 ///   the sliding nodes a displacement, which is projected on each node's plane or line
 ///   (ResolvedBoundary::project), and the projected values join the constraints of a second
@@ -62,7 +64,8 @@ struct RbfOptions {
   /// Global kernels: setup stores the dense evaluation matrix (evaluated nodes × centres, 8
   /// bytes an entry) when it takes at most this many bytes, so a move is one dense matrix
   /// product instead of n × m kernel evaluations; larger matrices are recomputed every move.
-  /// 0 never caches. Compact kernels always keep their (sparse) operator.
+  /// 0 never caches. Compact kernels keep a sparse operator unless their support reaches most
+  /// centres from most nodes and the dense matrix fits here.
   std::size_t max_evaluation_cache_bytes = std::size_t{256} << 20;
 };
 
@@ -77,8 +80,8 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
 
   [[nodiscard]] const RbfOptions& options() const noexcept { return options_; }
   [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
-  /// True when the last setup stored the dense evaluation matrix of a global kernel (see
-  /// RbfOptions::max_evaluation_cache_bytes); compact kernels always keep a sparse operator.
+  /// True when the last setup stored a dense evaluation matrix: a global kernel, or a compact
+  /// one whose support covers most centres (see RbfOptions::max_evaluation_cache_bytes).
   [[nodiscard]] bool evaluation_cached() const noexcept { return dense_operator_.size() > 0; }
 
   /// Reference-configuration work (see the file comment). `mesh`: any MeshLike of dimension
@@ -165,7 +168,13 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
     for (Index i = 0; i < n; ++i)
       if (!is_boundary[static_cast<std::size_t>(i)]) interior_.push_back(i);
     evaluated_.clear();
-    if (is_compact(options_.kernel)) {
+    const bool fits = !interior_.empty() && static_cast<double>(interior_.size()) * static_cast<double>(k) * sizeof(double) <=
+                                                static_cast<double>(options_.max_evaluation_cache_bytes);
+    // A compact support that reaches most centres from most nodes (a radius far larger than the
+    // moving body, as rotations want) makes the sparse operator a full one stored with indices:
+    // building it dense is several times cheaper and so is every move.
+    const bool dense = fits && (!is_compact(options_.kernel) || covered_fraction(kernel.radius) > 0.5);
+    if (is_compact(options_.kernel) && !dense) {
       // Only rows with weights are kept, so skipped nodes cost nothing per move; the operator
       // is only multiplied, so its rows need no sorting.
       std::vector<Index> kept;
@@ -176,8 +185,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
     } else {
       evaluated_ = interior_;
       operator_.resize(0, 0);
-      const auto bytes = static_cast<double>(evaluated_.size()) * static_cast<double>(k) * sizeof(double);
-      if (bytes <= static_cast<double>(options_.max_evaluation_cache_bytes) && !evaluated_.empty()) {
+      if (dense) {
         dense_operator_.resize(static_cast<Index>(evaluated_.size()), k);
         const auto n_eval = static_cast<Index>(evaluated_.size());
 #pragma omp parallel for schedule(static)
@@ -305,6 +313,18 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   }
   [[nodiscard]] Eigen::RowVectorXd kernel_row(const Vec<Dim>& x) const { return kernel_row(all_, x); }
 
+  /// Mean share of the centres inside the support of a sample of evaluated nodes (up to 64,
+  /// evenly spread over interior_): a cheap estimate of the compact operator's density.
+  [[nodiscard]] double covered_fraction(double radius) const {
+    const auto n = static_cast<Index>(interior_.size());
+    const Index samples = std::min<Index>(n, 64);
+    std::vector<Neighbor> found;
+    double covered = 0.0;
+    for (Index s = 0; s < samples; ++s)
+      covered += static_cast<double>(all_.tree().radius_search(points_.col(interior_[static_cast<std::size_t>(s * n / samples)]), radius, found));
+    return samples == 0 ? 0.0 : covered / (static_cast<double>(samples) * static_cast<double>(all_.size()));
+  }
+
   /// The linear map boundary displacements → node displacements.
   void apply(const Points<Dim>& d, Points<Dim>& out) {
     const Index k = all_.size();
@@ -347,10 +367,10 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   void evaluate_interior(Points<Dim>& out) {
     const auto n_eval = static_cast<Index>(evaluated_.size());
     if (is_compact(options_.kernel) || evaluation_cached()) {
-      if (is_compact(options_.kernel))
-        evaluated_values_.noalias() = operator_ * alpha_;
-      else
+      if (evaluation_cached())
         evaluated_values_.noalias() = dense_operator_ * alpha_;
+      else
+        evaluated_values_.noalias() = operator_ * alpha_;
 #pragma omp parallel for schedule(static)
       for (Index r = 0; r < n_eval; ++r) out.col(evaluated_[static_cast<std::size_t>(r)]) = evaluated_values_.row(r).transpose();
     } else {
@@ -374,10 +394,10 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
     const Index k = all_.size();
     Eigen::MatrixXd v_eval(static_cast<Index>(evaluated_.size()), Dim);
     for (std::size_t r = 0; r < evaluated_.size(); ++r) v_eval.row(static_cast<Index>(r)) = v.col(evaluated_[r]).transpose();
-    if (is_compact(options_.kernel)) {
-      alpha_bar = operator_.transpose() * v_eval;
-    } else if (evaluation_cached()) {
+    if (evaluation_cached()) {
       alpha_bar = dense_operator_.transpose() * v_eval;
+    } else if (is_compact(options_.kernel)) {
+      alpha_bar = operator_.transpose() * v_eval;
     } else {
       alpha_bar.setZero(k, Dim);
       for (std::size_t r = 0; r < evaluated_.size(); ++r)
@@ -406,7 +426,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   std::vector<Index> interior_;             ///< non-boundary nodes
   std::vector<Index> evaluated_;            ///< interior nodes with kernel weights
   Operator operator_;                       ///< evaluated_ × centres (compact kernels)
-  Eigen::MatrixXd dense_operator_;          ///< evaluated_ × centres (global kernels, when cached)
+  Eigen::MatrixXd dense_operator_;          ///< evaluated_ × centres, when cached
   Eigen::MatrixXd values_, alpha_, evaluated_values_;
   Poly beta_ = Poly::Zero();
 };
