@@ -378,6 +378,30 @@ TEST_CASE("bump_channel_3d: the TMR 3D bump-in-channel grid family", "[curving]"
   CHECK_THROWS_AS(bump_channel_3d(5), InputError);
 }
 
+TEST_CASE("nasa_bump_3d projects every wall edge midpoint and face centre of the fine grid", "[curving]") {
+  // The fine level's wall: 16 × 80 quadrilaterals (the projection once stalled on one).
+  const Mesh<3> fine = bump_channel_3d(2);
+  const GraphProjection3 bump = nasa_bump_3d();
+  const int tag = fine.group("bump").tag;
+  Index projected = 0;
+  for (const auto& block : fine.facets)
+    for (Index e = 0; e < block.size(); ++e) {
+      if (block.tags[static_cast<std::size_t>(e)] != tag) continue;
+      const auto q = block.element(e);
+      Vec<3> centre = Vec<3>::Zero();
+      for (int k = 0; k < 4; ++k) {
+        const Vec<3> a = fine.points.col(q[static_cast<std::size_t>(k)]), b = fine.points.col(q[static_cast<std::size_t>((k + 1) % 4)]);
+        centre += a / 4.0;
+        const Vec<3> x = bump(0.5 * (a + b));
+        CHECK(std::abs(x.z() - nasa_bump_3d_height(x.x(), x.y()).value) < 1e-15);
+        ++projected;
+      }
+      const Vec<3> x = bump(centre);
+      CHECK(std::abs(x.z() - nasa_bump_3d_height(x.x(), x.y()).value) < 1e-15);
+    }
+  CHECK(projected == 4 * 16 * 80);
+}
+
 TEST_CASE("pipeline: the coarse 3D bump-in-channel curves onto the analytic bump", "[curving][slow]") {
   const Mesh<3> linear = bump_channel_3d(0);
   CurveOptions<3> options;

@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <utility>
@@ -82,6 +83,7 @@ class GraphProjection3 {
   [[nodiscard]] Vec<3> operator()(const Vec<3>& p) const {
     detail::require_finite_point<3>(p, "GraphProjection3");
     Eigen::Vector2d xy = p.head<2>();
+    double previous = std::numeric_limits<double>::infinity();
     for (int iteration = 0; iteration < 100; ++iteration) {
       const GraphSample2 g = sample(xy);
       const double gap = g.value - p.z();
@@ -91,7 +93,10 @@ class GraphProjection3 {
       Eigen::Matrix2d hessian = gauss_newton + gap * g.hessian;
       if (!(hessian.determinant() > 0.0 && hessian.trace() > 0.0)) hessian = gauss_newton;
       const Eigen::Vector2d step = -hessian.inverse() * gradient;
-      if (step.norm() <= 1e-14 * (1.0 + xy.norm())) {
+      // Converged when the step is at round-off, or stops shrinking near it (round-off in
+      // f can make Newton cycle between neighbouring doubles a few ulps apart).
+      const double size = step.norm();
+      if (size <= 1e-14 * (1.0 + xy.norm()) || (size <= 1e-10 * (1.0 + xy.norm()) && size >= 0.5 * previous)) {
         xy += step;
         return {xy.x(), xy.y(), sample(xy).value};
       }
@@ -103,6 +108,10 @@ class GraphProjection3 {
         length *= 0.5;
         next = xy + length * step;
       }
+      // No decrease along a descent direction: xy is the minimum to round-off (the step
+      // test above can miss it where the distance is flat to the last bits).
+      if (!(length > 1e-10)) return {xy.x(), xy.y(), sample(xy).value};
+      previous = size;
       xy = next;
     }
     throw SolverError("GraphProjection3: closest-point iteration did not converge in 100 steps "
