@@ -24,6 +24,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -43,7 +44,7 @@ struct Arguments {
   std::string method = "rbf";
   std::string kernel = "wendland2";
   double support_radius = 0.0;
-  double support_factor = 1.0;
+  double support_factor = 0.0;  // unset: the library's default for the dimension
   double blending_length = 0.0;
   int steps = 1;
   std::vector<std::string> geometry;
@@ -125,7 +126,7 @@ CurveOptions<Dim> curve_options(const Arguments& args) {
   options.method = args.method;
   options.kernel = rbf_kernel_from_name(args.kernel);
   options.support_radius = args.support_radius;
-  options.support_radius_factor = args.support_factor;
+  if (args.support_factor > 0.0) options.support_radius_factor = args.support_factor;
   options.blending_length = args.blending_length;
   options.steps = args.steps;
   examples::add_mechanics_parameters(args.mechanics, options.parameters);
@@ -244,7 +245,13 @@ int main(int argc, char** argv) {
   app.add_option("--method", args.method, "interior regularization: rbf, blend, none, or a mover (sle, le, nle, torsion, spring, ...)")->capture_default_str();
   app.add_option("--kernel", args.kernel, "RBF kernel (wendland2, wendland0/4/6, tps, gaussian, ...)")->capture_default_str();
   app.add_option("--support-radius", args.support_radius, "RBF support radius (0: from the boundary-layer thickness)");
-  app.add_option("--support-factor", args.support_factor, "default radius = this x the thickest wall layer")->capture_default_str();
+  app.add_option("--support-factor", args.support_factor,
+                 "default radius = this x the thickest wall layer (default: 4 in 2D, 1 in 3D)")
+      ->check([](const std::string& value) {
+        char* end = nullptr;
+        const double x = std::strtod(value.c_str(), &end);
+        return end != value.c_str() && *end == '\0' && x > 0.0 ? std::string() : "must be a number > 0 (got " + value + ")";
+      });
   app.add_option("--blending-length", args.blending_length, "blend: length (0: each wall's layer thickness)");
   app.add_option("--steps", args.steps, "regularize in this many increments")->capture_default_str();
   app.add_option("--geometry", args.geometry,
