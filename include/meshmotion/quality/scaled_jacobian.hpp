@@ -24,8 +24,10 @@
 #include <Eigen/LU>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -68,13 +70,94 @@ template <int D>
 using ElementCoords = Eigen::Matrix<double, D, Eigen::Dynamic, 0, D, 27>;
 using LatticeVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 216, 1>;
 
+// One pass of apply_factors: to[o, r, i] = Σ_b f(r, b) from[o, b, i], as whole rows over i (the
+// compiler vectorizes them) or, on the last axis (inner = 1), as sums kept in a register.
+inline void factor_pass(const Eigen::MatrixXd& f, Index outer, Index inner, const double* from, double* to) {
+  const Index in_len = f.cols(), out_len = f.rows();
+  for (Index o = 0; o < outer; ++o, from += in_len * inner, to += out_len * inner)
+    for (Index r = 0; r < out_len; ++r) {
+      if (inner == 1) {
+        double sum = 0.0;
+        for (Index b = 0; b < in_len; ++b) sum += f(r, b) * from[b];
+        to[r] = sum;
+        continue;
+      }
+      double* row = to + r * inner;
+      for (Index i = 0; i < inner; ++i) row[i] = f(r, 0) * from[i];
+      for (Index b = 1; b < in_len; ++b) {
+        const double w = f(r, b);
+        const double* in = from + b * inner;
+        for (Index i = 0; i < inner; ++i) row[i] += w * in[i];
+      }
+    }
+}
+
+// values ← (F_0 ⊗ F_1 ⊗ ...) values on the lattice order (simplex index outermost, then the line
+// coordinates, the last fastest): one pass of a small matrix per factor. A factor may be
+// rectangular (rows × cols maps an axis of cols entries to rows entries). The last axis goes
+// first, while the data is smallest: its pass is the one that cannot be vectorized.
+inline void apply_factors(std::span<const Eigen::MatrixXd* const> factors, LatticeVector& values) {
+  thread_local LatticeVector out;
+  std::array<Index, 4> sizes{};
+  for (std::size_t a = 0; a < factors.size(); ++a) sizes[a] = factors[a]->cols();
+  for (std::size_t a = factors.size(); a-- > 0;) {
+    const Eigen::MatrixXd& f = *factors[a];
+    Index outer = 1, inner = 1;
+    for (std::size_t b = 0; b < a; ++b) outer *= sizes[b];
+    for (std::size_t b = a + 1; b < factors.size(); ++b) inner *= sizes[b];
+    sizes[a] = f.rows();
+    out.resize(outer * f.rows() * inner);
+    factor_pass(f, outer, inner, values.data(), out.data());
+    values.swap(out);
+  }
+}
+
+// det J at every lattice point, divided by `scale`. The transposed Jacobians (row point · D +
+// reference direction, column physical coordinate) come by sum factorization for tensor
+// elements, otherwise as a sum of shape-gradient columns weighted by the coordinates (long
+// contiguous updates; a blocked product would repack the constant gradients for every cell).
 template <int D>
-double det_at(const JacobianSpace& s, const ElementCoords<D>& x, int point) {
-  Eigen::Matrix<double, D, D> jac = Eigen::Matrix<double, D, D>::Zero();
-  const double* g = s.gradients.data() + static_cast<std::size_t>(point) * static_cast<std::size_t>(s.num_nodes * D);
-  for (int i = 0; i < s.num_nodes; ++i)
-    for (int d = 0; d < D; ++d) jac.col(d) += x.col(i) * g[i * D + d];
-  return jac.determinant();
+void lattice_dets(const JacobianSpace& s, const ElementCoords<D>& x, double scale, LatticeVector& values) {
+  thread_local Eigen::Matrix<double, Eigen::Dynamic, D> jacobians;
+  jacobians.resize(static_cast<Index>(s.num_points) * D, D);
+  if (!s.tensor_node.empty()) {
+    std::array<const Eigen::MatrixXd*, D> f{};
+    LatticeVector v;
+    for (int c = 0; c < D; ++c)
+      for (int d = 0; d < D; ++d) {
+        v.resize(static_cast<Index>(s.tensor_node.size()));
+        for (std::size_t q = 0; q < s.tensor_node.size(); ++q) v(static_cast<Index>(q)) = x(c, s.tensor_node[q]);
+        for (int l = 0; l < D; ++l) f[static_cast<std::size_t>(l)] = l == d ? &s.line_derivatives : &s.line_values;
+        apply_factors(f, v);
+        for (int j = 0; j < s.num_points; ++j) jacobians(static_cast<Index>(j) * D + d, c) = v(j);
+      }
+  } else {
+    jacobians.setZero();
+    for (Index i = 0; i < s.gradients.cols(); ++i)
+      for (int c = 0; c < D; ++c) jacobians.col(c) += x(c, i) * s.gradients.col(i);
+  }
+  values.resize(s.num_points);
+  for (int j = 0; j < s.num_points; ++j)
+    values(j) = Eigen::Matrix<double, D, D>(jacobians.template middleRows<D>(static_cast<Index>(j) * D)).determinant() * scale;
+}
+
+// The factors of the Bézier transform (child < 0) or of child `child`'s lattice values.
+inline int space_factors(const JacobianSpace& s, int child, std::array<const Eigen::MatrixXd*, 4>& f) {
+  int count = 0;
+  const int bits = child < 0 ? 0 : child & ((1 << s.line_dims) - 1);
+  if (s.simplex_dim > 0)
+    f[static_cast<std::size_t>(count++)] =
+        child < 0 ? &s.simplex.to_bezier : &s.simplex.children[static_cast<std::size_t>(child >> s.line_dims)];
+  for (int l = 0; l < s.line_dims; ++l)
+    // The first line coordinate's bit is the lowest (see make_children).
+    f[static_cast<std::size_t>(count++)] = child < 0 ? &s.line.to_bezier : &s.line.children[static_cast<std::size_t>((bits >> l) & 1)];
+  return count;
+}
+
+inline void transform(const JacobianSpace& s, int child, LatticeVector& values) {
+  std::array<const Eigen::MatrixXd*, 4> f{};
+  const int count = space_factors(s, child, f);
+  apply_factors(std::span<const Eigen::MatrixXd* const>(f.data(), static_cast<std::size_t>(count)), values);
 }
 
 template <int D>
@@ -92,8 +175,9 @@ struct BezierLeaf {
   int depth = 0;
 };
 
-inline BezierLeaf make_leaf(const JacobianSpace& s, const LatticeVector& values, int depth) {
-  BezierLeaf leaf{s.lag2bez * values, 0.0, 0.0, depth};
+inline BezierLeaf make_leaf(const JacobianSpace& s, LatticeVector values, int depth) {
+  transform(s, -1, values);
+  BezierLeaf leaf{std::move(values), 0.0, 0.0, depth};
   leaf.min = leaf.coefficients.minCoeff();
   leaf.max = leaf.coefficients.maxCoeff();
   return leaf;
@@ -123,12 +207,13 @@ inline void certify(const JacobianSpace& s, const LatticeVector& values, const S
     if (opt.sharp ? (min_sharp && max_sharp) : decided) break;
     const std::size_t pick = (opt.sharp && min_sharp) ? worst_max : worst_min;
     if (leaves[pick].depth >= opt.max_depth ||
-        static_cast<int>(leaves.size() + s.child_values.size()) > opt.max_leaves)
+        static_cast<int>(leaves.size()) + s.num_children() > opt.max_leaves)
       break;
     const BezierLeaf parent = leaves[pick];
     leaves.erase(leaves.begin() + static_cast<std::ptrdiff_t>(pick));
-    for (const auto& child : s.child_values) {
-      const LatticeVector v = child * parent.coefficients;
+    for (int child = 0; child < s.num_children(); ++child) {
+      LatticeVector v = parent.coefficients;
+      transform(s, child, v);
       upper_min = std::min(upper_min, v.minCoeff());
       lower_max = std::max(lower_max, v.maxCoeff());
       leaves.push_back(make_leaf(s, v, parent.depth + 1));
@@ -158,8 +243,8 @@ ScaledJacobian scaled_jacobian_fixed(ElementType type, const ElementCoords<D>& x
     return r;
   }
   const double scale = 1.0 / std::abs(lin);
-  LatticeVector values(s.num_points);
-  for (int j = 0; j < s.num_points; ++j) values(j) = det_at<D>(s, x, j) * scale;
+  LatticeVector values;
+  lattice_dets<D>(s, x, scale, values);
   r.sampled_min = r.certified_min = values.minCoeff();
   r.sampled_max = r.certified_max = values.maxCoeff();
   r.leaves = 1;

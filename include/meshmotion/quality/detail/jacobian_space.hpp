@@ -26,6 +26,15 @@
 
 namespace meshmotion::detail {
 
+// Bézier tables of one factor of a space: the simplex coordinates together, or one line
+// coordinate. A space's Bernstein basis is the product of its factors' bases, so its tables are
+// Kronecker products of these, applied factor by factor (a hex27's 216 × 216 transform becomes
+// three passes of a 6 × 6 one).
+struct BezierFactor {
+  Eigen::MatrixXd to_bezier;              // Bézier coefficients = to_bezier × lattice values
+  std::vector<Eigen::MatrixXd> children;  // lattice values of child c = children[c] × coefficients
+};
+
 struct JacobianSpace {
   int dim = 0;            // reference dimension
   int simplex_dim = 0;    // 0 (none), 2 (triangle) or 3 (tetrahedron) leading coordinates
@@ -38,10 +47,20 @@ struct JacobianSpace {
   std::vector<RefPoint> points;                // sampling lattice
   std::vector<std::array<int, 4>> simplex_index;  // barycentric multi-index per point
   std::vector<std::array<int, 3>> line_index;     // 1D index per line dimension per point
-  std::vector<double> gradients;               // [(point * num_nodes + node) * dim + d]
+  Eigen::MatrixXd gradients;                   // (num_points · dim) × num_nodes: row point · dim + d
   std::vector<double> linear_gradients;        // vertex shape gradients at the centroid: [vertex * dim + d]
-  Eigen::MatrixXd lag2bez;                     // Bézier coefficients = lag2bez × lattice values
-  std::vector<Eigen::MatrixXd> child_values;   // lattice values of child c = child_values[c] × coefficients
+  // Tensor-product elements (quad4/9, hex8/27): the Jacobians at the lattice by sum
+  // factorization, a 1D table per reference axis instead of `gradients` (a hex27's 52k
+  // multiply-adds become 10k).
+  std::vector<int> tensor_node;                // element node at each tensor position (empty: not a tensor element)
+  Eigen::MatrixXd line_values;                 // (line_degree + 1) × (order + 1): 1D Lagrange basis at the line lattice
+  Eigen::MatrixXd line_derivatives;            // the same for its derivative
+  BezierFactor simplex;                        // when simplex_dim > 0
+  BezierFactor line;                           // when line_dims > 0
+  // Children of a subdivision: simplex child outermost, then one bit per line coordinate.
+  [[nodiscard]] int num_children() const {
+    return (simplex_dim > 0 ? static_cast<int>(simplex.children.size()) : 1) << line_dims;
+  }
 };
 
 inline double factorial(int n) {
@@ -160,6 +179,53 @@ inline void add_lattice(JacobianSpace& s) {
     }
 }
 
+// The Bézier tables of a space with one factor (simplex only, or a single line coordinate).
+inline BezierFactor bezier_factor(JacobianSpace f) {
+  add_lattice(f);
+  const auto np = static_cast<Index>(f.points.size());
+  const auto values_at = [&](const auto& point_of) {
+    Eigen::MatrixXd e(np, np);
+    for (Index j = 0; j < np; ++j)
+      for (Index k = 0; k < np; ++k) e(j, k) = bernstein(f, static_cast<std::size_t>(k), point_of(j));
+    return e;
+  };
+  BezierFactor out;
+  out.to_bezier = values_at([&](Index j) { return f.points[static_cast<std::size_t>(j)]; }).inverse();
+  for (const auto& child : make_children(f))
+    out.children.push_back(values_at([&](Index j) { return map_child(child, f.points[static_cast<std::size_t>(j)]); }));
+  return out;
+}
+
+// The 1D Lagrange basis on p + 1 equispaced nodes of [-1, 1] (and its derivative) at the line
+// lattice, and each element node's place in the tensor order (first axis outermost, as the lattice).
+inline void add_tensor_tables(JacobianSpace& s, ElementType t, int p) {
+  const int m = s.line_degree;
+  const auto node = [p](int a) { return 2.0 * a / p - 1.0; };
+  s.line_values.resize(m + 1, p + 1);
+  s.line_derivatives.resize(m + 1, p + 1);
+  for (int r = 0; r <= m; ++r) {
+    const double x = 2.0 * r / m - 1.0;
+    for (int a = 0; a <= p; ++a) {
+      double value = 1.0, derivative = 0.0;
+      for (int b = 0; b <= p; ++b) {
+        if (b == a) continue;
+        const double w = 1.0 / (node(a) - node(b));
+        derivative = derivative * (x - node(b)) * w + value * w;
+        value *= (x - node(b)) * w;
+      }
+      s.line_values(r, a) = value;
+      s.line_derivatives(r, a) = derivative;
+    }
+  }
+  const auto nodes = reference_nodes(t);
+  s.tensor_node.assign(nodes.size(), -1);
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    int position = 0;
+    for (int d = 0; d < s.dim; ++d) position = position * (p + 1) + static_cast<int>(std::lround((nodes[i][static_cast<std::size_t>(d)] + 1.0) * 0.5 * p));
+    s.tensor_node[static_cast<std::size_t>(position)] = static_cast<int>(i);
+  }
+}
+
 // Pyramid sampling: a lattice of order 4 on the levels w = k/4 below the apex (the apex
 // itself is a singular point of the rational map), plus the centroid.
 inline void add_pyramid_samples(JacobianSpace& s) {
@@ -195,11 +261,14 @@ inline JacobianSpace make_jacobian_space(ElementType t) {
   s.num_points = static_cast<int>(s.points.size());
 
   std::vector<std::array<double, 3>> g(static_cast<std::size_t>(s.num_nodes));
-  for (const auto& x : s.points) {
-    shape_derivatives(t, x, g);
-    for (const auto& gi : g)
-      for (int d = 0; d < s.dim; ++d) s.gradients.push_back(gi[static_cast<std::size_t>(d)]);
+  s.gradients.resize(static_cast<Index>(s.num_points) * s.dim, s.num_nodes);
+  for (int j = 0; j < s.num_points; ++j) {
+    shape_derivatives(t, s.points[static_cast<std::size_t>(j)], g);
+    for (int i = 0; i < s.num_nodes; ++i)
+      for (int d = 0; d < s.dim; ++d) s.gradients(j * s.dim + d, i) = g[static_cast<std::size_t>(i)][static_cast<std::size_t>(d)];
   }
+  const bool tensor_shape = shape(t) == Shape::quadrilateral || shape(t) == Shape::hexahedron;
+  if (tensor_shape && s.num_nodes == (s.dim == 2 ? (p + 1) * (p + 1) : (p + 1) * (p + 1) * (p + 1))) add_tensor_tables(s, t, p);
   const ElementType lin = linear_type(t);
   std::vector<std::array<double, 3>> gl(static_cast<std::size_t>(num_nodes(lin)));
   shape_derivatives(lin, reference_centroid(lin), gl);
@@ -207,18 +276,17 @@ inline JacobianSpace make_jacobian_space(ElementType t) {
     for (int d = 0; d < s.dim; ++d) s.linear_gradients.push_back(gi[static_cast<std::size_t>(d)]);
 
   if (!s.bezier) return s;
-  const auto np = static_cast<Index>(s.num_points);
-  Eigen::MatrixXd eval(np, np);
-  for (Index j = 0; j < np; ++j)
-    for (Index k = 0; k < np; ++k) eval(j, k) = bernstein(s, static_cast<std::size_t>(k), s.points[static_cast<std::size_t>(j)]);
-  s.lag2bez = eval.inverse();
-  for (const auto& child : make_children(s)) {
-    Eigen::MatrixXd e(np, np);
-    for (Index j = 0; j < np; ++j) {
-      const RefPoint y = map_child(child, s.points[static_cast<std::size_t>(j)]);
-      for (Index k = 0; k < np; ++k) e(j, k) = bernstein(s, static_cast<std::size_t>(k), y);
-    }
-    s.child_values.push_back(e);
+  if (s.simplex_dim > 0) {
+    JacobianSpace factor;
+    factor.simplex_dim = s.simplex_dim;
+    factor.simplex_degree = s.simplex_degree;
+    s.simplex = bezier_factor(factor);
+  }
+  if (s.line_dims > 0) {
+    JacobianSpace factor;
+    factor.line_dims = 1;
+    factor.line_degree = s.line_degree;
+    s.line = bezier_factor(factor);
   }
   return s;
 }
