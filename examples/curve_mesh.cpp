@@ -186,6 +186,7 @@ void run(const Mesh<Dim>& linear, const Arguments& args) {
     w.key("output").value(args.output).key("vtu").value(vtu.string());
     w.key("dim").value(Dim).key("nodes").value(result.curved.num_nodes()).key("cells").value(result.curved.num_cells());
     w.key("method").value(result.method).key("steps").value(args.steps).key("support_radius").value(result.support_radius);
+    w.key("support_radius_limited").value(result.support_radius_limited);
     w.key("seconds").begin_object();
     w.key("quadratic").value(result.seconds.quadratic).key("snap").value(result.seconds.snap);
     w.key("layer").value(result.seconds.layer).key("regularize").value(result.seconds.regularize);
@@ -204,7 +205,9 @@ void run(const Mesh<Dim>& linear, const Arguments& args) {
   std::printf("curved %lld cells, %lld nodes (%lld linear) with %s", static_cast<long long>(result.curved.num_cells()),
               static_cast<long long>(result.curved.num_nodes()), static_cast<long long>(result.num_linear_nodes),
               result.method.c_str());
-  if (result.method == "rbf") std::printf(", support radius %.4g", result.support_radius);
+  if (result.method == "rbf")
+    std::printf(", support radius %.4g%s", result.support_radius,
+                result.support_radius_limited ? " (limited to keep the system sparse)" : "");
   std::printf(", %d step(s)\n", args.steps);
   for (const auto& layer : result.layers)
     std::printf("  wall '%s': boundary layer %.4g thick (max %.4g)\n", layer.group.c_str(), layer.thickness, layer.max_thickness);
