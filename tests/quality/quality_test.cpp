@@ -486,3 +486,38 @@ TEST_CASE("SVG picture: well-formed, one path per cell in the zoom box, curved P
   options.zoom = std::array<double, 4>{1.0, 1.0, 0.0, 1.0};
   CHECK_THROWS_AS(svg_picture(mesh, values, options), InputError);
 }
+
+TEST_CASE("SVG picture: a ring and a count for exactly the invalid cells drawn", "[quality]") {
+  // 4 × 2 unit squares; cell order is row by row from the bottom left.
+  const Mesh<2> mesh = rectangle_mesh({.nx = 4, .ny = 2, .x_min = 0.0, .x_max = 4.0, .y_min = 0.0, .y_max = 2.0});
+  std::vector<double> values(static_cast<std::size_t>(mesh.num_cells()), 0.5);
+  SvgOptions options;
+  const std::string valid = svg_picture(mesh, values, options);
+  CHECK(occurrences(valid, "class=\"invalid\"") == 0);
+  CHECK(occurrences(valid, ">0 invalid<") == 1);
+
+  // ≤ 0 and NaN are invalid; a value just above 0 is not.
+  values[1] = -3.0, values[2] = 0.0, values[5] = std::nan(""), values[6] = 1e-12;
+  const std::string marked = svg_picture(mesh, values, options);
+  CHECK(occurrences(marked, "<circle class=\"invalid\"") == 3);
+  CHECK(occurrences(marked, ">3 invalid<") == 1);
+  CHECK(occurrences(marked, "fill=\"#ff00ff\" d=") == 3);
+  // Rings are drawn after every cell, at the centroids (1000 px for 4 units: cell 1 is
+  // centred at x = 1.5, y = 0.5 → 375, 375 px).
+  CHECK(marked.find("<circle class=\"invalid\"") > marked.rfind("<path "));
+  CHECK(marked.find("cx=\"375.00\" cy=\"375.00\" r=\"5.0\"") != std::string::npos);
+  CHECK(marked.size() > 7);
+  CHECK(marked.substr(marked.size() - 7) == "</svg>\n");
+
+  // Zoom on the right half: only cells 2, 3, 6, 7 are drawn, and of the invalid ones only 2.
+  options.zoom = std::array<double, 4>{2.1, 3.9, 0.1, 1.9};
+  const std::string zoomed = svg_picture(mesh, values, options);
+  CHECK(occurrences(zoomed, "<path ") == 4);
+  CHECK(occurrences(zoomed, "<circle class=\"invalid\"") == 1);
+  CHECK(occurrences(zoomed, ">1 invalid<") == 1);
+
+  options.mark_invalid = false;
+  const std::string plain = svg_picture(mesh, values, options);
+  CHECK(occurrences(plain, "<circle") == 0);
+  CHECK(plain.find(" invalid<") == std::string::npos);
+}

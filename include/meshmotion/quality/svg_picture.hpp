@@ -2,7 +2,10 @@
 /// \file
 /// An SVG picture of a 2D mesh with its cells coloured by a per-cell value (quality), a
 /// colour bar, P2 edges drawn curved (the quadratic Bézier through the edge's mid node) and an
-/// optional zoom box (near-wall cells of boundary-layer meshes are 1e-5 thin).
+/// optional zoom box (near-wall cells of boundary-layer meshes are 1e-5 thin). Invalid cells
+/// (value ≤ 0) get a red ring of fixed pixel size at their centroid, drawn over the cells, and
+/// a legend line with their count: at any zoom that shows the body, a 1e-5 thin inverted cell
+/// is narrower than a pixel.
 
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
@@ -30,6 +33,8 @@ struct SvgOptions {
   double value_max = 1.0;                     ///< value at the top of the colour scale
   std::string title;                          ///< shown in a band above the picture
   bool draw_edges = true;
+  bool mark_invalid = true;                   ///< ring each cell with value ≤ 0 (or NaN) and count them
+  double marker_radius = 5.0;                 ///< ring radius in pixels, whatever the cell's size
 };
 
 namespace detail {
@@ -61,9 +66,11 @@ inline std::string colour(double t) {
 
 }  // namespace detail
 
-/// The SVG text of `mesh` with cell i coloured by values[i] (cell order). Cells whose value is
-/// ≤ 0 (invalid) are magenta. Throws InputError when values.size() != num_cells() or the
-/// zoom box is empty.
+/// The SVG text of `mesh` with cell i coloured by values[i] (cell order); only the cells that
+/// reach into the zoom box are written. Cells whose value is ≤ 0 or NaN (invalid) are magenta
+/// whatever the scale, and with options.mark_invalid each one drawn also gets a
+/// `<circle class="invalid" .../>` ring and the colour-bar column a line "N invalid" (N: the
+/// rings drawn). Throws InputError when values.size() != num_cells() or the zoom box is empty.
 [[nodiscard]] inline std::string svg_picture(const Mesh<2>& mesh, const std::vector<double>& values,
                                              const SvgOptions& options = {}) {
   if (static_cast<Index>(values.size()) != mesh.num_cells())
@@ -79,7 +86,7 @@ inline std::string colour(double t) {
   if (!(box[1] > box[0]) || !(box[3] > box[2]))
     throw InputError("svg_picture: empty zoom box (got x " + std::to_string(box[0]) + ".." + std::to_string(box[1]) +
                      ", y " + std::to_string(box[2]) + ".." + std::to_string(box[3]) + ")");
-  const double w = options.width, h = std::clamp(w * (box[3] - box[2]) / (box[1] - box[0]), 50.0, 4.0 * w);
+  const double w = options.width, h = std::clamp(w * (box[3] - box[2]) / (box[1] - box[0]), 100.0, 4.0 * w);
   const double bar = 90;
   // The title gets a band of its own above the picture: in the colour-bar column a long one
   // ran off the right edge.
@@ -94,6 +101,7 @@ inline std::string colour(double t) {
                 "<g clip-path=\"url(#box)\" stroke=\"%s\" stroke-width=\"0.4\">\n",
                 w + bar, h + band, w + bar, h + band, band, w, h, options.draw_edges ? "black" : "none");
   const double span = options.value_max - options.value_min;
+  std::vector<std::array<double, 2>> markers;  // pixel centroids of the invalid cells drawn
   Index cell = 0;
   for (const auto& block : mesh.cells) {
     const int nv = num_vertices(block.type);
@@ -108,8 +116,14 @@ inline std::string colour(double t) {
       }
       if (!(xmax >= box[0] && xmin <= box[1] && ymax >= box[2] && ymin <= box[3])) continue;  // also skips NaN
       const double v = values[static_cast<std::size_t>(cell)];
-      const std::string fill = v <= 0 || !std::isfinite(v) ? std::string("#ff00ff")
-                                                           : detail::colour(span > 0 ? (v - options.value_min) / span : 1.0);
+      const bool invalid = v <= 0 || !std::isfinite(v);
+      const std::string fill = invalid ? std::string("#ff00ff")
+                                       : detail::colour(span > 0 ? (v - options.value_min) / span : 1.0);
+      if (invalid && options.mark_invalid) {
+        std::array<double, 2> c{0.0, 0.0};
+        for (int k = 0; k < nv; ++k) c[0] += px(p(k).x()) / nv, c[1] += py(p(k).y()) / nv;
+        markers.push_back(c);
+      }
       detail::append_format(out, "<path fill=\"%s\" d=\"M%.3f %.3f", fill.c_str(), px(p(0).x()), py(p(0).y()));
       for (int k = 0; k < nv; ++k) {
         const auto b = p((k + 1) % nv);
@@ -125,8 +139,16 @@ inline std::string colour(double t) {
     }
   }
   out += "</g>\n";
+  if (!markers.empty()) {
+    // Over the cells, so that neighbours drawn later do not hide them.
+    out += "<g clip-path=\"url(#box)\" fill=\"none\" stroke=\"red\" stroke-width=\"1.5\">\n";
+    for (const auto& m : markers)
+      detail::append_format(out, "<circle class=\"invalid\" cx=\"%.2f\" cy=\"%.2f\" r=\"%.1f\"/>\n", m[0], m[1],
+                            options.marker_radius);
+    out += "</g>\n";
+  }
   // Colour bar: 20 steps from value_max (top) to value_min (bottom).
-  const double bx = w + 15, bh = std::min(h - 40, 400.0), by = 25;
+  const double bx = w + 15, bh = std::min(h - 70, 400.0), by = 25;  // room for the legend below
   for (int k = 0; k < 20; ++k) {
     detail::append_format(out, "<rect x=\"%.1f\" y=\"%.2f\" width=\"20\" height=\"%.2f\" fill=\"%s\"/>\n", bx,
                           by + k * bh / 20, bh / 20 + 0.5, detail::colour(1.0 - (k + 0.5) / 20).c_str());
@@ -134,6 +156,14 @@ inline std::string colour(double t) {
   for (int k = 0; k <= 4; ++k) {
     detail::append_format(out, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" font-family=\"sans-serif\">%.3g</text>\n",
                           bx + 24, by + bh * (1.0 - k / 4.0) + 4, options.value_min + span * k / 4.0);
+  }
+  if (options.mark_invalid) {
+    const double ly = by + bh + 25;
+    detail::append_format(out,
+                          "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"5\" fill=\"#ff00ff\" stroke=\"red\" stroke-width=\"1.5\"/>\n"
+                          "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" font-family=\"sans-serif\">%zu invalid</text>\n"
+                          "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" font-family=\"sans-serif\">(≤ 0, ringed)</text>\n",
+                          bx + 5, ly - 4, bx + 14, ly, markers.size(), bx, ly + 14);
   }
   out += "</g>\n";
   if (!options.title.empty()) {
