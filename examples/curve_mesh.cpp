@@ -5,7 +5,8 @@
 //   curve_mesh in.msh -o out.msh --group 7 --geometry sphere:0,0,0,0.5 --sliding 20 --json
 //
 // Writes OUTPUT (.msh/.su2), OUTPUT's .vtu beside it (per-cell certified scaled Jacobian),
-// and in 2D an SVG picture coloured by quality when --svg is given (always in the demo).
+// and in 2D an SVG picture coloured by quality when --svg is given (always in the demo), with
+// a red ring on every invalid cell (too thin to see at a zoom that shows the body).
 // The input file is never modified.
 
 #include "meshmotion/core/detail/json.hpp"
@@ -56,6 +57,7 @@ struct Arguments {
   bool json = false;
   std::string svg;
   std::vector<double> zoom;
+  bool svg_no_markers = false;
   examples::MechanicsArguments mechanics;
 };
 
@@ -174,7 +176,10 @@ void run(const Mesh<Dim>& linear, const Arguments& args) {
       SvgOptions svg;
       svg.title = "certified scaled Jacobian (" + result.method + ")";
       if (args.zoom.size() == 4) svg.zoom = std::array<double, 4>{args.zoom[0], args.zoom[1], args.zoom[2], args.zoom[3]};
-      svg.value_min = std::min(0.0, result.quality.min);
+      // Invalid cells are magenta and ringed: the scale keeps the valid range [0, 1] instead of
+      // stretching down to the worst negative value (which left every valid cell one colour).
+      svg.mark_invalid = !args.svg_no_markers;
+      svg.value_min = svg.mark_invalid ? 0.0 : std::min(0.0, result.quality.min);
       write_svg(args.svg, result.curved, values, svg);
     }
   }
@@ -268,7 +273,12 @@ int main(int argc, char** argv) {
   app.add_flag("--strict", args.strict, "fail (exit 2) when invalid cells remain");
   app.add_flag("--json", args.json, "print one JSON object");
   app.add_option("--svg", args.svg, "2D: write an SVG picture coloured by quality");
-  app.add_option("--zoom", args.zoom, "SVG zoom box x0,x1,y0,y1")->delimiter(',')->expected(4);
+  app.add_option("--zoom", args.zoom, "SVG zoom box x0,x1,y0,y1 (only cells reaching into it are written)")
+      ->delimiter(',')
+      ->expected(4);
+  app.add_flag("--svg-no-markers", args.svg_no_markers,
+               "SVG: do not ring invalid cells (by default each cell with scaled Jacobian <= 0 gets a red ring, "
+               "the legend counts them and the colour scale spans [0, 1]); the scale then reaches down to the minimum");
   CLI11_PARSE(app, argc, argv);
 
   args.demo = args.demo || args.input.empty();

@@ -25,6 +25,7 @@ struct Settings {
   bool json = false;
   std::string vtu, svg;
   std::vector<double> zoom;
+  bool svg_no_markers = false;
   int worst = 5;
 };
 
@@ -56,6 +57,7 @@ int run(const Mesh<Dim>& mesh, const Settings& s) {
         svg.zoom = std::array<double, 4>{s.zoom[0], s.zoom[1], s.zoom[2], s.zoom[3]};
       }
       svg.title = std::string(metric_name(metrics.front()));
+      svg.mark_invalid = !s.svg_no_markers;
       write_svg(s.svg, mesh, first_values, svg);
     } else {
       std::cerr << "mesh_quality: --svg is for 2D meshes; " << s.file << " is 3D, no picture written\n";
@@ -88,7 +90,10 @@ int main(int argc, char** argv) {
   app.add_option("--metric", s.metrics, "shape, skew, size, size-shape, size-skew or jacobian (repeatable; default shape, skew, size, jacobian)");
   app.add_flag("--json", s.json, "print one JSON object instead of the table");
   app.add_option("--vtu", s.vtu, "write the mesh with one cell array per metric");
-  app.add_option("--svg", s.svg, "write a picture of a 2D mesh coloured by the first metric");
+  app.add_option("--svg", s.svg,
+                 "write a picture of a 2D mesh coloured by the first metric on [0, 1]; cells with a value <= 0 are "
+                 "magenta, ringed in red and counted in the legend");
+  app.add_flag("--svg-no-markers", s.svg_no_markers, "SVG: no rings on invalid cells");
   app.add_option("--zoom", s.zoom, "picture box xmin,xmax,ymin,ymax")->delimiter(',');
   app.add_option("--worst", s.worst, "how many worst cells to list per metric");
   CLI11_PARSE(app, argc, argv);
