@@ -122,6 +122,16 @@ smoke_test(NAME curve_mesh.bad_poisson_ratio.json EXPECT_RC 1
            KEYS error
            COMMAND curve_mesh --demo -o "${smoke_dir}/demo_bad.msh" --method sle --poisson-ratio 0.7 --json)
 
+# SVG pictures: invalid cells ringed (the default) or not; snapping alone leaves invalid cells.
+smoke_test(NAME curve_mesh.svg_no_markers.json
+           KEYS output,min_scaled_jacobian,invalid
+           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_none.msh" --method none --svg "${smoke_dir}/demo_none.svg"
+                   --zoom -0.8,0.8,-0.8,0.8 --svg-no-markers --json)
+smoke_test(NAME mesh_quality.svg_no_markers.json REQUIRES examples_demo_mesh
+           KEYS nodes,elements,metrics/scaled_jacobian/invalid
+           COMMAND mesh_quality "${smoke_dir}/demo.msh" --metric jacobian --svg "${smoke_dir}/demo_quality.svg"
+                   --svg-no-markers --json)
+
 # Bad input: a clear error, in JSON too, and a non-zero exit.
 smoke_test(NAME mesh_info.missing_file.json EXPECT_RC 1
            KEYS error
