@@ -174,7 +174,11 @@ void run(const Mesh<Dim>& linear, const Arguments& args) {
   if constexpr (Dim == 2) {
     if (!args.svg.empty()) {
       SvgOptions svg;
-      svg.title = "certified scaled Jacobian (" + result.method + ")";
+      char numbers[160];
+      std::snprintf(numbers, sizeof numbers, "): min %.4g, mean %.4g, %lld of %lld cells invalid", result.quality.min,
+                    result.quality.mean, static_cast<long long>(result.quality.num_invalid),
+                    static_cast<long long>(result.quality.num_elements));
+      svg.title = "certified scaled Jacobian of the P2 mesh (" + result.method + numbers;
       if (args.zoom.size() == 4) svg.zoom = std::array<double, 4>{args.zoom[0], args.zoom[1], args.zoom[2], args.zoom[3]};
       // Invalid cells are magenta and ringed: the scale keeps the valid range [0, 1] instead of
       // stretching down to the worst negative value (which left every valid cell one colour).
