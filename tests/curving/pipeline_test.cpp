@@ -8,12 +8,15 @@
 
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/core/shape_functions.hpp"
+#include "meshmotion/core/topology.hpp"
 #include "meshmotion/curving/blend_regularizer.hpp"
 #include "meshmotion/curving/boundary_layer.hpp"
 #include "meshmotion/curving/curve_mesh.hpp"
 #include "meshmotion/curving/function_graph.hpp"
 #include "meshmotion/curving/geometry.hpp"
+#include "meshmotion/curving/p2_conversion.hpp"
 #include "meshmotion/io/mesh_io.hpp"
+#include "meshmotion/spatial/kd_tree.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -424,6 +427,59 @@ TEST_CASE("pipeline: the coarse 3D bump-in-channel curves onto the analytic bump
   for (const Index v : curved.curved.group_nodes("side_y0")) CHECK(std::abs(curved.curved.points(1, v) + 1.0) < 1e-14);
   for (const Index v : curved.curved.group_nodes("side_y1")) CHECK(std::abs(curved.curved.points(1, v)) < 1e-14);
   // Snapping alone leaves the thin wall cells invalid: the regularization is what saves them.
-  options.method = "none";
-  CHECK(curve_mesh(linear, options).invalid() > 0);
+  CurveOptions<3> snap_only = options;
+  snap_only.method = "none";
+  CHECK(curve_mesh(linear, snap_only).invalid() > 0);
+
+  // Every boundary node a centre (the thesis) against centres within 2 radii of the motion:
+  // far fewer centres, the same mesh up to a small fraction of the wall displacement, and the
+  // boundary nodes without a centre stay where they were.
+  CurveOptions<3> all_centres = options;
+  all_centres.centre_reach = 0.0;
+  const CurveResult<3> thesis = curve_mesh(linear, all_centres);
+  CHECK(curved.steps.back().boundary_nodes < thesis.steps.back().boundary_nodes / 3);
+  CHECK(curved.quality.min == Approx(thesis.quality.min).margin(1e-3));
+  CHECK((curved.curved.points - thesis.curved.points).cwiseAbs().maxCoeff() < 0.02 * curved.max_boundary_displacement);
+  const Mesh<3> straight = convert_to_quadratic(linear).mesh;
+  for (const char* group : {"top", "inflow", "outflow", "symmetry_lower"})
+    for (const Index v : curved.curved.group_nodes(group)) CHECK(curved.curved.points.col(v) == straight.points.col(v));
+}
+
+TEST_CASE("pipeline: the default support radius is limited to a budget of boundary nodes", "[curving][slow]") {
+  const Mesh<3> linear = bump_channel_3d(0);
+  CurveOptions<3> options;
+  options.geometry.emplace("bump", BoundaryGeometry<3>::project(nasa_bump_3d()));
+  options.sliding = {"side_y0", "side_y1"};
+  options.max_support_nodes = 0.0;
+  const CurveResult<3> free = curve_mesh(linear, options);
+  CHECK_FALSE(free.support_radius_limited);
+  CHECK(free.support_radius == Approx(options.support_radius_factor * free.layers.front().thickness));
+  options.max_support_nodes = 20.0;
+  const CurveResult<3> limited = curve_mesh(linear, options);
+  CHECK(limited.support_radius_limited);
+  CHECK(limited.support_radius < free.support_radius);
+  CHECK(limited.invalid() == 0);
+  // Around the wall nodes the snapping moved, a support holds 20 boundary nodes or fewer on average.
+  const Mesh<3> straight = convert_to_quadratic(linear).mesh;
+  std::vector<Index> boundary;
+  for (const auto& block : boundary_facets(straight)) boundary.insert(boundary.end(), block.connectivity.begin(), block.connectivity.end());
+  std::sort(boundary.begin(), boundary.end());
+  boundary.erase(std::unique(boundary.begin(), boundary.end()), boundary.end());
+  Points<3> at(3, static_cast<Index>(boundary.size()));
+  for (std::size_t k = 0; k < boundary.size(); ++k) at.col(static_cast<Index>(k)) = straight.points.col(boundary[k]);
+  const KdTree<3> tree(at);
+  double inside = 0.0, moving = 0.0;
+  for (const Index v : straight.group_nodes("bump"))
+    if (limited.curved.points.col(v) != straight.points.col(v)) {
+      inside += static_cast<double>(tree.radius_search(Vec<3>(straight.points.col(v)), limited.support_radius).size());
+      moving += 1.0;
+    }
+  REQUIRE(moving > 0.0);
+  CHECK(inside / moving <= 20.0);
+  CHECK(inside / moving > 10.0);  // not shrunk far below the budget
+  options.max_support_nodes = -1.0;
+  CHECK_THROWS_AS(curve_mesh(linear, options), InputError);
+  options.max_support_nodes = 100.0;
+  options.centre_reach = -1.0;
+  CHECK_THROWS_AS(curve_mesh(linear, options), InputError);
 }

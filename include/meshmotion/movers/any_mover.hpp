@@ -159,6 +159,7 @@ mover_registry() {
          o.kernel = rbf_kernel_from_name(p.get("kernel", std::string(name(o.kernel))));
          o.support_radius = p.get("support_radius", o.support_radius);
          o.polynomial = p.get("polynomial", 0.0) != 0.0;
+         o.solver = detail::mechanics_solver(p);
          return AnyMover<Dim>(RbfMover<Dim>(o));
        }},
       // Delaunay-graph movers: "simplex_support" (relative per-simplex RBF support), "kernel",
