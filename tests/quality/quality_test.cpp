@@ -502,6 +502,9 @@ TEST_CASE("SVG picture: a ring and a count for exactly the invalid cells drawn",
   CHECK(occurrences(marked, "<circle class=\"invalid\"") == 3);
   CHECK(occurrences(marked, ">3 invalid<") == 1);
   CHECK(occurrences(marked, "fill=\"#ff00ff\" d=") == 3);
+  // Invalid cells are drawn over the valid ones (value 0.5, 1e-12).
+  CHECK(marked.find("fill=\"#ff00ff\" d=") > marked.rfind("<path fill=\"" + detail::colour(0.5) + "\""));
+  CHECK(marked.find("fill=\"#ff00ff\" d=") > marked.rfind("<path fill=\"" + detail::colour(1e-12) + "\""));
   // Rings are drawn after every cell, at the centroids (1000 px for 4 units: cell 1 is
   // centred at x = 1.5, y = 0.5 → 375, 375 px).
   CHECK(marked.find("<circle class=\"invalid\"") > marked.rfind("<path "));

@@ -68,7 +68,7 @@ inline std::string colour(double t) {
 
 /// The SVG text of `mesh` with cell i coloured by values[i] (cell order); only the cells that
 /// reach into the zoom box are written. Cells whose value is ≤ 0 or NaN (invalid) are magenta
-/// whatever the scale, and with options.mark_invalid each one drawn also gets a
+/// whatever the scale and drawn over the valid ones, and with options.mark_invalid each one drawn also gets a
 /// `<circle class="invalid" .../>` ring and the colour-bar column a line "N invalid" (N: the
 /// rings drawn). Throws InputError when values.size() != num_cells() or the zoom box is empty.
 [[nodiscard]] inline std::string svg_picture(const Mesh<2>& mesh, const std::vector<double>& values,
@@ -87,7 +87,7 @@ inline std::string colour(double t) {
     throw InputError("svg_picture: empty zoom box (got x " + std::to_string(box[0]) + ".." + std::to_string(box[1]) +
                      ", y " + std::to_string(box[2]) + ".." + std::to_string(box[3]) + ")");
   const double w = options.width, h = std::clamp(w * (box[3] - box[2]) / (box[1] - box[0]), 100.0, 4.0 * w);
-  const double bar = 90;
+  const double bar = 100;
   // The title gets a band of its own above the picture: in the colour-bar column a long one
   // ran off the right edge.
   const double band = options.title.empty() ? 0.0 : 22.0;
@@ -102,6 +102,9 @@ inline std::string colour(double t) {
                 w + bar, h + band, w + bar, h + band, band, w, h, options.draw_edges ? "black" : "none");
   const double span = options.value_max - options.value_min;
   std::vector<std::array<double, 2>> markers;  // pixel centroids of the invalid cells drawn
+  // Invalid cells go on top of the valid ones: a folded cell overlaps its neighbours, and
+  // drawn in turn it would hide under the layers it folds across.
+  std::string invalid_paths;
   Index cell = 0;
   for (const auto& block : mesh.cells) {
     const int nv = num_vertices(block.type);
@@ -124,20 +127,22 @@ inline std::string colour(double t) {
         for (int k = 0; k < nv; ++k) c[0] += px(p(k).x()) / nv, c[1] += py(p(k).y()) / nv;
         markers.push_back(c);
       }
-      detail::append_format(out, "<path fill=\"%s\" d=\"M%.3f %.3f", fill.c_str(), px(p(0).x()), py(p(0).y()));
+      std::string& path = invalid ? invalid_paths : out;
+      detail::append_format(path, "<path fill=\"%s\" d=\"M%.3f %.3f", fill.c_str(), px(p(0).x()), py(p(0).y()));
       for (int k = 0; k < nv; ++k) {
         const auto b = p((k + 1) % nv);
         if (curved) {
           // The quadratic through a, m (at t = 1/2) and b has control point 2m - (a + b)/2.
           const Eigen::Vector2d c = 2.0 * p(nv + k) - 0.5 * (p(k) + b);
-          detail::append_format(out, " Q%.3f %.3f %.3f %.3f", px(c.x()), py(c.y()), px(b.x()), py(b.y()));
+          detail::append_format(path, " Q%.3f %.3f %.3f %.3f", px(c.x()), py(c.y()), px(b.x()), py(b.y()));
         } else {
-          detail::append_format(out, " L%.3f %.3f", px(b.x()), py(b.y()));
+          detail::append_format(path, " L%.3f %.3f", px(b.x()), py(b.y()));
         }
       }
-      out += "Z\"/>\n";
+      path += "Z\"/>\n";
     }
   }
+  out += invalid_paths;
   out += "</g>\n";
   if (!markers.empty()) {
     // Over the cells, so that neighbours drawn later do not hide them.
