@@ -7,7 +7,10 @@
 // quads), and the sphere mesh with its STEP file. Gmsh's `-order 2` snapping and each
 // Mesh.HighOrderOptimize variant curve the linear mesh it saved; our pipeline curves the same
 // linear mesh with the analytic geometry; every P2 mesh is judged by our certified scaled
-// Jacobian and by gmsh's AnalyseMeshQuality plugin. Prints tables and one JSON line per row.
+// Jacobian and by gmsh's AnalyseMeshQuality plugin. Prints tables and one JSON line per row;
+// each JSON line holds the "histogram" of our certified scaled Jacobian (valid cells in 10
+// equal bins on [0, 1]; the invalid ones are counted by "invalid" alone), which
+// plot_results.py draws per mesh.
 // Times are this machine's; the thesis's are beside ours for reference.
 //
 // usage: curving_bench [--no-gmsh] [--gmsh-only] [--quick] [path/to/su2_30p30n_rans_L1_coarse.su2]
@@ -68,6 +71,18 @@ Mesh<2> split_quads(const Mesh<2>& mesh) {
   return out;
 }
 
+// The valid cells of a report per bin, as a JSON array. make_report puts invalid cells
+// (value ≤ 0) into the first bin; they are taken out so that the plot shows them apart.
+[[nodiscard]] std::string histogram_json(const QualityReport& q) {
+  std::string out = "[";
+  for (std::size_t b = 0; b < q.histogram.size(); ++b) {
+    const Index count = b == 0 ? std::max<Index>(0, q.histogram[0] - q.num_invalid) : q.histogram[b];
+    if (b > 0) out += ',';
+    out += std::to_string(count);
+  }
+  return out + "]";
+}
+
 void print_row(const std::string& mesh_name, const std::string& label, double radius, int steps, const QualityReport& q,
                double seconds, Index iterations, double baseline_seconds, const char* thesis) {
   std::printf("%-10s %-22s %9.5f %5d %8.4f %9.6f %7lld %9.3f %8.2f %7lld   %s\n", mesh_name.c_str(), label.c_str(), radius,
@@ -75,9 +90,11 @@ void print_row(const std::string& mesh_name, const std::string& label, double ra
               baseline_seconds > 0 ? seconds / baseline_seconds : 0.0, static_cast<long long>(iterations), thesis);
   std::printf(
       "{\"bench\":\"curving\",\"mesh\":\"%s\",\"case\":\"%s\",\"support_radius\":%.6g,\"steps\":%d,\"min\":%.6f,"
-      "\"mean\":%.6f,\"invalid\":%lld,\"seconds\":%.6f,\"ratio_to_baseline\":%.4f,\"iterations\":%lld,\"thesis\":\"%s\"}\n",
+      "\"mean\":%.6f,\"invalid\":%lld,\"seconds\":%.6f,\"ratio_to_baseline\":%.4f,\"iterations\":%lld,\"thesis\":\"%s\","
+      "\"histogram\":%s}\n",
       mesh_name.c_str(), label.c_str(), radius, steps, q.min, q.mean, static_cast<long long>(q.num_invalid), seconds,
-      baseline_seconds > 0 ? seconds / baseline_seconds : 0.0, static_cast<long long>(iterations), thesis);
+      baseline_seconds > 0 ? seconds / baseline_seconds : 0.0, static_cast<long long>(iterations), thesis,
+      histogram_json(q).c_str());
 }
 
 void thesis_table(const fs::path& file) {
@@ -187,10 +204,10 @@ void print_peer_row(const std::string& name, const PeerRow& r, double reference_
       "{\"bench\":\"curving_vs_gmsh\",\"case\":\"%s\",\"tool\":\"%s\",\"method\":\"%s\",\"cpu_seconds\":%.6f,"
       "\"wall_seconds\":%.6f,\"ratio_to_best_gmsh_cpu\":%.4f,\"min\":%.6f,\"mean\":%.6f,\"invalid\":%lld,"
       "\"gmsh_minJ_maxJ_worst\":%.6f,\"gmsh_minJ_maxJ_avg\":%.6f,\"gmsh_invalid\":%ld,\"geometry_error\":%.3e,"
-      "\"note\":\"%s\"}\n",
+      "\"note\":\"%s\",\"histogram\":%s}\n",
       name.c_str(), r.tool.c_str(), r.method.c_str(), r.cpu, r.wall, ratio, r.ours.min, r.ours.mean,
       static_cast<long long>(r.ours.num_invalid), r.gmsh.worst, r.gmsh.average, r.gmsh.invalid, r.geometry_error,
-      note.c_str());
+      note.c_str(), histogram_json(r.ours).c_str());
   std::fflush(stdout);
 }
 

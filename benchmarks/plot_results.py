@@ -5,7 +5,10 @@
   plot_results.py RESULTS.jsonl [--out-dir DIR]
       every known plot that RESULTS has data for: time against size on log-log axes for the
       RBF scaling family, the compact-vs-dense RBF peer, the 3D bump levels and the
-      compact-vs-direct evaluation; one SVG per plot.
+      compact-vs-direct evaluation; one SVG per plot. And one quality histogram per mesh of
+      the curving bench (rows with a "histogram" field): the certified scaled Jacobian's
+      counts per bin on [0, 1], a bar per method, log counts, the invalid cells as a separate
+      bar at the left; named curving_hist_<mesh>.svg.
   plot_results.py RESULTS.jsonl --x FIELD --y FIELD[,FIELD...] [--where KEY=VALUE ...]
                   [--group FIELD] [--linear] [--title TEXT] --out FILE.svg
       one plot of the rows matching every --where, a line per --y field (or per value of
@@ -21,7 +24,8 @@ import os
 import re
 import sys
 
-COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"]
+COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#7f7f7f",
+           "#bcbd22"]
 
 
 def read_rows(path):
@@ -110,6 +114,81 @@ def svg_plot(series, title, x_label, y_label, log=True, width=760, height=420):
     return "\n".join(out)
 
 
+def histogram_groups(rows):
+    """{mesh: [(method label, invalid, [count per bin]), ...]} from the curving bench's rows, in
+    the order they were printed. The 30P30N table names the mesh "mesh" and the method "case";
+    the Gmsh comparison names the mesh "case" and the method "tool" + "method"."""
+    groups = {}
+    for row in rows:
+        counts = row.get("histogram")
+        if not isinstance(counts, list) or not counts or not isinstance(row.get("invalid"), int):
+            continue  # a failed run has no histogram
+        if row.get("bench") == "curving":
+            mesh, label = "30p30n_" + str(row.get("mesh")), str(row.get("case"))
+            if row.get("steps", 1) != 1:
+                label += f", {row['steps']} steps"
+        elif row.get("bench") == "curving_vs_gmsh":
+            mesh, label = str(row.get("case")), f"{row.get('tool')}: {row.get('method')}"
+        else:
+            continue
+        groups.setdefault(mesh, []).append((label, row["invalid"], counts))
+    return groups
+
+
+def svg_histogram(series, title, plot_width=700, height=460):
+    """The SVG text of grouped bars: for each method the invalid count, then the count per
+    equal bin on [0, 1]; log10 counts (a count of 1 still shows a bar, 0 shows none)."""
+    bins = max(len(counts) for _, _, counts in series)
+    legend = [f"{label} ({invalid} invalid)" for label, invalid, _ in series]
+    left, top, bottom = 70, 40, 60
+    right = 50 + 7 * max(len(text) for text in legend)  # legend labels are long ("gmsh: elastic (HOO=3) nl=40")
+    width, pw = left + plot_width + right, plot_width
+    height = max(height, top + 18 * len(series) + 20)
+    ph = height - top - bottom
+    groups = bins + 1  # the invalid bar first
+    gap = 0.6  # extra space (in groups) between the invalid group and the bins
+    group_w = pw / (groups + gap)
+    bar_w = group_w * 0.85 / len(series)
+    largest = max([inv for _, inv, _ in series] + [c for _, _, counts in series for c in counts] + [1])
+    y0, y1 = math.log10(0.5), math.ceil(math.log10(largest) + 1e-9)
+    py = lambda v: top + ph - (math.log10(v) - y0) / (y1 - y0) * ph
+    esc = lambda s: s.replace("&", "&amp;").replace("<", "&lt;")
+    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" font-family="sans-serif" font-size="12">',
+           '<rect width="100%" height="100%" fill="white"/>',
+           f'<text x="{left}" y="22" font-size="14">{esc(title)}</text>']
+    for k in range(0, int(y1) + 1):
+        y = py(10.0 ** k)
+        out.append(f'<line x1="{left}" y1="{y:.1f}" x2="{left + pw}" y2="{y:.1f}" stroke="#ddd"/>')
+        out.append(f'<text x="{left - 6}" y="{y + 4:.1f}" text-anchor="end">{10 ** k:g}</text>')
+
+    def group_x(g):  # left edge of group g (0: invalid)
+        return left + (g + (gap if g > 0 else 0.0)) * group_w + group_w * 0.075
+
+    for g in range(groups):
+        label = "invalid" if g == 0 else f"{(g - 1) / bins:g}–{g / bins:g}"
+        fill = "#c00" if g == 0 else "black"
+        out.append(f'<text x="{group_x(g) + group_w * 0.425:.1f}" y="{top + ph + 16}" text-anchor="middle"'
+                   f' font-size="10" fill="{fill}">{label}</text>')
+    sep = left + (1 + gap / 2) * group_w
+    out.append(f'<line x1="{sep:.1f}" y1="{top}" x2="{sep:.1f}" y2="{top + ph}" stroke="#888" stroke-dasharray="4 3"/>')
+    for k, (label, invalid, counts) in enumerate(series):
+        colour = COLOURS[k % len(COLOURS)]
+        for g, count in enumerate([invalid] + list(counts)):
+            if count > 0:
+                x, y = group_x(g) + k * bar_w, py(count)
+                out.append(f'<rect x="{x:.1f}" y="{y:.1f}" width="{bar_w:.1f}" height="{top + ph - y:.1f}" fill="{colour}">'
+                           f'<title>{esc(label)}: {count}</title></rect>')
+        ly = top + 14 + 18 * k
+        out.append(f'<rect x="{left + pw + 12}" y="{ly - 10}" width="14" height="10" fill="{colour}"/>')
+        out.append(f'<text x="{left + pw + 32}" y="{ly}">{esc(legend[k])}</text>')
+    out.append(f'<rect x="{left}" y="{top}" width="{pw}" height="{ph}" fill="none" stroke="black"/>')
+    out.append(f'<text x="{left + pw / 2}" y="{height - 14}" text-anchor="middle">'
+               'certified scaled Jacobian (min det J / det J of the straight element)</text>')
+    out.append(f'<text transform="translate(16 {top + ph / 2}) rotate(-90)" text-anchor="middle">cells (log scale)</text>')
+    out.append("</svg>\n")
+    return "\n".join(out)
+
+
 def write(path, text):
     tmp = path + ".tmp"
     with open(tmp, "w", encoding="utf-8") as f:
@@ -164,6 +243,11 @@ def main():
         if sum(len(p) for p in series.values()) >= 2:
             write(os.path.join(out_dir, name), svg_plot(series, title, x_label, y_label))
             made += 1
+    for mesh, series in histogram_groups(rows).items():
+        name = "curving_hist_" + re.sub(r"[^A-Za-z0-9_.-]", "_", mesh) + ".svg"
+        title = f"Certified scaled Jacobian of the P2 mesh: {mesh}"
+        write(os.path.join(out_dir, name), svg_histogram(series, title))
+        made += 1
     if made == 0:
         print(f"plot_results: nothing to plot in {args.results} (no known benchmark series)")
 
