@@ -49,6 +49,9 @@ struct JacobianSpace {
   std::vector<std::array<int, 3>> line_index;     // 1D index per line dimension per point
   Eigen::MatrixXd gradients;                   // (num_points · dim) × num_nodes: row point · dim + d
   std::vector<double> linear_gradients;        // vertex shape gradients at the centroid: [vertex * dim + d]
+  // Higher-order types: column i = the linear cell's shape functions at node i, so that
+  // x_vertices × linear_embedding are the node positions of the straight-sided cell.
+  Eigen::MatrixXd linear_embedding;
   // Tensor-product elements (quad4/9, hex8/27): the Jacobians at the lattice by sum
   // factorization, a 1D table per reference axis instead of `gradients` (a hex27's 52k
   // multiply-adds become 10k).
@@ -274,6 +277,16 @@ inline JacobianSpace make_jacobian_space(ElementType t) {
   shape_derivatives(lin, reference_centroid(lin), gl);
   for (const auto& gi : gl)
     for (int d = 0; d < s.dim; ++d) s.linear_gradients.push_back(gi[static_cast<std::size_t>(d)]);
+  if (lin != t && s.bezier) {
+    const int nv = num_nodes(lin);
+    std::vector<double> values(static_cast<std::size_t>(nv));
+    s.linear_embedding.resize(nv, s.num_nodes);
+    const auto nodes = reference_nodes(t);
+    for (int i = 0; i < s.num_nodes; ++i) {
+      shape_functions(lin, nodes[static_cast<std::size_t>(i)], values);
+      for (int v = 0; v < nv; ++v) s.linear_embedding(v, i) = values[static_cast<std::size_t>(v)];
+    }
+  }
 
   if (!s.bezier) return s;
   if (s.simplex_dim > 0) {
