@@ -247,6 +247,38 @@ TEST_CASE("certified bound is below the sampled minimum and sharp on curved elem
   }
 }
 
+TEST_CASE("straight-sided high-order cells certify as their linear cell, with the same values", "[quality]") {
+  // Vertices of a non-parallelepiped cell; higher-order nodes where the linear cell's map puts
+  // them (the shortcut), or 1e-9 off (the full high-order path): the bounds agree.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.2, 0.2);
+  for (ElementType t : {ElementType::tri6, ElementType::quad8, ElementType::quad9, ElementType::tet10, ElementType::hex20,
+                        ElementType::hex27, ElementType::prism15, ElementType::prism18}) {
+    INFO(name(t));
+    const ElementType lin = linear_type(t);
+    const int d = dimension(t), nv = num_vertices(t);
+    Eigen::MatrixXd vertices(d, nv);
+    const auto ref = reference_nodes(lin);
+    for (int v = 0; v < nv; ++v)
+      for (int k = 0; k < d; ++k) vertices(k, v) = ref[static_cast<std::size_t>(v)][static_cast<std::size_t>(k)] + u(rng);
+    Eigen::MatrixXd x(d, num_nodes(t));
+    std::vector<double> n(static_cast<std::size_t>(nv));
+    for (int i = 0; i < num_nodes(t); ++i) {
+      shape_functions(lin, reference_nodes(t)[static_cast<std::size_t>(i)], n);
+      x.col(i) = vertices * Eigen::Map<const Eigen::VectorXd>(n.data(), nv);
+    }
+    const ScaledJacobian straight = scaled_jacobian(t, x);
+    const ScaledJacobian linear = scaled_jacobian(lin, vertices);
+    CHECK(straight.certified_min == linear.certified_min);
+    CHECK(straight.leaves == linear.leaves);
+    x(0, nv) += 1e-9;
+    const ScaledJacobian full = scaled_jacobian(t, x);
+    CHECK(full.certified_min == Approx(straight.certified_min).margin(2e-4));
+    CHECK(full.sampled_min == Approx(straight.sampled_min).margin(1e-6));
+    CHECK(full.valid == straight.valid);
+  }
+}
+
 TEST_CASE("scaled Jacobian flags tangled curved elements", "[quality]") {
   // Midpoint of edge (1,2) pushed across vertex 0.
   auto tri = columns<2>({{0, 0}, {1, 0}, {0, 1}, {0.5, 0}, {-0.3, -0.3}, {0, 0.5}});
