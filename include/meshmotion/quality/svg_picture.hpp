@@ -68,9 +68,10 @@ inline std::string colour(double t) {
 
 /// The SVG text of `mesh` with cell i coloured by values[i] (cell order); only the cells that
 /// reach into the zoom box are written. Cells whose value is ≤ 0 or NaN (invalid) are magenta
-/// whatever the scale and drawn over the valid ones, and with options.mark_invalid each one drawn also gets a
-/// `<circle class="invalid" .../>` ring and the colour-bar column a line "N invalid" (N: the
-/// rings drawn). Throws InputError when values.size() != num_cells() or the zoom box is empty.
+/// whatever the scale, drawn translucent over the valid ones, and with options.mark_invalid
+/// each one drawn also gets a `<circle class="invalid" .../>` ring and the colour-bar column a
+/// line "N invalid" (N: the rings drawn). Throws InputError when values.size() !=
+/// num_cells() or the zoom box is empty.
 [[nodiscard]] inline std::string svg_picture(const Mesh<2>& mesh, const std::vector<double>& values,
                                              const SvgOptions& options = {}) {
   if (static_cast<Index>(values.size()) != mesh.num_cells())
@@ -142,7 +143,12 @@ inline std::string colour(double t) {
       path += "Z\"/>\n";
     }
   }
-  out += invalid_paths;
+  // Translucent, so that the layers a folded cell lies across still show.
+  if (!invalid_paths.empty()) {
+    out += "<g fill-opacity=\"0.6\">\n";
+    out += invalid_paths;
+    out += "</g>\n";
+  }
   out += "</g>\n";
   if (!markers.empty()) {
     // Over the cells, so that neighbours drawn later do not hide them.
