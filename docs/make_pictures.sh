@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# Makes the before/after pictures of docs/curving.md with the built example programs:
+#
+#   docs/make_pictures.sh [BUILD_DIR]        # default ./build
+#
+# docs/images/ gets only pictures of meshes the programs make themselves: curve_mesh's demo
+# (a boundary-layer O-mesh around a cylinder of radius 0.5, 128 x 64 quads, first cell 1e-5,
+# aspect ratio ≥ 1000) curved into P2 by snapping alone (--method none), by the default RBF
+# regularizer and by blending; each seen whole around the body and zoomed on one wall cell.
+#
+# With MESHMOTION_DATA pointing at a folder holding su2_30p30n_rans_L1_coarse.su2, it also
+# draws the 30P30N slat cove, into BUILD_DIR/pictures/ only: that mesh's licence is not the
+# project's, so neither the mesh nor pictures of it go into the repository.
+set -euo pipefail
+
+build=${1:-./build}
+docs=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+curve_mesh=$build/examples/curve_mesh
+if [[ ! -x $curve_mesh ]]; then
+  echo "make_pictures.sh: $curve_mesh not found (build the curve_mesh target first, or pass the build dir)" >&2
+  exit 1
+fi
+images=$docs/images
+mkdir -p "$images"
+scratch=$(mktemp -d)
+trap 'rm -rf "$scratch"' EXIT
+
+# Whole body, and the middle of one wall cell: the cell between the wall nodes at 0° and 2.8°
+# (y = 0 .. 0.0245), whose wall edge snapping bends outwards by 1.5e-4 (15 first-cell heights)
+# at y = 0.0123; 1e-3 of its length is shown, at 7 pixels per first-cell height.
+body=-0.75,0.75,-0.75,0.75
+wall=0.4994,0.5008,0.0118,0.0128
+
+for method in none rbf blend; do
+  for view in body wall; do
+    zoom=$body
+    [[ $view == wall ]] && zoom=$wall
+    svg=$images/cylinder_${method}_${view}.svg
+    "$curve_mesh" --demo --method "$method" -o "$scratch/cylinder_$method.msh" --svg "$svg" --zoom "$zoom" 2>/dev/null |
+      grep -E "certified scaled Jacobian|^wrote" | sed "s|^|$method/$view: |"
+  done
+done
+
+data=${MESHMOTION_DATA:-}
+if [[ -n $data && -f $data/su2_30p30n_rans_L1_coarse.su2 ]]; then
+  out=$build/pictures
+  mkdir -p "$out"
+  # The slat cove (metres), and the flap's leading edge under the main element's trailing
+  # edge, where snapping alone leaves its worst cells.
+  for view in slat_cove:-0.042,0.012,-0.036,0.006 flap:0.395,0.465,-0.022,0.016; do
+    for method in none rbf; do
+      "$curve_mesh" "$data/su2_30p30n_rans_L1_coarse.su2" -o "$scratch/30p30n_$method.msh" --method "$method" \
+        --group farfield --geometry straight --svg "$out/30p30n_${view%%:*}_$method.svg" --zoom "${view#*:}" 2>/dev/null |
+        grep -E "certified scaled Jacobian|^wrote" | sed "s|^|30p30n ${view%%:*} $method: |"
+    done
+  done
+fi
+ls -l "$images"/cylinder_*.svg
