@@ -65,7 +65,7 @@ struct CurveOptions {
   RbfKernel kernel = RbfKernel::wendland2;
   /// RBF support radius (given to every registry mover as "support_radius"); 0:
   /// support_radius_factor × the thickest estimated wall layer
-  /// (suggest_support_radius() when no wall has an anisotropic layer).
+  /// (suggest_support_radius() with 3 wall node spacings when no wall has an anisotropic layer).
   double support_radius = 0.0;
   /// 4 in 2D (on the 30P30N triangles the minimum quality rises from 0.47 at 1 to 0.80 at 4,
   /// for 0.06 s more), 1 in 3D (on the bump 2 costs 6× the time); docs/curving.md.
@@ -419,7 +419,12 @@ template <int Dim>
     if (!(result.support_radius > 0.0)) {
       Points<Dim> at(Dim, static_cast<Index>(snapped.nodes.size()));
       for (std::size_t k = 0; k < snapped.nodes.size(); ++k) at.col(static_cast<Index>(k)) = result.curved.points.col(snapped.nodes[k]);
-      result.support_radius = snapped.nodes.size() >= 2 ? suggest_support_radius(at, snapped.displacements) : 1.0;
+      // Curving displacements are tiny, so the spacing term decides. The motion default (10
+      // wall spacings) spans the whole body on the sphere test case (0.75 for radius 0.5) and
+      // gives 0.22, below snapping alone; 3 spacings give 0.64 (docs/curving.md).
+      SupportRadiusOptions wall_spacing;
+      wall_spacing.spacing_factor = 3.0;
+      result.support_radius = snapped.nodes.size() >= 2 ? suggest_support_radius(at, snapped.displacements, wall_spacing) : 1.0;
     }
     MoverParameters parameters = options.parameters;
     parameters.values.try_emplace("kernel", std::string(name(options.kernel)));
