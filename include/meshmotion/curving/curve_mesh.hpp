@@ -73,14 +73,14 @@ struct CurveOptions {
   /// A default radius (support_radius = 0) is shrunk until a support holds at most this many
   /// boundary nodes on average around the moving ones; 0: no limit. On the 3D bump's medium
   /// level the layer-based radius (0.177) takes minutes to factorize; the limit of 100 gives
-  /// 0.105 (docs/curving.md, "Support radius"). 2D supports grow only linearly with the
+  /// 0.1035 (docs/curving.md, "Support radius"). 2D supports grow only linearly with the
   /// radius and are not limited by default.
   double max_support_nodes = Dim == 2 ? 0.0 : 100.0;
   /// Method "rbf": boundary nodes that stay put (fixed, sliding, or snapped with zero
   /// displacement) are RBF centres only within this many support radii of a node the snapping
   /// moved; farther ones keep their place without a centre. 0 keeps every boundary node a
-  /// centre (the thesis). At 2 the 3D bump's minimum quality is unchanged to 3 digits with a
-  /// fifth of the centres (docs/curving.md, "Centres near the motion").
+  /// centre (the thesis). At 2 the 3D bump's minimum quality is unchanged to 4 digits with a
+  /// sixth of the centres (docs/curving.md, "Centres near the motion").
   double centre_reach = 2.0;
   /// Blending length of method "blend"; 0: each wall's layer thickness.
   double blending_length = 0.0;
@@ -184,15 +184,22 @@ template <int Dim>
   return make_resolved_boundary(entries);
 }
 
+/// The nodes of `boundary` with a nonzero displacement.
+template <int Dim>
+[[nodiscard]] std::vector<Index> moving_nodes(const ResolvedBoundary<Dim>& boundary) {
+  std::vector<Index> moving;
+  for (Index k = 0; k < boundary.size(); ++k)
+    if (boundary.displacements.col(k).squaredNorm() > 0.0) moving.push_back(boundary.nodes[static_cast<std::size_t>(k)]);
+  return moving;
+}
+
 /// The entries of `boundary` within `reach` of an entry with a nonzero displacement. The RBF
 /// system of a compact kernel couples centres only through overlapping supports, so the
 /// coefficients of zero-displacement centres decay with their distance from the motion; those
 /// beyond a couple of radii change the interpolant by a small fraction of the displacement.
 template <int Dim>
 [[nodiscard]] ResolvedBoundary<Dim> near_motion(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary, double reach) {
-  std::vector<Index> moving;
-  for (Index k = 0; k < boundary.size(); ++k)
-    if (boundary.displacements.col(k).squaredNorm() > 0.0) moving.push_back(boundary.nodes[static_cast<std::size_t>(k)]);
+  const std::vector<Index> moving = moving_nodes(boundary);
   if (moving.empty()) return boundary;
   Points<Dim> at(Dim, static_cast<Index>(moving.size()));
   for (std::size_t k = 0; k < moving.size(); ++k) at.col(static_cast<Index>(k)) = mesh.points.col(moving[k]);
@@ -213,9 +220,7 @@ template <int Dim>
 template <int Dim>
 [[nodiscard]] double limit_support_radius(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary, double radius,
                                           double budget) {
-  std::vector<Index> moving;
-  for (Index k = 0; k < boundary.size(); ++k)
-    if (boundary.displacements.col(k).squaredNorm() > 0.0) moving.push_back(boundary.nodes[static_cast<std::size_t>(k)]);
+  const std::vector<Index> moving = moving_nodes(boundary);
   if (moving.empty() || !(budget > 0.0)) return radius;
   Points<Dim> at(Dim, boundary.size());
   for (Index k = 0; k < boundary.size(); ++k) at.col(k) = mesh.points.col(boundary.nodes[static_cast<std::size_t>(k)]);
