@@ -4,8 +4,9 @@
 // the same displacement, judges every result with our quality layer (Knupp skew and scaled
 // Jacobian) and prints a table and one JSON line per row.
 //
-//   motion_peer_bench foam-export CASE DIR             OpenFOAM polyMesh (2D cases extruded one
+//   motion_peer_bench foam-export CASE DIR [FROM_CASE] OpenFOAM polyMesh (2D cases extruded one
 //                                                      cell thick) and 0/pointDisplacement
+//                                                      (minus FROM_CASE's: one step of a motion)
 //   motion_peer_bench foam-judge CASE DIR SECONDS [ITERATIONS]
 //                                                      DIR/1/polyMesh/points vs our movers
 //   motion_peer_bench rbf-export CASE DIR              points, centres, values (raw float64)
@@ -294,7 +295,10 @@ std::vector<Index> foam_patch_points(const FoamMesh& foam, const std::string& pa
   throw InputError("foam_patch_points: no patch named '" + patch + "'");
 }
 
-void foam_export(const Case<2>& c, const fs::path& dir) {
+/// `from`: a case on the same mesh whose displacement is subtracted on the moving patch, for one
+/// increment of a motion spread over several moveMesh runs (the script then replaces the
+/// exported points by the previous run's moved points).
+void foam_export(const Case<2>& c, const fs::path& dir, const Case<2>* from = nullptr) {
   const FoamMesh foam = foam_mesh(c.mesh);
   const Index n = c.mesh.num_nodes();
   fs::create_directories(dir / "constant" / "polyMesh");
@@ -340,7 +344,13 @@ void foam_export(const Case<2>& c, const fs::path& dir) {
   detail::write_file_atomically(poly / "boundary", s.str());
 
   // The prescribed displacement on the moving patch (both layers), zero on the others.
-  const ResolvedBoundary<2> b = c.spec.resolve(c.mesh);
+  ResolvedBoundary<2> b = c.spec.resolve(c.mesh);
+  if (from != nullptr) {
+    const ResolvedBoundary<2> before = from->spec.resolve(from->mesh);
+    if (from->mesh.num_nodes() != n || before.nodes != b.nodes)
+      throw InputError("foam_export: case " + from->name + " is not on the mesh of " + c.name);
+    b.displacements -= before.displacements;
+  }
   std::vector<Index> slot(static_cast<std::size_t>(n), -1);
   for (Index k = 0; k < b.size(); ++k) slot[static_cast<std::size_t>(b.nodes[static_cast<std::size_t>(k)])] = k;
   s.str("");
@@ -556,9 +566,17 @@ void rbf_judge(const Case<Dim>& c, const fs::path& dir) {
 
 int usage() {
   std::fprintf(stderr,
-               "usage: motion_peer_bench foam-export CASE DIR | foam-judge CASE DIR SECONDS [NOTE] | rbf-export CASE DIR | "
-               "rbf-judge CASE DIR\n  CASE: bump | ellipse:<n_around>:<degrees> | box:<n>\n");
+               "usage: motion_peer_bench foam-export CASE DIR [FROM_CASE] | foam-judge CASE DIR SECONDS [NOTE] | "
+               "rbf-export CASE DIR | rbf-judge CASE DIR\n  CASE: bump | ellipse:<n_around>:<degrees> | box:<n>\n");
   return 1;
+}
+
+// The 2D case of a stepped foam-export's FROM_CASE.
+Case<2> case_2d(const std::string& name) {
+  const std::vector<std::string> parts = split(name, ':');
+  if (!parts.empty() && parts[0] == "ellipse") return ellipse_case(parts);
+  if (name == "bump") return bump_case();
+  throw InputError("motion_peer_bench: FROM_CASE must be a 2D case, bump or ellipse:<n_around>:<degrees> (got '" + name + "')");
 }
 
 template <int Dim>
@@ -566,6 +584,10 @@ int run(const std::string& command, const Case<Dim>& c, const fs::path& dir, int
   if (command == "rbf-export") return rbf_export(c, dir), 0;
   if (command == "rbf-judge") return rbf_judge(c, dir), 0;
   if constexpr (Dim == 2) {
+    if (command == "foam-export" && argc >= 5) {
+      const Case<2> from = case_2d(argv[4]);
+      return foam_export(c, dir, &from), 0;
+    }
     if (command == "foam-export") return foam_export(c, dir), 0;
     if (command == "foam-judge" && argc >= 5) return foam_judge(c, dir, std::atof(argv[4]), argc > 5 ? argv[5] : ""), 0;
   }

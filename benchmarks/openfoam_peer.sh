@@ -136,7 +136,38 @@ run_case() {
   "$bench" foam-judge "$case" "$dir" "$seconds" "$note"
 }
 
+# The rotation spread over STEPS moveMesh runs, as OpenFOAM users move a body through a large
+# angle: each run starts from the previous one's moved points and prescribes the increment of
+# the wall's rotation (inverseDistance diffusivity and the Laplacian on the current mesh).
+run_steps() {
+  local around=$1 degrees=$2 steps=$3 patch=$4
+  local case="ellipse:$around:$degrees" dir="$work/ellipse_${around}_${degrees}_steps$steps"
+  local points="$work/points.previous" seconds=0 iterations=0 k
+  ((have_foam)) || { "$bench" foam-judge "$case" "$dir" 0 "OpenFOAM not installed"; return; }
+  for ((k = 1; k <= steps; ++k)); do
+    local to from start end
+    to=$(awk -v d="$degrees" -v k="$k" -v n="$steps" 'BEGIN { printf "%.12g", d * k / n }')
+    from=$(awk -v d="$degrees" -v k="$k" -v n="$steps" 'BEGIN { printf "%.12g", d * (k - 1) / n }')
+    rm -rf "$dir"
+    "$bench" foam-export "ellipse:$around:$to" "$dir" "ellipse:$around:$from" >/dev/null || return 1
+    write_dicts "$dir" "$patch"
+    ((k > 1)) && cp "$points" "$dir/constant/polyMesh/points"
+    start=$(date +%s.%N)
+    if ! moveMesh -case "$dir" >"$dir/log.moveMesh" 2>&1; then
+      tail -5 "$dir/log.moveMesh"
+      "$bench" foam-judge "$case" "$dir" 0 "moveMesh failed at step $k of $steps"
+      return
+    fi
+    end=$(date +%s.%N)
+    seconds=$(awk -v s="$seconds" -v a="$start" -v b="$end" 'BEGIN { printf "%.4f", s + b - a }')
+    iterations=$((iterations + $(grep -o 'No Iterations [0-9]*' "$dir/log.moveMesh" | awk '{ s += $3 } END { print s + 0 }')))
+    cp "$dir/1/polyMesh/points" "$points"
+  done
+  "$bench" foam-judge "$case" "$dir" "$seconds" "moveMesh wall time summed over $steps runs of ${degrees}/$steps deg; $iterations GAMG iterations (x+y)"
+}
+
 mkdir -p "$work"
 run_case bump interface
 run_case ellipse:128:30 wall
 run_case ellipse:128:60 wall
+run_steps 128 60 10 wall
