@@ -81,6 +81,8 @@ Motion<Dim> motion(const Arguments& a) {
 
 template <int Dim>
 int run(const Arguments& a, Mesh<Dim> mesh) {
+  // Files without physical names: `--group 3` addresses the facets tagged 3.
+  name_unnamed_facet_groups(mesh);
   BoundarySpec<Dim> spec;
   if (!a.displacements_file.empty())
     spec.moving(a.group, read_displacements<Dim>(a.displacements_file, static_cast<Index>(mesh.group_nodes(a.group).size())));

@@ -146,3 +146,18 @@ TEST_CASE("generators reject impossible sizes", "[core]") {
   CHECK_THROWS_WITH(o_mesh({.farfield_radius = 0.4}), Catch::Contains("does not enclose"));
   CHECK_THROWS_WITH(o_mesh({.n_radial = 10, .first_height = 5.0}), Catch::Contains("past the farfield"));
 }
+
+TEST_CASE("facet tags without a group get one named by their number", "[core]") {
+  Mesh<2> m = rectangle_mesh({.nx = 4, .ny = 2});
+  const PhysicalGroup left = m.group("left");
+  // As read from a file without physical names: the tags stay, the names go, except "top".
+  std::erase_if(m.groups, [](const PhysicalGroup& g) { return g.name != "top"; });
+  const Index groups_with_a_name = static_cast<Index>(m.groups.size());
+  CHECK_THROWS_AS(m.group_nodes(std::to_string(left.tag)), InputError);
+  CHECK(name_unnamed_facet_groups(m) == 3);
+  CHECK(static_cast<Index>(m.groups.size()) == groups_with_a_name + 3);
+  CHECK(m.group_nodes(std::to_string(left.tag)).size() == 3);
+  for (const Index v : m.group_nodes(std::to_string(left.tag))) CHECK(m.points(0, v) == 0.0);
+  CHECK(m.group("top").name == "top");
+  CHECK(name_unnamed_facet_groups(m) == 0);  // idempotent
+}

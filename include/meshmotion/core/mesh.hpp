@@ -216,4 +216,22 @@ void validate(const Mesh<Dim>& mesh) {
   check_blocks(mesh.lower, -1);
 }
 
+/// Gives every facet tag that has no group a group named by its number ("7"), the way files
+/// without physical names (Gmsh without $PhysicalNames) are addressed on command lines.
+/// Returns the number of groups added.
+template <int Dim>
+Index name_unnamed_facet_groups(Mesh<Dim>& mesh) {
+  Index added = 0;
+  for (const auto& block : mesh.facets)
+    for (const int tag : block.tags) {
+      const bool named = std::any_of(mesh.groups.begin(), mesh.groups.end(),
+                                     [&](const PhysicalGroup& g) { return g.dim == Dim - 1 && g.tag == tag; });
+      if (!named && tag != 0) {
+        mesh.groups.push_back({Dim - 1, tag, std::to_string(tag)});
+        ++added;
+      }
+    }
+  return added;
+}
+
 }  // namespace meshmotion

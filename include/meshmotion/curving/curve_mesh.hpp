@@ -265,18 +265,6 @@ class SnapOnlyMover {
   ResolvedBoundary<Dim> boundary_;
 };
 
-/// Names every facet tag that has no group by its number ("7"), as files without physical
-/// names (Gmsh without $PhysicalNames) are meant to be addressed.
-template <int Dim>
-void name_unnamed_facet_groups(Mesh<Dim>& mesh) {
-  for (const auto& block : mesh.facets)
-    for (const int tag : block.tags) {
-      const bool named = std::any_of(mesh.groups.begin(), mesh.groups.end(),
-                                     [&](const PhysicalGroup& g) { return g.dim == Dim - 1 && g.tag == tag; });
-      if (!named && tag != 0) mesh.groups.push_back({Dim - 1, tag, std::to_string(tag)});
-    }
-}
-
 /// A double as text that reads back to the same value (for MoverParameters).
 [[nodiscard]] inline std::string exact_decimal(double x) {
   char buffer[32];
@@ -369,7 +357,7 @@ template <int Dim>
   QuadraticConversion<Dim> conversion = convert_to_quadratic(linear);
   result.curved = std::move(conversion.mesh);
   result.num_linear_nodes = conversion.num_linear_nodes;
-  detail::name_unnamed_facet_groups(result.curved);
+  name_unnamed_facet_groups(result.curved);
   result.seconds.quadratic = clock.seconds();
 
   const std::map<int, BoundaryGeometry<Dim>> geometry = detail::resolve_geometry(result.curved, options);
