@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Makes the before/after pictures of docs/curving.md with the built example programs:
+# Makes the before/after pictures of docs/curving.md, docs/interpolation.md and docs/mechanics.md
+# with the built example programs:
 #
 #   docs/make_pictures.sh [BUILD_DIR]        # default ./build
 #
@@ -41,6 +42,23 @@ for method in none rbf blend; do
   done
 done
 
+# Mesh motion (docs/interpolation.md, docs/mechanics.md): the curved demo's wall rotated 90°
+# about its centre, the farfield fixed, by RBF, lineal springs and stiffened elasticity; Knupp
+# skew, invalid cells ringed.
+move_mesh=$build/examples/move_mesh
+mesh_quality=$build/examples/mesh_quality
+if [[ -x $move_mesh && -x $mesh_quality ]]; then
+  "$curve_mesh" --demo -o "$scratch/cylinder.msh" >/dev/null 2>&1
+  for method in rbf spring sle; do
+    # move_mesh exits with 2 when it leaves invalid cells, as springs and elasticity do here.
+    { "$move_mesh" "$scratch/cylinder.msh" -o "$scratch/rotated_$method.msh" --group wall --rotate 90 --center 0,0 \
+      --fixed farfield --method "$method" 2>/dev/null || [[ $? == 2 ]]; } | grep -E "skew after" | sed "s|^|rotate 90 $method: |"
+    "$mesh_quality" "$scratch/rotated_$method.msh" --metric skew --svg "$images/rotate90_$method.svg" --zoom "$body" >/dev/null
+  done
+else
+  echo "make_pictures.sh: move_mesh or mesh_quality not built, motion pictures skipped" >&2
+fi
+
 data=${MESHMOTION_DATA:-}
 if [[ -n $data && -f $data/su2_30p30n_rans_L1_coarse.su2 ]]; then
   out=$build/pictures
@@ -55,4 +73,4 @@ if [[ -n $data && -f $data/su2_30p30n_rans_L1_coarse.su2 ]]; then
     done
   done
 fi
-ls -l "$images"/cylinder_*.svg
+ls -l "$images"/cylinder_*.svg "$images"/rotate90_*.svg 2>/dev/null
