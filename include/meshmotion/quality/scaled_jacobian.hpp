@@ -141,16 +141,18 @@ void lattice_dets(const JacobianSpace& s, const ElementCoords<D>& x, double scal
     values(j) = Eigen::Matrix<double, D, D>(jacobians.template middleRows<D>(static_cast<Index>(j) * D)).determinant() * scale;
 }
 
-// The factors of the Bézier transform (child < 0) or of child `child`'s lattice values.
+// The factors of the Bézier transform (child < 0), or of child `child`'s Bézier coefficients
+// from its parent's.
 inline int space_factors(const JacobianSpace& s, int child, std::array<const Eigen::MatrixXd*, 4>& f) {
   int count = 0;
   const int bits = child < 0 ? 0 : child & ((1 << s.line_dims) - 1);
   if (s.simplex_dim > 0)
     f[static_cast<std::size_t>(count++)] =
-        child < 0 ? &s.simplex.to_bezier : &s.simplex.children[static_cast<std::size_t>(child >> s.line_dims)];
+        child < 0 ? &s.simplex.to_bezier : &s.simplex.child_bezier[static_cast<std::size_t>(child >> s.line_dims)];
   for (int l = 0; l < s.line_dims; ++l)
     // The first line coordinate's bit is the lowest (see make_children).
-    f[static_cast<std::size_t>(count++)] = child < 0 ? &s.line.to_bezier : &s.line.children[static_cast<std::size_t>((bits >> l) & 1)];
+    f[static_cast<std::size_t>(count++)] =
+        child < 0 ? &s.line.to_bezier : &s.line.child_bezier[static_cast<std::size_t>((bits >> l) & 1)];
   return count;
 }
 
@@ -211,12 +213,18 @@ inline void certify(const JacobianSpace& s, const LatticeVector& values, const S
       break;
     const BezierLeaf parent = leaves[pick];
     leaves.erase(leaves.begin() + static_cast<std::ptrdiff_t>(pick));
+    // Children's coefficients straight from the parent's (one pass per axis instead of two);
+    // their corner coefficients are values of det J and tighten the sampled extremes.
     for (int child = 0; child < s.num_children(); ++child) {
-      LatticeVector v = parent.coefficients;
-      transform(s, child, v);
-      upper_min = std::min(upper_min, v.minCoeff());
-      lower_max = std::max(lower_max, v.maxCoeff());
-      leaves.push_back(make_leaf(s, v, parent.depth + 1));
+      BezierLeaf leaf{parent.coefficients, 0.0, 0.0, parent.depth + 1};
+      transform(s, child, leaf.coefficients);
+      leaf.min = leaf.coefficients.minCoeff();
+      leaf.max = leaf.coefficients.maxCoeff();
+      for (const int k : s.corners) {
+        upper_min = std::min(upper_min, leaf.coefficients(k));
+        lower_max = std::max(lower_max, leaf.coefficients(k));
+      }
+      leaves.push_back(std::move(leaf));
     }
   }
   r.leaves = static_cast<int>(leaves.size());

@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
@@ -33,6 +34,7 @@ namespace meshmotion::detail {
 struct BezierFactor {
   Eigen::MatrixXd to_bezier;              // Bézier coefficients = to_bezier × lattice values
   std::vector<Eigen::MatrixXd> children;  // lattice values of child c = children[c] × coefficients
+  std::vector<Eigen::MatrixXd> child_bezier;  // Bézier coefficients of child c = child_bezier[c] × coefficients
 };
 
 struct JacobianSpace {
@@ -58,6 +60,7 @@ struct JacobianSpace {
   std::vector<int> tensor_node;                // element node at each tensor position (empty: not a tensor element)
   Eigen::MatrixXd line_values;                 // (line_degree + 1) × (order + 1): 1D Lagrange basis at the line lattice
   Eigen::MatrixXd line_derivatives;            // the same for its derivative
+  std::vector<int> corners;                    // lattice points at the element's vertices
   BezierFactor simplex;                        // when simplex_dim > 0
   BezierFactor line;                           // when line_dims > 0
   // Children of a subdivision: simplex child outermost, then one bit per line coordinate.
@@ -177,6 +180,11 @@ inline void add_lattice(JacobianSpace& s) {
       for (int l = 0; l < s.line_dims; ++l)
         x[static_cast<std::size_t>(sd + l)] = m == 0 ? 0.0 : 2.0 * line[static_cast<std::size_t>(l)] / m - 1.0;
       s.points.push_back(x);
+      // A vertex of the element: its Bézier coefficient is the function's value there.
+      const bool simplex_vertex = sd == 0 || n == 0 || std::find(alpha.begin(), alpha.begin() + sd + 1, n) != alpha.begin() + sd + 1;
+      bool line_ends = true;
+      for (int l = 0; l < s.line_dims; ++l) line_ends = line_ends && (line[static_cast<std::size_t>(l)] == 0 || line[static_cast<std::size_t>(l)] == m);
+      if (simplex_vertex && line_ends) s.corners.push_back(static_cast<int>(s.points.size()) - 1);
       s.simplex_index.push_back(alpha);
       s.line_index.push_back(line);
     }
@@ -194,8 +202,10 @@ inline BezierFactor bezier_factor(JacobianSpace f) {
   };
   BezierFactor out;
   out.to_bezier = values_at([&](Index j) { return f.points[static_cast<std::size_t>(j)]; }).inverse();
-  for (const auto& child : make_children(f))
+  for (const auto& child : make_children(f)) {
     out.children.push_back(values_at([&](Index j) { return map_child(child, f.points[static_cast<std::size_t>(j)]); }));
+    out.child_bezier.push_back(out.to_bezier * out.children.back());
+  }
   return out;
 }
 
