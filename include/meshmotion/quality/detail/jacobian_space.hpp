@@ -8,8 +8,8 @@
 /// hexes, degree dp-1 in each direction; prisms, degree 3p-2 on the triangle times 3p-1 along
 /// the axis (serendipity types lie in the space of their complete sibling). A function of
 /// that space is sampled at the uniform lattice of the space, converted to Bézier
-/// coefficients (lag2bez), which bound it from below and above; subdividing the domain into
-/// 2^d similar children tightens the bounds (child values = child_values[c] × parent
+/// coefficients (BezierFactor::to_bezier per factor), which bound it from below and above; subdividing the domain into
+/// 2^d similar children tightens the bounds (child coefficients = child_bezier[c] × parent
 /// coefficients, exactly, since children are affine images of the reference element).
 /// Pyramids are rational: they get a sampling lattice only (no Bézier bound).
 
@@ -33,7 +33,6 @@ namespace meshmotion::detail {
 // three passes of a 6 × 6 one).
 struct BezierFactor {
   Eigen::MatrixXd to_bezier;              // Bézier coefficients = to_bezier × lattice values
-  std::vector<Eigen::MatrixXd> children;  // lattice values of child c = children[c] × coefficients
   std::vector<Eigen::MatrixXd> child_bezier;  // Bézier coefficients of child c = child_bezier[c] × coefficients
 };
 
@@ -65,7 +64,7 @@ struct JacobianSpace {
   BezierFactor line;                           // when line_dims > 0
   // Children of a subdivision: simplex child outermost, then one bit per line coordinate.
   [[nodiscard]] int num_children() const {
-    return (simplex_dim > 0 ? static_cast<int>(simplex.children.size()) : 1) << line_dims;
+    return (simplex_dim > 0 ? static_cast<int>(simplex.child_bezier.size()) : 1) << line_dims;
   }
 };
 
@@ -202,10 +201,8 @@ inline BezierFactor bezier_factor(JacobianSpace f) {
   };
   BezierFactor out;
   out.to_bezier = values_at([&](Index j) { return f.points[static_cast<std::size_t>(j)]; }).inverse();
-  for (const auto& child : make_children(f)) {
-    out.children.push_back(values_at([&](Index j) { return map_child(child, f.points[static_cast<std::size_t>(j)]); }));
-    out.child_bezier.push_back(out.to_bezier * out.children.back());
-  }
+  for (const auto& child : make_children(f))
+    out.child_bezier.push_back(out.to_bezier * values_at([&](Index j) { return map_child(child, f.points[static_cast<std::size_t>(j)]); }));
   return out;
 }
 
