@@ -187,6 +187,84 @@ TEST_CASE("affine motions are reproduced exactly with polynomial augmentation", 
   }
 }
 
+TEST_CASE("a support radius per boundary entry: interpolation, reach of each centre, affine reproduction", "[movers]") {
+  const Grid<2> g = grid<2>(20);
+  BoundarySpec<2> spec;
+  spec.moving("x0", Translation<2>{Vec<2>(0.0, 0.02)}).fixed("x1").fixed("y0").fixed("y1");
+  const auto boundary = spec.resolve(g.mesh.points, g.groups);
+  // The moving side gets a short support, the fixed sides a long one, as two walls whose
+  // layers differ.
+  std::vector<double> radii(static_cast<std::size_t>(boundary.size()));
+  for (Index b = 0; b < boundary.size(); ++b) radii[std::size_t(b)] = g.mesh.points(0, boundary.nodes[std::size_t(b)]) == 0.0 ? 0.15 : 0.4;
+  for (const RbfKernel kernel : {RbfKernel::wendland2, RbfKernel::gaussian}) {
+    CAPTURE(name(kernel));
+    RbfOptions options;
+    options.kernel = kernel;
+    options.support_radii = radii;
+    // Global kernels: shape scales below the side length keep the dense system well conditioned.
+    if (!is_compact(kernel))
+      for (double& r : options.support_radii) r *= 0.375;
+    RbfMover<2> mover(options);
+    mover.setup(g.mesh, boundary);
+    const Points<2> d = random_displacements<2>(boundary.size(), 7);
+    const Points<2> u = mover.move(d);
+    for (Index b = 0; b < boundary.size(); ++b) CHECK((u.col(boundary.nodes[std::size_t(b)]) - d.col(b)).norm() == 0.0);
+    CHECK(mover.stats().residual < (is_compact(kernel) ? 1e-10 : 1e-8));  // the Gaussian system is less well conditioned
+    if (!is_compact(kernel)) continue;
+    // Each centre reaches exactly its own radius: a node is moved iff some centre covers it.
+    Index beyond = 0, covered_only_by_long = 0;
+    for (Index i = 0; i < g.mesh.num_nodes(); ++i) {
+      bool covered = false, by_short = false;
+      for (Index b = 0; b < boundary.size(); ++b) {
+        const double r = (g.mesh.points.col(i) - g.mesh.points.col(boundary.nodes[std::size_t(b)])).norm();
+        if (r == 0.0) covered = by_short = true;
+        if (r < radii[std::size_t(b)]) {
+          covered = true;
+          by_short = by_short || radii[std::size_t(b)] < 0.2;
+        }
+      }
+      CHECK((u.col(i).norm() > 0.0) == covered);
+      beyond += covered ? 0 : 1;
+      covered_only_by_long += covered && !by_short && g.mesh.points(0, i) < 0.5 ? 1 : 0;
+    }
+    CHECK(beyond > 0);
+    CHECK(covered_only_by_long > 0);  // the long supports of the fixed sides reach there, the short ones not
+  }
+  SECTION("equal per-entry radii are the uniform radius") {
+    RbfOptions uniform;
+    uniform.support_radius = 0.3;
+    RbfOptions listed = uniform;
+    listed.support_radii.assign(static_cast<std::size_t>(boundary.size()), 0.3);
+    RbfMover<2> a(uniform), b(listed);
+    a.setup(g.mesh, boundary);
+    b.setup(g.mesh, boundary);
+    const Points<2> ua = a.move(boundary.displacements);
+    CHECK((ua - b.move(boundary.displacements)).norm() <= 1e-13 * ua.norm());
+  }
+  SECTION("affine motions are reproduced exactly with polynomial augmentation") {
+    Eigen::Matrix2d a;
+    a << 0.05, -0.02, 0.03, 0.01;
+    const Vec<2> t(0.1, -0.05);
+    Points<2> d(2, boundary.size());
+    for (Index b = 0; b < boundary.size(); ++b) d.col(b) = a * g.mesh.points.col(boundary.nodes[std::size_t(b)]) + t;
+    RbfOptions options;
+    options.support_radii = radii;
+    options.polynomial = true;
+    RbfMover<2> mover(options);
+    mover.setup(g.mesh, boundary);
+    const Points<2> u = mover.move(d);
+    for (Index i = 0; i < g.mesh.num_nodes(); ++i) CHECK((u.col(i) - (a * g.mesh.points.col(i) + t)).norm() < 1e-9);
+  }
+  SECTION("a radius list that does not match the boundary, or a non-positive radius, is named") {
+    RbfOptions options;
+    options.support_radii.assign(3, 0.2);
+    CHECK_THROWS_WITH(RbfMover<2>(options).setup(g.mesh, boundary), Catch::Contains("3 support radii for a boundary of"));
+    options.support_radii = radii;
+    options.support_radii[5] = 0.0;
+    CHECK_THROWS_WITH(RbfMover<2>(options).setup(g.mesh, boundary), Catch::Contains("boundary entry 5 (node"));
+  }
+}
+
 TEST_CASE("global kernels refuse large systems and suggest a compact kernel", "[movers]") {
   const Grid<2> g = grid<2>(30);
   BoundarySpec<2> spec;
@@ -281,10 +359,17 @@ TEST_CASE("derivatives: forward and reverse products agree with finite differenc
   BoundarySpec<2> spec;
   spec.moving("x0", Rotation2D{Vec<2>(0.5, 0.5), 0.1}).fixed("x1").sliding("y0").sliding("y1");
   const auto boundary = spec.resolve(g.mesh.points, g.groups);
+  // Per-entry radii (0.35 on the rotating side, 0.6 elsewhere) make the system nonsymmetric:
+  // the reverse product then needs the transposed factorization.
+  std::vector<double> varying(static_cast<std::size_t>(boundary.size()));
+  for (Index b = 0; b < boundary.size(); ++b) varying[std::size_t(b)] = g.mesh.points(0, boundary.nodes[std::size_t(b)]) == 0.0 ? 0.35 : 0.6;
+  for (const bool per_entry : {false, true})
   for (const bool polynomial : {false, true}) {
+    CAPTURE(per_entry, polynomial);
     RbfOptions options;
     options.support_radius = 0.6;
     options.polynomial = polynomial;
+    if (per_entry) options.support_radii = varying;
     RbfMover<2> mover(options);
     mover.setup(g.mesh, boundary);
     const Points<2> d = boundary.displacements;

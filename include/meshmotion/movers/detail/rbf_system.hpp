@@ -1,12 +1,19 @@
 #pragma once
 /// \file
 /// The interpolation system of the RBF mover over a set of centres (thesis eqs. 2.10–2.13):
-/// A α + P β = d, Pᵀ α = 0, with A_ij = φ(|c_i - c_j|) and P the optional linear polynomial
-/// [1, x]. Compact kernels give a sparse A (assembled with k-d tree radius queries), global
-/// kernels a dense one. The saddle-point system is never factorized: A is factorized once and
-/// the polynomial part eliminated through the small Schur complement S = Pᵀ A⁻¹ P, which keeps
-/// SimplicialLDLT applicable (A is SPD for Wendland kernels) and costs Dim + 1 extra solves in
-/// setup.
+/// A α + P β = d, Pᵀ α = 0, with A_ij = φ(|c_i - c_j| / ρ_j) and P the optional linear
+/// polynomial [1, x]. Compact kernels give a sparse A (assembled with k-d tree radius
+/// queries), global kernels a dense one. The saddle-point system is never factorized: A is
+/// factorized once and the polynomial part eliminated through the small Schur complement
+/// S = Pᵀ A⁻¹ P, which keeps SimplicialLDLT applicable (A is SPD for Wendland kernels) and
+/// costs Dim + 1 extra solves in setup.
+///
+/// One radius ρ for every centre gives a symmetric A. A radius per centre (a support that
+/// follows each wall's boundary layer) keeps the interpolant s(x) = Σ_j α_j φ(|x - c_j| / ρ_j)
+/// consistent between the system and the evaluation, but A is then no longer symmetric: it is
+/// factorized by LU (symmetric solver kinds are replaced by sparse LU, dense Cholesky by
+/// partial-pivoting LU), and transposed solves (the mover's reverse derivative) factorize Aᵀ
+/// on first use.
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/types.hpp"
@@ -17,9 +24,9 @@
 
 #include <Eigen/LU>
 
-
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -28,11 +35,28 @@ namespace meshmotion::detail {
 /// Kernel settings shared by the system and the evaluation operators.
 struct RbfKernelSettings {
   RbfKernel kernel = RbfKernel::wendland2;
+  /// The radius of every centre; with `radii`, their maximum (the reach of radius queries).
   double radius = 1.0;
   bool polynomial = false;
+  /// Radius of each centre (empty: `radius` for all).
+  std::vector<double> radii{};
+
+  [[nodiscard]] double radius_of(Index centre) const {
+    return radii.empty() ? radius : radii[static_cast<std::size_t>(centre)];
+  }
+  /// Settings of the first `count` centres (the radii follow the centres).
+  [[nodiscard]] RbfKernelSettings leading(Index count) const {
+    RbfKernelSettings out = *this;
+    if (!radii.empty()) out.radii.resize(static_cast<std::size_t>(count));
+    return out;
+  }
+  /// True when the centres' radii differ (A is then not symmetric).
+  [[nodiscard]] bool varying() const {
+    return std::any_of(radii.begin(), radii.end(), [&](double r) { return r != radii.front(); });
+  }
 };
 
-/// Rows of φ(|x_i - c_j|) for the points x_i (columns of `points` listed in `rows`) against
+/// Rows of φ(|x_i - c_j| / ρ_j) for the points x_i (columns of `points` listed in `rows`) against
 /// the centres in `tree`, compact kernels only: a row-major sparse matrix (rows.size() ×
 /// n_centres; with `kept`, only the rows with some centre inside the support, their positions
 /// in `rows` written to *kept). With `sorted` false the column indices of a row are in k-d
@@ -57,6 +81,11 @@ template <int Dim>
       std::vector<Neighbor>& pairs = found[static_cast<std::size_t>(c)];
       for (Index r = n * c / chunks; r < n * (c + 1) / chunks; ++r) {
         tree.radius_search(points.col(rows[static_cast<std::size_t>(r)]), k.radius, buffer);
+        if (!k.radii.empty())
+          std::erase_if(buffer, [&](const Neighbor& hit) {
+            const double own = k.radii[static_cast<std::size_t>(hit.first)];
+            return hit.second >= own * own;
+          });
         if (sorted) std::sort(buffer.begin(), buffer.end());
         count[static_cast<std::size_t>(r)] = static_cast<int>(buffer.size());
         pairs.insert(pairs.end(), buffer.begin(), buffer.end());
@@ -89,7 +118,7 @@ template <int Dim>
     double* value = m.valuePtr() + start[static_cast<std::size_t>(c)];
     for (std::size_t i = 0; i < pairs.size(); ++i) {
       inner[i] = static_cast<int>(pairs[i].first);
-      value[i] = rbf_value(k.kernel, std::sqrt(pairs[i].second), k.radius);
+      value[i] = rbf_value(k.kernel, std::sqrt(pairs[i].second), k.radius_of(pairs[i].first));
     }
   }
   return m;
@@ -101,10 +130,10 @@ class RbfSystem {
   using Coefficients = Eigen::Matrix<double, Eigen::Dynamic, Dim>;       ///< n_centres × Dim
   using PolyCoefficients = Eigen::Matrix<double, Dim + 1, Dim>;        ///< (Dim + 1) × Dim
 
-  /// Assembles and factorizes the system over `centres` (Dim × k, distinct points).
-  /// Throws InputError when a global kernel has more than `max_dense` centres, SolverError
-  /// when the factorization fails.
-  void setup(const Points<Dim>& centres, const RbfKernelSettings& kernel, const SolverOptions& sparse_options,
+  /// Assembles and factorizes the system over `centres` (Dim × k, distinct points; with
+  /// kernel.radii, one radius each). Throws InputError when a global kernel has more than
+  /// `max_dense` centres, SolverError when the factorization fails.
+  void setup(const Points<Dim>& centres, const RbfKernelSettings& kernel, SolverOptions sparse_options,
              DenseSolverKind dense_kind, Index max_dense) {
     centres_ = centres;
     kernel_ = kernel;
@@ -115,32 +144,43 @@ class RbfSystem {
       scale_ = std::max((centres_.colwise() - shift_).colwise().norm().maxCoeff(), 1e-300);
     }
     compact_ = is_compact(kernel.kernel);
+    symmetric_ = !kernel.varying();
+    transposed_.reset();
+    if (!symmetric_) {
+      if (sparse_options.kind != SolverKind::bicgstab) sparse_options.kind = SolverKind::sparse_lu;
+      if (dense_kind != DenseSolverKind::partial_piv_lu) dense_kind = DenseSolverKind::partial_piv_lu;
+    }
+    sparse_options_ = sparse_options;
     if (compact_) {
       std::vector<Index> all(static_cast<std::size_t>(k));
       for (Index i = 0; i < k; ++i) all[static_cast<std::size_t>(i)] = i;
-      // The pattern is symmetric, so the row-major rows are the columns of a column-major A.
-      const auto rows = compact_kernel_rows(centres_, all, tree_, k, kernel);
-      const SparseMatrix a = rows.transpose();
-      nonzeros_ = a.nonZeros();
+      // Row i holds A_i·. With one radius the pattern and values are symmetric, so the rows
+      // are also the columns of a column-major A and need no sorting conversion.
+      const auto rows = compact_kernel_rows(centres_, all, tree_, k, kernel_);
+      matrix_ = symmetric_ ? SparseMatrix(rows.transpose()) : SparseMatrix(rows);
+      nonzeros_ = matrix_.nonZeros();
       sparse_ = LinearSolver(sparse_options);
-      sparse_.compute(a);
+      sparse_.compute(matrix_);
+      if (symmetric_) matrix_.resize(0, 0);
     } else {
       if (k > max_dense)
         throw InputError("RbfMover::setup: " + std::to_string(k) + " boundary nodes give a dense " +
                          std::string(name(kernel.kernel)) + " system beyond the limit (expected at most " +
                          std::to_string(max_dense) + "); use a compact kernel such as wendland2 or raise max_dense_centres");
-      Eigen::MatrixXd a(k, k);
+      dense_matrix_.resize(k, k);
       for (Index j = 0; j < k; ++j)
-        for (Index i = 0; i < k; ++i) a(i, j) = rbf_value(kernel.kernel, (centres_.col(i) - centres_.col(j)).norm(), kernel.radius);
+        for (Index i = 0; i < k; ++i)
+          dense_matrix_(i, j) = rbf_value(kernel.kernel, (centres_.col(i) - centres_.col(j)).norm(), kernel_.radius_of(j));
       nonzeros_ = k * k;
       dense_ = DenseSolver(dense_kind);
-      dense_.compute(a);
+      dense_.compute(dense_matrix_);
+      if (symmetric_) dense_matrix_.resize(0, 0);
     }
     if (kernel.polynomial && k > 0) {
-      Eigen::MatrixXd p(k, Dim + 1);
-      for (Index i = 0; i < k; ++i) p.row(i) = polynomial(centres_.col(i)).transpose();
-      solve_a(p, g_);
-      const Eigen::Matrix<double, Dim + 1, Dim + 1> s = p.transpose() * g_;
+      p_.resize(k, Dim + 1);
+      for (Index i = 0; i < k; ++i) p_.row(i) = polynomial(centres_.col(i)).transpose();
+      solve_a(p_, g_);
+      const Eigen::Matrix<double, Dim + 1, Dim + 1> s = p_.transpose() * g_;
       schur_.compute(s);
       if (!(std::abs(schur_.determinant()) > 1e-14 * std::max(1.0, s.norm())))
         throw InputError("RbfMover::setup: linear polynomial augmentation needs boundary nodes that span the space "
@@ -169,17 +209,30 @@ class RbfSystem {
     solve_a(values, alpha);
     beta.setZero();
     if (!kernel_.polynomial || size() == 0) return;
-    // β = S⁻¹ Gᵀ d, α = A⁻¹ d - G β  (Gᵀ d = Pᵀ A⁻¹ d since A is symmetric).
-    beta = schur_.solve(g_.transpose() * values);
+    // With α₀ = A⁻¹ d: β = S⁻¹ Pᵀ α₀, α = α₀ - G β (G = A⁻¹ P).
+    beta = schur_.solve(p_.transpose() * alpha);
     alpha.noalias() -= g_ * beta;
   }
 
-  /// Transpose of solve(): the gradient with respect to `values` of ⟨ᾱ, α⟩ + ⟨β̄, β⟩.
+  /// Transpose of solve(): the gradient with respect to `values` of ⟨ᾱ, α⟩ + ⟨β̄, β⟩,
+  /// A⁻ᵀ (ᾱ + P S⁻ᵀ (β̄ - Gᵀ ᾱ)).
   void solve_transpose(const Eigen::MatrixXd& alpha_bar, const PolyCoefficients& beta_bar, Eigen::MatrixXd& values_bar) {
-    solve_a(alpha_bar, values_bar);
-    if (!kernel_.polynomial || size() == 0) return;
-    const PolyCoefficients t = schur_.solve(beta_bar - g_.transpose() * alpha_bar);
-    values_bar.noalias() += g_ * t;
+    Eigen::MatrixXd rhs = alpha_bar;
+    if (kernel_.polynomial && size() > 0) {
+      const PolyCoefficients t = schur_.transpose().solve(beta_bar - g_.transpose() * alpha_bar);
+      rhs.noalias() += p_ * t;
+    }
+    if (symmetric_) {
+      solve_a(rhs, values_bar);
+    } else if (compact_) {
+      if (!transposed_) {
+        transposed_ = std::make_unique<LinearSolver>(sparse_options_);
+        transposed_->compute(SparseMatrix(matrix_.transpose()));
+      }
+      transposed_->solve(rhs, values_bar);
+    } else {
+      values_bar = dense_matrix_.transpose().partialPivLu().solve(rhs);
+    }
   }
 
  private:
@@ -198,11 +251,17 @@ class RbfSystem {
   RbfKernelSettings kernel_;
   KdTree<Dim> tree_;
   bool compact_ = true;
+  bool symmetric_ = true;
+  SolverOptions sparse_options_;
+  SparseMatrix matrix_;             ///< A, kept only when not symmetric (for Aᵀ)
+  Eigen::MatrixXd dense_matrix_;    ///< dense A, kept only when not symmetric
+  std::unique_ptr<LinearSolver> transposed_;  ///< factorized Aᵀ, on first transposed solve
   LinearSolver sparse_;
   DenseSolver dense_;
   Index nonzeros_ = 0;
   Vec<Dim> shift_ = Vec<Dim>::Zero();
   double scale_ = 1.0;
+  Eigen::MatrixXd p_;  ///< P, k × (Dim + 1)
   Eigen::MatrixXd g_;  ///< A⁻¹ P, k × (Dim + 1)
   Eigen::PartialPivLU<Eigen::Matrix<double, Dim + 1, Dim + 1>> schur_;
 };
