@@ -139,12 +139,37 @@ TEST_CASE("O-mesh around an ellipse and a square, quads and triangles", "[core]"
   CHECK(h2 / h1 == Approx(1.3));
 }
 
+TEST_CASE("annulus between two walls: each layer starts at its first height, rings on their circles", "[core]") {
+  for (const bool triangles : {false, true}) {
+    const AnnulusOptions o{.n_around = 64, .triangles = triangles};
+    const Mesh<2> m = annulus_mesh(o);
+    CHECK(min_measure(m) > 0);
+    const Index n = o.n_around, rings = m.num_nodes() / n;
+    CHECK(m.num_cells() == (triangles ? 2 : 1) * n * (rings - 1));
+    CHECK(m.group_nodes("inner").size() == static_cast<std::size_t>(n));
+    CHECK(m.group_nodes("outer").size() == static_cast<std::size_t>(n));
+    for (Index v : m.group_nodes("inner")) CHECK(m.points.col(v).norm() == Approx(0.5).epsilon(1e-15));
+    for (Index v : m.group_nodes("outer")) CHECK(m.points.col(v).norm() == Approx(1.5).epsilon(1e-15));
+    CHECK(m.points.col(n).norm() - 0.5 == Approx(o.inner_first_height).epsilon(1e-9));
+    CHECK(m.points.col(n).norm() - m.points.col(0).norm() == Approx(o.inner_first_height).epsilon(1e-9));
+    CHECK(1.5 - m.points.col((rings - 2) * n).norm() == Approx(o.outer_first_height).epsilon(1e-9));
+    // Heights grow by each wall's ratio, and no cell is taller than the core spacing.
+    const auto height = [&](Index j) { return m.points.col((j + 1) * n).norm() - m.points.col(j * n).norm(); };
+    CHECK(height(1) / height(0) == Approx(o.inner_growth));
+    CHECK(height(rings - 3) / height(rings - 2) == Approx(o.outer_growth));
+    for (Index j = 0; j + 1 < rings; ++j) CHECK(height(j) <= o.core_spacing * (1 + 1e-12));
+  }
+}
+
 TEST_CASE("generators reject impossible sizes", "[core]") {
   CHECK_THROWS_AS(rectangle_mesh({.nx = 0}), InputError);
   CHECK_THROWS_AS(box_mesh({.nz = -1}), InputError);
   CHECK_THROWS_WITH(o_mesh({.body = OMeshBody::square, .n_around = 30}), Catch::Contains("multiple of 4"));
   CHECK_THROWS_WITH(o_mesh({.farfield_radius = 0.4}), Catch::Contains("does not enclose"));
   CHECK_THROWS_WITH(o_mesh({.n_radial = 10, .first_height = 5.0}), Catch::Contains("past the farfield"));
+  CHECK_THROWS_WITH(annulus_mesh({.inner_radius = 2.0}), Catch::Contains("inner_radius < outer_radius"));
+  CHECK_THROWS_WITH(annulus_mesh({.outer_growth = 1.0}), Catch::Contains("growths above 1"));
+  CHECK_THROWS_WITH(annulus_mesh({.core_spacing = 0.6}), Catch::Contains("more than the gap"));
 }
 
 TEST_CASE("facet tags without a group get one named by their number", "[core]") {

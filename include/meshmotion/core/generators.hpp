@@ -2,7 +2,7 @@
 /// \file
 /// Built-in meshes: structured rectangles and boxes of every linear element type (and mixed
 /// ones), a boundary-layer O-mesh around an ellipse (a cylinder) or a square inside a
-/// circular farfield, and the NASA Turbulence Modeling Resource 3D bump-in-channel hex grid.
+/// circular farfield, the gap between two circular walls with a layer each, and the NASA Turbulence Modeling Resource 3D bump-in-channel hex grid.
 /// Every generator returns positively oriented cells and the boundary
 /// facets tagged with named groups.
 
@@ -79,6 +79,20 @@ struct OMeshOptions {
   bool triangles = false;       ///< split each quadrilateral into two triangles
 };
 
+/// Options of annulus_mesh(): the gap between two concentric circular walls, each with its own
+/// boundary layer (the gap of a journal bearing or a Taylor–Couette cell).
+struct AnnulusOptions {
+  double inner_radius = 0.5;
+  double outer_radius = 1.5;
+  Index n_around = 128;              ///< nodes around each circle
+  double inner_first_height = 1e-4;  ///< height of the cells on the inner wall
+  double inner_growth = 1.3;         ///< ratio of successive layer heights off the inner wall
+  double outer_first_height = 2e-3;
+  double outer_growth = 1.15;
+  double core_spacing = 0.03;        ///< the layers grow up to this height; the core is uniform, about as fine
+  bool triangles = false;            ///< split each quadrilateral into two triangles
+};
+
 namespace detail {
 
 /// Sets mesh.facets to the boundary facets, each tagged by classify(facet nodes) in
@@ -116,6 +130,22 @@ void add_box_groups(Mesh<Dim>& mesh, const std::array<double, Dim>& lo, const st
 inline void require_cells(const char* where, std::initializer_list<Index> counts) {
   for (Index n : counts)
     if (n < 1) throw InputError(std::string(where) + ": cell counts must be positive (got " + std::to_string(n) + ")");
+}
+
+/// The cells between `rings` rings of n nodes each (ring j: nodes j n .. (j+1) n - 1, counter-
+/// clockwise, outward with j): quadrilaterals, or each split into two triangles.
+inline void add_ring_cells(Mesh<2>& mesh, Index n, Index rings, bool triangles) {
+  for (Index j = 0; j + 1 < rings; ++j)
+    for (Index i = 0; i < n; ++i) {
+      const Index i1 = (i + 1) % n;
+      const std::array<Index, 4> q{j * n + i, (j + 1) * n + i, (j + 1) * n + i1, j * n + i1};
+      if (triangles) {
+        mesh.block(ElementType::tri3).add({q[0], q[1], q[2]});
+        mesh.block(ElementType::tri3).add({q[0], q[2], q[3]});
+      } else {
+        mesh.block(ElementType::quad4).add(q);
+      }
+    }
 }
 
 /// Appends a tetrahedron, swapping two nodes if needed so that it is positively oriented.
@@ -300,23 +330,60 @@ inline void add_positive_tet(ElementBlock& block, const Points<3>& p, std::array
       mesh.points.col(j * n + i) = j == 0 ? wall : Vec<2>(wall + s * dir);
     }
   }
-  for (Index j = 0; j < layers; ++j)
-    for (Index i = 0; i < n; ++i) {
-      const Index i1 = (i + 1) % n;
-      const std::array<Index, 4> q{j * n + i, (j + 1) * n + i, (j + 1) * n + i1, j * n + i1};
-      if (options.triangles) {
-        mesh.block(ElementType::tri3).add({q[0], q[1], q[2]});
-        mesh.block(ElementType::tri3).add({q[0], q[2], q[3]});
-      } else {
-        mesh.block(ElementType::quad4).add(q);
-      }
-    }
+  detail::add_ring_cells(mesh, n, layers + 1, options.triangles);
   detail::add_boundary_groups(mesh, {"wall", "farfield"}, [&](std::span<const Index> nodes) {
     return nodes[0] < n ? 1 : 2;
   });
   return mesh;
 }
 
+
+/// The gap between two concentric circles (centre 0), each wall with a boundary layer
+/// growing geometrically from its first height to core_spacing, and a uniform core between
+/// them. Groups "inner" (tag 1) and "outer" (tag 2); ring j (0 on the inner wall) holds nodes
+/// j n_around .. (j+1) n_around - 1, counter-clockwise, every node of ring j on the circle of
+/// its radius. Throws InputError for radii, heights or growths that cannot make a valid mesh,
+/// or layers that do not fit in the gap.
+[[nodiscard]] inline Mesh<2> annulus_mesh(const AnnulusOptions& o = {}) {
+  if (!(o.inner_radius > 0.0 && o.outer_radius > o.inner_radius) || o.n_around < 3)
+    throw InputError("annulus_mesh: need 0 < inner_radius < outer_radius and n_around >= 3 (got " +
+                     std::to_string(o.inner_radius) + ", " + std::to_string(o.outer_radius) + ", " +
+                     std::to_string(o.n_around) + ")");
+  if (!(o.inner_first_height > 0.0 && o.outer_first_height > 0.0 && o.inner_growth > 1.0 && o.outer_growth > 1.0 &&
+        o.core_spacing > 0.0))
+    throw InputError("annulus_mesh: first heights and core_spacing must be positive and growths above 1");
+  // Wall distances of each layer's rings, up to the first cell of core_spacing height.
+  const auto layer = [&](double h, double growth) {
+    std::vector<double> s{0.0};
+    for (; h < o.core_spacing; h *= growth) s.push_back(s.back() + h);
+    return s;
+  };
+  const std::vector<double> inner = layer(o.inner_first_height, o.inner_growth);
+  const std::vector<double> outer = layer(o.outer_first_height, o.outer_growth);
+  const double core = o.outer_radius - o.inner_radius - inner.back() - outer.back();
+  if (!(core > 0.0))
+    throw InputError("annulus_mesh: the two layers are " + std::to_string(inner.back() + outer.back()) +
+                     " thick together, more than the gap (expected < " + std::to_string(o.outer_radius - o.inner_radius) + ")");
+  const auto n_core = static_cast<Index>(std::ceil(core / o.core_spacing));
+  std::vector<double> radii;
+  for (const double s : inner) radii.push_back(o.inner_radius + s);
+  for (Index k = 1; k < n_core; ++k)
+    radii.push_back(o.inner_radius + inner.back() + core * static_cast<double>(k) / static_cast<double>(n_core));
+  for (auto s = outer.rbegin(); s != outer.rend(); ++s) radii.push_back(o.outer_radius - *s);
+
+  const Index n = o.n_around;
+  const auto rings = static_cast<Index>(radii.size());
+  Mesh<2> mesh;
+  mesh.points.resize(2, rings * n);
+  for (Index j = 0; j < rings; ++j)
+    for (Index i = 0; i < n; ++i) {
+      const double t = 2.0 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(n);
+      mesh.points.col(j * n + i) << radii[static_cast<std::size_t>(j)] * std::cos(t), radii[static_cast<std::size_t>(j)] * std::sin(t);
+    }
+  detail::add_ring_cells(mesh, n, rings, o.triangles);
+  detail::add_boundary_groups(mesh, {"inner", "outer"}, [&](std::span<const Index> nodes) { return nodes[0] < n ? 1 : 2; });
+  return mesh;
+}
 
 /// Height of the NASA Turbulence Modeling Resource bump-in-channel wall at streamwise
 /// station x0: 0.05 sin^4(pi x0 / 0.9 - pi / 3) for 0.3 <= x0 <= 1.2, 0 elsewhere.
