@@ -22,6 +22,7 @@
 
 #include "gmsh_peer.hpp"
 
+#include "meshmotion/core/generators.hpp"
 #include "meshmotion/curving/curve_mesh.hpp"
 #include "meshmotion/curving/geometry.hpp"
 #include "meshmotion/curving/naca_section.hpp"
@@ -36,6 +37,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace {
@@ -141,6 +143,39 @@ void thesis_table(const fs::path& file) {
   }
   std::printf("\nseconds: P2 conversion + snapping + layer estimate + regularization (certification excluded);\n"
               "ratio: to snapping alone (the first row) on the same mesh.\n");
+}
+
+// Two walls with layers of different thickness (annulus_mesh: a journal bearing's gap): RBF
+// with the thickest layer's radius for both walls (the thesis's one radius) against a radius
+// per wall (the default), blending, and snapping alone.
+void two_walls_table() {
+  std::printf("\nTwo walls: the gap between a shaft (r = 0.5, first cell 1e-4) and a housing (r = 1.5, first cell\n"
+              "2e-3), 256 cells around; both walls projected on their circles.\n");
+  std::printf("\n%-10s %-22s %9s %5s %8s %9s %7s %9s %8s %7s\n", "mesh", "case", "radius", "steps", "min", "mean", "invalid",
+              "seconds", "ratio", "iters");
+  for (const bool triangles : {false, true}) {
+    const Mesh<2> linear = annulus_mesh({.n_around = 256, .triangles = triangles});
+    const std::string mesh_name = triangles ? "gap_tri" : "gap_quad";
+    double baseline = 0.0;
+    for (const auto& [label, method, per_wall] : {std::tuple{"none (snap only)", "none", true},
+                                                  std::tuple{"rbf one radius", "rbf", false},
+                                                  std::tuple{"rbf radius per wall", "rbf", true},
+                                                  std::tuple{"blend L=layer", "blend", true}}) {
+      CurveOptions<2> options;
+      options.method = method;
+      options.per_wall_radius = per_wall;
+      options.geometry.emplace("inner", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 0.5)));
+      options.geometry.emplace("outer", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 1.5)));
+      const CurveResult<2> r = curve_mesh(linear, options);
+      const double seconds = r.seconds.total - r.seconds.certify;
+      if (std::string(method) == "none") baseline = seconds;
+      print_row(mesh_name, label, r.support_radius, 1, r.quality, seconds, r.solver_iterations, baseline, "");
+      if (r.wall_support_radii.size() == 2)
+        std::printf("%-10s   layers %.4g (shaft) and %.4g (housing): radii %.4g and %.4g\n", "", r.layers[0].thickness,
+                    r.layers[1].thickness, r.wall_support_radii[0], r.wall_support_radii[1]);
+    }
+  }
+  std::printf("\nradius: the largest support; ratio: time to snapping alone on the same mesh.\n");
 }
 
 // ---- Gmsh comparison ------------------------------------------------------------------
@@ -408,7 +443,10 @@ int main(int argc, char** argv) {
       return 0;
     } else file = a;
   }
-  if (with_thesis) thesis_table(file);
+  if (with_thesis) {
+    thesis_table(file);
+    two_walls_table();
+  }
   if (with_gmsh) gmsh_comparison(quick);
   return 0;
 }

@@ -45,6 +45,7 @@ struct Arguments {
   std::string method = "rbf";
   std::string kernel = "wendland2";
   double support_radius = 0.0;
+  bool single_radius = false;
   double support_factor = 0.0;  // unset: the library's default for the dimension
   double blending_length = 0.0;
   int steps = 1;
@@ -128,6 +129,7 @@ CurveOptions<Dim> curve_options(const Arguments& args) {
   options.method = args.method;
   options.kernel = rbf_kernel_from_name(args.kernel);
   options.support_radius = args.support_radius;
+  options.per_wall_radius = !args.single_radius;
   if (args.support_factor > 0.0) options.support_radius_factor = args.support_factor;
   options.blending_length = args.blending_length;
   options.steps = args.steps;
@@ -196,6 +198,13 @@ void run(const Mesh<Dim>& linear, const Arguments& args) {
     w.key("dim").value(Dim).key("nodes").value(result.curved.num_nodes()).key("cells").value(result.curved.num_cells());
     w.key("method").value(result.method).key("steps").value(args.steps).key("support_radius").value(result.support_radius);
     w.key("support_radius_limited").value(result.support_radius_limited);
+    w.key("walls").begin_array();
+    for (std::size_t k = 0; k < result.layers.size(); ++k) {
+      w.begin_object().key("group").value(result.layers[k].group).key("layer_thickness").value(result.layers[k].thickness);
+      if (!result.wall_support_radii.empty()) w.key("support_radius").value(result.wall_support_radii[k]);
+      w.end_object();
+    }
+    w.end_array();
     w.key("seconds").begin_object();
     w.key("quadratic").value(result.seconds.quadratic).key("snap").value(result.seconds.snap);
     w.key("layer").value(result.seconds.layer).key("regularize").value(result.seconds.regularize);
@@ -214,12 +223,18 @@ void run(const Mesh<Dim>& linear, const Arguments& args) {
   std::printf("curved %lld cells, %lld nodes (%lld linear) with %s", static_cast<long long>(result.curved.num_cells()),
               static_cast<long long>(result.curved.num_nodes()), static_cast<long long>(result.num_linear_nodes),
               result.method.c_str());
-  if (result.method == "rbf")
+  if (!result.wall_support_radii.empty())
+    std::printf(", a support radius per wall%s", result.support_radius_limited ? " (limited to keep the system sparse)" : "");
+  else if (result.method == "rbf")
     std::printf(", support radius %.4g%s", result.support_radius,
                 result.support_radius_limited ? " (limited to keep the system sparse)" : "");
   std::printf(", %d step(s)\n", args.steps);
-  for (const auto& layer : result.layers)
-    std::printf("  wall '%s': boundary layer %.4g thick (max %.4g)\n", layer.group.c_str(), layer.thickness, layer.max_thickness);
+  for (std::size_t k = 0; k < result.layers.size(); ++k) {
+    const auto& layer = result.layers[k];
+    std::printf("  wall '%s': boundary layer %.4g thick (max %.4g)", layer.group.c_str(), layer.thickness, layer.max_thickness);
+    if (!result.wall_support_radii.empty()) std::printf(", support radius %.4g", result.wall_support_radii[k]);
+    std::printf("\n");
+  }
   std::printf("  boundary: %lld nodes snapped, %lld vertices moved onto the geometry, largest move %.3g\n",
               static_cast<long long>(result.snapped_nodes), static_cast<long long>(result.moved_vertices),
               result.max_boundary_displacement);
@@ -274,6 +289,8 @@ int main(int argc, char** argv) {
   app.add_option("--corner-angle", args.corner_angle, "spline corners above this angle (degrees)")->capture_default_str();
   examples::add_mechanics_options(app, args.mechanics);
   app.add_flag("--arc-length", args.arc_length, "spline: arc-length midpoint instead of the parameter midpoint");
+  app.add_flag("--single-radius", args.single_radius,
+               "rbf default radius: the thickest wall layer's for every wall, not each wall's own");
   app.add_flag("--strict", args.strict, "fail (exit 2) when invalid cells remain");
   app.add_flag("--json", args.json, "print one JSON object");
   app.add_option("--svg", args.svg, "2D: write an SVG picture coloured by quality");

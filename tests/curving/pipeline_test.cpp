@@ -228,8 +228,63 @@ TEST_CASE("pipeline: boundary-layer mesh (aspect ratio >= 1000) needs the regula
     CHECK(curved.layers[0].group == "wall");
     CHECK(curved.layers[0].thickness > 100 * o.first_height);
     CHECK(curved.layers[1].thickness == 0.0);
-    if (method == "rbf") CHECK(curved.support_radius == options.support_radius_factor * curved.layers[0].thickness);
+    if (method != "rbf") continue;
+    // The wall's radius follows its layer; the farfield, without one, gets 3 of its node spacings.
+    REQUIRE(curved.wall_support_radii.size() == 2);
+    CHECK(curved.wall_support_radii[0] == options.support_radius_factor * curved.layers[0].thickness);
+    CHECK(curved.wall_support_radii[1] > 5 * curved.wall_support_radii[0]);
+    CHECK(curved.support_radius == curved.wall_support_radii[1]);
   }
+}
+
+TEST_CASE("pipeline: each wall's RBF support follows its own boundary layer", "[curving]") {
+  // The gap of a journal bearing: a shaft (r = 0.5) with a thin layer, a housing (r = 1.5)
+  // with a thick one.
+  const Mesh<2> linear = annulus_mesh({});
+  CurveOptions<2> options;
+  options.geometry.emplace("inner", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 0.5)));
+  options.geometry.emplace("outer", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 1.5)));
+  const CurveResult<2> curved = curve_mesh(linear, options);
+  REQUIRE(curved.layers.size() == 2);
+  const double inner = curved.layers[0].thickness, outer = curved.layers[1].thickness;
+  INFO("layers " << inner << ", " << outer << "; min " << curved.quality.min);
+  CHECK(inner > 0.0);
+  CHECK(outer > 3.0 * inner);
+  REQUIRE(curved.wall_support_radii.size() == 2);
+  const double r_inner = curved.wall_support_radii[0], r_outer = curved.wall_support_radii[1];
+  CHECK(r_inner == options.support_radius_factor * inner);
+  CHECK(r_outer == options.support_radius_factor * outer);
+  REQUIRE(r_inner + r_outer < 1.0);  // a band of the core is beyond both walls' supports
+  CHECK(curved.invalid() == 0);
+  const auto on_circles = [](const Mesh<2>& mesh) {
+    double worst = 0.0;
+    for (const auto& block : mesh.facets)
+      for (Index e = 0; e < block.size(); ++e)
+        for (const Index v : block.element(e))
+          worst = std::max(worst, std::abs(mesh.points.col(v).norm() - (block.tags[std::size_t(e)] == 1 ? 0.5 : 1.5)));
+    return worst;
+  };
+  CHECK(on_circles(curved.curved) < 1e-14);
+
+  // A vertex moves iff a wall's support reaches it: with each wall's radius, the core from
+  // r_inner off the shaft to r_outer off the housing stays; with the housing's radius for both
+  // (options.per_wall_radius = false) the shaft's motion reaches r_outer into the gap.
+  options.per_wall_radius = false;
+  const CurveResult<2> single = curve_mesh(linear, options);
+  CHECK(single.wall_support_radii.empty());
+  CHECK(single.support_radius == r_outer);
+  CHECK(single.invalid() == 0);
+  Index between = 0;
+  for (Index v = 0; v < linear.num_nodes(); ++v) {
+    const double from_shaft = linear.points.col(v).norm() - 0.5, from_housing = 1.5 - linear.points.col(v).norm();
+    if (from_shaft < 1e-12 || from_housing < 1e-12) continue;
+    const bool moved = curved.curved.points.col(v) != linear.points.col(v);
+    const bool moved_single = single.curved.points.col(v) != linear.points.col(v);
+    CHECK(moved == (from_shaft < r_inner || from_housing < r_outer));
+    CHECK(moved_single == (from_shaft < r_outer || from_housing < r_outer));
+    between += from_shaft > r_inner && from_shaft < r_outer ? 1 : 0;
+  }
+  CHECK(between > 0);
 }
 
 TEST_CASE("pipeline: every element type and mixed meshes curve onto a graph", "[curving][slow]") {

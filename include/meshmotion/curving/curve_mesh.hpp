@@ -17,8 +17,9 @@
 ///    mode throws InvalidMeshError when invalid cells remain, default mode reports them.
 ///
 /// The default RBF support radius follows the boundary layer (curving/boundary_layer.hpp):
-/// `support_radius_factor` × the thickest layer among the curved walls. docs/curving.md gives
-/// the measured effect of larger radii.
+/// `support_radius_factor` × each curved wall's own layer thickness (one radius per wall, the
+/// RBF centres of a wall take its radius). docs/curving.md gives the measured effect of larger
+/// radii and of one radius for all walls.
 
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
@@ -32,6 +33,7 @@
 #include "meshmotion/movers/any_mover.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/mover.hpp"
+#include "meshmotion/movers/rbf.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
 #include "meshmotion/movers/support_radius.hpp"
 #include "meshmotion/quality/cell_quality.hpp"
@@ -64,12 +66,20 @@ struct CurveOptions {
   MoverParameters parameters{};
   RbfKernel kernel = RbfKernel::wendland2;
   /// RBF support radius (given to every registry mover as "support_radius"); 0:
-  /// support_radius_factor × the thickest estimated wall layer
+  /// support_radius_factor × each wall's estimated layer for "rbf" (per_wall_radius), × the
+  /// thickest one for the other movers
   /// (suggest_support_radius() with 3 wall node spacings when no wall has an anisotropic layer).
   double support_radius = 0.0;
   /// 4 in 2D (on the 30P30N triangles the minimum quality rises from 0.47 at 1 to 0.80 at 4,
   /// for 0.06 s more), 1 in 3D (on the bump 2 costs 6× the time); docs/curving.md.
   double support_radius_factor = Dim == 2 ? 4.0 : 1.0;
+  /// Method "rbf" with the default radius: each curved wall's centres get the radius of its
+  /// own layer (walls without a layer: 3 of their node spacings), and the other boundary
+  /// centres the radius of the nearest moving wall node, so a thin layer is not overrun by the
+  /// support of a thick one. false: the thickest layer's radius everywhere (the thesis's one
+  /// radius). Differing radii make the RBF system nonsymmetric (sparse LU instead of
+  /// Cholesky); docs/curving.md, "A radius per wall".
+  bool per_wall_radius = true;
   /// A default radius (support_radius = 0) is shrunk until a support holds at most this many
   /// boundary nodes on average around the moving ones; 0: no limit. On the 3D bump's medium
   /// level the layer-based radius (0.177) takes minutes to factorize; the limit of 100 gives
@@ -120,7 +130,8 @@ struct CurveResult {
   Index num_linear_nodes = 0;
   CurveTimes seconds;
   std::string method;
-  double support_radius = 0.0;      ///< support radius given to the mover (0 for blend and none)
+  double support_radius = 0.0;      ///< support radius given to the mover, the largest when per wall (0 for blend and none)
+  std::vector<double> wall_support_radii;  ///< per wall of `layers` when each has its own radius (rbf default)
   bool support_radius_limited = false;  ///< the default radius was shrunk to max_support_nodes
   std::vector<WallLayer> layers;    ///< estimated layers of the curved walls (when estimated)
   Index snapped_nodes = 0;          ///< boundary nodes given a position on the true boundary
@@ -214,13 +225,12 @@ template <int Dim>
   return make_resolved_boundary(kept);
 }
 
-/// The largest radius ≤ `radius` whose ball around a node with a nonzero displacement holds
-/// at most `budget` boundary nodes on average (a sample of up to 256 moving nodes). Supports on
-/// a surface hold ~r² nodes, on a curve ~r: a few rescaling rounds settle either.
+/// The largest radius ≤ `radius` whose ball around a node of `moving` holds at most `budget`
+/// nodes of `boundary` on average (a sample of up to 256 of them). Supports on a surface hold
+/// ~r² nodes, on a curve ~r: a few rescaling rounds settle either.
 template <int Dim>
-[[nodiscard]] double limit_support_radius(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary, double radius,
-                                          double budget) {
-  const std::vector<Index> moving = moving_nodes(boundary);
+[[nodiscard]] double limit_support_radius(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary,
+                                          const std::vector<Index>& moving, double radius, double budget) {
   if (moving.empty() || !(budget > 0.0)) return radius;
   Points<Dim> at(Dim, boundary.size());
   for (Index k = 0; k < boundary.size(); ++k) at.col(k) = mesh.points.col(boundary.nodes[static_cast<std::size_t>(k)]);
@@ -236,6 +246,104 @@ template <int Dim>
     radius *= std::sqrt(budget / mean);
   }
   return radius;
+}
+
+/// The wall (index into `walls`) of each node of the facets of the named groups; -1 for other
+/// nodes. A node shared by two walls belongs to the first listed.
+template <int Dim>
+[[nodiscard]] std::vector<int> wall_of_nodes(const Mesh<Dim>& mesh, const std::vector<std::string>& walls) {
+  std::vector<int> wall_of(static_cast<std::size_t>(mesh.num_nodes()), -1);
+  for (std::size_t w = walls.size(); w-- > 0;) {
+    const int tag = mesh.group(walls[w]).tag;
+    for (const auto& block : mesh.facets)
+      for (Index e = 0; e < block.size(); ++e)
+        if (block.tags[static_cast<std::size_t>(e)] == tag)
+          for (const Index v : block.element(e)) wall_of[static_cast<std::size_t>(v)] = static_cast<int>(w);
+  }
+  return wall_of;
+}
+
+/// Default support radii from the wall layers (see CurveOptions::support_radius).
+struct DefaultRadii {
+  double uniform = 0.0;          ///< one radius for every wall: the thickest layer's
+  std::vector<double> per_wall;  ///< each wall's own: its layer's, or its node spacing's without a layer
+  bool limited = false;          ///< some wall's layer radius was shrunk to max_support_nodes
+};
+
+/// suggest_support_radius() over the snapped nodes for which keep(node) holds, with 3 wall
+/// node spacings; 0 for fewer than two such nodes. Curving displacements are tiny, so the
+/// spacing term decides. The motion default (10 spacings) spans the whole body on the sphere
+/// test case (0.75 for radius 0.5) and gives 0.22, below snapping alone; 3 spacings give 0.64
+/// (docs/curving.md).
+template <int Dim, class Keep>
+[[nodiscard]] double spacing_radius(const Mesh<Dim>& mesh, const SnappedBoundary<Dim>& snapped, Keep keep) {
+  std::vector<Index> kept;
+  for (std::size_t k = 0; k < snapped.nodes.size(); ++k)
+    if (keep(snapped.nodes[k])) kept.push_back(static_cast<Index>(k));
+  if (kept.size() < 2) return 0.0;
+  Points<Dim> at(Dim, static_cast<Index>(kept.size())), moved(Dim, static_cast<Index>(kept.size()));
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    at.col(static_cast<Index>(i)) = mesh.points.col(snapped.nodes[static_cast<std::size_t>(kept[i])]);
+    moved.col(static_cast<Index>(i)) = snapped.displacements.col(kept[i]);
+  }
+  SupportRadiusOptions wall_spacing;
+  wall_spacing.spacing_factor = 3.0;
+  return suggest_support_radius(at, moved, wall_spacing);
+}
+
+/// The default radii of the curved `walls` (wall_of: wall_of_nodes()): support_radius_factor ×
+/// each wall's layer thickness, limited to max_support_nodes boundary nodes per support around
+/// the wall's moving nodes; a wall without a layer gets spacing_radius() of its own nodes.
+/// The uniform radius is the largest layer radius, or spacing_radius() of every snapped node
+/// when no wall has a layer.
+template <int Dim>
+[[nodiscard]] DefaultRadii default_support_radii(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary,
+                                                 const SnappedBoundary<Dim>& snapped, const std::vector<WallLayer>& layers,
+                                                 const std::vector<int>& wall_of, const CurveOptions<Dim>& options) {
+  if (options.max_support_nodes < 0.0)
+    throw InputError("curve_mesh: max_support_nodes must be non-negative (got " + std::to_string(options.max_support_nodes) + ")");
+  DefaultRadii out;
+  out.per_wall.assign(layers.size(), 0.0);
+  std::vector<std::vector<Index>> moving(layers.size());
+  for (const Index v : moving_nodes(boundary))
+    if (const int w = wall_of[static_cast<std::size_t>(v)]; w >= 0) moving[static_cast<std::size_t>(w)].push_back(v);
+  for (std::size_t w = 0; w < layers.size(); ++w) {
+    if (!(layers[w].thickness > 0.0)) continue;
+    const double full = options.support_radius_factor * layers[w].thickness;
+    out.per_wall[w] = limit_support_radius(mesh, boundary, moving[w], full, options.max_support_nodes);
+    out.limited = out.limited || out.per_wall[w] < full;
+    out.uniform = std::max(out.uniform, out.per_wall[w]);
+  }
+  if (!(out.uniform > 0.0)) out.uniform = spacing_radius(mesh, snapped, [](Index) { return true; });
+  if (!(out.uniform > 0.0)) out.uniform = 1.0;  // nothing moves: any radius
+  for (std::size_t w = 0; w < layers.size(); ++w)
+    if (!(out.per_wall[w] > 0.0)) {
+      const double own = spacing_radius(mesh, snapped, [&](Index v) { return wall_of[static_cast<std::size_t>(v)] == static_cast<int>(w); });
+      out.per_wall[w] = own > 0.0 ? own : out.uniform;
+    }
+  return out;
+}
+
+/// The radius of each entry of `given`: its wall's, or for a node on no curved wall (fixed,
+/// sliding) the wall's of the nearest node that moves.
+template <int Dim>
+[[nodiscard]] std::vector<double> entry_radii(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& given,
+                                              const std::vector<int>& wall_of, const std::vector<double>& per_wall) {
+  std::vector<Index> moving;
+  for (const Index v : moving_nodes(given))
+    if (wall_of[static_cast<std::size_t>(v)] >= 0) moving.push_back(v);
+  Points<Dim> at(Dim, static_cast<Index>(moving.size()));
+  for (std::size_t k = 0; k < moving.size(); ++k) at.col(static_cast<Index>(k)) = mesh.points.col(moving[k]);
+  const KdTree<Dim> tree(at);
+  const double largest = *std::max_element(per_wall.begin(), per_wall.end());
+  std::vector<double> radii(given.nodes.size(), largest);
+  for (std::size_t k = 0; k < given.nodes.size(); ++k) {
+    int w = wall_of[static_cast<std::size_t>(given.nodes[k])];
+    if (w < 0 && !moving.empty())
+      w = wall_of[static_cast<std::size_t>(moving[tree.nearest(Vec<Dim>(mesh.points.col(given.nodes[k]))).first])];
+    if (w >= 0) radii[k] = per_wall[static_cast<std::size_t>(w)];
+  }
+  return radii;
 }
 
 /// The "none" method: the snapped boundary nodes move, nothing else (models MeshMover).
@@ -399,25 +507,17 @@ template <int Dim>
     regularize_and_certify(mover, boundary, options, result);
   } else {
     result.support_radius = options.support_radius;
+    std::vector<int> wall_of;
     if (!(result.support_radius > 0.0)) {
-      double thickest = 0.0;
-      for (const auto& w : result.layers) thickest = std::max(thickest, w.thickness);
-      result.support_radius = options.support_radius_factor * thickest;
-      if (options.max_support_nodes < 0.0)
-        throw InputError("curve_mesh: max_support_nodes must be non-negative (got " + std::to_string(options.max_support_nodes) + ")");
-      const double limited = detail::limit_support_radius(result.curved, boundary, result.support_radius, options.max_support_nodes);
-      result.support_radius_limited = limited < result.support_radius;
-      result.support_radius = limited;
-    }
-    if (!(result.support_radius > 0.0)) {
-      Points<Dim> at(Dim, static_cast<Index>(snapped.nodes.size()));
-      for (std::size_t k = 0; k < snapped.nodes.size(); ++k) at.col(static_cast<Index>(k)) = result.curved.points.col(snapped.nodes[k]);
-      // Curving displacements are tiny, so the spacing term decides. The motion default (10
-      // wall spacings) spans the whole body on the sphere test case (0.75 for radius 0.5) and
-      // gives 0.22, below snapping alone; 3 spacings give 0.64 (docs/curving.md).
-      SupportRadiusOptions wall_spacing;
-      wall_spacing.spacing_factor = 3.0;
-      result.support_radius = snapped.nodes.size() >= 2 ? suggest_support_radius(at, snapped.displacements, wall_spacing) : 1.0;
+      wall_of = detail::wall_of_nodes(result.curved, walls);
+      const detail::DefaultRadii radii = detail::default_support_radii(result.curved, boundary, snapped, result.layers, wall_of, options);
+      result.support_radius = radii.uniform;
+      result.support_radius_limited = radii.limited;
+      // Only the RBF mover takes a radius per centre; the other registry movers get one.
+      if (options.method == "rbf" && options.per_wall_radius) {
+        result.wall_support_radii = radii.per_wall;
+        result.support_radius = *std::max_element(radii.per_wall.begin(), radii.per_wall.end());
+      }
     }
     MoverParameters parameters = options.parameters;
     parameters.values.try_emplace("kernel", std::string(name(options.kernel)));
@@ -426,14 +526,20 @@ template <int Dim>
     // whole-mesh result to 4 digits of min quality on 30P30N with a sixth of the unknowns
     // (docs/mechanics.md, "Active region"); an explicit "active_radius" (0: whole mesh) wins.
     if (options.method == "sle" || options.method == "le") parameters.values.try_emplace("active_radius_factor", "4");
-    AnyMover<Dim> mover = make_mover<Dim>(options.method, parameters);
     if (options.centre_reach < 0.0)
       throw InputError("curve_mesh: centre_reach must be non-negative (got " + std::to_string(options.centre_reach) + ")");
     const bool trim = options.method == "rbf" && options.centre_reach > 0.0;
-    regularize_and_certify(mover, boundary,
-                           trim ? detail::near_motion(result.curved, boundary, options.centre_reach * result.support_radius)
-                                : boundary,
-                           options, result);
+    const ResolvedBoundary<Dim> given =
+        trim ? detail::near_motion(result.curved, boundary, options.centre_reach * result.support_radius) : boundary;
+    const auto& per_wall = result.wall_support_radii;
+    const bool varying = std::any_of(per_wall.begin(), per_wall.end(), [&](double r) { return r != per_wall.front(); });
+    AnyMover<Dim> mover = [&] {
+      if (!varying) return make_mover<Dim>(options.method, parameters);
+      RbfOptions rbf = detail::rbf_parameters(parameters);
+      rbf.support_radii = detail::entry_radii(result.curved, given, wall_of, per_wall);
+      return AnyMover<Dim>(RbfMover<Dim>(rbf));
+    }();
+    regularize_and_certify(mover, boundary, given, options, result);
   }
   result.seconds.total = total.seconds();
   return result;

@@ -127,6 +127,16 @@ template <int Dim>
   return o;
 }
 
+/// RBF options from "kernel", "support_radius", "polynomial" (nonzero: on), "solver", "tolerance".
+[[nodiscard]] inline RbfOptions rbf_parameters(const MoverParameters& p) {
+  RbfOptions o;
+  o.kernel = rbf_kernel_from_name(p.get("kernel", std::string(name(o.kernel))));
+  o.support_radius = p.get("support_radius", o.support_radius);
+  o.polynomial = p.get("polynomial", 0.0) != 0.0;
+  o.solver = mechanics_solver(p);
+  return o;
+}
+
 /// Elasticity options from "youngs_modulus", "poisson_ratio", "stiffening_exponent",
 /// "reference_jacobian", "distance_exponent", "active_radius" (or "active_radius_factor" ×
 /// "support_radius"), "solver", "tolerance".
@@ -153,15 +163,7 @@ template <int Dim>
 [[nodiscard]] const std::map<std::string, std::function<AnyMover<Dim>(const MoverParameters&)>, std::less<>>&
 mover_registry() {
   static const std::map<std::string, std::function<AnyMover<Dim>(const MoverParameters&)>, std::less<>> registry{
-      {"rbf",
-       [](const MoverParameters& p) {
-         RbfOptions o;
-         o.kernel = rbf_kernel_from_name(p.get("kernel", std::string(name(o.kernel))));
-         o.support_radius = p.get("support_radius", o.support_radius);
-         o.polynomial = p.get("polynomial", 0.0) != 0.0;
-         o.solver = detail::mechanics_solver(p);
-         return AnyMover<Dim>(RbfMover<Dim>(o));
-       }},
+      {"rbf", [](const MoverParameters& p) { return AnyMover<Dim>(RbfMover<Dim>(detail::rbf_parameters(p))); }},
       // Delaunay-graph movers: "simplex_support" (relative per-simplex RBF support), "kernel",
       // and for dgrbf2 "center" ("x,y[,z]") and "axis" ("ax,ay,az") of the rigid rotation.
       {"dgm", [](const MoverParameters&) { return AnyMover<Dim>(DgmMover<Dim>()); }},
