@@ -137,7 +137,8 @@ TEST_CASE("Wendland C2 matrices are symmetric positive definite in 2D and 3D", "
     std::vector<Index> rows(200);
     for (Index i = 0; i < 200; ++i) rows[std::size_t(i)] = i;
     const KdTree<Dim> tree(c);
-    const Eigen::MatrixXd a(detail::compact_kernel_rows<Dim>(c, rows, tree, 200, {RbfKernel::wendland2, 0.4, false}));
+    const auto within = [&](const Vec<Dim>& x, std::vector<Neighbor>& out) { tree.radius_search(x, 0.4, out); };
+    const Eigen::MatrixXd a(detail::compact_kernel_rows<Dim>(c, rows, within, 200, {RbfKernel::wendland2, 0.4, false}));
     CHECK((a - a.transpose()).norm() == 0.0);
     CHECK(a(3, 3) == 1.0);
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a);
@@ -229,6 +230,28 @@ TEST_CASE("a support radius per boundary entry: interpolation, reach of each cen
     }
     CHECK(beyond > 0);
     CHECK(covered_only_by_long > 0);  // the long supports of the fixed sides reach there, the short ones not
+  }
+  SECTION("a radius per node (too many to query one radius at a time): each still reaches its own") {
+    std::vector<double> graded(static_cast<std::size_t>(boundary.size()));
+    for (Index b = 0; b < boundary.size(); ++b) graded[std::size_t(b)] = 0.1 + 0.3 * double(b) / double(boundary.size());
+    RbfOptions options;
+    options.support_radii = graded;
+    RbfMover<2> mover(options);
+    mover.setup(g.mesh, boundary);
+    const Points<2> d = random_displacements<2>(boundary.size(), 8);
+    const Points<2> u = mover.move(d);
+    Index beyond = 0;
+    for (Index i = 0; i < g.mesh.num_nodes(); ++i) {
+      bool covered = false;
+      for (Index b = 0; b < boundary.size(); ++b) {
+        const double r = (g.mesh.points.col(i) - g.mesh.points.col(boundary.nodes[std::size_t(b)])).norm();
+        covered = covered || r < graded[std::size_t(b)];
+      }
+      CHECK((u.col(i).norm() > 0.0) == covered);
+      beyond += covered ? 0 : 1;
+    }
+    CHECK(beyond > 0);
+    for (Index b = 0; b < boundary.size(); ++b) CHECK((u.col(boundary.nodes[std::size_t(b)]) - d.col(b)).norm() == 0.0);
   }
   SECTION("equal per-entry radii are the uniform radius") {
     RbfOptions uniform;

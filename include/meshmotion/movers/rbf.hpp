@@ -200,12 +200,12 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
     // A compact support that reaches most centres from most nodes (a radius far larger than the
     // moving body, as rotations want) makes the sparse operator a full one stored with indices:
     // building it dense is several times cheaper and so is every move.
-    const bool dense = fits && (!is_compact(options_.kernel) || covered_fraction(kernel.radius) > 0.5);
+    const bool dense = fits && (!is_compact(options_.kernel) || covered_fraction() > 0.5);
     if (is_compact(options_.kernel) && !dense) {
       // Only rows with weights are kept, so skipped nodes cost nothing per move; the operator
       // is only multiplied, so its rows need no sorting.
       std::vector<Index> kept;
-      operator_ = detail::compact_kernel_rows(points_, interior_, all_.tree(), k, kernel, false, &kept);
+      operator_ = detail::compact_kernel_rows(points_, interior_, all_.within(), k, kernel, false, &kept);
       evaluated_.reserve(kept.size());
       for (const Index r : kept) evaluated_.push_back(interior_[static_cast<std::size_t>(r)]);
       stats_.nonzeros += operator_.nonZeros();
@@ -308,7 +308,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   [[nodiscard]] static Operator build_operator(const Points<Dim>& at, const std::vector<Index>& rows,
                                                const detail::RbfSystem<Dim>& system) {
     if (is_compact(system.kernel().kernel))
-      return detail::compact_kernel_rows(at, rows, system.tree(), system.size(), system.kernel(), false);
+      return detail::compact_kernel_rows(at, rows, system.within(), system.size(), system.kernel(), false);
     Eigen::MatrixXd dense(static_cast<Index>(rows.size()), system.size());
     for (Index r = 0; r < dense.rows(); ++r)
       dense.row(r) = kernel_row(system, at.col(rows[static_cast<std::size_t>(r)]));
@@ -340,15 +340,17 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   }
   [[nodiscard]] Eigen::RowVectorXd kernel_row(const Vec<Dim>& x) const { return kernel_row(all_, x); }
 
-  /// Mean share of the centres inside the support of a sample of evaluated nodes (up to 64,
+  /// Mean share of the centres whose support holds a sample of evaluated nodes (up to 64,
   /// evenly spread over interior_): a cheap estimate of the compact operator's density.
-  [[nodiscard]] double covered_fraction(double radius) const {
+  [[nodiscard]] double covered_fraction() const {
     const auto n = static_cast<Index>(interior_.size());
     const Index samples = std::min<Index>(n, 64);
     std::vector<Neighbor> found;
     double covered = 0.0;
-    for (Index s = 0; s < samples; ++s)
-      covered += static_cast<double>(all_.tree().radius_search(points_.col(interior_[static_cast<std::size_t>(s * n / samples)]), radius, found));
+    for (Index s = 0; s < samples; ++s) {
+      all_.centres_within(points_.col(interior_[static_cast<std::size_t>(s * n / samples)]), found);
+      covered += static_cast<double>(found.size());
+    }
     return samples == 0 ? 0.0 : covered / (static_cast<double>(samples) * static_cast<double>(all_.size()));
   }
 

@@ -56,16 +56,17 @@ struct RbfKernelSettings {
   }
 };
 
-/// Rows of φ(|x_i - c_j| / ρ_j) for the points x_i (columns of `points` listed in `rows`) against
-/// the centres in `tree`, compact kernels only: a row-major sparse matrix (rows.size() ×
-/// n_centres; with `kept`, only the rows with some centre inside the support, their positions
-/// in `rows` written to *kept). With `sorted` false the column indices of a row are in k-d
-/// tree order: enough for products and for a storage-order conversion (which sorts), not for
-/// coefficient access. Parallel over ranges of rows, each queried into one buffer that is
-/// copied once into the matrix.
-template <int Dim>
+/// Rows of φ(|x_i - c_j| / ρ_j) for the points x_i (columns of `points` listed in `rows`)
+/// against the centres that `within(x, out)` lists for x (pairs of centre index and squared
+/// distance, each centre within its own radius), compact kernels only: a row-major sparse
+/// matrix (rows.size() × n_centres; with `kept`, only the rows with some centre inside the
+/// support, their positions in `rows` written to *kept). With `sorted` false the column indices
+/// of a row are in query order: enough for products and for a storage-order conversion (which
+/// sorts), not for coefficient access. Parallel over ranges of rows, each queried into one
+/// buffer that is copied once into the matrix; `within` must be safe to call concurrently.
+template <int Dim, class Within>
 [[nodiscard]] Eigen::SparseMatrix<double, Eigen::RowMajor, int> compact_kernel_rows(
-    const Points<Dim>& points, const std::vector<Index>& rows, const KdTree<Dim>& tree, Index n_centres,
+    const Points<Dim>& points, const std::vector<Index>& rows, Within&& within, Index n_centres,
     const RbfKernelSettings& k, bool sorted = true, std::vector<Index>* kept = nullptr) {
   const auto n = static_cast<Index>(rows.size());
   std::vector<int> count(static_cast<std::size_t>(n));
@@ -80,12 +81,7 @@ template <int Dim>
     for (Index c = 0; c < chunks; ++c) {
       std::vector<Neighbor>& pairs = found[static_cast<std::size_t>(c)];
       for (Index r = n * c / chunks; r < n * (c + 1) / chunks; ++r) {
-        tree.radius_search(points.col(rows[static_cast<std::size_t>(r)]), k.radius, buffer);
-        if (!k.radii.empty())
-          std::erase_if(buffer, [&](const Neighbor& hit) {
-            const double own = k.radii[static_cast<std::size_t>(hit.first)];
-            return hit.second >= own * own;
-          });
+        within(Vec<Dim>(points.col(rows[static_cast<std::size_t>(r)])), buffer);
         if (sorted) std::sort(buffer.begin(), buffer.end());
         count[static_cast<std::size_t>(r)] = static_cast<int>(buffer.size());
         pairs.insert(pairs.end(), buffer.begin(), buffer.end());
@@ -146,6 +142,7 @@ class RbfSystem {
     compact_ = is_compact(kernel.kernel);
     symmetric_ = !kernel.varying();
     transposed_.reset();
+    build_radius_classes();
     if (!symmetric_) {
       if (sparse_options.kind != SolverKind::bicgstab) sparse_options.kind = SolverKind::sparse_lu;
       if (dense_kind != DenseSolverKind::partial_piv_lu) dense_kind = DenseSolverKind::partial_piv_lu;
@@ -156,7 +153,7 @@ class RbfSystem {
       for (Index i = 0; i < k; ++i) all[static_cast<std::size_t>(i)] = i;
       // Row i holds A_i·. With one radius the pattern and values are symmetric, so the rows
       // are also the columns of a column-major A and need no sorting conversion.
-      const auto rows = compact_kernel_rows(centres_, all, tree_, k, kernel_);
+      const auto rows = compact_kernel_rows(centres_, all, within(), k, kernel_);
       matrix_ = symmetric_ ? SparseMatrix(rows.transpose()) : SparseMatrix(rows);
       nonzeros_ = matrix_.nonZeros();
       sparse_ = LinearSolver(sparse_options);
@@ -190,7 +187,30 @@ class RbfSystem {
 
   [[nodiscard]] Index size() const noexcept { return centres_.cols(); }
   [[nodiscard]] const Points<Dim>& centres() const noexcept { return centres_; }
-  [[nodiscard]] const KdTree<Dim>& tree() const noexcept { return tree_; }
+  /// The centres whose support holds x, as (centre, squared distance) pairs in `out`. With
+  /// differing radii each radius class is queried at its own radius: one query at the largest
+  /// radius would return, around a thin wall's nodes, every centre of a thick one's support.
+  void centres_within(const Vec<Dim>& x, std::vector<Neighbor>& out) const {
+    if (classes_.empty()) {
+      tree_.radius_search(x, kernel_.radius, out);
+      if (!kernel_.radii.empty())
+        std::erase_if(out, [&](const Neighbor& hit) {
+          const double own = kernel_.radii[hit.first];
+          return hit.second >= own * own;
+        });
+      return;
+    }
+    thread_local std::vector<Neighbor> hits;
+    out.clear();
+    for (const RadiusClass& c : classes_) {
+      c.tree.radius_search(x, c.radius, hits);
+      for (const auto& [id, d2] : hits) out.emplace_back(static_cast<std::size_t>(c.ids[id]), d2);
+    }
+  }
+  /// centres_within() as a callable for compact_kernel_rows().
+  [[nodiscard]] auto within() const {
+    return [this](const Vec<Dim>& x, std::vector<Neighbor>& out) { centres_within(x, out); };
+  }
   [[nodiscard]] const RbfKernelSettings& kernel() const noexcept { return kernel_; }
   [[nodiscard]] Index nonzeros() const noexcept { return nonzeros_; }
   [[nodiscard]] const SolverReport& report() const noexcept { return compact_ ? sparse_.report() : dense_.report(); }
@@ -236,6 +256,28 @@ class RbfSystem {
   }
 
  private:
+  /// A few distinct radii (one per wall) get a k-d tree each; many (a radius per node) share
+  /// the tree of all centres, queried at the largest radius and filtered.
+  void build_radius_classes() {
+    classes_.clear();
+    if (kernel_.radii.empty() || symmetric_) return;
+    std::vector<double> distinct = kernel_.radii;
+    std::sort(distinct.begin(), distinct.end());
+    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+    if (distinct.size() > max_radius_classes) return;
+    classes_.resize(distinct.size());
+    for (std::size_t c = 0; c < distinct.size(); ++c) classes_[c].radius = distinct[c];
+    for (Index i = 0; i < centres_.cols(); ++i) {
+      const auto c = static_cast<std::size_t>(std::lower_bound(distinct.begin(), distinct.end(), kernel_.radii[static_cast<std::size_t>(i)]) - distinct.begin());
+      classes_[c].ids.push_back(i);
+    }
+    for (RadiusClass& c : classes_) {
+      c.at.resize(Dim, static_cast<Index>(c.ids.size()));
+      for (std::size_t j = 0; j < c.ids.size(); ++j) c.at.col(static_cast<Index>(j)) = centres_.col(c.ids[j]);
+      c.tree.build(c.at);
+    }
+  }
+
   void solve_a(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) {
     if (b.rows() == 0) {
       x.resize(0, b.cols());
@@ -247,9 +289,18 @@ class RbfSystem {
       dense_.solve(b, x);
   }
 
+  struct RadiusClass {
+    double radius = 0.0;
+    std::vector<Index> ids;  ///< centres of this radius
+    Points<Dim> at;          ///< their positions (the tree indexes this storage)
+    KdTree<Dim> tree;
+  };
+  static constexpr std::size_t max_radius_classes = 16;
+
   Points<Dim> centres_;
   RbfKernelSettings kernel_;
   KdTree<Dim> tree_;
+  std::vector<RadiusClass> classes_;  ///< per distinct radius, when few differ
   bool compact_ = true;
   bool symmetric_ = true;
   SolverOptions sparse_options_;
