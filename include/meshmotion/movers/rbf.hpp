@@ -58,7 +58,7 @@ struct RbfOptions {
   /// support_radius; empty: support_radius everywhere. Coincident nodes share the radius of
   /// the one that gives their value. Lets each wall's support follow its own boundary layer.
   /// Differing radii make the interpolation matrix nonsymmetric: it is factorized by sparse LU
-  /// whatever `solver` says (BiCGSTAB is kept), at about twice the Cholesky cost.
+  /// whatever `solver` says (BiCGSTAB is kept).
   std::vector<double> support_radii{};
   /// Add a linear polynomial (reproduces affine motions exactly; needed by the thin plate spline).
   bool polynomial = false;
