@@ -211,6 +211,13 @@ TEST_CASE("a support radius per boundary entry: interpolation, reach of each cen
     const Points<2> u = mover.move(d);
     for (Index b = 0; b < boundary.size(); ++b) CHECK((u.col(boundary.nodes[std::size_t(b)]) - d.col(b)).norm() == 0.0);
     CHECK(mover.stats().residual < (is_compact(kernel) ? 1e-10 : 1e-8));  // the Gaussian system is less well conditioned
+    // The reverse derivative goes through Aᵀ, factorized on the first call and reused:
+    // ⟨v, J w⟩ = ⟨Jᵀ v, w⟩ both times.
+    const Points<2> w = random_displacements<2>(boundary.size(), 9, 1.0);
+    const Points<2> v = random_displacements<2>(g.mesh.num_nodes(), 10, 1.0);
+    const double forward = (v.array() * mover.derivative_forward(w).array()).sum();
+    for (int call = 0; call < 2; ++call)
+      CHECK((mover.derivative_reverse(v).array() * w.array()).sum() == Approx(forward).epsilon(1e-8));
     if (!is_compact(kernel)) continue;
     // Each centre reaches exactly its own radius: a node is moved iff some centre covers it.
     Index beyond = 0, covered_only_by_long = 0;

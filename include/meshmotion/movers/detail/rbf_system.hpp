@@ -27,6 +27,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -142,6 +143,7 @@ class RbfSystem {
     compact_ = is_compact(kernel.kernel);
     symmetric_ = !kernel.varying();
     transposed_.reset();
+    dense_transposed_.reset();
     build_radius_classes();
     if (!symmetric_) {
       if (sparse_options.kind != SolverKind::bicgstab) sparse_options.kind = SolverKind::sparse_lu;
@@ -151,9 +153,10 @@ class RbfSystem {
     if (compact_) {
       std::vector<Index> all(static_cast<std::size_t>(k));
       for (Index i = 0; i < k; ++i) all[static_cast<std::size_t>(i)] = i;
-      // Row i holds A_i·. With one radius the pattern and values are symmetric, so the rows
-      // are also the columns of a column-major A and need no sorting conversion.
-      const auto rows = compact_kernel_rows(centres_, all, within(), k, kernel_);
+      // Row i holds A_i·. With one radius the pattern and values are symmetric, so the sorted
+      // rows are also the columns of a column-major A; otherwise the storage-order conversion
+      // sorts them.
+      const auto rows = compact_kernel_rows(centres_, all, within(), k, kernel_, symmetric_);
       matrix_ = symmetric_ ? SparseMatrix(rows.transpose()) : SparseMatrix(rows);
       nonzeros_ = matrix_.nonZeros();
       sparse_ = LinearSolver(sparse_options);
@@ -248,10 +251,15 @@ class RbfSystem {
       if (!transposed_) {
         transposed_ = std::make_unique<LinearSolver>(sparse_options_);
         transposed_->compute(SparseMatrix(matrix_.transpose()));
+        matrix_.resize(0, 0);
       }
       transposed_->solve(rhs, values_bar);
     } else {
-      values_bar = dense_matrix_.transpose().partialPivLu().solve(rhs);
+      if (!dense_transposed_) {
+        dense_transposed_ = Eigen::PartialPivLU<Eigen::MatrixXd>(dense_matrix_.transpose());
+        dense_matrix_.resize(0, 0);
+      }
+      values_bar = dense_transposed_->solve(rhs);
     }
   }
 
@@ -304,9 +312,10 @@ class RbfSystem {
   bool compact_ = true;
   bool symmetric_ = true;
   SolverOptions sparse_options_;
-  SparseMatrix matrix_;             ///< A, kept only when not symmetric (for Aᵀ)
-  Eigen::MatrixXd dense_matrix_;    ///< dense A, kept only when not symmetric
+  SparseMatrix matrix_;             ///< A, kept only when not symmetric, until Aᵀ is factorized
+  Eigen::MatrixXd dense_matrix_;    ///< dense A, likewise
   std::unique_ptr<LinearSolver> transposed_;  ///< factorized Aᵀ, on first transposed solve
+  std::optional<Eigen::PartialPivLU<Eigen::MatrixXd>> dense_transposed_;  ///< dense Aᵀ, likewise
   LinearSolver sparse_;
   DenseSolver dense_;
   Index nonzeros_ = 0;
