@@ -29,6 +29,7 @@
 #include <limits>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace meshmotion {
@@ -71,9 +72,56 @@ using ElementCoords = Eigen::Matrix<double, D, Eigen::Dynamic, 0, D, 27>;
 using LatticeVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 216, 1>;
 
 // One pass of apply_factors: to[o, r, i] = Σ_b f(r, b) from[o, b, i], as whole rows over i (the
-// compiler vectorizes them) or, on the last axis (inner = 1), as sums kept in a register.
+// compiler vectorizes them) or, on the last axis (inner = 1), as sums kept in a register. The
+// factor sizes are compile-time constants: with 2–6 terms a runtime trip count costs more than
+// the arithmetic (a third off the certification of the curved coarse 3D bump).
+template <int In, int Out>
+void factor_pass_fixed(const double* f, Index outer, Index inner, const double* from, double* to) {
+  // f is column-major Out × In: f(r, b) = f[r + b * Out].
+  if (inner == 1) {
+    for (Index o = 0; o < outer; ++o, from += In, to += Out)
+      for (int r = 0; r < Out; ++r) {
+        double sum = 0.0;
+        for (int b = 0; b < In; ++b) sum += f[r + b * Out] * from[b];
+        to[r] = sum;
+      }
+    return;
+  }
+  for (Index o = 0; o < outer; ++o, from += In * inner, to += Out * inner)
+    for (int r = 0; r < Out; ++r) {
+      double* row = to + r * inner;
+      for (Index i = 0; i < inner; ++i) {
+        double sum = 0.0;
+        for (int b = 0; b < In; ++b) sum += f[r + b * Out] * from[b * inner + i];
+        row[i] = sum;
+      }
+    }
+}
+
 inline void factor_pass(const Eigen::MatrixXd& f, Index outer, Index inner, const double* from, double* to) {
   const Index in_len = f.cols(), out_len = f.rows();
+  // Every line factor of the catalogue (P1/P2 lines: 2–6 lattice points); simplex factors of
+  // other sizes take the generic loop.
+  const auto dispatch = [&]<int In>(std::integral_constant<int, In>) {
+    switch (out_len) {
+      case 2: return factor_pass_fixed<In, 2>(f.data(), outer, inner, from, to), true;
+      case 3: return factor_pass_fixed<In, 3>(f.data(), outer, inner, from, to), true;
+      case 4: return factor_pass_fixed<In, 4>(f.data(), outer, inner, from, to), true;
+      case 5: return factor_pass_fixed<In, 5>(f.data(), outer, inner, from, to), true;
+      case 6: return factor_pass_fixed<In, 6>(f.data(), outer, inner, from, to), true;
+      default: return false;
+    }
+  };
+  bool done = false;
+  switch (in_len) {
+    case 2: done = dispatch(std::integral_constant<int, 2>{}); break;
+    case 3: done = dispatch(std::integral_constant<int, 3>{}); break;
+    case 4: done = dispatch(std::integral_constant<int, 4>{}); break;
+    case 5: done = dispatch(std::integral_constant<int, 5>{}); break;
+    case 6: done = dispatch(std::integral_constant<int, 6>{}); break;
+    default: break;
+  }
+  if (done) return;
   for (Index o = 0; o < outer; ++o, from += in_len * inner, to += out_len * inner)
     for (Index r = 0; r < out_len; ++r) {
       if (inner == 1) {
@@ -141,25 +189,43 @@ void lattice_dets(const JacobianSpace& s, const ElementCoords<D>& x, double scal
     values(j) = Eigen::Matrix<double, D, D>(jacobians.template middleRows<D>(static_cast<Index>(j) * D)).determinant() * scale;
 }
 
-// The factors of the Bézier transform (child < 0), or of child `child`'s Bézier coefficients
-// from its parent's.
-inline int space_factors(const JacobianSpace& s, int child, std::array<const Eigen::MatrixXd*, 4>& f) {
+// values ← Bézier coefficients of the lattice values.
+inline void to_bezier(const JacobianSpace& s, LatticeVector& values) {
+  std::array<const Eigen::MatrixXd*, 4> f{};
   int count = 0;
-  const int bits = child < 0 ? 0 : child & ((1 << s.line_dims) - 1);
-  if (s.simplex_dim > 0)
-    f[static_cast<std::size_t>(count++)] =
-        child < 0 ? &s.simplex.to_bezier : &s.simplex.child_bezier[static_cast<std::size_t>(child >> s.line_dims)];
-  for (int l = 0; l < s.line_dims; ++l)
-    // The first line coordinate's bit is the lowest (see make_children).
-    f[static_cast<std::size_t>(count++)] =
-        child < 0 ? &s.line.to_bezier : &s.line.child_bezier[static_cast<std::size_t>((bits >> l) & 1)];
-  return count;
+  if (s.simplex_dim > 0) f[static_cast<std::size_t>(count++)] = &s.simplex.to_bezier;
+  for (int l = 0; l < s.line_dims; ++l) f[static_cast<std::size_t>(count++)] = &s.line.to_bezier;
+  apply_factors(std::span<const Eigen::MatrixXd* const>(f.data(), static_cast<std::size_t>(count)), values);
 }
 
-inline void transform(const JacobianSpace& s, int child, LatticeVector& values) {
-  std::array<const Eigen::MatrixXd*, 4> f{};
-  const int count = space_factors(s, child, f);
-  apply_factors(std::span<const Eigen::MatrixXd* const>(f.data(), static_cast<std::size_t>(count)), values);
+// visit(coefficients) for every child of a subdivision, from its parent's coefficients. The
+// last factor is applied first, so children that differ only in earlier factors share the
+// passes over the later ones: a hex's 8 children take 2 + 4 + 8 passes instead of 24, and
+// only 2 of them are the unvectorized last-axis kind.
+template <class Visit>
+void for_each_child(const JacobianSpace& s, const LatticeVector& parent, Visit&& visit) {
+  const int count = (s.simplex_dim > 0 ? 1 : 0) + s.line_dims;
+  std::array<Index, 4> sizes{};
+  for (int a = 0; a < count; ++a)
+    sizes[static_cast<std::size_t>(a)] = (a == 0 && s.simplex_dim > 0) ? s.simplex.to_bezier.cols() : s.line.to_bezier.cols();
+  thread_local std::array<LatticeVector, 4> levels;
+  const auto descend = [&](const auto& self, int a, const LatticeVector& from) -> void {
+    if (a < 0) {
+      visit(from);
+      return;
+    }
+    Index outer = 1, inner = 1;
+    for (int b = 0; b < a; ++b) outer *= sizes[static_cast<std::size_t>(b)];
+    for (int b = a + 1; b < count; ++b) inner *= sizes[static_cast<std::size_t>(b)];
+    const auto& choices = (a == 0 && s.simplex_dim > 0) ? s.simplex.child_bezier : s.line.child_bezier;
+    LatticeVector& to = levels[static_cast<std::size_t>(a)];
+    for (const auto& factor : choices) {
+      to.resize(from.size());
+      factor_pass(factor, outer, inner, from.data(), to.data());
+      self(self, a - 1, to);
+    }
+  };
+  descend(descend, count - 1, parent);
 }
 
 template <int D>
@@ -178,7 +244,7 @@ struct BezierLeaf {
 };
 
 inline BezierLeaf make_leaf(const JacobianSpace& s, LatticeVector values, int depth) {
-  transform(s, -1, values);
+  to_bezier(s, values);
   BezierLeaf leaf{std::move(values), 0.0, 0.0, depth};
   leaf.min = leaf.coefficients.minCoeff();
   leaf.max = leaf.coefficients.maxCoeff();
@@ -215,9 +281,8 @@ inline void certify(const JacobianSpace& s, const LatticeVector& values, const S
     leaves.erase(leaves.begin() + static_cast<std::ptrdiff_t>(pick));
     // Children's coefficients straight from the parent's (one pass per axis instead of two);
     // their corner coefficients are values of det J and tighten the sampled extremes.
-    for (int child = 0; child < s.num_children(); ++child) {
-      BezierLeaf leaf{parent.coefficients, 0.0, 0.0, parent.depth + 1};
-      transform(s, child, leaf.coefficients);
+    for_each_child(s, parent.coefficients, [&](const LatticeVector& coefficients) {
+      BezierLeaf leaf{coefficients, 0.0, 0.0, parent.depth + 1};
       leaf.min = leaf.coefficients.minCoeff();
       leaf.max = leaf.coefficients.maxCoeff();
       for (const int k : s.corners) {
@@ -225,7 +290,7 @@ inline void certify(const JacobianSpace& s, const LatticeVector& values, const S
         lower_max = std::max(lower_max, leaf.coefficients(k));
       }
       leaves.push_back(std::move(leaf));
-    }
+    });
   }
   r.leaves = static_cast<int>(leaves.size());
   r.sampled_min = std::min(r.sampled_min, upper_min);
@@ -255,7 +320,7 @@ ScaledJacobian scaled_jacobian_fixed(ElementType type, const ElementCoords<D>& x
   // lower degree (a hex27's 216 Bézier coefficients become a hex8's 27).
   if (s.linear_embedding.size() > 0) {
     const double tolerance = 1e-12 * extent;
-    const ElementCoords<D> straight = vertices * s.linear_embedding;
+    const ElementCoords<D> straight = vertices.lazyProduct(s.linear_embedding);  // no GEMM dispatch for 3 × 8 × 27
     if (((x - straight).cwiseAbs().array() <= tolerance).all())
       return scaled_jacobian_fixed<D>(linear_type(type), ElementCoords<D>(vertices), opt);
   }
