@@ -58,6 +58,14 @@ TEST_CASE("k-d tree reads the matrix in place and handles edge cases", "[spatial
   points << 0, 1, 2, 0, 0, 0;
   const KdTree<2> tree(points);
   CHECK(tree.radius_search(Vec<2>(0.9, 0.0), 0.2).size() == 1);
+  // Queries outside the points' bounding box: found exactly when strictly within the radius,
+  // across a side and past a corner.
+  CHECK(tree.radius_search(Vec<2>(2.5, 0.0), 0.5).empty());
+  CHECK(tree.radius_search(Vec<2>(2.5, 0.0), 0.5001).size() == 1);
+  CHECK(tree.radius_search(Vec<2>(1.0, 0.3), 0.31).size() == 1);
+  CHECK(tree.radius_search(Vec<2>(1.0, 0.3), 0.29).empty());
+  CHECK(tree.radius_search(Vec<2>(3.0, 4.0), 4.2).size() == 1);
+  CHECK(tree.radius_search(Vec<2>(3.0, 4.0), 4.1).empty());
   const KdTree<2> empty(Points<2>(2, 0));
   CHECK(empty.radius_search(Vec<2>(0.0, 0.0), 1.0).empty());
   CHECK(empty.nearest(Vec<2>(0.0, 0.0), 3).empty());

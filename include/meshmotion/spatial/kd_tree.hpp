@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -76,6 +77,13 @@ class KdTree {
     for (Index k = 0; k < n * Dim; ++k)
       if (!std::isfinite(data[k]))
         throw InputError("KdTree::build: point " + std::to_string(k / Dim) + " has a non-finite coordinate");
+    lower_.setConstant(std::numeric_limits<double>::infinity());
+    upper_.setConstant(-std::numeric_limits<double>::infinity());
+    for (Index k = 0; k < n; ++k) {
+      const Eigen::Map<const Vec<Dim>> p(data + k * Dim);
+      lower_ = lower_.cwiseMin(p);
+      upper_ = upper_.cwiseMax(p);
+    }
     adaptor_ = std::make_unique<Adaptor>(Adaptor{data, static_cast<std::size_t>(n)});
     tree_ = std::make_unique<Tree>(Dim, *adaptor_, nanoflann::KDTreeSingleIndexAdaptorParams(options.leaf_max_size));
     if (n > 0) tree_->buildIndex();
@@ -89,7 +97,10 @@ class KdTree {
   /// Reusing `out` across queries avoids allocation.
   Index radius_search(const Vec<Dim>& query, double radius, std::vector<Neighbor>& out, bool sorted = false) const {
     out.clear();
-    if (size() == 0) return 0;
+    // A query farther than `radius` from the points' bounding box finds nothing: most nodes of
+    // a mesh asking for centres on a small wall. nanoflann would still descend to a leaf.
+    const Vec<Dim> outside = (lower_ - query).cwiseMax(query - upper_).cwiseMax(0.0);
+    if (size() == 0 || outside.squaredNorm() >= radius * radius) return 0;
     nanoflann::SearchParams params;
     params.sorted = sorted;
     return static_cast<Index>(tree_->radiusSearch(query.data(), radius * radius, out, params));
@@ -126,6 +137,7 @@ class KdTree {
  private:
   std::unique_ptr<Adaptor> adaptor_;
   std::unique_ptr<Tree> tree_;
+  Vec<Dim> lower_ = Vec<Dim>::Zero(), upper_ = Vec<Dim>::Zero();  // bounding box of the points
 };
 
 }  // namespace meshmotion
