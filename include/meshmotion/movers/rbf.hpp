@@ -202,10 +202,9 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
     // building it dense is several times cheaper and so is every move.
     const bool dense = fits && (!is_compact(options_.kernel) || covered_fraction() > 0.5);
     if (is_compact(options_.kernel) && !dense) {
-      // Only rows with weights are kept, so skipped nodes cost nothing per move; the operator
-      // is only multiplied, so its rows need no sorting.
+      // Only rows with weights are kept, so skipped nodes cost nothing per move.
       std::vector<Index> kept;
-      operator_ = detail::compact_kernel_rows(points_, interior_, all_.within(), k, kernel, false, &kept);
+      operator_ = detail::compact_kernel_rows(points_, interior_, all_.within(), k, kernel, &kept);
       evaluated_.reserve(kept.size());
       for (const Index r : kept) evaluated_.push_back(interior_[static_cast<std::size_t>(r)]);
       stats_.nonzeros += operator_.nonZeros();
@@ -308,7 +307,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   [[nodiscard]] static Operator build_operator(const Points<Dim>& at, const std::vector<Index>& rows,
                                                const detail::RbfSystem<Dim>& system) {
     if (is_compact(system.kernel().kernel))
-      return detail::compact_kernel_rows(at, rows, system.within(), system.size(), system.kernel(), false);
+      return detail::compact_kernel_rows(at, rows, system.within(), system.size(), system.kernel());
     Eigen::MatrixXd dense(static_cast<Index>(rows.size()), system.size());
     for (Index r = 0; r < dense.rows(); ++r)
       dense.row(r) = kernel_row(system, at.col(rows[static_cast<std::size_t>(r)]));

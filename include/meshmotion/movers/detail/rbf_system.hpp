@@ -61,14 +61,14 @@ struct RbfKernelSettings {
 /// against the centres that `within(x, out)` lists for x (pairs of centre index and squared
 /// distance, each centre within its own radius), compact kernels only: a row-major sparse
 /// matrix (rows.size() × n_centres; with `kept`, only the rows with some centre inside the
-/// support, their positions in `rows` written to *kept). With `sorted` false the column indices
-/// of a row are in query order: enough for products and for a storage-order conversion (which
-/// sorts), not for coefficient access. Parallel over ranges of rows, each queried into one
+/// support, their positions in `rows` written to *kept). The column indices of a row are in
+/// query order: enough for products and for a storage-order conversion (which sorts), not for
+/// coefficient access. Parallel over ranges of rows, each queried into one
 /// buffer that is copied once into the matrix; `within` must be safe to call concurrently.
 template <int Dim, class Within>
 [[nodiscard]] Eigen::SparseMatrix<double, Eigen::RowMajor, int> compact_kernel_rows(
     const Points<Dim>& points, const std::vector<Index>& rows, Within&& within, Index n_centres,
-    const RbfKernelSettings& k, bool sorted = true, std::vector<Index>* kept = nullptr) {
+    const RbfKernelSettings& k, std::vector<Index>* kept = nullptr) {
   const auto n = static_cast<Index>(rows.size());
   std::vector<int> count(static_cast<std::size_t>(n));
   // Contiguous row ranges, more of them than threads so that dynamic scheduling balances
@@ -83,7 +83,6 @@ template <int Dim, class Within>
       std::vector<Neighbor>& pairs = found[static_cast<std::size_t>(c)];
       for (Index r = n * c / chunks; r < n * (c + 1) / chunks; ++r) {
         within(Vec<Dim>(points.col(rows[static_cast<std::size_t>(r)])), buffer);
-        if (sorted) std::sort(buffer.begin(), buffer.end());
         count[static_cast<std::size_t>(r)] = static_cast<int>(buffer.size());
         pairs.insert(pairs.end(), buffer.begin(), buffer.end());
       }
@@ -153,11 +152,10 @@ class RbfSystem {
     if (compact_) {
       std::vector<Index> all(static_cast<std::size_t>(k));
       for (Index i = 0; i < k; ++i) all[static_cast<std::size_t>(i)] = i;
-      // Row i holds A_i·. With one radius the pattern and values are symmetric, so the sorted
-      // rows are also the columns of a column-major A; otherwise the storage-order conversion
-      // sorts them.
-      const auto rows = compact_kernel_rows(centres_, all, within(), k, kernel_, symmetric_);
-      matrix_ = symmetric_ ? SparseMatrix(rows.transpose()) : SparseMatrix(rows);
+      // Row i holds A_i·, its centres in k-d tree order: the storage-order conversion sorts
+      // them by a counting pass, cheaper than sorting each row (sliding centres on a side
+      // plane through a wall's layer have a hundred neighbours).
+      matrix_ = SparseMatrix(compact_kernel_rows(centres_, all, within(), k, kernel_));
       nonzeros_ = matrix_.nonZeros();
       sparse_ = LinearSolver(sparse_options);
       sparse_.compute(matrix_);
