@@ -173,26 +173,25 @@ template <int Dim>
 [[nodiscard]] ResolvedBoundary<Dim> curving_boundary(const Mesh<Dim>& mesh, const SnappedBoundary<Dim>& snapped,
                                                      const std::vector<std::string>& sliding) {
   using Entry = BoundaryEntry<Dim>;
-  std::map<Index, Entry> entries;
+  BoundaryCollector<Dim> entries(mesh.num_nodes());
   for (std::size_t k = 0; k < snapped.nodes.size(); ++k)
-    entries.emplace(snapped.nodes[k],
-                    Entry{BoundaryKind::prescribed, Vec<Dim>(snapped.displacements.col(static_cast<Index>(k)))});
+    entries.add(snapped.nodes[k], Entry{BoundaryKind::prescribed, Vec<Dim>(snapped.displacements.col(static_cast<Index>(k)))});
   if (!sliding.empty()) {
     BoundarySpec<Dim> spec;
     for (const auto& g : sliding) spec.sliding(g);
     const ResolvedBoundary<Dim> slide = spec.resolve(mesh);
     for (Index k = 0; k < slide.size(); ++k)
-      entries.emplace(slide.nodes[static_cast<std::size_t>(k)],
-                      Entry{slide.kinds[static_cast<std::size_t>(k)], Vec<Dim>::Zero(), Vec<Dim>(slide.normals.col(k)),
-                            Vec<Dim>(slide.directions.col(k))});
+      entries.add(slide.nodes[static_cast<std::size_t>(k)],
+                  Entry{slide.kinds[static_cast<std::size_t>(k)], Vec<Dim>::Zero(), Vec<Dim>(slide.normals.col(k)),
+                        Vec<Dim>(slide.directions.col(k))});
   }
   const auto fix = [&](const std::vector<ElementBlock>& blocks) {
     for (const auto& b : blocks)
-      for (const Index v : b.connectivity) entries.emplace(v, Entry{BoundaryKind::fixed});
+      for (const Index v : b.connectivity) entries.add(v, Entry{BoundaryKind::fixed});
   };
   fix(mesh.facets);
   fix(boundary_facets(mesh));
-  return make_resolved_boundary(entries);
+  return entries.resolve();
 }
 
 /// The nodes of `boundary` with a nonzero displacement.

@@ -116,25 +116,66 @@ struct BoundaryEntry {
   Vec<Dim> direction = Vec<Dim>::Zero();  ///< line of a node on two sliding planes (3D)
 };
 
-/// The ResolvedBoundary of conditions by node (the map keeps the nodes sorted).
-template <int Dim>
-[[nodiscard]] ResolvedBoundary<Dim> make_resolved_boundary(const std::map<Index, BoundaryEntry<Dim>>& entries) {
+namespace detail {
+
+// A ResolvedBoundary of `count` conditions, which visit(add) passes to add(node, entry) in
+// ascending node order.
+template <int Dim, class Visit>
+[[nodiscard]] ResolvedBoundary<Dim> collect_boundary(Index count, Visit&& visit) {
   ResolvedBoundary<Dim> out;
-  const auto m = static_cast<Index>(entries.size());
-  out.displacements.setZero(Dim, m);
-  out.normals.setZero(Dim, m);
-  out.directions.setZero(Dim, m);
+  out.nodes.reserve(static_cast<std::size_t>(count));
+  out.kinds.reserve(static_cast<std::size_t>(count));
+  out.displacements.setZero(Dim, count);
+  out.normals.setZero(Dim, count);
+  out.directions.setZero(Dim, count);
   Index k = 0;
-  for (const auto& [node, e] : entries) {
+  visit([&](Index node, const BoundaryEntry<Dim>& e) {
     out.nodes.push_back(node);
     out.kinds.push_back(e.kind);
     out.displacements.col(k) = e.displacement;
     out.normals.col(k) = e.normal;
     out.directions.col(k) = e.direction;
     ++k;
-  }
+  });
   return out;
 }
+
+}  // namespace detail
+
+/// The ResolvedBoundary of conditions by node (the map keeps the nodes sorted).
+template <int Dim>
+[[nodiscard]] ResolvedBoundary<Dim> make_resolved_boundary(const std::map<Index, BoundaryEntry<Dim>>& entries) {
+  return detail::collect_boundary<Dim>(static_cast<Index>(entries.size()), [&](auto&& add) {
+    for (const auto& [node, e] : entries) add(node, e);
+  });
+}
+
+/// Conditions of a whole mesh's boundary collected by node in a dense table: a map's node
+/// allocations cost more than the rest of a 3D curving boundary's setup. The first condition
+/// given to a node stays.
+template <int Dim>
+class BoundaryCollector {
+ public:
+  explicit BoundaryCollector(Index num_nodes) : slot_(static_cast<std::size_t>(num_nodes), -1) {}
+  /// Gives `node` the condition `entry` unless it has one already.
+  void add(Index node, const BoundaryEntry<Dim>& entry) {
+    int& s = slot_[static_cast<std::size_t>(node)];
+    if (s >= 0) return;
+    s = static_cast<int>(entries_.size());
+    entries_.push_back(entry);
+  }
+  /// The collected conditions, nodes ascending.
+  [[nodiscard]] ResolvedBoundary<Dim> resolve() const {
+    return detail::collect_boundary<Dim>(static_cast<Index>(entries_.size()), [&](auto&& add) {
+      for (std::size_t v = 0; v < slot_.size(); ++v)
+        if (slot_[v] >= 0) add(static_cast<Index>(v), entries_[static_cast<std::size_t>(slot_[v])]);
+    });
+  }
+
+ private:
+  std::vector<int> slot_;
+  std::vector<BoundaryEntry<Dim>> entries_;
+};
 
 /// Node lists by group name, for meshes without named groups (any MeshLike).
 using GroupNodes = std::map<std::string, std::vector<Index>, std::less<>>;
