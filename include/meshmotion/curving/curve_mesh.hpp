@@ -214,14 +214,20 @@ template <int Dim>
   Points<Dim> at(Dim, static_cast<Index>(moving.size()));
   for (std::size_t k = 0; k < moving.size(); ++k) at.col(static_cast<Index>(k)) = mesh.points.col(moving[k]);
   const KdTree<Dim> tree(at);
-  std::map<Index, BoundaryEntry<Dim>> kept;
+  // Most boundary nodes (inflow, outflow, farfield) lie far outside the moving nodes' box.
+  const Vec<Dim> lower = at.rowwise().minCoeff(), upper = at.rowwise().maxCoeff();
+  std::vector<Index> kept;  // entries of `boundary`, whose nodes ascend
   for (Index k = 0; k < boundary.size(); ++k) {
-    const Index v = boundary.nodes[static_cast<std::size_t>(k)];
-    if (tree.nearest(Vec<Dim>(mesh.points.col(v))).second > reach * reach) continue;
-    kept.emplace(v, BoundaryEntry<Dim>{boundary.kinds[static_cast<std::size_t>(k)], Vec<Dim>(boundary.displacements.col(k)),
-                                       Vec<Dim>(boundary.normals.col(k)), Vec<Dim>(boundary.directions.col(k))});
+    const Vec<Dim> p = mesh.points.col(boundary.nodes[static_cast<std::size_t>(k)]);
+    if ((lower - p).cwiseMax(p - upper).cwiseMax(0.0).squaredNorm() <= reach * reach && tree.nearest(p).second <= reach * reach)
+      kept.push_back(k);
   }
-  return make_resolved_boundary(kept);
+  return detail::collect_boundary<Dim>(static_cast<Index>(kept.size()), [&](auto&& add) {
+    for (const Index k : kept)
+      add(boundary.nodes[static_cast<std::size_t>(k)],
+          BoundaryEntry<Dim>{boundary.kinds[static_cast<std::size_t>(k)], Vec<Dim>(boundary.displacements.col(k)),
+                             Vec<Dim>(boundary.normals.col(k)), Vec<Dim>(boundary.directions.col(k))});
+  });
 }
 
 /// The largest radius ≤ `radius` whose ball around a node of `moving` holds at most `budget`
