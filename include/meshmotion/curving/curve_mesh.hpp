@@ -214,13 +214,11 @@ template <int Dim>
   Points<Dim> at(Dim, static_cast<Index>(moving.size()));
   for (std::size_t k = 0; k < moving.size(); ++k) at.col(static_cast<Index>(k)) = mesh.points.col(moving[k]);
   const KdTree<Dim> tree(at);
-  // Most boundary nodes (inflow, outflow, farfield) lie far outside the moving nodes' box.
-  const Vec<Dim> lower = at.rowwise().minCoeff(), upper = at.rowwise().maxCoeff();
   std::vector<Index> kept;  // entries of `boundary`, whose nodes ascend
   for (Index k = 0; k < boundary.size(); ++k) {
     const Vec<Dim> p = mesh.points.col(boundary.nodes[static_cast<std::size_t>(k)]);
-    if ((lower - p).cwiseMax(p - upper).cwiseMax(0.0).squaredNorm() <= reach * reach && tree.nearest(p).second <= reach * reach)
-      kept.push_back(k);
+    // Most boundary nodes (inflow, outflow, farfield) lie far outside the moving nodes' box.
+    if (tree.box_squared_distance(p) <= reach * reach && tree.nearest(p).second <= reach * reach) kept.push_back(k);
   }
   return detail::collect_boundary<Dim>(static_cast<Index>(kept.size()), [&](auto&& add) {
     for (const Index k : kept)

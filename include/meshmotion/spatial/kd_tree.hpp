@@ -99,8 +99,7 @@ class KdTree {
     out.clear();
     // A query farther than `radius` from the points' bounding box finds nothing: most nodes of
     // a mesh asking for centres on a small wall. nanoflann would still descend to a leaf.
-    const Vec<Dim> outside = (lower_ - query).cwiseMax(query - upper_).cwiseMax(0.0);
-    if (size() == 0 || outside.squaredNorm() >= radius * radius) return 0;
+    if (size() == 0 || box_squared_distance(query) >= radius * radius) return 0;
     nanoflann::SearchParams params;
     params.sorted = sorted;
     return static_cast<Index>(tree_->radiusSearch(query.data(), radius * radius, out, params));
@@ -111,6 +110,11 @@ class KdTree {
     return out;
   }
 
+  /// Squared distance from `query` to the points' bounding box: 0 inside it, a lower bound of
+  /// every point's squared distance, infinite for an empty tree. A cheap rejection test.
+  [[nodiscard]] double box_squared_distance(const Vec<Dim>& query) const {
+    return (lower_ - query).cwiseMax(query - upper_).cwiseMax(0.0).squaredNorm();
+  }
   /// The k nearest points to `query`, nearest first, as (index, squared distance); fewer when
   /// the tree holds fewer than k points.
   [[nodiscard]] std::vector<Neighbor> nearest(const Vec<Dim>& query, Index k) const {
@@ -137,7 +141,9 @@ class KdTree {
  private:
   std::unique_ptr<Adaptor> adaptor_;
   std::unique_ptr<Tree> tree_;
-  Vec<Dim> lower_ = Vec<Dim>::Zero(), upper_ = Vec<Dim>::Zero();  // bounding box of the points
+  // Bounding box of the points (empty: lower above upper).
+  Vec<Dim> lower_ = Vec<Dim>::Constant(std::numeric_limits<double>::infinity());
+  Vec<Dim> upper_ = Vec<Dim>::Constant(-std::numeric_limits<double>::infinity());
 };
 
 }  // namespace meshmotion

@@ -134,7 +134,6 @@ class RbfSystem {
     centres_ = centres;
     kernel_ = kernel;
     const Index k = centres_.cols();
-    tree_.build(centres_);
     if (k > 0) {
       shift_ = centres_.rowwise().mean();
       scale_ = std::max((centres_.colwise() - shift_).colwise().norm().maxCoeff(), 1e-300);
@@ -144,6 +143,10 @@ class RbfSystem {
     transposed_.reset();
     dense_transposed_.reset();
     build_radius_classes();
+    // The tree of all centres answers centres_within() unless radius classes do; global kernels
+    // query neither.
+    tree_ = KdTree<Dim>{};
+    if (compact_ && classes_.empty()) tree_.build(centres_);
     if (!symmetric_) {
       if (sparse_options.kind != SolverKind::bicgstab) sparse_options.kind = SolverKind::sparse_lu;
       if (dense_kind != DenseSolverKind::partial_piv_lu) dense_kind = DenseSolverKind::partial_piv_lu;
@@ -266,7 +269,7 @@ class RbfSystem {
   /// the tree of all centres, queried at the largest radius and filtered.
   void build_radius_classes() {
     classes_.clear();
-    if (kernel_.radii.empty() || symmetric_) return;
+    if (kernel_.radii.empty() || symmetric_ || !compact_) return;
     std::vector<double> distinct = kernel_.radii;
     std::sort(distinct.begin(), distinct.end());
     distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
