@@ -161,6 +161,51 @@ TEST_CASE("annulus between two walls: each layer starts at its first height, rin
   }
 }
 
+TEST_CASE("extruded 2D meshes: prisms and hexahedra, lateral groups keep their 2D tags, end caps", "[core]") {
+  const Mesh<2> flat = rectangle_mesh({.nx = 4, .ny = 3, .x_max = 2.0, .cells = RectangleCells::tri_quad});
+  const ExtrudeOptions o{.layers = 3, .height = 0.6};
+  const Mesh<3> m = extrude_mesh(flat, o);
+  CHECK_NOTHROW(validate(m));
+  CHECK(m.num_nodes() == flat.num_nodes() * (o.layers + 1));
+  REQUIRE(m.find_block(ElementType::prism6));
+  REQUIRE(m.find_block(ElementType::hex8));
+  CHECK(m.find_block(ElementType::prism6)->size() == flat.find_block(ElementType::tri3)->size() * o.layers);
+  CHECK(m.find_block(ElementType::hex8)->size() == flat.find_block(ElementType::quad4)->size() * o.layers);
+  CHECK(min_measure(m) > 0);
+  double volume = 0;
+  for (const auto& b : m.cells)
+    for (Index e = 0; e < b.size(); ++e) volume += signed_measure(m, b.type, b.element(e));
+  CHECK(volume == Approx(2.0 * 1.0 * 0.6));
+  // Every boundary facet is tagged: the 2D sides keep name and tag, the caps come after them.
+  for (const auto& b : m.facets)
+    for (const int tag : b.tags) CHECK(tag > 0);
+  for (const auto& g : flat.groups) {
+    INFO(g.name);
+    CHECK(m.group(g.name).tag == g.tag);
+    CHECK(m.group_nodes(g.name).size() == flat.group_nodes(g.name).size() * static_cast<std::size_t>(o.layers + 1));
+  }
+  CHECK(m.group("z_min").tag == 5);
+  CHECK(m.group("z_max").tag == 6);
+  for (const Index v : m.group_nodes("left")) CHECK(m.points(0, v) == 0.0);
+  for (const Index v : m.group_nodes("z_max")) CHECK(m.points(2, v) == Approx(0.6).epsilon(1e-15));
+  CHECK(m.group_nodes("z_min").size() == static_cast<std::size_t>(flat.num_nodes()));
+
+  // The walls of an extruded annulus are cylinders.
+  const Mesh<3> tube = extrude_mesh(annulus_mesh({.n_around = 32}), {.layers = 2, .height = 0.1});
+  CHECK(min_measure(tube) > 0);
+  for (const Index v : tube.group_nodes("inner")) CHECK(tube.points.col(v).head<2>().norm() == Approx(0.5).epsilon(1e-15));
+
+  CHECK_THROWS_WITH(extrude_mesh(flat, {.layers = 0}), Catch::Contains("layers >= 1"));
+  CHECK_THROWS_WITH(extrude_mesh(flat, {.height = -1.0}), Catch::Contains("positive height"));
+  Mesh<2> named = flat;
+  named.groups.push_back({1, 9, "z_max"});
+  CHECK_THROWS_WITH(extrude_mesh(named), Catch::Contains("'z_max'"));
+  Mesh<2> curved = flat;
+  curved.cells.clear();
+  curved.block(ElementType::tri6).add({0, 1, 2, 3, 4, 5});
+  CHECK_THROWS_WITH(extrude_mesh(curved), Catch::Contains("tri6"));
+}
+
 TEST_CASE("generators reject impossible sizes", "[core]") {
   CHECK_THROWS_AS(rectangle_mesh({.nx = 0}), InputError);
   CHECK_THROWS_AS(box_mesh({.nz = -1}), InputError);

@@ -2,7 +2,9 @@
 /// \file
 /// Built-in meshes: structured rectangles and boxes of every linear element type (and mixed
 /// ones), a boundary-layer O-mesh around an ellipse (a cylinder) or a square inside a
-/// circular farfield, the gap between two circular walls with a layer each, and the NASA Turbulence Modeling Resource 3D bump-in-channel hex grid.
+/// circular farfield, the gap between two circular walls with a layer each, the NASA
+/// Turbulence Modeling Resource 3D bump-in-channel hex grid, and the extrusion of any linear
+/// 2D mesh into a 3D slab (hexahedra and prisms).
 /// Every generator returns positively oriented cells and the boundary
 /// facets tagged with named groups.
 
@@ -14,8 +16,10 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <span>
 #include <string>
@@ -91,6 +95,12 @@ struct AnnulusOptions {
   double outer_growth = 1.15;
   double core_spacing = 0.03;        ///< the layers grow up to this height; the core is uniform, about as fine
   bool triangles = false;            ///< split each quadrilateral into two triangles
+};
+
+/// Options of extrude_mesh(): `layers` cell layers evenly spaced from z = 0 to z = height.
+struct ExtrudeOptions {
+  Index layers = 1;
+  double height = 1.0;
 };
 
 namespace detail {
@@ -508,6 +518,84 @@ inline void add_positive_tet(ElementBlock& block, const Points<3>& p, std::array
         throw InvalidMeshError("bump_channel_3d: a boundary facet lies on no side of the channel");
       });
   return mesh;
+}
+
+/// A 2D mesh of triangles and quadrilaterals extruded along z into prisms and hexahedra: node
+/// v of the 2D mesh becomes nodes v + k n (n its node count, k = 0 .. layers at z = k height /
+/// layers), and cell e of layer k keeps its 2D orientation, so positive 2D cells give positive
+/// 3D cells. Each 2D facet group becomes the lateral group of the same name and tag (its
+/// edges swept into quadrilaterals); the end caps are "z_min" (z = 0) and "z_max" (z = height),
+/// tagged after the largest 2D tag. A boundary edge's tag carries over whether or not a group
+/// names it; untagged edges give untagged facets. Throws InputError for cells other than tri3 and quad4, a 2D facet group whose name
+/// is "z_min" or "z_max", layers < 1, or a height that is not positive.
+[[nodiscard]] inline Mesh<3> extrude_mesh(const Mesh<2>& mesh, const ExtrudeOptions& options = {}) {
+  if (options.layers < 1 || !(options.height > 0.0) || !std::isfinite(options.height))
+    throw InputError("extrude_mesh: need layers >= 1 and a positive height (got " + std::to_string(options.layers) + ", " +
+                     std::to_string(options.height) + ")");
+  const Index n = mesh.num_nodes(), layers = options.layers;
+  Mesh<3> out;
+  out.points.resize(3, n * (layers + 1));
+  for (Index k = 0; k <= layers; ++k)
+    for (Index v = 0; v < n; ++v)
+      out.points.col(k * n + v) << mesh.points.col(v), options.height * static_cast<double>(k) / static_cast<double>(layers);
+  for (const auto& block : mesh.cells) {
+    if (block.type != ElementType::tri3 && block.type != ElementType::quad4)
+      throw InputError("extrude_mesh: cannot extrude " + std::string(name(block.type)) + " cells (expected tri3 or quad4)");
+    ElementBlock& swept = out.block(block.type == ElementType::tri3 ? ElementType::prism6 : ElementType::hex8);
+    const int nv = num_vertices(block.type);
+    std::array<Index, 8> nodes{};
+    for (Index k = 0; k < layers; ++k)
+      for (Index e = 0; e < block.size(); ++e) {
+        const auto el = block.element(e);
+        for (int a = 0; a < nv; ++a) {
+          nodes[static_cast<std::size_t>(a)] = k * n + el[static_cast<std::size_t>(a)];
+          nodes[static_cast<std::size_t>(a + nv)] = (k + 1) * n + el[static_cast<std::size_t>(a)];
+        }
+        swept.add(std::span<const Index>(nodes.data(), static_cast<std::size_t>(2 * nv)), block.tags[static_cast<std::size_t>(e)]);
+      }
+  }
+  // The 2D tag of each boundary edge, by its sorted vertex pair.
+  std::vector<std::pair<std::array<Index, 2>, int>> edge_tags;
+  int largest = 0;
+  for (const auto& block : mesh.facets)
+    for (Index e = 0; e < block.size(); ++e) {
+      const auto el = block.element(e);
+      const int tag = block.tags[static_cast<std::size_t>(e)];
+      edge_tags.push_back({{std::min(el[0], el[1]), std::max(el[0], el[1])}, tag});
+      largest = std::max(largest, tag);
+    }
+  std::sort(edge_tags.begin(), edge_tags.end());
+  for (const auto& g : mesh.groups) {
+    if (g.dim != 1) continue;
+    if (g.name == "z_min" || g.name == "z_max")
+      throw InputError("extrude_mesh: the 2D mesh has a facet group named '" + g.name +
+                       "', the name of an end cap (expected other names)");
+    out.groups.push_back({2, g.tag, g.name});
+  }
+  out.groups.push_back({2, largest + 1, "z_min"});
+  out.groups.push_back({2, largest + 2, "z_max"});
+  out.facets = boundary_facets(out);
+  const auto layer_of = [&](Index v) { return v / n; };
+  for (auto& block : out.facets)
+    for (Index e = 0; e < block.size(); ++e) {
+      const auto nodes = block.element(e);
+      int& tag = block.tags[static_cast<std::size_t>(e)];
+      if (std::all_of(nodes.begin(), nodes.end(), [&](Index v) { return layer_of(v) == 0; })) {
+        tag = largest + 1;
+      } else if (std::all_of(nodes.begin(), nodes.end(), [&](Index v) { return layer_of(v) == layers; })) {
+        tag = largest + 2;
+      } else {
+        // A lateral quadrilateral: its nodes in the lower layer are the swept 2D edge.
+        Index a = -1, b = -1;
+        const Index lower = std::min(layer_of(nodes[0]), layer_of(nodes[2]));
+        for (const Index v : nodes)
+          if (layer_of(v) == lower) (a < 0 ? a : b) = v % n;
+        const std::array<Index, 2> key{std::min(a, b), std::max(a, b)};
+        const auto it = std::lower_bound(edge_tags.begin(), edge_tags.end(), std::pair{key, std::numeric_limits<int>::min()});
+        tag = it != edge_tags.end() && it->first == key ? it->second : 0;
+      }
+    }
+  return out;
 }
 
 }  // namespace meshmotion
