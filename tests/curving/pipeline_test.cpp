@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <utility>
@@ -285,6 +286,77 @@ TEST_CASE("pipeline: each wall's RBF support follows its own boundary layer", "[
     between += from_shaft > r_inner && from_shaft < r_outer ? 1 : 0;
   }
   CHECK(between > 0);
+}
+
+TEST_CASE("pipeline: each wall's RBF support follows its own layer in 3D (two cylinders)", "[curving]") {
+  // The journal-bearing gap extruded along its axis: a shaft cylinder (r = 0.5) with a thin
+  // layer, a housing cylinder (r = 1.5) with a thick one, end planes sliding.
+  const AnnulusOptions gap{.n_around = 48, .inner_first_height = 1e-3, .inner_growth = 1.5,
+                           .outer_first_height = 5e-3, .outer_growth = 1.3, .core_spacing = 0.08};
+  const ExtrudeOptions slab{.layers = 2, .height = 0.1};
+  const Mesh<3> linear = extrude_mesh(annulus_mesh(gap), slab);
+  const auto cylinder = [](double radius) {
+    return BoundaryGeometry<3>::project([radius](const Vec<3>& p) {
+      Vec<3> q = p;
+      q.head<2>() *= radius / p.head<2>().norm();
+      return q;
+    });
+  };
+  CurveOptions<3> options;
+  options.geometry.emplace("inner", cylinder(0.5));
+  options.geometry.emplace("outer", cylinder(1.5));
+  options.sliding = {"z_min", "z_max"};
+  const CurveResult<3> curved = curve_mesh(linear, options);
+  REQUIRE(curved.layers.size() == 2);
+  const double inner = curved.layers[0].thickness, outer = curved.layers[1].thickness;
+  INFO("layers " << inner << ", " << outer << "; min " << curved.quality.min);
+  CHECK(inner > 0.0);
+  CHECK(outer > 3.0 * inner);
+  REQUIRE(curved.wall_support_radii.size() == 2);
+  const double r_inner = curved.wall_support_radii[0], r_outer = curved.wall_support_radii[1];
+  CHECK(r_inner == options.support_radius_factor * inner);
+  // The housing's radius is limited to max_support_nodes boundary nodes per support (3D).
+  CHECK(r_outer <= options.support_radius_factor * outer);
+  REQUIRE(2.0 * r_inner < 0.8 * r_outer);
+  CHECK(curved.invalid() == 0);
+  double off_wall = 0.0, off_plane = 0.0;
+  for (const auto& block : curved.curved.facets)
+    for (Index e = 0; e < block.size(); ++e)
+      for (const Index v : block.element(e)) {
+        const Vec<3> p = curved.curved.points.col(v);
+        const int tag = block.tags[static_cast<std::size_t>(e)];
+        if (tag <= 2) off_wall = std::max(off_wall, std::abs(p.head<2>().norm() - (tag == 1 ? 0.5 : 1.5)));
+        else off_plane = std::max(off_plane, std::min(std::abs(p.z()), std::abs(p.z() - slab.height)));
+      }
+  CHECK(off_wall < 1e-14);
+  CHECK(off_plane < 1e-14);
+
+  // With the housing's radius for both walls the shaft's motion reaches r_outer into the gap;
+  // with each wall's own it stays within a couple of r_inner (the sliding end planes' centres
+  // reach a radius beyond the walls' own).
+  options.per_wall_radius = false;
+  const CurveResult<3> single = curve_mesh(linear, options);
+  CHECK(single.support_radius == r_outer);
+  CHECK(single.invalid() == 0);
+  const double wall_motion = curved.max_boundary_displacement;
+  double band_own = 0.0, band_single = 0.0, reached_own = std::numeric_limits<double>::infinity();
+  Index band = 0;
+  for (Index v = 0; v < linear.num_nodes(); ++v) {
+    const Vec<3> p = linear.points.col(v);
+    const double from_shaft = p.head<2>().norm() - 0.5;
+    const double own = (curved.curved.points.col(v) - p).norm(), one = (single.curved.points.col(v) - p).norm();
+    if (from_shaft > 1e-12 && from_shaft < 0.5 * r_inner) reached_own = std::min(reached_own, own);
+    if (from_shaft < 2.0 * r_inner || from_shaft > 0.8 * r_outer) continue;
+    ++band;
+    band_own = std::max(band_own, own);
+    band_single = std::max(band_single, one);
+  }
+  INFO("wall motion " << wall_motion << ", band " << band << ": own " << band_own << ", single " << band_single
+                      << "; near the shaft at least " << reached_own);
+  CHECK(band > 0);
+  CHECK(reached_own > 0.0);
+  CHECK(band_own < 1e-4 * wall_motion);
+  CHECK(band_single > 1e-3 * wall_motion);
 }
 
 TEST_CASE("pipeline: every element type and mixed meshes curve onto a graph", "[curving][slow]") {
