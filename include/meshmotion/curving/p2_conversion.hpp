@@ -75,6 +75,10 @@ template <int Dim>
   QuadraticConversion<Dim> out;
   out.num_linear_nodes = n_linear;
   auto& sources = out.sources;
+  std::size_t num_hexahedra = 0;
+  for (const auto& b : linear.cells)
+    if (quadratic_type(b.type, options.complete) == ElementType::hex27) num_hexahedra += static_cast<std::size_t>(b.size());
+  sources.reserve(edge_topo.edges.size() + static_cast<std::size_t>(face_topo.size()) + num_hexahedra);
   for (const auto& e : edge_topo.edges) sources.push_back({HighOrderNodeSource::Kind::edge, {e[0], e[1], -1, -1}, -1, {-1, -1}});
   std::vector<Index> face_node(static_cast<std::size_t>(face_topo.size()), -1);
   for (Index f = 0; f < face_topo.size(); ++f)

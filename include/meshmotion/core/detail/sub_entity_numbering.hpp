@@ -58,11 +58,19 @@ template <std::size_t N, class Visit>
   for (Index v = 0; v < num_nodes; ++v) {
     const auto begin = entries.begin() + offsets[static_cast<std::size_t>(v)];
     const auto end = entries.begin() + offsets[static_cast<std::size_t>(v) + 1];
+    // Element-wise comparisons: std::array's operators call memcmp, which dominated the sort.
     std::sort(begin, end, [](const Entry& a, const Entry& b) {
-      return a.rest != b.rest ? a.rest < b.rest : a.item < b.item;
+      for (std::size_t i = 0; i + 1 < N; ++i)
+        if (a.rest[i] != b.rest[i]) return a.rest[i] < b.rest[i];
+      return a.item < b.item;
     });
+    const auto same_key = [](const Entry& a, const Entry& b) {
+      for (std::size_t i = 0; i + 1 < N; ++i)
+        if (a.rest[i] != b.rest[i]) return false;
+      return true;
+    };
     for (auto it = begin; it != end; ++it) {
-      if (it == begin || it->rest != (it - 1)->rest) {
+      if (it == begin || !same_key(*it, *(it - 1))) {
         out.first_item.push_back(it->item);
         out.second_item.push_back(-1);
         out.count.push_back(0);
@@ -110,12 +118,6 @@ struct MeshLikeSource {
   for (const auto& b : blocks) out.push_back(&b);
   return out;
 }
-
-/// Local sub-entities of one element, each a list of local vertices.
-struct LocalEntities {
-  std::array<LocalFacet, 6> entities{};
-  int count = 0;
-};
 
 /// Which sub-entities of an element a numbering counts.
 enum class SubEntity {
@@ -167,14 +169,16 @@ template <std::size_t N, class Source>
   }
   const Index num_nodes = source.num_nodes();
   const auto visit = [&](auto&& f) {
+    std::array<LocalFacet, 12> local{};  // the block type's sub-entities (a hexahedron has 12 edges), looked up once per block
     for (Index b = 0; b < num_blocks; ++b) {
       const ElementType t = source.type(b);
       const int n_local = num_local_entities(t, which);
+      for (int k = 0; k < n_local; ++k) local[static_cast<std::size_t>(k)] = local_entity(t, which, k);
       const Index n = source.size(b);
       Index item = out.block_offsets[static_cast<std::size_t>(b)];
       for (Index e = 0; e < n; ++e)
         for (int k = 0; k < n_local; ++k, ++item) {
-          const LocalFacet ent = local_entity(t, which, k);
+          const LocalFacet& ent = local[static_cast<std::size_t>(k)];
           std::array<Index, N> key;
           key.fill(key_padding);
           for (int v = 0; v < ent.num_vertices; ++v) {
