@@ -142,14 +142,6 @@ template <int Dim, class Visit>
 
 }  // namespace detail
 
-/// The ResolvedBoundary of conditions by node (the map keeps the nodes sorted).
-template <int Dim>
-[[nodiscard]] ResolvedBoundary<Dim> make_resolved_boundary(const std::map<Index, BoundaryEntry<Dim>>& entries) {
-  return detail::collect_boundary<Dim>(static_cast<Index>(entries.size()), [&](auto&& add) {
-    for (const auto& [node, e] : entries) add(node, e);
-  });
-}
-
 /// Conditions of a whole mesh's boundary collected by node in a dense table: a map's node
 /// allocations cost more than the rest of a 3D curving boundary's setup. The first condition
 /// given to a node stays.
@@ -163,6 +155,11 @@ class BoundaryCollector {
     if (s >= 0) return;
     s = static_cast<int>(entries_.size());
     entries_.push_back(entry);
+  }
+  /// The condition of `node`, or nullptr when it has none yet.
+  [[nodiscard]] BoundaryEntry<Dim>* find(Index node) {
+    const int s = slot_[static_cast<std::size_t>(node)];
+    return s >= 0 ? &entries_[static_cast<std::size_t>(s)] : nullptr;
   }
   /// The collected conditions, nodes ascending.
   [[nodiscard]] ResolvedBoundary<Dim> resolve() const {
@@ -225,7 +222,7 @@ class BoundarySpec {
   /// node indices outside [0, n_nodes).
   [[nodiscard]] ResolvedBoundary<Dim> resolve(const Points<Dim>& points, const GroupNodes& group_nodes,
                                               double to = 1.0, double from = 0.0) const {
-    std::map<Index, Entry> entries;
+    BoundaryCollector<Dim> entries(points.cols());
     for (const auto& g : groups_) {
       const auto found = group_nodes.find(g.name);
       if (found == group_nodes.end()) {
@@ -243,7 +240,7 @@ class BoundarySpec {
       list.erase(std::unique(list.begin(), list.end()), list.end());
       add_group(g, list, points, to, from, entries);
     }
-    return make_resolved_boundary(entries);
+    return entries.resolve();
   }
 
  private:
@@ -308,7 +305,7 @@ class BoundarySpec {
   }
 
   static void add_group(const Group& g, const std::vector<Index>& list, const Points<Dim>& points, double to,
-                        double from, std::map<Index, Entry>& entries) {
+                        double from, BoundaryCollector<Dim>& entries) {
     const auto n = static_cast<Index>(list.size());
     Points<Dim> targets = Points<Dim>::Zero(Dim, n);
     if (g.kind == BoundaryKind::prescribed) {
@@ -326,9 +323,12 @@ class BoundarySpec {
     const Vec<Dim> normal = g.kind == BoundaryKind::sliding ? plane_normal(g, list, points) : Vec<Dim>::Zero();
     for (Index k = 0; k < n; ++k) {
       const Entry incoming{g.kind, targets.col(k), normal};
-      const auto [it, inserted] = entries.emplace(list[k], incoming);
-      if (inserted) continue;
-      Entry& e = it->second;
+      Entry* existing = entries.find(list[k]);
+      if (!existing) {
+        entries.add(list[k], incoming);
+        continue;
+      }
+      Entry& e = *existing;
       if (e.kind == BoundaryKind::prescribed && g.kind == BoundaryKind::prescribed) {
         const double scale = std::max({1.0, e.displacement.norm(), incoming.displacement.norm()});
         if ((e.displacement - incoming.displacement).norm() > 1e-12 * scale)
