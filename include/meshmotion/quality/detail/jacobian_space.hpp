@@ -48,12 +48,12 @@ struct JacobianSpace {
   std::vector<RefPoint> points;                // sampling lattice
   std::vector<std::array<int, 4>> simplex_index;  // barycentric multi-index per point
   std::vector<std::array<int, 3>> line_index;     // 1D index per line dimension per point
-  Eigen::MatrixXd gradients;                   // (num_points · dim) × num_nodes: row point · dim + d
+  Eigen::MatrixXd gradients;                   // (num_points · dim) × num_nodes: row point · dim + d (empty for tensor elements)
   std::vector<double> linear_gradients;        // vertex shape gradients at the centroid: [vertex * dim + d]
   // Higher-order types: column i = the linear cell's shape functions at node i, so that
   // x_vertices × linear_embedding are the node positions of the straight-sided cell.
   Eigen::MatrixXd linear_embedding;
-  // Tensor-product elements (quad4/9, hex8/27): the Jacobians at the lattice by sum
+  // Tensor-product elements of degree 2 (quad9, hex27): the Jacobians at the lattice by sum
   // factorization, a 1D table per reference axis instead of `gradients` (a hex27's 52k
   // multiply-adds become 10k).
   std::vector<int> tensor_node;                // element node at each tensor position (empty: not a tensor element)
@@ -270,15 +270,20 @@ inline JacobianSpace make_jacobian_space(ElementType t) {
   else if (shape(t) == Shape::pyramid) add_pyramid_samples(s);
   s.num_points = static_cast<int>(s.points.size());
 
-  std::vector<std::array<double, 3>> g(static_cast<std::size_t>(s.num_nodes));
-  s.gradients.resize(static_cast<Index>(s.num_points) * s.dim, s.num_nodes);
-  for (int j = 0; j < s.num_points; ++j) {
-    shape_derivatives(t, s.points[static_cast<std::size_t>(j)], g);
-    for (int i = 0; i < s.num_nodes; ++i)
-      for (int d = 0; d < s.dim; ++d) s.gradients(j * s.dim + d, i) = g[static_cast<std::size_t>(i)][static_cast<std::size_t>(d)];
-  }
+  // Sum factorization pays from degree 2 on (quad9, hex27); for quad4 and hex8 its many tiny
+  // passes cost more than the gradient table's multiply-adds.
   const bool tensor_shape = shape(t) == Shape::quadrilateral || shape(t) == Shape::hexahedron;
-  if (tensor_shape && s.num_nodes == (s.dim == 2 ? (p + 1) * (p + 1) : (p + 1) * (p + 1) * (p + 1))) add_tensor_tables(s, t, p);
+  if (p >= 2 && tensor_shape && s.num_nodes == (s.dim == 2 ? (p + 1) * (p + 1) : (p + 1) * (p + 1) * (p + 1))) {
+    add_tensor_tables(s, t, p);
+  } else {
+    std::vector<std::array<double, 3>> g(static_cast<std::size_t>(s.num_nodes));
+    s.gradients.resize(static_cast<Index>(s.num_points) * s.dim, s.num_nodes);
+    for (int j = 0; j < s.num_points; ++j) {
+      shape_derivatives(t, s.points[static_cast<std::size_t>(j)], g);
+      for (int i = 0; i < s.num_nodes; ++i)
+        for (int d = 0; d < s.dim; ++d) s.gradients(j * s.dim + d, i) = g[static_cast<std::size_t>(i)][static_cast<std::size_t>(d)];
+    }
+  }
   const ElementType lin = linear_type(t);
   std::vector<std::array<double, 3>> gl(static_cast<std::size_t>(num_nodes(lin)));
   shape_derivatives(lin, reference_centroid(lin), gl);
