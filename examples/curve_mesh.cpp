@@ -48,6 +48,7 @@ struct Arguments {
   bool single_radius = false;
   double support_factor = 0.0;  // unset: the library's default for the dimension
   double blending_length = 0.0;
+  double blending_factor = 0.0;  // unset: the library's default for the dimension
   int steps = 1;
   std::vector<std::string> geometry;
   std::vector<std::string> groups;
@@ -132,6 +133,7 @@ CurveOptions<Dim> curve_options(const Arguments& args) {
   options.per_wall_radius = !args.single_radius;
   if (args.support_factor > 0.0) options.support_radius_factor = args.support_factor;
   options.blending_length = args.blending_length;
+  if (args.blending_factor > 0.0) options.blending_factor = args.blending_factor;
   options.steps = args.steps;
   examples::add_mechanics_parameters(args.mechanics, options.parameters);
   options.sliding = args.sliding;
@@ -272,14 +274,17 @@ int main(int argc, char** argv) {
   app.add_option("--method", args.method, "interior regularization: rbf, blend, none, or a mover (sle, le, nle, torsion, spring, ...)")->capture_default_str();
   app.add_option("--kernel", args.kernel, "RBF kernel (wendland2, wendland0/4/6, tps, gaussian, ...)")->capture_default_str();
   app.add_option("--support-radius", args.support_radius, "RBF support radius (0: from the boundary-layer thickness)");
+  const auto positive = [](const std::string& value) {
+    char* end = nullptr;
+    const double x = std::strtod(value.c_str(), &end);
+    return end != value.c_str() && *end == '\0' && x > 0.0 ? std::string() : "must be a number > 0 (got " + value + ")";
+  };
   app.add_option("--support-factor", args.support_factor,
                  "default radius = this x the thickest wall layer (default: 4 in 2D, 1 in 3D)")
-      ->check([](const std::string& value) {
-        char* end = nullptr;
-        const double x = std::strtod(value.c_str(), &end);
-        return end != value.c_str() && *end == '\0' && x > 0.0 ? std::string() : "must be a number > 0 (got " + value + ")";
-      });
-  app.add_option("--blending-length", args.blending_length, "blend: length (0: each wall's layer thickness)");
+      ->check(positive);
+  app.add_option("--blending-length", args.blending_length, "blend: length (0: --blending-factor x each wall's layer thickness)");
+  app.add_option("--blending-factor", args.blending_factor, "blend: default length = this x each wall's layer (default: 6 in 2D, 1 in 3D)")
+      ->check(positive);
   app.add_option("--steps", args.steps, "regularize in this many increments")->capture_default_str();
   app.add_option("--geometry", args.geometry,
                  "true boundary: spline | reconstruct | straight | bump | circle:X,Y,R | naca:XXXX[,CHORD,X0,Y0] | sphere:X,Y,Z,R "

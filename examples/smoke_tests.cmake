@@ -122,6 +122,13 @@ smoke_test(NAME curve_mesh.bad_poisson_ratio.json EXPECT_RC 1
            KEYS error
            COMMAND curve_mesh --demo -o "${smoke_dir}/demo_bad.msh" --method sle --poisson-ratio 0.7 --json)
 
+# The blending regularizer with its length in wall layers; a length factor must be positive.
+smoke_test(NAME curve_mesh.blend.json
+           KEYS output,min_scaled_jacobian,invalid
+           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_blend.msh" --method blend --blending-factor 4 --json)
+smoke_test(NAME curve_mesh.bad_blending_factor EXPECT_RC 105
+           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_bad_blend.msh" --method blend --blending-factor 0)
+
 # SVG pictures: invalid cells ringed (the default) or not; snapping alone leaves invalid cells.
 smoke_test(NAME curve_mesh.svg_no_markers.json
            KEYS output,min_scaled_jacobian,invalid

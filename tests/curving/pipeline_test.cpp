@@ -135,6 +135,53 @@ TEST_CASE("blend mover: one wall's field vanishes on the other wall", "[curving]
     CHECK(u(1, 4 * 9 + i) > 0.0);              // middle row: in between
     CHECK(u(1, 4 * 9 + i) < 1e-3);
   }
+  // The gap (0.1) is narrower than L (1): the damping runs over the gap, not over L, so the
+  // bottom's first row keeps nearly all of its wall's displacement (over L it kept 6%).
+  for (Index j = 1; j < 8; ++j) {
+    const double y = 0.1 * static_cast<double>(j) / 8.0;
+    const double expected = rbf_value(RbfKernel::wendland2, y, 1.0) * (1.0 - rbf_value(RbfKernel::wendland2, 0.1 - y, 0.1)) * 1e-3;
+    for (Index i = 1; i < 8; ++i) CHECK(u(1, 9 * j + i) == Approx(expected).epsilon(1e-12));
+  }
+  CHECK(u(1, 9 + 4) > 0.98e-3);
+}
+
+TEST_CASE("blend mover: the default length is layer_factor wall layers, and longer is better on a thin layer", "[curving]") {
+  // The O-mesh triangles of docs/curving.md "Blending length" at 64 wall facets: a bow of
+  // h^2/(8 rho) that a blend over one layer bends most inside the layer's thin cells.
+  OMeshOptions o;
+  o.n_around = 64;
+  o.triangles = true;
+  const Mesh<2> linear = o_mesh(o);
+  const BoundaryLayerEstimate layer = estimate_boundary_layer(linear, std::vector<std::string>{"wall"});
+  const double thickness = layer.wall("wall").thickness;
+  REQUIRE(thickness > 100 * o.first_height);
+  BoundarySpec<2> spec;
+  spec.moving("wall", Translation<2>{Vec<2>(1e-4, 0.0)});
+  spec.fixed("farfield");
+  const ResolvedBoundary<2> boundary = spec.resolve(linear);
+  for (const double factor : {1.0, 6.0}) {
+    BlendOptions options;
+    options.layer_factor = factor;
+    BlendMover<2> mover(options);
+    mover.setup(linear, boundary);
+    REQUIRE(mover.blending_lengths().size() == 1);
+    CHECK(mover.blending_lengths()[0] == Approx(factor * thickness).epsilon(1e-12));
+  }
+  BlendOptions zero;
+  zero.layer_factor = 0.0;
+  CHECK_THROWS_WITH(BlendMover<2>(zero).setup(linear, boundary), Catch::Contains("layer factor 0"));
+
+  CurveOptions<2> curve;
+  curve.method = "blend";
+  curve.geometry.emplace("wall", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 0.5)));
+  REQUIRE(curve.blending_factor == 6.0);
+  const CurveResult<2> six = curve_mesh(linear, curve);
+  curve.blending_factor = 1.0;
+  const CurveResult<2> one = curve_mesh(linear, curve);
+  INFO("blend over 1 layer: " << one.quality.min << ", over 6: " << six.quality.min);
+  CHECK(one.invalid() == 0);
+  CHECK(six.invalid() == 0);
+  CHECK(1.0 - six.quality.min < 0.5 * (1.0 - one.quality.min));
 }
 
 namespace {

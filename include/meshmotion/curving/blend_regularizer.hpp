@@ -5,14 +5,14 @@
 ///
 /// The prescribed (moving) boundary nodes are split into walls: connected sets of facets
 /// whose nodes are all prescribed. Every other node x takes
-///   u(x) = Σ_b φ(d_b / L_b) Π_{c ≠ b} (1 - φ(d_c / L_c)) u_b(p_b(x)),
+///   u(x) = Σ_b φ(d_b / L_b) Π_{c ≠ b} (1 - φ(d_c / min(L_c, d_b + d_c))) u_b(p_b(x)),
 /// where p_b(x) is the closest point of wall b (its straight facets in the reference
 /// configuration), u_b the wall's displacement interpolated there by the facet's own P1/P2
 /// shape functions, d_b = |x - p_b(x)|, L_b the wall's blending length and φ Wendland's C2
 /// function φ(r) = (1 - r)^4 (4 r + 1) for r < 1, 0 beyond. φ is flat at the wall, so the
 /// first cells follow the wall almost rigidly and the curvature is extruded through the
 /// layer, as boundary-layer meshes want; the product makes each wall's field vanish on the
-/// other walls. Fixed boundary nodes stay, sliding ones keep the in-plane part of the blend.
+/// other walls, over the width of the gap between them where that is shorter than L. Fixed boundary nodes stay, sliding ones keep the in-plane part of the blend.
 ///
 /// Linear in the displacements: setup stores the sparse operator (per node, the weights of
 /// the wall nodes of its closest facets), move is one sparse product. Setup: a k-d tree per
@@ -45,12 +45,17 @@ namespace meshmotion {
 
 /// Options of BlendMover.
 struct BlendOptions {
-  /// Blending length for every wall; 0 (default): each wall's boundary-layer thickness
-  /// (estimate_boundary_layer), or `fallback_spacings` × its largest facet when it has no
-  /// anisotropic layer.
+  /// Blending length for every wall; 0 (default): `layer_factor` × each wall's boundary-layer
+  /// thickness (estimate_boundary_layer), or `fallback_spacings` × its largest facet when it
+  /// has no anisotropic layer.
   double blending_length = 0.0;
   BoundaryLayerOptions layer{};
   double fallback_spacings = 3.0;
+  /// The default length in layer thicknesses. φ is steepest at a quarter of the length, so at
+  /// 1 the steepest gradient lies inside the layer's thin cells; at k it lies k/4 layers out,
+  /// in cells that tolerate it, and the gradient within the layer falls roughly as 1/k
+  /// (docs/curving.md, "Blending length").
+  double layer_factor = 1.0;
 };
 
 /// Wall-distance blending mover (models MeshMover).
@@ -68,6 +73,8 @@ class BlendMover {
     const detail::Stopwatch clock;
     if (!(options_.blending_length >= 0.0))
       throw InputError("BlendMover::setup: negative blending length (got " + std::to_string(options_.blending_length) + ")");
+    if (!(options_.layer_factor > 0.0))
+      throw InputError("BlendMover::setup: layer factor " + std::to_string(options_.layer_factor) + " (expected > 0)");
     const Index n = mesh.num_nodes();
     const Index m = boundary.size();
     boundary_ = boundary;
@@ -114,9 +121,14 @@ class BlendMover {
       ++evaluated_;
       for (std::size_t b = 0; b < walls.size(); ++b) {
         if (phi[b] == 0.0) continue;
+        // Another wall c within reach damps b's share to zero on c. In a gap narrower than
+        // L_c the damping runs over the gap's width d_b + d_c instead: over L_c it would
+        // suppress b's share already at b's own first cells (the 30P30N flap gap folded).
         double weight = phi[b];
         for (std::size_t c = 0; c < walls.size(); ++c)
-          if (c != b) weight *= 1.0 - phi[c];
+          if (c != b && phi[c] > 0.0)
+            weight *= 1.0 - rbf_value(RbfKernel::wendland2, closest[c].distance,
+                                      std::min(lengths_[c], closest[b].distance + closest[c].distance));
         const detail::WallFacet& f = distance[b].facets()[static_cast<std::size_t>(closest[b].facet)];
         shape_functions(f.type, closest[b].xi, std::span<double>(shape.data(), static_cast<std::size_t>(num_nodes(f.type))));
         for (int j = 0; j < num_nodes(f.type); ++j)
@@ -231,7 +243,7 @@ class BlendMover {
     if (options_.blending_length > 0.0) return lengths;
     const BoundaryLayerEstimate layer = estimate_boundary_layer(mesh, walls, options_.layer);
     for (std::size_t b = 0; b < walls.size(); ++b) {
-      lengths[b] = layer.walls[b].thickness;
+      lengths[b] = options_.layer_factor * layer.walls[b].thickness;
       if (!(lengths[b] > 0.0)) lengths[b] = options_.fallback_spacings * largest_facet(mesh.points, walls[b]);
     }
     return lengths;
