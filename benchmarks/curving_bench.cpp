@@ -1,9 +1,10 @@
 // curving_bench: thesis table 4.2 on the 30P30N RANS mesh (three-element high-lift airfoil,
 // all quads, and the same mesh split into triangles): RBF (Wendland C2) at the thesis's
 // support radii scaled to the chord, 1 and 2 steps; the layer-based default radius; the
-// blending regularizer; snapping alone. Gmsh has no CAD of the 30P30N, so it cannot curve
-// that mesh: the comparison with Gmsh runs on cases where it has the true geometry
-// (gmsh_peer.hpp): a NACA0012 boundary-layer mesh that gmsh itself makes (triangles, and
+// blending regularizer; snapping alone. Then two walls with layers of their own (one radius
+// against a radius per wall), and a wall-resolution study (what limits RBF on thin layers).
+// Gmsh has no CAD of the 30P30N, so it cannot curve that mesh: the comparison with Gmsh runs
+// on cases where it has the true geometry (gmsh_peer.hpp): a NACA0012 boundary-layer mesh that gmsh itself makes (triangles, and
 // quads), and the sphere mesh with its STEP file. Gmsh's `-order 2` snapping and each
 // Mesh.HighOrderOptimize variant curve the linear mesh it saved; our pipeline curves the same
 // linear mesh with the analytic geometry; every P2 mesh is judged by our certified scaled
@@ -14,7 +15,7 @@
 // Times are this machine's; the thesis's are beside ours for reference.
 //
 // usage: curving_bench [--no-gmsh] [--gmsh-only] [--quick] [path/to/su2_30p30n_rans_L1_coarse.su2]
-//   --no-gmsh    only the 30P30N table
+//   --no-gmsh    only the 30P30N, two-wall and wall-resolution tables
 //   --gmsh-only  only the Gmsh comparison
 //   --quick      Gmsh comparison without gmsh's slow variants (HighOrderOptimize 1 and 2, and 3
 //                with more layers), which take minutes of CPU each
@@ -36,6 +37,8 @@
 #include <exception>
 #include <filesystem>
 #include <functional>
+#include <limits>
+#include <numbers>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -123,7 +126,7 @@ void thesis_table(const fs::path& file) {
       {"rbf r=0.12/18.3", "rbf", 0.12 / 18.3, 1, "0.637 / 0.99159, 1.89 s, 2295x2 it"},
       {"rbf r=0.04/18.3", "rbf", 0.04 / 18.3, 2, "0.641 / 0.991099, 2.58 s, 365x4 it"},
       {"rbf r=layer", "rbf", 0.0, 1, ""},
-      {"blend L=layer", "blend", 0.0, 1, ""},
+      {"blend L=6 layers", "blend", 0.0, 1, ""},
   };
   std::printf("\n%-10s %-22s %9s %5s %8s %9s %7s %9s %8s %7s   %s\n", "mesh", "case", "radius", "steps", "min", "mean",
               "invalid", "seconds", "ratio", "iters", "thesis (min / mean, time, iterations)");
@@ -160,7 +163,7 @@ void two_walls_table() {
     for (const auto& [label, method, per_wall] : {std::tuple{"none (snap only)", "none", true},
                                                   std::tuple{"rbf one radius", "rbf", false},
                                                   std::tuple{"rbf radius per wall", "rbf", true},
-                                                  std::tuple{"blend L=layer", "blend", true}}) {
+                                                  std::tuple{"blend L=6 layers", "blend", true}}) {
       CurveOptions<2> options;
       options.method = method;
       options.per_wall_radius = per_wall;
@@ -176,6 +179,53 @@ void two_walls_table() {
     }
   }
   std::printf("\nradius: the largest support; ratio: time to snapping alone on the same mesh.\n");
+}
+
+// Why RBF stops short of 1 on thin layers: the O-mesh triangles around a circle (diameter 1,
+// first cell 1e-5, 64 layers) at 64–512 wall facets. Curving bows a facet's edge node by
+// b ≈ h²/(8ρ) while its vertices stay, a displacement of period h along the wall; an isotropic
+// kernel loses that part within a fraction of h off the wall, whatever its radius, so a layer
+// cell's top edge no longer bows like its bottom one and the minimum falls by c·h/ρ. Blending
+// carries the wall's own displacement up and loses b·|φ'|/L, smaller as L grows.
+void wall_resolution_table() {
+  std::printf("\nWall resolution: O-mesh triangles around a circle of radius rho = 0.5 (first cell 1e-5, 64 layers);\n"
+              "h: wall facet length; loss = 1 - min; the defaults: RBF radius 4 layers, blending length 6 layers.\n");
+  std::printf("\n%-9s %8s %-26s %9s %8s %10s %11s\n", "n_around", "h", "case", "length", "min", "loss", "loss/(h/rho)");
+  constexpr double rho = 0.5;
+  double rbf_lowest = std::numeric_limits<double>::infinity(), rbf_highest = 0.0;  // of loss / (h / rho)
+  for (const Index n : {64, 128, 256, 512}) {
+    const Mesh<2> linear = o_mesh({.n_around = n, .n_radial = 64, .triangles = true});
+    const double h = 2.0 * rho * std::sin(std::numbers::pi / static_cast<double>(n));
+    double layer = 0.0;
+    for (const auto& [label, method, factor] : {std::tuple{"rbf, 4 layers (default)", "rbf", 0.0},
+                                                std::tuple{"rbf, 1 layer", "rbf", 1.0},
+                                                std::tuple{"rbf, 16 layers", "rbf", 16.0},
+                                                std::tuple{"blend, 1 layer", "blend", 1.0},
+                                                std::tuple{"blend, 6 layers (default)", "blend", 0.0}}) {
+      CurveOptions<2> options;
+      options.method = method;
+      options.geometry.emplace("wall", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), rho)));
+      options.geometry.emplace("farfield", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 20.0)));
+      if (std::string(method) == "rbf") options.support_radius = factor * layer;
+      else if (factor > 0.0) options.blending_factor = factor;
+      const CurveResult<2> r = curve_mesh(linear, options);
+      if (layer == 0.0) layer = r.layers.front().thickness;
+      const double length = std::string(method) == "rbf" ? r.wall_support_radii.empty() ? r.support_radius : r.wall_support_radii.front()
+                                                         : options.blending_factor * layer;
+      const double loss = 1.0 - r.quality.min;
+      if (std::string(method) == "rbf") {
+        rbf_lowest = std::min(rbf_lowest, loss / (h / rho));
+        rbf_highest = std::max(rbf_highest, loss / (h / rho));
+      }
+      std::printf("%-9lld %8.5f %-26s %9.5f %8.5f %10.3e %11.3f\n", static_cast<long long>(n), h, label, length, r.quality.min, loss,
+                  loss / (h / rho));
+      std::printf("{\"bench\":\"curving_wall_resolution\",\"n_around\":%lld,\"h\":%.6g,\"case\":\"%s\",\"length\":%.6g,"
+                  "\"min\":%.6f,\"loss\":%.6g,\"loss_per_h_over_rho\":%.4f,\"invalid\":%lld}\n",
+                  static_cast<long long>(n), h, label, length, r.quality.min, loss, loss / (h / rho),
+                  static_cast<long long>(r.quality.num_invalid));
+    }
+  }
+  std::printf("\nRBF at every radius and resolution: loss between %.2f and %.2f times h/rho.\n", rbf_lowest, rbf_highest);
 }
 
 // ---- Gmsh comparison ------------------------------------------------------------------
@@ -304,7 +354,7 @@ void compare_case(const PeerCase<Dim>& c, const fs::path& scratch) {
     std::snprintf(blend_label, sizeof blend_label, "blend (L = %g, given layer)", blending_length);
     r.method = method == "none"    ? "snap only"
                : method == "rbf"   ? "rbf (Wendland C2, r = layer)"
-               : method == "blend" ? (blending_length > 0.0 ? blend_label : "blend (L = estimated layer)")
+               : method == "blend" ? (blending_length > 0.0 ? blend_label : "blend (default length)")
                                    : method + " (stiffened elasticity)";
     try {
       const CurveResult<Dim> result = curve_mesh(linear, options);
@@ -449,6 +499,7 @@ int main(int argc, char** argv) {
   if (with_thesis) {
     thesis_table(file);
     two_walls_table();
+    wall_resolution_table();
   }
   if (with_gmsh) gmsh_comparison(quick);
   return 0;
