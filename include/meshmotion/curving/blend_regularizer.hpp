@@ -12,7 +12,8 @@
 /// function φ(r) = (1 - r)^4 (4 r + 1) for r < 1, 0 beyond. φ is flat at the wall, so the
 /// first cells follow the wall almost rigidly and the curvature is extruded through the
 /// layer, as boundary-layer meshes want; the product makes each wall's field vanish on the
-/// other walls, over the width of the gap between them where that is shorter than L. Fixed boundary nodes stay, sliding ones keep the in-plane part of the blend.
+/// other walls, over the width of the gap between them where that is shorter than L. Fixed
+/// boundary nodes stay, sliding ones keep the in-plane part of the blend.
 ///
 /// Linear in the displacements: setup stores the sparse operator (per node, the weights of
 /// the wall nodes of its closest facets), move is one sparse product. Setup: a k-d tree per
