@@ -158,6 +158,35 @@ struct Mesh {
     return node_ids.empty() ? static_cast<std::int64_t>(i) + 1 : node_ids[static_cast<std::size_t>(i)];
   }
 
+  /// The node indices of file node ids (node_id()'s inverse), in the order given. Throws
+  /// InputError naming the first id that no node has.
+  [[nodiscard]] std::vector<Index> node_indices(std::span<const std::int64_t> ids) const {
+    std::vector<Index> out;
+    out.reserve(ids.size());
+    if (node_ids.empty()) {
+      for (const std::int64_t id : ids) {
+        if (id < 1 || id > num_nodes())
+          throw InputError("Mesh::node_indices: no node has id " + std::to_string(id) + " (ids are 1 to " +
+                           std::to_string(num_nodes()) + ")");
+        out.push_back(static_cast<Index>(id - 1));
+      }
+      return out;
+    }
+    std::vector<Index> order(node_ids.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<Index>(i);
+    std::sort(order.begin(), order.end(), [&](Index a, Index b) {
+      return node_ids[static_cast<std::size_t>(a)] < node_ids[static_cast<std::size_t>(b)];
+    });
+    for (const std::int64_t id : ids) {
+      const auto it = std::lower_bound(order.begin(), order.end(), id,
+                                       [&](Index a, std::int64_t x) { return node_ids[static_cast<std::size_t>(a)] < x; });
+      if (it == order.end() || node_ids[static_cast<std::size_t>(*it)] != id)
+        throw InputError("Mesh::node_indices: no node has id " + std::to_string(id));
+      out.push_back(*it);
+    }
+    return out;
+  }
+
  private:
   static Index count(const std::vector<ElementBlock>& list) {
     Index n = 0;
@@ -168,6 +197,41 @@ struct Mesh {
 
 using Mesh2 = Mesh<2>;
 using Mesh3 = Mesh<3>;
+
+namespace detail {
+
+/// Element blocks in the order the .msh writer lists them: by dimension, then lower, facet
+/// and cell blocks, each in its own order.
+template <int Dim>
+[[nodiscard]] std::vector<const ElementBlock*> blocks_in_file_order(const Mesh<Dim>& mesh) {
+  std::vector<const ElementBlock*> list;
+  for (int d = 0; d <= Dim; ++d)
+    for (const auto* b : {&mesh.lower, &mesh.facets, &mesh.cells})
+      for (const auto& block : *b)
+        if (dimension(block.type) == d && !block.empty()) list.push_back(&block);
+  return list;
+}
+
+/// Element id of element e of `block`: the stored one, else its 1-based position in the file.
+[[nodiscard]] inline std::int64_t element_id(const ElementBlock& block, Index e, std::int64_t position) {
+  return block.ids.empty() ? position + 1 : block.ids[static_cast<std::size_t>(e)];
+}
+
+}  // namespace detail
+
+/// The id element e of `block` (a block of `mesh`) has in a .msh file written from `mesh`:
+/// its stored id, else its 1-based position among all the elements the file lists (lower
+/// dimensions first), which is what a user sees in Gmsh.
+template <int Dim>
+[[nodiscard]] std::int64_t msh_element_id(const Mesh<Dim>& mesh, const ElementBlock& block, Index e) {
+  if (!block.ids.empty()) return block.ids[static_cast<std::size_t>(e)];
+  std::int64_t before = 0;
+  for (const auto* b : detail::blocks_in_file_order(mesh)) {
+    if (b == &block) return before + e + 1;
+    before += b->size();
+  }
+  return e + 1;
+}
 
 /// Checks what every algorithm of the library relies on: finite coordinates, node indices in
 /// range, blocks whose sizes agree with their types, one tag per element, ids (when given)

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <array>
 #include <span>
+#include <string_view>
 #include <vector>
 
 namespace meshmotion {
@@ -149,6 +150,53 @@ Index fix_orientation(Mesh<Dim>& mesh) {
     }
   }
   return changed;
+}
+
+/// How a mesh's cells are listed, as orient_consistently() found and left them.
+struct OrientationFix {
+  enum class Found {
+    positive,  ///< every cell of nonzero measure positive: nothing to do
+    reversed,  ///< every cell of nonzero measure negative: the file's convention, reversed
+    mixed,     ///< some of each: inverted cells, or a file listing cells inconsistently
+  };
+  Found found = Found::positive;
+  Index num_cells = 0;
+  Index num_negative = 0;      ///< before any fix
+  Index first_negative = -1;   ///< position in cell order, -1 if none
+  Index reoriented = 0;        ///< cells whose nodes were reordered
+};
+
+/// "positive", "reversed", "mixed".
+[[nodiscard]] constexpr std::string_view name(OrientationFix::Found f) {
+  switch (f) {
+    case OrientationFix::Found::positive: return "positive";
+    case OrientationFix::Found::reversed: return "reversed";
+    case OrientationFix::Found::mixed: return "mixed";
+  }
+  return "unknown";
+}
+
+/// Makes a consistently reversed mesh positive (every cell mirrored, as fix_orientation()),
+/// and leaves a positive or a mixed mesh as it is: a consistently reversed mesh is a
+/// convention (SU2 files exist that list every cell clockwise), while in a mixed one the
+/// negative cells may be truly inverted and mirroring them would hide it. Facets are left as
+/// they are. Returns what was found and done.
+template <int Dim>
+OrientationFix orient_consistently(Mesh<Dim>& mesh) {
+  const OrientationReport r = orientation_report(mesh);
+  OrientationFix fix;
+  fix.num_cells = r.num_cells;
+  fix.num_negative = r.num_negative;
+  fix.first_negative = r.first_negative;
+  const Index signed_cells = r.num_cells - r.num_degenerate;
+  if (r.num_negative == 0) return fix;
+  if (r.num_negative < signed_cells) {
+    fix.found = OrientationFix::Found::mixed;
+    return fix;
+  }
+  fix.found = OrientationFix::Found::reversed;
+  fix.reoriented = fix_orientation(mesh);
+  return fix;
 }
 
 }  // namespace meshmotion

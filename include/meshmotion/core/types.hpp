@@ -2,6 +2,12 @@
 /// \file
 /// The one index type of the library and the point types built on Eigen.
 
+// The exact predicates (delaunay/predicates.hpp) and the certified quality bounds rely on
+// IEEE arithmetic: -ffast-math reorders and contracts it and silently breaks both.
+#if defined(__FAST_MATH__)
+#error "meshmotion cannot be compiled with -ffast-math (its exact predicates and certified bounds need IEEE arithmetic)"
+#endif
+
 #include <Eigen/Core>
 
 #include <cstddef>

@@ -32,21 +32,6 @@ struct GmshWriteOptions {
 
 namespace detail {
 
-template <int Dim>
-[[nodiscard]] std::vector<const ElementBlock*> blocks_in_file_order(const Mesh<Dim>& mesh) {
-  std::vector<const ElementBlock*> list;
-  for (int d = 0; d <= Dim; ++d)
-    for (const auto* b : {&mesh.lower, &mesh.facets, &mesh.cells})
-      for (const auto& block : *b)
-        if (dimension(block.type) == d && !block.empty()) list.push_back(&block);
-  return list;
-}
-
-/// Element id of element e of `block`: the stored one, else its 1-based position in the file.
-[[nodiscard]] inline std::int64_t element_id(const ElementBlock& block, Index e, std::int64_t position) {
-  return block.ids.empty() ? position + 1 : block.ids[static_cast<std::size_t>(e)];
-}
-
 class GmshFormatter {
  public:
   explicit GmshFormatter(bool binary) : binary_(binary) {}

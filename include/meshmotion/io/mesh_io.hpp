@@ -5,6 +5,8 @@
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/mesh_like.hpp"
+#include "meshmotion/core/orientation.hpp"
 #include "meshmotion/io/any_mesh.hpp"
 #include "meshmotion/io/gmsh_reader.hpp"
 #include "meshmotion/io/gmsh_writer.hpp"
@@ -12,6 +14,7 @@
 #include "meshmotion/io/su2_writer.hpp"
 #include "meshmotion/io/vtu_writer.hpp"
 
+#include <concepts>
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
@@ -28,23 +31,67 @@ namespace detail {
 }
 }  // namespace detail
 
+/// What read_mesh() does with the orientation of the cells (core/orientation.hpp).
+enum class ReadOrientation {
+  keep,              ///< as the file lists them (default)
+  fix_reversed,      ///< a mesh whose every cell is negative is mirrored (orient_consistently)
+  require_positive,  ///< InputError for a negative cell, naming it
+};
+
+/// Options of read_mesh().
+struct ReadOptions {
+  ReadOrientation orientation = ReadOrientation::keep;
+};
+
+namespace detail {
+
+template <int Dim>
+void apply_orientation(Mesh<Dim>& mesh, const std::filesystem::path& file, ReadOrientation policy) {
+  if (policy == ReadOrientation::keep) return;
+  if (policy == ReadOrientation::fix_reversed) {
+    orient_consistently(mesh);
+    return;
+  }
+  const OrientationReport r = orientation_report(mesh);
+  if (r.num_negative == 0) return;
+  Index local = r.first_negative;
+  for (const auto& b : mesh.cells) {
+    if (local < b.size()) {
+      throw InputError("read_mesh: " + file.string() + ": " + std::to_string(r.num_negative) + " of " +
+                       std::to_string(r.num_cells) + " cells are negatively oriented (" +
+                       (r.num_negative + r.num_degenerate == r.num_cells ? "every cell: the file's convention is reversed"
+                                                                         : "mixed orientation") +
+                       "; first: " + std::string(name(b.type)) + " element " +
+                       std::to_string(msh_element_id(mesh, b, local)) + ")");
+    }
+    local -= b.size();
+  }
+}
+
+}  // namespace detail
+
 /// Reads a mesh, choosing the format by extension (.msh or .su2). The result is 3D if the file
-/// holds 3D elements (SU2: NDIME 3), else 2D. The mesh is validated.
+/// holds 3D elements (SU2: NDIME 3), else 2D. The mesh is validated, and its orientation
+/// handled as `options` says.
 /// Throws InputError for an unknown extension, IoError for an unreadable file, ParseError (file
 /// and line or byte offset) for malformed content, InputError for an invalid mesh (a 2D mesh
-/// with nonzero z names the first such node).
-[[nodiscard]] inline AnyMesh read_mesh(const std::filesystem::path& file) {
+/// with nonzero z names the first such node) or a negative cell under require_positive.
+[[nodiscard]] inline AnyMesh read_mesh(const std::filesystem::path& file, const ReadOptions& options = {}) {
   const std::string ext = detail::lower_extension(file);
-  if (ext == ".msh") return read_gmsh(file);
-  if (ext == ".su2") return read_su2(file);
-  throw InputError("read_mesh: " + file.string() + ": unknown mesh format '" + ext + "' (expected .msh or .su2)");
+  AnyMesh mesh = [&]() -> AnyMesh {
+    if (ext == ".msh") return read_gmsh(file);
+    if (ext == ".su2") return read_su2(file);
+    throw InputError("read_mesh: " + file.string() + ": unknown mesh format '" + ext + "' (expected .msh or .su2)");
+  }();
+  std::visit([&](auto& m) { detail::apply_orientation(m, file, options.orientation); }, mesh);
+  return mesh;
 }
 
 /// Reads a mesh that must have dimension Dim; throws InputError when the file's differs, and
 /// as read_mesh() otherwise.
 template <int Dim>
-[[nodiscard]] Mesh<Dim> read_mesh_as(const std::filesystem::path& file) {
-  AnyMesh any = read_mesh(file);
+[[nodiscard]] Mesh<Dim> read_mesh_as(const std::filesystem::path& file, const ReadOptions& options = {}) {
+  AnyMesh any = read_mesh(file, options);
   if (auto* mesh = std::get_if<Mesh<Dim>>(&any)) return std::move(*mesh);
   throw InputError("read_mesh_as: " + file.string() + " holds a " + std::to_string(dimension(any)) + "D mesh (expected " +
                    std::to_string(Dim) + "D)");
@@ -69,9 +116,43 @@ void write_mesh(const std::filesystem::path& file, const Mesh<Dim>& mesh, const 
   throw InputError("write_mesh: " + file.string() + ": unknown mesh format '" + ext + "' (expected .msh, .su2 or .vtu)");
 }
 
+/// Checks, before any work, that write_mesh() can write a mesh of element order `order` (1:
+/// linear, 2: quadratic) to `file`: a known extension whose format holds that order, and an
+/// existing folder. Throws InputError saying which formats would do, or naming the folder.
+inline void check_mesh_output(const std::filesystem::path& file, int order = 1) {
+  const std::string ext = detail::lower_extension(file);
+  if (ext != ".msh" && ext != ".su2" && ext != ".vtu")
+    throw InputError("output " + file.string() + ": unknown mesh format '" + ext + "' (expected .msh, .su2 or .vtu)");
+  if (ext == ".su2" && order > 1)
+    throw InputError("output " + file.string() + ": .su2 holds linear elements only (expected .msh or .vtu for order " +
+                     std::to_string(order) + ")");
+  const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  std::error_code ec;
+  if (!std::filesystem::is_directory(folder, ec))
+    throw InputError("output " + file.string() + ": folder " + folder.string() + " does not exist");
+}
+
+/// Writes a solver's own mesh type (any MeshLike): its nodes and cells, copied into a
+/// Mesh<Dim> first (a MeshLike carries no boundary groups).
+template <MeshLike M>
+  requires(!std::same_as<M, Mesh<mesh_dim<M>>>)
+void write_mesh(const std::filesystem::path& file, const M& mesh, const WriteOptions& options = {}) {
+  write_mesh(file, to_mesh(mesh), options);
+}
+
 /// Writes whichever mesh `mesh` holds, as write_mesh().
 inline void write_mesh(const std::filesystem::path& file, const AnyMesh& mesh, const WriteOptions& options = {}) {
   std::visit([&](const auto& m) { write_mesh(file, m, options); }, mesh);
 }
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template Mesh<2> read_mesh_as<2>(const std::filesystem::path&, const ReadOptions&);
+extern template Mesh<3> read_mesh_as<3>(const std::filesystem::path&, const ReadOptions&);
+extern template void write_mesh<2>(const std::filesystem::path&, const Mesh<2>&, const WriteOptions&);
+extern template void write_mesh<3>(const std::filesystem::path&, const Mesh<3>&, const WriteOptions&);
+}  // namespace meshmotion
+#endif

@@ -6,6 +6,7 @@
 
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/json.hpp"
 #include "meshmotion/core/orientation.hpp"
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -100,20 +102,6 @@ namespace detail {
   std::snprintf(buffer, sizeof buffer, "%.10g", v);
   return buffer;
 }
-[[nodiscard]] inline std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) {
-      char buffer[8];
-      std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
-      out += buffer;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
 }  // namespace detail
 
 /// The summary as readable lines.
@@ -137,47 +125,55 @@ namespace detail {
   out += "] to [";
   for (int d = 0; d < s.dim; ++d) (out += d ? ", " : "") += detail::format_real(s.bbox_max[static_cast<std::size_t>(d)]);
   out += "]\nedge length: min " + detail::format_real(s.min_edge) + ", max " + detail::format_real(s.max_edge) + "\n";
-  out += "orientation: " + std::to_string(s.orientation.num_negative) + " of " + std::to_string(s.orientation.num_cells) +
+  const Index signed_cells = s.orientation.num_cells - s.orientation.num_degenerate;
+  out += std::string("orientation: ") +
+         (s.orientation.num_negative == 0              ? "positive"
+          : s.orientation.num_negative == signed_cells ? "reversed (every cell negative: the file's convention)"
+                                                       : "mixed") +
+         ", " + std::to_string(s.orientation.num_negative) + " of " + std::to_string(s.orientation.num_cells) +
          " cells negative, " + std::to_string(s.orientation.num_degenerate) + " degenerate\n";
   return out;
 }
 
+/// Writes the summary as one JSON object.
+inline void write_json(JsonWriter& w, const MeshSummary& s) {
+  const auto counts = [&](const char* key, const std::vector<std::pair<std::string, Index>>& list) {
+    w.key(key).begin_object();
+    for (const auto& [type, n] : list) w.key(type).value(n);
+    w.end_object();
+  };
+  const auto point = [&](const char* key, const std::array<double, 3>& p) {
+    w.key(key).begin_array();
+    for (int d = 0; d < s.dim; ++d) w.value(p[static_cast<std::size_t>(d)]);
+    w.end_array();
+  };
+  w.begin_object().key("dim").value(s.dim).key("nodes").value(s.num_nodes);
+  counts("cells", s.cells);
+  counts("facets", s.facets);
+  counts("lower", s.lower);
+  w.key("groups").begin_array();
+  for (const auto& g : s.groups) {
+    w.begin_object().key("name").value(g.name).key("dim").value(g.dim).key("tag").value(g.tag);
+    w.key("elements").value(g.num_elements).key("nodes").value(g.num_nodes).end_object();
+  }
+  w.end_array();
+  point("bbox_min", s.bbox_min);
+  point("bbox_max", s.bbox_max);
+  w.key("min_edge").value(s.min_edge).key("max_edge").value(s.max_edge);
+  w.key("negative_cells").value(s.orientation.num_negative).key("degenerate_cells").value(s.orientation.num_degenerate);
+  const Index signed_cells = s.orientation.num_cells - s.orientation.num_degenerate;
+  w.key("orientation").value(s.orientation.num_negative == 0              ? "positive"
+                             : s.orientation.num_negative == signed_cells ? "reversed"
+                                                                          : "mixed");
+  w.end_object();
+}
+
 /// The summary as one JSON object (one line).
 [[nodiscard]] inline std::string to_json(const MeshSummary& s) {
-  const auto counts = [](const std::vector<std::pair<std::string, Index>>& list) {
-    std::string out = "{";
-    for (const auto& [type, n] : list) {
-      if (out.size() > 1) out += ',';
-      out += detail::json_string(type);
-      out += ':';
-      out += std::to_string(n);
-    }
-    out += '}';
-    return out;
-  };
-  const auto point = [&](const std::array<double, 3>& p) {
-    std::string out = "[";
-    for (int d = 0; d < s.dim; ++d) {
-      if (d) out += ',';
-      out += detail::format_real(p[static_cast<std::size_t>(d)]);
-    }
-    out += ']';
-    return out;
-  };
-  std::string out = "{\"dim\":" + std::to_string(s.dim) + ",\"nodes\":" + std::to_string(s.num_nodes) + ",\"cells\":" +
-                    counts(s.cells) + ",\"facets\":" + counts(s.facets) + ",\"lower\":" + counts(s.lower) + ",\"groups\":[";
-  for (std::size_t k = 0; k < s.groups.size(); ++k) {
-    const auto& g = s.groups[k];
-    if (k) out += ',';
-    out += "{\"name\":" + detail::json_string(g.name) + ",\"dim\":" + std::to_string(g.dim) +
-           ",\"tag\":" + std::to_string(g.tag) + ",\"elements\":" + std::to_string(g.num_elements) +
-           ",\"nodes\":" + std::to_string(g.num_nodes) + "}";
-  }
-  out += "],\"bbox_min\":" + point(s.bbox_min) + ",\"bbox_max\":" + point(s.bbox_max) +
-         ",\"min_edge\":" + detail::format_real(s.min_edge) + ",\"max_edge\":" + detail::format_real(s.max_edge) +
-         ",\"negative_cells\":" + std::to_string(s.orientation.num_negative) +
-         ",\"degenerate_cells\":" + std::to_string(s.orientation.num_degenerate) + "}";
-  return out;
+  std::ostringstream out;
+  JsonWriter w(out);
+  write_json(w, s);
+  return out.str();
 }
 
 }  // namespace meshmotion

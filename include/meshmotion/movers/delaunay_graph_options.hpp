@@ -6,6 +6,9 @@
 
 #include "meshmotion/movers/rbf_kernels.hpp"
 
+#include <array>
+#include <string_view>
+
 namespace meshmotion {
 
 /// Treatment of mesh nodes outside the convex hull of the graph nodes. Every node of a mesh
@@ -21,6 +24,12 @@ enum class OutsideGraph {
   /// everywhere, but far nodes amplify rotations.
   extrapolate,
 };
+
+[[nodiscard]] constexpr std::string_view name(OutsideGraph o) { return o == OutsideGraph::clamp ? "clamp" : "extrapolate"; }
+/// Both treatments, for the option parser (core/option_text.hpp).
+[[nodiscard]] constexpr std::array<OutsideGraph, 2> option_choices(OutsideGraph) {
+  return {OutsideGraph::clamp, OutsideGraph::extrapolate};
+}
 
 /// Per-simplex RBF interpolation of DGRBF (Wang, Qin & Zhao, JCP 2015; thesis eqs. 2.15–2.16):
 /// inside graph simplex T with vertices x_t1..x_t(Dim+1), s(x) = Σ_j a_j φ(|x − x_tj|) with

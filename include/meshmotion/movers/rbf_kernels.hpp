@@ -44,6 +44,9 @@ inline constexpr std::array<RbfKernel, 8> all_rbf_kernels{
   return "unknown";
 }
 
+/// Every kernel, for the option parser (core/option_text.hpp).
+[[nodiscard]] constexpr const std::array<RbfKernel, 8>& option_choices(RbfKernel) { return all_rbf_kernels; }
+
 /// The kernel of that name; throws InputError listing the names otherwise.
 [[nodiscard]] inline RbfKernel rbf_kernel_from_name(std::string_view kernel_name) {
   std::string known;

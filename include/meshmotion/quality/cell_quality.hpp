@@ -8,6 +8,7 @@
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/threads.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/quality/knupp.hpp"
 #include "meshmotion/quality/scaled_jacobian.hpp"
@@ -130,7 +131,7 @@ template <int Dim>
   for (const auto& block : mesh.cells) {
     const Index n = block.size();
 #if defined(_OPENMP)
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
 #endif
     for (Index e = 0; e < n; ++e) {
       const auto q = knupp_quality(block.type, detail::gather(mesh, block, e), reference);
@@ -151,3 +152,11 @@ template <int Dim>
 }
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template std::vector<CellQuality> evaluate_cells<2>(const Mesh<2>&, Metric, const QualityOptions&);
+extern template std::vector<CellQuality> evaluate_cells<3>(const Mesh<3>&, Metric, const QualityOptions&);
+}  // namespace meshmotion
+#endif

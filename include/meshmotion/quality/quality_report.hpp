@@ -4,12 +4,14 @@
 /// worst elements (id, type, value, centroid) and a breakdown per element type; printed as a
 /// table or written as JSON.
 
-#include "meshmotion/core/detail/json.hpp"
+#include "meshmotion/core/json.hpp"
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/quality/cell_quality.hpp"
 
+#include <concepts>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -25,7 +27,7 @@ namespace meshmotion {
 /// One of the worst cells of a report.
 struct WorstElement {
   Index id = 0;                       ///< position in cell order
-  std::int64_t file_id = 0;           ///< the element id the file gave (1-based position when none)
+  std::int64_t file_id = 0;           ///< the element id the file gave, else the one a written .msh gives it (msh_element_id)
   ElementType type = ElementType::tri3;
   double value = 0.0;
   bool valid = false;
@@ -120,7 +122,7 @@ template <int Dim>
     WorstElement w;
     w.id = id;
     w.type = block->type;
-    w.file_id = block->ids.empty() ? local + 1 : block->ids[static_cast<std::size_t>(local)];
+    w.file_id = msh_element_id(mesh, *block, local);
     w.value = finite(cells[static_cast<std::size_t>(id)].value);
     w.valid = cells[static_cast<std::size_t>(id)].valid;
     const auto nodes = block->element(local);
@@ -139,8 +141,16 @@ template <int Dim>
   return make_report(mesh, metric, evaluate_cells(mesh, metric, options.quality), options);
 }
 
+/// The report of a solver's own mesh type (any MeshLike): its cells are copied into a
+/// Mesh<Dim> first.
+template <MeshLike M>
+  requires(!std::same_as<M, Mesh<mesh_dim<M>>>)
+[[nodiscard]] QualityReport quality_report(const M& mesh, Metric metric, const ReportOptions& options = {}) {
+  return quality_report(to_mesh(mesh), metric, options);
+}
+
 /// Writes the report as one JSON object.
-inline void write_json(detail::JsonWriter& w, const QualityReport& r) {
+inline void write_json(JsonWriter& w, const QualityReport& r) {
   w.begin_object();
   w.key("metric").value(metric_name(r.metric));
   w.key("elements").value(r.num_elements).key("invalid").value(r.num_invalid);
@@ -167,7 +177,7 @@ inline void write_json(detail::JsonWriter& w, const QualityReport& r) {
 /// The report as a JSON string.
 [[nodiscard]] inline std::string to_json(const QualityReport& r) {
   std::ostringstream s;
-  detail::JsonWriter w(s);
+  JsonWriter w(s);
   write_json(w, r);
   return s.str();
 }
@@ -197,3 +207,13 @@ inline void print_report(std::ostream& out, const QualityReport& r) {
 }
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template QualityReport make_report<2>(const Mesh<2>&, Metric, const std::vector<CellQuality>&, const ReportOptions&);
+extern template QualityReport make_report<3>(const Mesh<3>&, Metric, const std::vector<CellQuality>&, const ReportOptions&);
+extern template QualityReport quality_report<2>(const Mesh<2>&, Metric, const ReportOptions&);
+extern template QualityReport quality_report<3>(const Mesh<3>&, Metric, const ReportOptions&);
+}  // namespace meshmotion
+#endif

@@ -17,6 +17,7 @@
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/threads.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/quality/detail/jacobian_space.hpp"
 
@@ -371,7 +372,7 @@ template <int Dim>
                        std::string(name(block.type)) + " (expected elements of dimension " + std::to_string(Dim) + ")");
     (void)detail::jacobian_space(block.type);  // build the tables before the threads start
 #if defined(_OPENMP)
-#pragma omp parallel for schedule(dynamic, 256)
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(dynamic, 256)
 #endif
     for (Index e = 0; e < n; ++e) {
       detail::ElementCoords<Dim> x(Dim, nn);

@@ -12,6 +12,7 @@
 #include <Eigen/LU>
 
 #include <optional>
+#include <array>
 #include <string>
 #include <string_view>
 
@@ -33,10 +34,18 @@ enum class DenseSolverKind {
   return "unknown";
 }
 
-/// A dense linear solver over one square matrix A (n × n), factorized once.
-class DenseSolver {
+/// Every dense factorization, for the option parser (core/option_text.hpp).
+[[nodiscard]] constexpr std::array<DenseSolverKind, 3> option_choices(DenseSolverKind) {
+  return {DenseSolverKind::llt, DenseSolverKind::ldlt, DenseSolverKind::partial_piv_lu};
+}
+
+/// A dense linear solver over one square matrix A (n × n), factorized once. A template
+/// (DenseSolver is BasicDenseSolver<>), so that its factorizations are compiled only where a
+/// solve is (docs/compiled.md).
+template <class Matrix = Eigen::MatrixXd>
+class BasicDenseSolver {
  public:
-  explicit DenseSolver(DenseSolverKind kind = DenseSolverKind::partial_piv_lu) : kind_(kind) {}
+  explicit BasicDenseSolver(DenseSolverKind kind = DenseSolverKind::partial_piv_lu) : kind_(kind) {}
 
   [[nodiscard]] DenseSolverKind kind() const noexcept { return kind_; }
   [[nodiscard]] const SolverReport& report() const noexcept { return report_; }
@@ -44,7 +53,7 @@ class DenseSolver {
 
   /// Factorizes A. Throws InputError when A is not square or not finite, SolverError when the
   /// factorization fails (LLT of a matrix that is not positive definite).
-  void compute(const Eigen::MatrixXd& a) {
+  void compute(const Matrix& a) {
     const detail::Stopwatch watch;
     if (a.rows() != a.cols())
       throw InputError("DenseSolver::compute: matrix is not square (got " + std::to_string(a.rows()) + " × " +
@@ -97,12 +106,14 @@ class DenseSolver {
  private:
   DenseSolverKind kind_;
   SolverReport report_;
-  Eigen::MatrixXd matrix_;
+  Matrix matrix_;
   // Created by compute() only: Eigen leaves a default-constructed factorization's status
   // uninitialized, and moving a solver would read it.
-  std::optional<Eigen::LLT<Eigen::MatrixXd>> llt_;
-  std::optional<Eigen::LDLT<Eigen::MatrixXd>> ldlt_;
-  std::optional<Eigen::PartialPivLU<Eigen::MatrixXd>> lu_;
+  std::optional<Eigen::LLT<Matrix>> llt_;
+  std::optional<Eigen::LDLT<Matrix>> ldlt_;
+  std::optional<Eigen::PartialPivLU<Matrix>> lu_;
 };
+using DenseSolver = BasicDenseSolver<>;
+
 
 }  // namespace meshmotion

@@ -5,6 +5,7 @@
 
 #include "meshmotion/core/types.hpp"
 
+#include <array>
 #include <string_view>
 
 namespace meshmotion {
@@ -30,6 +31,12 @@ enum class SolverKind {
     case SolverKind::bicgstab: return "bicgstab";
   }
   return "unknown";
+}
+
+/// Every solver kind, for the option parser (core/option_text.hpp).
+[[nodiscard]] constexpr std::array<SolverKind, 6> option_choices(SolverKind) {
+  return {SolverKind::simplicial_ldlt, SolverKind::simplicial_llt, SolverKind::sparse_lu,
+          SolverKind::cg_jacobi,       SolverKind::cg_incomplete_cholesky, SolverKind::bicgstab};
 }
 
 /// True for the Krylov solvers (tolerance and max_iterations apply to them only).

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// KdTree<Dim>: a nanoflann 1.4 k-d tree over the columns of a Dim × n point matrix, read in
+/// KdTree<Dim>: a nanoflann (1.4, or 1.5+ with its renamed types) k-d tree over the columns of a Dim × n point matrix, read in
 /// place (no copy), with radius and k-nearest queries. Distances returned are squared
 /// Euclidean distances, as nanoflann's L2 metric gives them.
 
@@ -22,7 +22,18 @@ namespace meshmotion {
 
 /// One neighbour found by a query: point index (column of the indexed matrix) and squared
 /// distance to the query point.
+#if NANOFLANN_VERSION >= 0x150
+// nanoflann 1.5 returns its own (first, second) struct and renamed SearchParams.
+using Neighbor = nanoflann::ResultItem<std::size_t, double>;
+namespace detail {
+using RadiusSearchParameters = nanoflann::SearchParameters;
+}
+#else
 using Neighbor = std::pair<std::size_t, double>;
+namespace detail {
+using RadiusSearchParameters = nanoflann::SearchParams;
+}
+#endif
 
 namespace detail {
 
@@ -100,7 +111,7 @@ class KdTree {
     // A query farther than `radius` from the points' bounding box finds nothing: most nodes of
     // a mesh asking for centres on a small wall. nanoflann would still descend to a leaf.
     if (size() == 0 || box_squared_distance(query) >= radius * radius) return 0;
-    nanoflann::SearchParams params;
+    detail::RadiusSearchParameters params;
     params.sorted = sorted;
     return static_cast<Index>(tree_->radiusSearch(query.data(), radius * radius, out, params));
   }

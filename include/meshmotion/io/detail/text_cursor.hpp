@@ -20,8 +20,12 @@ namespace meshmotion::detail {
 class TextCursor {
  public:
   /// `text` must outlive the cursor; `file` is the name used in error messages.
+  /// A UTF-8 byte-order mark at the start (editors on Windows write one) is skipped.
   TextCursor(std::string_view text, std::filesystem::path file)
-      : begin_(text.data()), pos_(text.data()), end_(text.data() + text.size()), file_(std::move(file)) {}
+      : begin_(text.data()),
+        pos_(text.data() + (text.starts_with("\xEF\xBB\xBF") ? 3 : 0)),
+        end_(text.data() + text.size()),
+        file_(std::move(file)) {}
 
   [[nodiscard]] const std::filesystem::path& file() const noexcept { return file_; }
   [[nodiscard]] std::uint64_t line() const noexcept { return line_; }

@@ -15,6 +15,7 @@
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/shape_functions.hpp"
+#include "meshmotion/core/threads.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/solvers/linear_solver.hpp"
 
@@ -290,7 +291,7 @@ template <int Dim, class CellFn>
 [[nodiscard]] SparseMatrix assemble(const Mesh<Dim>& mesh, Index size, Index per_node_pair, CellFn&& cell) {
   using Triplet = Eigen::Triplet<double, int>;
 #ifdef _OPENMP
-  const auto threads = static_cast<std::size_t>(omp_get_max_threads());
+  const auto threads = static_cast<std::size_t>(::meshmotion::num_threads());
 #else
   const std::size_t threads = 1;
 #endif
@@ -300,7 +301,7 @@ template <int Dim, class CellFn>
   for (auto& l : lists) l.reserve(static_cast<std::size_t>(entries / static_cast<Index>(threads) + 64));
   for (Index b = 0; b < static_cast<Index>(mesh.cells.size()); ++b) {
     const Index n_cells = mesh.cells[static_cast<std::size_t>(b)].size();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
     for (Index e = 0; e < n_cells; ++e) {
 #ifdef _OPENMP
       std::vector<Triplet>& mine = lists[static_cast<std::size_t>(omp_get_thread_num())];

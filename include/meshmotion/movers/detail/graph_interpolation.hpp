@@ -6,6 +6,7 @@
 /// sum per query. Location and the inversion test are delaunay/graph_mapping.hpp's.
 
 #include "meshmotion/core/error.hpp"
+#include "meshmotion/core/threads.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/delaunay/bowyer_watson.hpp"
 #include "meshmotion/delaunay/delaunay_triangulation.hpp"
@@ -113,7 +114,7 @@ class GraphInterpolation {
                    Eigen::Matrix<double, Rows, Eigen::Dynamic>& out) const {
     const Index q = num_queries();
     out.resize(values.rows(), q);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
     for (Index k = 0; k < q; ++k) {
       Eigen::Matrix<double, Rows, 1> sum = weights_(0, k) * values.col(vertices_(0, k));
       for (int j = 1; j < corners; ++j) sum += weights_(j, k) * values.col(vertices_(j, k));

@@ -12,6 +12,7 @@
 /// then join the full graph.
 
 #include "meshmotion/core/error.hpp"
+#include "meshmotion/core/threads.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/delaunay_graph_options.hpp"
@@ -151,7 +152,7 @@ class GraphMoverBase {
     const Index n = points_.cols();
     if (out.cols() != n) out.resize(Dim, n);
     const auto q = static_cast<Index>(queries_.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
     for (Index k = 0; k < q; ++k) {
       const Index node = queries_[static_cast<std::size_t>(k)];
       out.col(node) = decode(Vec<Dim>(points_.col(node)), Eigen::Matrix<double, Rows, 1>(values.col(k)));

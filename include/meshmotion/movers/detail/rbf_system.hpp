@@ -16,6 +16,7 @@
 /// on first use.
 
 #include "meshmotion/core/error.hpp"
+#include "meshmotion/core/threads.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
 #include "meshmotion/solvers/dense_solver.hpp"
@@ -75,7 +76,7 @@ template <int Dim, class Within>
   // rows with many and with no neighbours; each range's pairs go to one buffer, in row order.
   const Index chunks = std::clamp<Index>(n / 256, 1, 64);
   std::vector<std::vector<Neighbor>> found(static_cast<std::size_t>(chunks));
-#pragma omp parallel
+#pragma omp parallel num_threads(::meshmotion::num_threads())
   {
     std::vector<Neighbor> buffer;
 #pragma omp for schedule(dynamic, 1)
@@ -107,7 +108,7 @@ template <int Dim, class Within>
   std::copy(outer.begin(), outer.end(), m.outerIndexPtr());
   std::vector<Index> start(found.size() + 1, 0);
   for (std::size_t c = 0; c < found.size(); ++c) start[c + 1] = start[c] + static_cast<Index>(found[c].size());
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(dynamic, 1)
   for (Index c = 0; c < chunks; ++c) {
     const auto& pairs = found[static_cast<std::size_t>(c)];
     int* inner = m.innerIndexPtr() + start[static_cast<std::size_t>(c)];

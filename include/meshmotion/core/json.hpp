@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// A minimal streaming JSON writer for reports and the example programs' --json output.
+/// The one JSON writer of the library and its programs (reports, --json output, errors).
 ///
 /// \code
 /// JsonWriter w(std::cout);
@@ -9,6 +9,7 @@
 /// Non-finite numbers are written as null (JSON has no NaN or infinity). Separators are
 /// inserted automatically; the writer does not check that keys and values alternate.
 
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -18,7 +19,7 @@
 #include <type_traits>
 #include <vector>
 
-namespace meshmotion::detail {
+namespace meshmotion {
 
 class JsonWriter {
  public:
@@ -54,9 +55,10 @@ class JsonWriter {
     if (!std::isfinite(x)) {
       out_ << "null";
     } else {
+      // The shortest text that reads back to the same double.
       char buf[32];
-      std::snprintf(buf, sizeof buf, "%.17g", x);
-      out_ << buf;
+      const auto end = std::to_chars(buf, buf + sizeof buf, x).ptr;
+      out_.write(buf, end - buf);
     }
     return *this;
   }
@@ -124,4 +126,4 @@ class JsonWriter {
   bool after_key_ = false;
 };
 
-}  // namespace meshmotion::detail
+}  // namespace meshmotion
