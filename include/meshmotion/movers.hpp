@@ -14,6 +14,7 @@
 #include "meshmotion/movers/improved_dgm.hpp"
 #include "meshmotion/movers/motion.hpp"
 #include "meshmotion/movers/mover.hpp"
+#include "meshmotion/movers/mover_options.hpp"
 #include "meshmotion/movers/nonlinear_elasticity.hpp"
 #include "meshmotion/movers/rbf.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"

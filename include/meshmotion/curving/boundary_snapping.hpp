@@ -125,7 +125,10 @@ template <int Dim>
   const double extent = mesh.num_nodes() > 0
                             ? (mesh.points.rowwise().maxCoeff() - mesh.points.rowwise().minCoeff()).norm()
                             : 0.0;
-  for (const auto& [tag, geo] : geometry) {
+  for (const auto& entry : geometry) {
+    // Named, not a structured binding: the lambdas below capture them (clang 14 cannot).
+    const int tag = entry.first;
+    const BoundaryGeometry<Dim>& geo = entry.second;
     using Kind = typename BoundaryGeometry<Dim>::Kind;
     if (geo.kind == Kind::straight) continue;
     if (geo.kind == Kind::spline) {

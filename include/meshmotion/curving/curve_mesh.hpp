@@ -33,6 +33,7 @@
 #include "meshmotion/movers/any_mover.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/mover.hpp"
+#include "meshmotion/movers/mover_options.hpp"
 #include "meshmotion/movers/rbf.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
 #include "meshmotion/movers/support_radius.hpp"
@@ -46,9 +47,11 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
+#include <variant>
 #include <vector>
 
 namespace meshmotion {
@@ -58,14 +61,20 @@ template <int Dim>
 struct CurveOptions {
   /// Interior regularization: "rbf" (default), "blend" (curving/blend_regularizer.hpp),
   /// "none" (snap the boundary only, to see why the pipeline exists) or any other method of
-  /// mover_registry() (movers/any_mover.hpp), which gets `kernel`, the support radius and
-  /// `parameters` (`le`/`sle` also "active_radius_factor" 4 unless `parameters` set it or
-  /// "active_radius").
+  /// mover_methods() (movers/mover_options.hpp).
   std::string method = "rbf";
-  /// Extra textual parameters of registry movers (keys they document).
-  MoverParameters parameters{};
-  RbfKernel kernel = RbfKernel::wendland2;
-  /// RBF support radius (given to every registry mover as "support_radius"); 0:
+  /// Typed options of a registered `method` (its MoverOptions alternative); empty: the
+  /// method's defaults. The pipeline sets what it measures in them, asking the options what
+  /// they take: the support radius (and a radius per centre) of movers with one
+  /// (TakesSupportRadius), and the active region of those with one (TakesActiveRadius) unless
+  /// these options set it.
+  std::optional<MoverOptions<Dim>> mover_options{};
+  /// Movers with an active region (TakesActiveRadius: le, sle) solve only within this many
+  /// support radii of the curved walls: on the 30P30N, 4 gives the whole-mesh result to 4
+  /// digits of minimum quality with a sixth of the unknowns (docs/mechanics.md, "Active
+  /// region"); 0: the whole mesh.
+  double active_radius_factor = 4.0;
+  /// Support radius of the movers that take one (TakesSupportRadius); 0:
   /// support_radius_factor × each wall's estimated layer for "rbf" (per_wall_radius), × the
   /// thickest one for the other movers
   /// (suggest_support_radius() with 3 wall node spacings when no wall has an anisotropic layer).
@@ -381,13 +390,6 @@ class SnapOnlyMover {
   ResolvedBoundary<Dim> boundary_;
 };
 
-/// A double as text that reads back to the same value (for MoverParameters).
-[[nodiscard]] inline std::string exact_decimal(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.17g", x);
-  return buffer;
-}
-
 inline void report_progress(const std::function<void(const std::string&)>& progress, const std::string& line) {
   if (progress) progress(line);
 }
@@ -461,11 +463,22 @@ void regularize_and_certify(Mover& mover, const ResolvedBoundary<Dim>& boundary,
 template <int Dim>
 [[nodiscard]] CurveResult<Dim> curve_mesh(const Mesh<Dim>& linear, const CurveOptions<Dim>& options = {}) {
   const detail::Stopwatch total;
-  if (options.method != "blend" && options.method != "none" && !mover_registry<Dim>().contains(options.method)) {
-    std::string known = "blend, none";
-    for (const auto& [key, factory] : mover_registry<Dim>()) known += ", " + key;
-    throw InputError("curve_mesh: unknown method '" + options.method + "' (expected one of " + known + ")");
+  // The method and its options are checked before any work.
+  std::optional<MoverConfig<Dim>> config;
+  if (options.method != "blend" && options.method != "none") {
+    try {
+      config = MoverConfig<Dim>{options.method, options.mover_options ? *options.mover_options
+                                                                      : mover_method<Dim>(options.method).defaults()};
+      config->check();
+    } catch (const InputError& e) {
+      throw InputError("curve_mesh: " + std::string(e.what()) + " (or blend, none)");
+    }
+  } else if (options.mover_options) {
+    throw InputError("curve_mesh: method '" + options.method + "' takes no mover options");
   }
+  if (!(options.active_radius_factor >= 0.0))
+    throw InputError("curve_mesh: active_radius_factor must be non-negative (got " +
+                     format_option_value(options.active_radius_factor) + ")");
   CurveResult<Dim> result;
   result.method = options.method;
   detail::report_progress(options.progress, "converting " + std::to_string(linear.num_cells()) + " cells to P2");
@@ -515,6 +528,7 @@ template <int Dim>
     detail::SnapOnlyMover<Dim> mover;
     regularize_and_certify(mover, boundary, options, result);
   } else {
+    const bool radial = std::visit([]<class O>(const O&) { return TakesSupportRadius<O>; }, config->options);
     result.support_radius = options.support_radius;
     std::vector<int> wall_of;
     if (!(result.support_radius > 0.0)) {
@@ -522,32 +536,29 @@ template <int Dim>
       const detail::DefaultRadii radii = detail::default_support_radii(result.curved, boundary, snapped, result.layers, wall_of, options);
       result.support_radius = radii.uniform;
       result.support_radius_limited = radii.limited;
-      // Only the RBF mover takes a radius per centre; the other registry movers get one.
-      if (options.method == "rbf" && options.per_wall_radius) {
+      if (radial && options.per_wall_radius) {
         result.wall_support_radii = radii.per_wall;
         result.support_radius = *std::max_element(radii.per_wall.begin(), radii.per_wall.end());
       }
     }
-    MoverParameters parameters = options.parameters;
-    parameters.values.try_emplace("kernel", std::string(name(options.kernel)));
-    parameters.values.try_emplace("support_radius", detail::exact_decimal(result.support_radius));
-    // (Stiffened) elasticity solves only near the curved walls, within 4 × that radius: the
-    // whole-mesh result to 4 digits of min quality on 30P30N with a sixth of the unknowns
-    // (docs/mechanics.md, "Active region"); an explicit "active_radius" (0: whole mesh) wins.
-    if (options.method == "sle" || options.method == "le") parameters.values.try_emplace("active_radius_factor", "4");
     if (options.centre_reach < 0.0)
       throw InputError("curve_mesh: centre_reach must be non-negative (got " + std::to_string(options.centre_reach) + ")");
-    const bool trim = options.method == "rbf" && options.centre_reach > 0.0;
+    const bool trim = radial && options.centre_reach > 0.0;
     const ResolvedBoundary<Dim> given =
         trim ? detail::near_motion(result.curved, boundary, options.centre_reach * result.support_radius) : boundary;
     const auto& per_wall = result.wall_support_radii;
     const bool varying = std::any_of(per_wall.begin(), per_wall.end(), [&](double r) { return r != per_wall.front(); });
-    AnyMover<Dim> mover = [&] {
-      if (!varying) return make_mover<Dim>(options.method, parameters);
-      RbfOptions rbf = detail::rbf_parameters(parameters);
-      rbf.support_radii = detail::entry_radii(result.curved, given, wall_of, per_wall);
-      return AnyMover<Dim>(RbfMover<Dim>(rbf));
-    }();
+    std::visit(
+        [&]<class O>(O& o) {
+          if constexpr (TakesSupportRadius<O>) {
+            o.support_radius = result.support_radius;
+            o.support_radii = varying ? detail::entry_radii(result.curved, given, wall_of, per_wall) : std::vector<double>{};
+          }
+          if constexpr (TakesActiveRadius<O>)
+            if (!(o.active_radius > 0.0)) o.active_radius = options.active_radius_factor * result.support_radius;
+        },
+        config->options);
+    AnyMover<Dim> mover = make_mover(*config);
     regularize_and_certify(mover, boundary, given, options, result);
   }
   result.seconds.total = total.seconds();
@@ -555,3 +566,11 @@ template <int Dim>
 }
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template CurveResult<2> curve_mesh<2>(const Mesh<2>&, const CurveOptions<2>&);
+extern template CurveResult<3> curve_mesh<3>(const Mesh<3>&, const CurveOptions<3>&);
+}  // namespace meshmotion
+#endif

@@ -94,6 +94,37 @@ struct ResolvedBoundary {
     if (slides_on_line(k)) return Basis(directions.col(k));
     return Basis(plane_basis<Dim>(Vec<Dim>(normals.col(k))));
   }
+  /// The column of `node` in move()'s input (its entry in `nodes`). Throws InputError when
+  /// the node is not on this boundary.
+  [[nodiscard]] Index column(Index node) const {
+    const auto it = std::lower_bound(nodes.begin(), nodes.end(), node);
+    if (it == nodes.end() || *it != node)
+      throw InputError("ResolvedBoundary::column: node " + std::to_string(node) + " is not a boundary node");
+    return static_cast<Index>(it - nodes.begin());
+  }
+  /// Writes `values.col(k)` into the column of node `node_list[k]` of `d` (Dim × size(),
+  /// move()'s input; sized and zeroed when its shape differs), in any node order. Throws
+  /// InputError naming the node for one not on the boundary, one that is fixed or sliding
+  /// (its displacement is not free), one given twice, or a non-finite value.
+  void scatter(const std::vector<Index>& node_list, const Points<Dim>& values, Points<Dim>& d) const {
+    if (static_cast<Index>(node_list.size()) != values.cols())
+      throw InputError("ResolvedBoundary::scatter: " + std::to_string(node_list.size()) + " nodes for " +
+                       std::to_string(values.cols()) + " displacements (expected one per node)");
+    if (d.cols() != size()) d.setZero(Dim, size());
+    std::vector<char> seen(nodes.size(), 0);
+    for (std::size_t k = 0; k < node_list.size(); ++k) {
+      const Index c = column(node_list[k]);
+      const auto slot = static_cast<std::size_t>(c);
+      if (kinds[slot] != BoundaryKind::prescribed)
+        throw InputError("ResolvedBoundary::scatter: node " + std::to_string(node_list[k]) + " is " +
+                         (kinds[slot] == BoundaryKind::fixed ? "fixed" : "sliding") + " (expected a prescribed node)");
+      if (seen[slot]) throw InputError("ResolvedBoundary::scatter: node " + std::to_string(node_list[k]) + " given twice");
+      if (!values.col(static_cast<Index>(k)).allFinite())
+        throw InputError("ResolvedBoundary::scatter: node " + std::to_string(node_list[k]) + " has a non-finite displacement");
+      seen[slot] = 1;
+      d.col(c) = values.col(static_cast<Index>(k));
+    }
+  }
   /// The part of u that entry k may take: u projected on its line or plane when it slides,
   /// u itself otherwise.
   [[nodiscard]] Vec<Dim> project(Index k, const Vec<Dim>& u) const {
@@ -183,24 +214,43 @@ class BoundarySpec {
  public:
   /// The group moves rigidly with `motion` (evaluated on the group's reference positions).
   BoundarySpec& moving(std::string group, Motion<Dim> motion) {
-    groups_.push_back({std::move(group), BoundaryKind::prescribed, std::move(motion), {}, {}});
+    groups_.push_back({std::move(group), BoundaryKind::prescribed, std::move(motion), {}, {}, {}, false});
     return *this;
   }
   /// The group moves by `displacements`: Dim × (number of group nodes), columns in the order
-  /// of the group's sorted node indices.
+  /// of the group's sorted node indices. A solver's own order is easy to get wrong here: prefer
+  /// the overload with node indices.
   BoundarySpec& moving(std::string group, Points<Dim> displacements) {
-    groups_.push_back({std::move(group), BoundaryKind::prescribed, std::nullopt, std::move(displacements), {}});
+    groups_.push_back({std::move(group), BoundaryKind::prescribed, std::nullopt, std::move(displacements), {}, {}, false});
+    return *this;
+  }
+  /// The group moves by displacements given with their nodes: node `nodes[k]` (a mesh node
+  /// index, 0-based, any order) moves by `displacements.col(k)`. resolve() throws InputError
+  /// naming the node for one outside the mesh, one not in the group, one given twice, and for
+  /// a group node without a displacement.
+  BoundarySpec& moving(std::string group, std::vector<Index> nodes, Points<Dim> displacements) {
+    if (static_cast<Index>(nodes.size()) != displacements.cols())
+      throw InputError("BoundarySpec::moving: group '" + group + "': " + std::to_string(nodes.size()) + " nodes for " +
+                       std::to_string(displacements.cols()) + " displacements (expected one per node)");
+    groups_.push_back({std::move(group), BoundaryKind::prescribed, std::nullopt, std::move(displacements), {},
+                       std::move(nodes), false});
+    return *this;
+  }
+  /// The group is prescribed, its displacements given later in move()'s input (columns by
+  /// ResolvedBoundary::column or scatter); resolve() gives it zero displacements.
+  BoundarySpec& prescribed(std::string group) {
+    groups_.push_back({std::move(group), BoundaryKind::prescribed, std::nullopt, {}, {}, {}, true});
     return *this;
   }
   /// The group does not move.
   BoundarySpec& fixed(std::string group) {
-    groups_.push_back({std::move(group), BoundaryKind::fixed, std::nullopt, {}, {}});
+    groups_.push_back({std::move(group), BoundaryKind::fixed, std::nullopt, {}, {}, {}, false});
     return *this;
   }
   /// The group slides in its plane; the normal is fitted to the group's nodes (least squares)
   /// when not given. Throws at resolve() when the nodes are not coplanar.
   BoundarySpec& sliding(std::string group, std::optional<Vec<Dim>> normal = std::nullopt) {
-    groups_.push_back({std::move(group), BoundaryKind::sliding, std::nullopt, {}, normal});
+    groups_.push_back({std::move(group), BoundaryKind::sliding, std::nullopt, {}, normal, {}, false});
     return *this;
   }
 
@@ -250,6 +300,8 @@ class BoundarySpec {
     std::optional<Motion<Dim>> motion;
     Points<Dim> displacements;
     std::optional<Vec<Dim>> normal;
+    std::vector<Index> node_order{};  ///< nodes of `displacements`' columns; empty: the sorted group
+    bool later = false;               ///< prescribed, displacements given to move()
   };
   using Entry = BoundaryEntry<Dim>;
 
@@ -304,6 +356,34 @@ class BoundarySpec {
     return normal;
   }
 
+  // The displacements of a group given with their nodes, in the order of the sorted `list`.
+  static Points<Dim> by_node(const Group& g, const std::vector<Index>& list, Index num_nodes) {
+    std::vector<Index> slot(static_cast<std::size_t>(num_nodes), -1);
+    for (std::size_t k = 0; k < list.size(); ++k) slot[static_cast<std::size_t>(list[k])] = static_cast<Index>(k);
+    Points<Dim> out(Dim, static_cast<Index>(list.size()));
+    std::vector<char> given(list.size(), 0);
+    const std::string where = "BoundarySpec::resolve: group '" + g.name + "': node ";
+    for (std::size_t k = 0; k < g.node_order.size(); ++k) {
+      const Index v = g.node_order[k];
+      if (v < 0 || v >= num_nodes)
+        throw InputError(where + std::to_string(v) + " is not a node of the mesh (expected 0 to " +
+                         std::to_string(num_nodes - 1) + ")");
+      const Index s = slot[static_cast<std::size_t>(v)];
+      if (s < 0) throw InputError(where + std::to_string(v) + " is not in the group");
+      if (given[static_cast<std::size_t>(s)]) throw InputError(where + std::to_string(v) + " is given twice");
+      if (!g.displacements.col(static_cast<Index>(k)).allFinite())
+        throw InputError(where + std::to_string(v) + " has a non-finite displacement");
+      given[static_cast<std::size_t>(s)] = 1;
+      out.col(s) = g.displacements.col(static_cast<Index>(k));
+    }
+    const auto missing = std::find(given.begin(), given.end(), 0);
+    if (missing != given.end())
+      throw InputError(where + std::to_string(list[static_cast<std::size_t>(missing - given.begin())]) +
+                       " has no displacement (" + std::to_string(std::count(given.begin(), given.end(), 0)) + " of " +
+                       std::to_string(list.size()) + " group nodes missing)");
+    return out;
+  }
+
   static void add_group(const Group& g, const std::vector<Index>& list, const Points<Dim>& points, double to,
                         double from, BoundaryCollector<Dim>& entries) {
     const auto n = static_cast<Index>(list.size());
@@ -311,6 +391,10 @@ class BoundarySpec {
     if (g.kind == BoundaryKind::prescribed) {
       if (g.motion) {
         for (Index k = 0; k < n; ++k) targets.col(k) = g.motion->displacement(points.col(list[k]), to, from);
+      } else if (g.later) {
+        // zero until move()'s input says otherwise
+      } else if (!g.node_order.empty()) {
+        targets = (to - from) * by_node(g, list, points.cols());
       } else {
         if (g.displacements.cols() != n)
           throw InputError("BoundarySpec::resolve: group '" + g.name + "' has " + std::to_string(n) +

@@ -39,6 +39,7 @@ struct DgmOptions {
 template <int Dim>
 class DgmMover : public detail::MoveFromMoveInto<DgmMover<Dim>, Dim> {
  public:
+  using detail::MoveFromMoveInto<DgmMover<Dim>, Dim>::move_into;  // into the caller's storage
   static constexpr int dim = Dim;
 
   explicit DgmMover(DgmOptions options = {}) : options_(options) {}

@@ -34,6 +34,7 @@ struct DgrbfOptions {
 template <int Dim>
 class DgrbfMover : public detail::MoveFromMoveInto<DgrbfMover<Dim>, Dim> {
  public:
+  using detail::MoveFromMoveInto<DgrbfMover<Dim>, Dim>::move_into;  // into the caller's storage
   static constexpr int dim = Dim;
 
   explicit DgrbfMover(DgrbfOptions options = {}) : options_(options) {}

@@ -68,6 +68,7 @@ struct Dgrbf2Options {
 template <int Dim>
 class Dgrbf2Mover : public detail::MoveFromMoveInto<Dgrbf2Mover<Dim>, Dim> {
  public:
+  using detail::MoveFromMoveInto<Dgrbf2Mover<Dim>, Dim>::move_into;  // into the caller's storage
   static constexpr int dim = Dim;
   /// Interpolated per node: angle and translation (2D), rotation vector and translation (3D).
   static constexpr int rows = Dim == 2 ? 3 : 6;

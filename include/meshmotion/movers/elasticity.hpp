@@ -34,6 +34,7 @@
 #include "meshmotion/spatial/kd_tree.hpp"
 
 #include <atomic>
+#include <concepts>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -82,63 +83,13 @@ class ElasticityMover : public detail::LinearMechanicsMover<Dim> {
   template <MeshLike M>
     requires(mesh_dim<M> == Dim)
   void setup(const M& mesh, const ResolvedBoundary<Dim>& boundary) {
-    const detail::Stopwatch watch;
-    const detail::Lame lame = detail::lame_parameters(options_.youngs_modulus, options_.poisson_ratio, "ElasticityMover::setup");
-    for (const double exponent : {options_.stiffening_exponent, options_.distance_exponent})
-      if (!(exponent >= 0.0) || !std::isfinite(exponent))
-        throw InputError("ElasticityMover::setup: stiffening exponents must be finite and >= 0 (got " +
-                         std::to_string(exponent) + ")");
-    if (!std::isfinite(options_.reference_jacobian) || !std::isfinite(options_.active_radius))
-      throw InputError("ElasticityMover::setup: reference_jacobian and active_radius must be finite");
-    const Mesh<Dim> copy = this->start_setup(mesh, boundary);
-    const std::vector<bool> unknown = free_nodes(copy, boundary);
-    ResolvedBoundary<Dim> limited;
-    if (!unknown.empty()) limited = hold_far_sliding_nodes(boundary, unknown);
-    const ResolvedBoundary<Dim>& used = unknown.empty() ? boundary : limited;
-    const double chi = options_.stiffening_exponent;
-    j0_ = chi == 0.0 ? 0.0 : options_.reference_jacobian > 0.0 ? options_.reference_jacobian : mean_cell_measure(copy);
-    const std::vector<double> wall_factor = distance_factors(copy, boundary);
-    std::vector<Index> block_start{0};
-    for (const auto& block : copy.cells) block_start.push_back(block_start.back() + block.size());
-
-    std::atomic<bool> degenerate{false};
-    SparseMatrix stiffness = detail::assemble(copy, copy.num_nodes() * Dim, Dim * Dim, [&](Index b, Index e, auto& out) {
-      const ElementBlock& block = copy.cells[static_cast<std::size_t>(b)];
-      const detail::QuadratureTable& table = detail::quadrature_table(block.type);
-      const double measure = detail::reference_measure(block.type);
-      const double cell_factor = wall_factor.empty() ? 1.0 : wall_factor[static_cast<std::size_t>(block_start[static_cast<std::size_t>(b)] + e)];
-      if (!unknown.empty()) {
-        bool touches_free = false;
-        for (const Index v : block.element(e)) touches_free = touches_free || unknown[static_cast<std::size_t>(v)];
-        if (!touches_free) return;
-      }
-      detail::ElementCoords<Dim> x;
-      detail::gather_coords(copy.points, block, e, x);
-      const int n = table.num_nodes;
-      detail::ElementMatrix<Dim> k = detail::ElementMatrix<Dim>::Zero(n * Dim, n * Dim);
-      detail::ElementGradients<Dim> g;
-      Eigen::Matrix<double, Dim, Dim> jacobian;
-      for (int q = 0; q < table.size(); ++q) {
-        const double det = std::abs(detail::element_geometry<Dim>(table, q, x, g, jacobian));
-        double scale = det * table.weights[static_cast<std::size_t>(q)] * cell_factor;
-        if (chi != 0.0) {
-          if (!(det > 0.0)) {
-            degenerate.store(true, std::memory_order_relaxed);
-            return;
-          }
-          scale *= std::pow(j0_ / (det * measure), chi);
-        }
-        detail::add_elastic_stiffness<Dim>(g, lame.lambda, lame.mu, scale, k);
-      }
-      detail::scatter_element_matrix<Dim>(block.element(e), k, out);
-    });
-    if (degenerate)
-      throw InputError("ElasticityMover::setup: a cell has a zero Jacobian determinant (degenerate cell), so its "
-                       "stiffening factor (J0/J)^chi is infinite");
-    SolverOptions solver = options_.solver;
-    solver.diagonal_scaling = true;
-    this->finish_setup(copy, used, std::move(stiffness), Dim, solver, watch, unknown.empty() ? nullptr : &unknown);
+    if constexpr (std::same_as<M, Mesh<Dim>>)
+      setup_mesh(mesh, boundary);
+    else
+      setup_mesh(to_mesh(mesh), boundary);
   }
+  /// setup() on the library's own mesh type.
+  void setup_mesh(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary);
 
  private:
   /// Mean over the cells of their measure Σ_q w_q |det J_q|.
@@ -236,4 +187,72 @@ class ElasticityMover : public detail::LinearMechanicsMover<Dim> {
   double j0_ = 0.0;
 };
 
+template <int Dim>
+void ElasticityMover<Dim>::setup_mesh(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) {
+  const detail::Stopwatch watch;
+  const detail::Lame lame = detail::lame_parameters(options_.youngs_modulus, options_.poisson_ratio, "ElasticityMover::setup");
+  for (const double exponent : {options_.stiffening_exponent, options_.distance_exponent})
+    if (!(exponent >= 0.0) || !std::isfinite(exponent))
+      throw InputError("ElasticityMover::setup: stiffening exponents must be finite and >= 0 (got " +
+                       std::to_string(exponent) + ")");
+  if (!std::isfinite(options_.reference_jacobian) || !std::isfinite(options_.active_radius))
+    throw InputError("ElasticityMover::setup: reference_jacobian and active_radius must be finite");
+  const Mesh<Dim> copy = this->start_setup(mesh, boundary);
+  const std::vector<bool> unknown = free_nodes(copy, boundary);
+  ResolvedBoundary<Dim> limited;
+  if (!unknown.empty()) limited = hold_far_sliding_nodes(boundary, unknown);
+  const ResolvedBoundary<Dim>& used = unknown.empty() ? boundary : limited;
+  const double chi = options_.stiffening_exponent;
+  j0_ = chi == 0.0 ? 0.0 : options_.reference_jacobian > 0.0 ? options_.reference_jacobian : mean_cell_measure(copy);
+  const std::vector<double> wall_factor = distance_factors(copy, boundary);
+  std::vector<Index> block_start{0};
+  for (const auto& block : copy.cells) block_start.push_back(block_start.back() + block.size());
+
+  std::atomic<bool> degenerate{false};
+  SparseMatrix stiffness = detail::assemble(copy, copy.num_nodes() * Dim, Dim * Dim, [&](Index b, Index e, auto& out) {
+    const ElementBlock& block = copy.cells[static_cast<std::size_t>(b)];
+    const detail::QuadratureTable& table = detail::quadrature_table(block.type);
+    const double measure = detail::reference_measure(block.type);
+    const double cell_factor = wall_factor.empty() ? 1.0 : wall_factor[static_cast<std::size_t>(block_start[static_cast<std::size_t>(b)] + e)];
+    if (!unknown.empty()) {
+      bool touches_free = false;
+      for (const Index v : block.element(e)) touches_free = touches_free || unknown[static_cast<std::size_t>(v)];
+      if (!touches_free) return;
+    }
+    detail::ElementCoords<Dim> x;
+    detail::gather_coords(copy.points, block, e, x);
+    const int n = table.num_nodes;
+    detail::ElementMatrix<Dim> k = detail::ElementMatrix<Dim>::Zero(n * Dim, n * Dim);
+    detail::ElementGradients<Dim> g;
+    Eigen::Matrix<double, Dim, Dim> jacobian;
+    for (int q = 0; q < table.size(); ++q) {
+      const double det = std::abs(detail::element_geometry<Dim>(table, q, x, g, jacobian));
+      double scale = det * table.weights[static_cast<std::size_t>(q)] * cell_factor;
+      if (chi != 0.0) {
+        if (!(det > 0.0)) {
+          degenerate.store(true, std::memory_order_relaxed);
+          return;
+        }
+        scale *= std::pow(j0_ / (det * measure), chi);
+      }
+      detail::add_elastic_stiffness<Dim>(g, lame.lambda, lame.mu, scale, k);
+    }
+    detail::scatter_element_matrix<Dim>(block.element(e), k, out);
+  });
+  if (degenerate)
+    throw InputError("ElasticityMover::setup: a cell has a zero Jacobian determinant (degenerate cell), so its "
+                     "stiffening factor (J0/J)^chi is infinite");
+  SolverOptions solver = options_.solver;
+  solver.diagonal_scaling = true;
+  this->finish_setup(copy, used, std::move(stiffness), Dim, solver, watch, unknown.empty() ? nullptr : &unknown);
+}
+
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template class ElasticityMover<2>;
+extern template class ElasticityMover<3>;
+}  // namespace meshmotion
+#endif

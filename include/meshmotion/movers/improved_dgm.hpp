@@ -63,6 +63,7 @@ struct ImprovedDgmOptions {
 template <int Dim>
 class ImprovedDgmMover : public detail::MoveFromMoveInto<ImprovedDgmMover<Dim>, Dim> {
  public:
+  using detail::MoveFromMoveInto<ImprovedDgmMover<Dim>, Dim>::move_into;  // into the caller's storage
   static constexpr int dim = Dim;
 
   explicit ImprovedDgmMover(ImprovedDgmOptions options = {}) : options_(options) {}

@@ -60,6 +60,7 @@ struct NonlinearElasticityOptions {
 template <int Dim>
 class NonlinearElasticityMover : public detail::MoveFromMoveInto<NonlinearElasticityMover<Dim>, Dim> {
  public:
+  using detail::MoveFromMoveInto<NonlinearElasticityMover<Dim>, Dim>::move_into;  // into the caller's storage
   static constexpr int dim = Dim;
 
   explicit NonlinearElasticityMover(NonlinearElasticityOptions options = {}) : options_(options) {}

@@ -30,6 +30,7 @@
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh_like.hpp"
+#include "meshmotion/core/threads.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/detail/coincident_nodes.hpp"
@@ -82,6 +83,7 @@ struct RbfOptions {
 template <int Dim>
 class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
  public:
+  using detail::MoveFromMoveInto<RbfMover<Dim>, Dim>::move_into;  // into the caller's storage
   static constexpr int dim = Dim;
   using Coefficients = Eigen::MatrixXd;
 
@@ -101,129 +103,10 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   template <MeshLike M>
     requires(mesh_dim<M> == Dim)
   void setup(const M& mesh, const ResolvedBoundary<Dim>& boundary) {
-    const detail::Stopwatch watch;
-    if (options_.support_radii.empty() && (!(options_.support_radius > 0.0) || !std::isfinite(options_.support_radius)))
-      throw InputError("RbfMover::setup: support radius must be positive (got " +
-                       std::to_string(options_.support_radius) + ")");
-    if (!options_.support_radii.empty()) {
-      if (static_cast<Index>(options_.support_radii.size()) != boundary.size())
-        throw InputError("RbfMover::setup: " + std::to_string(options_.support_radii.size()) +
-                         " support radii for a boundary of " + std::to_string(boundary.size()) +
-                         " entries (expected one per entry, or none)");
-      for (std::size_t b = 0; b < options_.support_radii.size(); ++b)
-        if (!(options_.support_radii[b] > 0.0) || !std::isfinite(options_.support_radii[b]))
-          throw InputError("RbfMover::setup: support radius of boundary entry " + std::to_string(b) + " (node " +
-                           std::to_string(boundary.nodes[b]) + ") must be positive (got " +
-                           std::to_string(options_.support_radii[b]) + ")");
-    }
-    points_ = copy_points(mesh);
-    const Index n = points_.cols();
-    if (!points_.allFinite()) throw InputError("RbfMover::setup: mesh has a non-finite coordinate");
-    detail::check_boundary<Dim>("RbfMover::setup", boundary, n, false);
-    boundary_nodes_ = boundary.nodes;
-    kinds_ = boundary.kinds;
-    dense_operator_.resize(0, 0);
-    const Index m = boundary.size();
-
-    // Merge coincident boundary nodes into centres; constrained centres first, sliding after.
-    Points<Dim> positions(Dim, m);
-    for (Index b = 0; b < m; ++b) positions.col(b) = points_.col(boundary_nodes_[static_cast<std::size_t>(b)]);
-    const double diagonal = m > 0 ? (positions.rowwise().maxCoeff() - positions.rowwise().minCoeff()).norm() : 0.0;
-    const auto rep = detail::coincident_representatives(positions, options_.coincidence_tolerance * diagonal);
-    std::vector<bool> constrained(static_cast<std::size_t>(m), false);
-    for (Index b = 0; b < m; ++b)
-      if (kinds_[static_cast<std::size_t>(b)] != BoundaryKind::sliding) constrained[static_cast<std::size_t>(rep[static_cast<std::size_t>(b)])] = true;
-    centre_of_.assign(static_cast<std::size_t>(m), -1);
-    source_.clear();
-    std::vector<Index> sliding_reps;
-    for (Index b = 0; b < m; ++b) {
-      if (rep[static_cast<std::size_t>(b)] != b) continue;
-      if (constrained[static_cast<std::size_t>(b)]) {
-        centre_of_[static_cast<std::size_t>(b)] = static_cast<Index>(source_.size());
-        source_.push_back(-1);
-      } else {
-        sliding_reps.push_back(b);
-      }
-    }
-    n_constrained_ = static_cast<Index>(source_.size());
-    for (const Index b : sliding_reps) {
-      centre_of_[static_cast<std::size_t>(b)] = static_cast<Index>(source_.size());
-      source_.push_back(b);
-    }
-    for (Index b = 0; b < m; ++b) centre_of_[static_cast<std::size_t>(b)] = centre_of_[static_cast<std::size_t>(rep[static_cast<std::size_t>(b)])];
-    // A constrained centre takes its value from its first constrained member node.
-    for (Index b = m - 1; b >= 0; --b)
-      if (kinds_[static_cast<std::size_t>(b)] != BoundaryKind::sliding && centre_of_[static_cast<std::size_t>(b)] < n_constrained_)
-        source_[static_cast<std::size_t>(centre_of_[static_cast<std::size_t>(b)])] = b;
-    const auto k = static_cast<Index>(source_.size());
-    Points<Dim> centres(Dim, k);
-    projectors_.clear();
-    for (Index c = 0; c < k; ++c) {
-      const Index b = source_[static_cast<std::size_t>(c)];
-      centres.col(c) = positions.col(b);
-      if (c < n_constrained_) continue;
-      Projector p;
-      for (int a = 0; a < Dim; ++a) p.col(a) = boundary.project(b, Vec<Dim>::Unit(a));
-      projectors_.push_back(p);
-    }
-
-    detail::RbfKernelSettings kernel{options_.kernel, options_.support_radius, options_.polynomial};
-    if (!options_.support_radii.empty()) {
-      kernel.radii.resize(static_cast<std::size_t>(k));
-      for (Index c = 0; c < k; ++c)
-        kernel.radii[static_cast<std::size_t>(c)] = options_.support_radii[static_cast<std::size_t>(source_[static_cast<std::size_t>(c)])];
-      kernel.radius = k > 0 ? *std::max_element(kernel.radii.begin(), kernel.radii.end()) : options_.support_radius;
-    }
-    all_.setup(centres, kernel, options_.solver, options_.dense_solver, options_.max_dense_centres);
-    stats_ = MoverStats{};
-    stats_.boundary_nodes = k;
-    stats_.nonzeros = all_.nonzeros();
-    if (k > n_constrained_) {
-      constrained_.setup(Points<Dim>(centres.leftCols(n_constrained_)), kernel.leading(n_constrained_), options_.solver,
-                         options_.dense_solver, options_.max_dense_centres);
-      sliding_rows_.resize(static_cast<std::size_t>(k - n_constrained_));
-      for (Index c = n_constrained_; c < k; ++c) sliding_rows_[static_cast<std::size_t>(c - n_constrained_)] = c;
-      sliding_operator_ = build_operator(centres, sliding_rows_, constrained_);
-      stats_.nonzeros += constrained_.nonzeros() + sliding_operator_.nonZeros();
-    }
-
-    // Nodes evaluated: every non-boundary node inside some support (all of them for global
-    // kernels); the polynomial part reaches every non-boundary node.
-    std::vector<bool> is_boundary(static_cast<std::size_t>(n), false);
-    for (const Index v : boundary_nodes_) is_boundary[static_cast<std::size_t>(v)] = true;
-    interior_.clear();
-    for (Index i = 0; i < n; ++i)
-      if (!is_boundary[static_cast<std::size_t>(i)]) interior_.push_back(i);
-    evaluated_.clear();
-    const bool fits = !interior_.empty() && static_cast<double>(interior_.size()) * static_cast<double>(k) * sizeof(double) <=
-                                                static_cast<double>(options_.max_evaluation_cache_bytes);
-    // A compact support that reaches most centres from most nodes (a radius far larger than the
-    // moving body, as rotations want) makes the sparse operator a full one stored with indices:
-    // building it dense is several times cheaper and so is every move.
-    const bool dense = fits && (!is_compact(options_.kernel) || covered_fraction() > 0.5);
-    if (is_compact(options_.kernel) && !dense) {
-      // Only rows with weights are kept, so skipped nodes cost nothing per move.
-      std::vector<Index> kept;
-      operator_ = detail::compact_kernel_rows(points_, interior_, all_.within(), k, kernel, &kept);
-      evaluated_.reserve(kept.size());
-      for (const Index r : kept) evaluated_.push_back(interior_[static_cast<std::size_t>(r)]);
-      stats_.nonzeros += operator_.nonZeros();
-    } else {
-      evaluated_ = interior_;
-      operator_.resize(0, 0);
-      if (dense) {
-        dense_operator_.resize(static_cast<Index>(evaluated_.size()), k);
-        const auto n_eval = static_cast<Index>(evaluated_.size());
-#pragma omp parallel for schedule(static)
-        for (Index r = 0; r < n_eval; ++r) dense_operator_.row(r) = kernel_row(points_.col(evaluated_[static_cast<std::size_t>(r)]));
-        stats_.nonzeros += dense_operator_.size();
-      }
-    }
-    stats_.evaluated_nodes = options_.polynomial ? static_cast<Index>(interior_.size()) : static_cast<Index>(evaluated_.size());
-    stats_.factorizations = all_.report().factorizations + (k > n_constrained_ ? constrained_.report().factorizations : 0);
-    ready_ = true;
-    stats_.setup_seconds = watch.seconds();
+    setup_reference(copy_points(mesh), boundary);
   }
+  /// setup() from the reference coordinates alone (Dim × n_nodes): all the RBF needs of a mesh.
+  void setup_reference(Points<Dim> points, const ResolvedBoundary<Dim>& boundary);
 
   /// Displacement of every node (Dim × n_nodes) for boundary displacements `d`
   /// (Dim × boundary.size(), boundary.nodes order; sliding entries ignored). Boundary nodes
@@ -232,66 +115,18 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   /// displacements (naming them); SolverError when an iterative solve fails.
   /// move() (inherited) returns the same; move_into writes into `out`, resized only when its
   /// shape differs.
-  void move_into(const Points<Dim>& d, Points<Dim>& out) {
-    detail::timed_move<Dim>("RbfMover::move", ready_, d, boundary_nodes_, stats_, [&] {
-      apply(d, out);
-      const SolverReport& r = all_.report();
-      stats_.iterations = r.iterations;
-      stats_.residual = r.residual;
-      stats_.fell_back = r.fell_back;
-    });
-  }
+  void move_into(const Points<Dim>& d, Points<Dim>& out);
 
   /// Forward derivative J w: the displacement change of every node (Dim × n_nodes) for a
   /// boundary displacement change w (Dim × boundary.size()). The mover is linear in the
   /// displacements, so this is move(w); coincident nodes must agree in w too.
-  [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w) {
-    require_ready("derivative_forward");
-    detail::check_displacements<Dim>("RbfMover::derivative_forward", w, boundary_nodes_);
-    Points<Dim> out;
-    apply(w, out);
-    return out;
-  }
+  [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w);
 
   /// Reverse derivative Jᵀ v: for v (Dim × n_nodes), the gradient with respect to the
   /// boundary displacements (Dim × boundary.size()) of ⟨v, move(d)⟩. Sliding nodes' entries are
   /// zero (their input is ignored); a merged centre's gradient goes to its first constrained
   /// node. Throws InputError for a wrong shape or a non-finite value.
-  [[nodiscard]] Points<Dim> derivative_reverse(const Points<Dim>& v) {
-    require_ready("derivative_reverse");
-    if (v.cols() != points_.cols() || !v.allFinite())
-      throw InputError("RbfMover::derivative_reverse: v must be finite and " + std::to_string(Dim) + " × " +
-                       std::to_string(points_.cols()) + " (got " + std::to_string(v.cols()) + " columns)");
-    const Index m = static_cast<Index>(boundary_nodes_.size());
-    const Index k = all_.size();
-    Points<Dim> grad = Points<Dim>::Zero(Dim, m);
-    // Boundary nodes output their target directly.
-    Eigen::MatrixXd values_bar = Eigen::MatrixXd::Zero(k, Dim);
-    for (Index b = 0; b < m; ++b) {
-      const Index node = boundary_nodes_[static_cast<std::size_t>(b)];
-      if (kinds_[static_cast<std::size_t>(b)] != BoundaryKind::sliding)
-        grad.col(b) += v.col(node);
-      else
-        values_bar.row(centre_of_[static_cast<std::size_t>(b)]) += v.col(node).transpose();
-    }
-    Eigen::MatrixXd alpha_bar;
-    typename detail::RbfSystem<Dim>::PolyCoefficients beta_bar;
-    interior_transpose(v, alpha_bar, beta_bar);
-    Eigen::MatrixXd through_all;
-    all_.solve_transpose(alpha_bar, beta_bar, through_all);
-    values_bar += through_all;
-    if (k > n_constrained_) {
-      Eigen::MatrixXd s_bar = values_bar.bottomRows(k - n_constrained_);
-      project_rows(s_bar);
-      const Eigen::MatrixXd a_bar = sliding_operator_.transpose() * s_bar;
-      typename detail::RbfSystem<Dim>::PolyCoefficients b_bar = polynomial_transpose(constrained_, sliding_rows_, all_centres(), s_bar);
-      Eigen::MatrixXd through_constrained;
-      constrained_.solve_transpose(a_bar, b_bar, through_constrained);
-      values_bar.topRows(n_constrained_) += through_constrained;
-    }
-    for (Index c = 0; c < n_constrained_; ++c) grad.col(source_[static_cast<std::size_t>(c)]) += values_bar.row(c).transpose();
-    return grad;
-  }
+  [[nodiscard]] Points<Dim> derivative_reverse(const Points<Dim>& v);
 
  private:
   using Operator = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
@@ -399,10 +234,10 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
         evaluated_values_.noalias() = dense_operator_ * alpha_;
       else
         evaluated_values_.noalias() = operator_ * alpha_;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
       for (Index r = 0; r < n_eval; ++r) out.col(evaluated_[static_cast<std::size_t>(r)]) = evaluated_values_.row(r).transpose();
     } else {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
       for (Index r = 0; r < n_eval; ++r) {
         const Index node = evaluated_[static_cast<std::size_t>(r)];
         out.col(node) = (kernel_row(points_.col(node)) * alpha_).transpose();
@@ -410,7 +245,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
     }
     if (!options_.polynomial) return;
     const auto n_interior = static_cast<Index>(interior_.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
     for (Index r = 0; r < n_interior; ++r) {
       const Index node = interior_[static_cast<std::size_t>(r)];
       out.col(node) += beta_.transpose() * all_.polynomial(points_.col(node));
@@ -459,4 +294,195 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   Poly beta_ = Poly::Zero();
 };
 
+template <int Dim>
+void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<Dim>& boundary) {
+  const detail::Stopwatch watch;
+  if (options_.support_radii.empty() && (!(options_.support_radius > 0.0) || !std::isfinite(options_.support_radius)))
+    throw InputError("RbfMover::setup: support radius must be positive (got " +
+                     std::to_string(options_.support_radius) + ")");
+  if (!options_.support_radii.empty()) {
+    if (static_cast<Index>(options_.support_radii.size()) != boundary.size())
+      throw InputError("RbfMover::setup: " + std::to_string(options_.support_radii.size()) +
+                       " support radii for a boundary of " + std::to_string(boundary.size()) +
+                       " entries (expected one per entry, or none)");
+    for (std::size_t b = 0; b < options_.support_radii.size(); ++b)
+      if (!(options_.support_radii[b] > 0.0) || !std::isfinite(options_.support_radii[b]))
+        throw InputError("RbfMover::setup: support radius of boundary entry " + std::to_string(b) + " (node " +
+                         std::to_string(boundary.nodes[b]) + ") must be positive (got " +
+                         std::to_string(options_.support_radii[b]) + ")");
+  }
+  points_ = std::move(points);
+  const Index n = points_.cols();
+  if (!points_.allFinite()) throw InputError("RbfMover::setup: mesh has a non-finite coordinate");
+  detail::check_boundary<Dim>("RbfMover::setup", boundary, n, false);
+  boundary_nodes_ = boundary.nodes;
+  kinds_ = boundary.kinds;
+  dense_operator_.resize(0, 0);
+  const Index m = boundary.size();
+
+  // Merge coincident boundary nodes into centres; constrained centres first, sliding after.
+  Points<Dim> positions(Dim, m);
+  for (Index b = 0; b < m; ++b) positions.col(b) = points_.col(boundary_nodes_[static_cast<std::size_t>(b)]);
+  const double diagonal = m > 0 ? (positions.rowwise().maxCoeff() - positions.rowwise().minCoeff()).norm() : 0.0;
+  const auto rep = detail::coincident_representatives(positions, options_.coincidence_tolerance * diagonal);
+  std::vector<bool> constrained(static_cast<std::size_t>(m), false);
+  for (Index b = 0; b < m; ++b)
+    if (kinds_[static_cast<std::size_t>(b)] != BoundaryKind::sliding) constrained[static_cast<std::size_t>(rep[static_cast<std::size_t>(b)])] = true;
+  centre_of_.assign(static_cast<std::size_t>(m), -1);
+  source_.clear();
+  std::vector<Index> sliding_reps;
+  for (Index b = 0; b < m; ++b) {
+    if (rep[static_cast<std::size_t>(b)] != b) continue;
+    if (constrained[static_cast<std::size_t>(b)]) {
+      centre_of_[static_cast<std::size_t>(b)] = static_cast<Index>(source_.size());
+      source_.push_back(-1);
+    } else {
+      sliding_reps.push_back(b);
+    }
+  }
+  n_constrained_ = static_cast<Index>(source_.size());
+  for (const Index b : sliding_reps) {
+    centre_of_[static_cast<std::size_t>(b)] = static_cast<Index>(source_.size());
+    source_.push_back(b);
+  }
+  for (Index b = 0; b < m; ++b) centre_of_[static_cast<std::size_t>(b)] = centre_of_[static_cast<std::size_t>(rep[static_cast<std::size_t>(b)])];
+  // A constrained centre takes its value from its first constrained member node.
+  for (Index b = m - 1; b >= 0; --b)
+    if (kinds_[static_cast<std::size_t>(b)] != BoundaryKind::sliding && centre_of_[static_cast<std::size_t>(b)] < n_constrained_)
+      source_[static_cast<std::size_t>(centre_of_[static_cast<std::size_t>(b)])] = b;
+  const auto k = static_cast<Index>(source_.size());
+  Points<Dim> centres(Dim, k);
+  projectors_.clear();
+  for (Index c = 0; c < k; ++c) {
+    const Index b = source_[static_cast<std::size_t>(c)];
+    centres.col(c) = positions.col(b);
+    if (c < n_constrained_) continue;
+    Projector p;
+    for (int a = 0; a < Dim; ++a) p.col(a) = boundary.project(b, Vec<Dim>::Unit(a));
+    projectors_.push_back(p);
+  }
+
+  detail::RbfKernelSettings kernel{options_.kernel, options_.support_radius, options_.polynomial};
+  if (!options_.support_radii.empty()) {
+    kernel.radii.resize(static_cast<std::size_t>(k));
+    for (Index c = 0; c < k; ++c)
+      kernel.radii[static_cast<std::size_t>(c)] = options_.support_radii[static_cast<std::size_t>(source_[static_cast<std::size_t>(c)])];
+    kernel.radius = k > 0 ? *std::max_element(kernel.radii.begin(), kernel.radii.end()) : options_.support_radius;
+  }
+  all_.setup(centres, kernel, options_.solver, options_.dense_solver, options_.max_dense_centres);
+  stats_ = MoverStats{};
+  stats_.boundary_nodes = k;
+  stats_.nonzeros = all_.nonzeros();
+  if (k > n_constrained_) {
+    constrained_.setup(Points<Dim>(centres.leftCols(n_constrained_)), kernel.leading(n_constrained_), options_.solver,
+                       options_.dense_solver, options_.max_dense_centres);
+    sliding_rows_.resize(static_cast<std::size_t>(k - n_constrained_));
+    for (Index c = n_constrained_; c < k; ++c) sliding_rows_[static_cast<std::size_t>(c - n_constrained_)] = c;
+    sliding_operator_ = build_operator(centres, sliding_rows_, constrained_);
+    stats_.nonzeros += constrained_.nonzeros() + sliding_operator_.nonZeros();
+  }
+
+  // Nodes evaluated: every non-boundary node inside some support (all of them for global
+  // kernels); the polynomial part reaches every non-boundary node.
+  std::vector<bool> is_boundary(static_cast<std::size_t>(n), false);
+  for (const Index v : boundary_nodes_) is_boundary[static_cast<std::size_t>(v)] = true;
+  interior_.clear();
+  for (Index i = 0; i < n; ++i)
+    if (!is_boundary[static_cast<std::size_t>(i)]) interior_.push_back(i);
+  evaluated_.clear();
+  const bool fits = !interior_.empty() && static_cast<double>(interior_.size()) * static_cast<double>(k) * sizeof(double) <=
+                                              static_cast<double>(options_.max_evaluation_cache_bytes);
+  // A compact support that reaches most centres from most nodes (a radius far larger than the
+  // moving body, as rotations want) makes the sparse operator a full one stored with indices:
+  // building it dense is several times cheaper and so is every move.
+  const bool dense = fits && (!is_compact(options_.kernel) || covered_fraction() > 0.5);
+  if (is_compact(options_.kernel) && !dense) {
+    // Only rows with weights are kept, so skipped nodes cost nothing per move.
+    std::vector<Index> kept;
+    operator_ = detail::compact_kernel_rows(points_, interior_, all_.within(), k, kernel, &kept);
+    evaluated_.reserve(kept.size());
+    for (const Index r : kept) evaluated_.push_back(interior_[static_cast<std::size_t>(r)]);
+    stats_.nonzeros += operator_.nonZeros();
+  } else {
+    evaluated_ = interior_;
+    operator_.resize(0, 0);
+    if (dense) {
+      dense_operator_.resize(static_cast<Index>(evaluated_.size()), k);
+      const auto n_eval = static_cast<Index>(evaluated_.size());
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
+      for (Index r = 0; r < n_eval; ++r) dense_operator_.row(r) = kernel_row(points_.col(evaluated_[static_cast<std::size_t>(r)]));
+      stats_.nonzeros += dense_operator_.size();
+    }
+  }
+  stats_.evaluated_nodes = options_.polynomial ? static_cast<Index>(interior_.size()) : static_cast<Index>(evaluated_.size());
+  stats_.factorizations = all_.report().factorizations + (k > n_constrained_ ? constrained_.report().factorizations : 0);
+  ready_ = true;
+  stats_.setup_seconds = watch.seconds();
+}
+
+template <int Dim>
+void RbfMover<Dim>::move_into(const Points<Dim>& d, Points<Dim>& out) {
+  detail::timed_move<Dim>("RbfMover::move", ready_, d, boundary_nodes_, stats_, [&] {
+    apply(d, out);
+    const SolverReport& r = all_.report();
+    stats_.iterations = r.iterations;
+    stats_.residual = r.residual;
+    stats_.fell_back = r.fell_back;
+  });
+}
+
+template <int Dim>
+Points<Dim> RbfMover<Dim>::derivative_forward(const Points<Dim>& w) {
+  require_ready("derivative_forward");
+  detail::check_displacements<Dim>("RbfMover::derivative_forward", w, boundary_nodes_);
+  Points<Dim> out;
+  apply(w, out);
+  return out;
+}
+
+template <int Dim>
+Points<Dim> RbfMover<Dim>::derivative_reverse(const Points<Dim>& v) {
+  require_ready("derivative_reverse");
+  if (v.cols() != points_.cols() || !v.allFinite())
+    throw InputError("RbfMover::derivative_reverse: v must be finite and " + std::to_string(Dim) + " × " +
+                     std::to_string(points_.cols()) + " (got " + std::to_string(v.cols()) + " columns)");
+  const Index m = static_cast<Index>(boundary_nodes_.size());
+  const Index k = all_.size();
+  Points<Dim> grad = Points<Dim>::Zero(Dim, m);
+  // Boundary nodes output their target directly.
+  Eigen::MatrixXd values_bar = Eigen::MatrixXd::Zero(k, Dim);
+  for (Index b = 0; b < m; ++b) {
+    const Index node = boundary_nodes_[static_cast<std::size_t>(b)];
+    if (kinds_[static_cast<std::size_t>(b)] != BoundaryKind::sliding)
+      grad.col(b) += v.col(node);
+    else
+      values_bar.row(centre_of_[static_cast<std::size_t>(b)]) += v.col(node).transpose();
+  }
+  Eigen::MatrixXd alpha_bar;
+  typename detail::RbfSystem<Dim>::PolyCoefficients beta_bar;
+  interior_transpose(v, alpha_bar, beta_bar);
+  Eigen::MatrixXd through_all;
+  all_.solve_transpose(alpha_bar, beta_bar, through_all);
+  values_bar += through_all;
+  if (k > n_constrained_) {
+    Eigen::MatrixXd s_bar = values_bar.bottomRows(k - n_constrained_);
+    project_rows(s_bar);
+    const Eigen::MatrixXd a_bar = sliding_operator_.transpose() * s_bar;
+    typename detail::RbfSystem<Dim>::PolyCoefficients b_bar = polynomial_transpose(constrained_, sliding_rows_, all_centres(), s_bar);
+    Eigen::MatrixXd through_constrained;
+    constrained_.solve_transpose(a_bar, b_bar, through_constrained);
+    values_bar.topRows(n_constrained_) += through_constrained;
+  }
+  for (Index c = 0; c < n_constrained_; ++c) grad.col(source_[static_cast<std::size_t>(c)]) += values_bar.row(c).transpose();
+  return grad;
+}
+
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template class RbfMover<2>;
+extern template class RbfMover<3>;
+}  // namespace meshmotion
+#endif

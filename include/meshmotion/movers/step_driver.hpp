@@ -7,10 +7,12 @@
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/quality/quality_report.hpp"
 
+#include <concepts>
 #include <optional>
 #include <string>
 #include <vector>
@@ -66,6 +68,15 @@ template <MeshMover Mover>
     result.steps.push_back(std::move(info));
   }
   return result;
+}
+
+/// run_steps() on a solver's own mesh type (any MeshLike), copied into a Mesh<Dim>; the
+/// groups come from `group_nodes` (a MeshLike carries none).
+template <MeshMover Mover, MeshLike M>
+  requires(!std::same_as<M, Mesh<Mover::dim>> && mesh_dim<M> == Mover::dim)
+[[nodiscard]] StepResult<Mover::dim> run_steps(Mover& mover, const M& mesh, const BoundarySpec<Mover::dim>& spec,
+                                               const StepOptions& options, const GroupNodes& group_nodes) {
+  return run_steps(mover, to_mesh(mesh), spec, options, group_nodes);
 }
 
 }  // namespace meshmotion

@@ -69,11 +69,11 @@ class LinearMechanicsMover {
   }
 
   /// move() into `out` (resized only when its shape differs).
-  void move_into(const Points<Dim>& d, Points<Dim>& out) {
-    timed_move<Dim>(name_ + "::move", ready_, d, boundary_nodes_, stats_, [&] {
-      system_.solve(d, out);
-      system_.record(stats_);
-    });
+  void move_into(const Points<Dim>& d, Points<Dim>& out);
+  /// move() into an Eigen::Map (or any Eigen::Ref) of the caller's Dim × n_nodes array.
+  void move_into(const Points<Dim>& d, Eigen::Ref<Points<Dim>> out) {
+    move_into(d, scratch_);
+    copy_to_caller<Dim>((name_ + "::move_into").c_str(), scratch_, out);
   }
 
  protected:
@@ -113,6 +113,23 @@ class LinearMechanicsMover {
   std::vector<Index> boundary_nodes_;
   ConstrainedSystem<Dim> system_;
   bool ready_ = false;
+  Points<Dim> scratch_;  // a move into the caller's storage
 };
 
+template <int Dim>
+void LinearMechanicsMover<Dim>::move_into(const Points<Dim>& d, Points<Dim>& out) {
+  timed_move<Dim>(name_ + "::move", ready_, d, boundary_nodes_, stats_, [&] {
+    system_.solve(d, out);
+    system_.record(stats_);
+  });
+}
+
 }  // namespace meshmotion::detail
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template class detail::LinearMechanicsMover<2>;
+extern template class detail::LinearMechanicsMover<3>;
+}  // namespace meshmotion
+#endif

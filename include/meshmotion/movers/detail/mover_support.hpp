@@ -80,10 +80,27 @@ void timed_move(std::string_view where, bool ready, const Points<Dim>& d, const 
   stats.move_seconds = watch.seconds();
 }
 
-/// CRTP base giving a mover the allocating `move(d)` from its `move_into(d, out)`.
+/// Copies a mover's result into the caller's own storage (an Eigen::Map over a solver's
+/// array), which must already be Dim × n_nodes. Throws InputError naming both shapes otherwise.
+template <int Dim>
+void copy_to_caller(const char* where, const Points<Dim>& result, Eigen::Ref<Points<Dim>> out) {
+  if (out.cols() != result.cols())
+    throw InputError(std::string(where) + ": the output has " + std::to_string(out.cols()) + " columns (expected " +
+                     std::to_string(result.cols()) + ", one per node)");
+  out = result;
+}
+
+/// CRTP base giving a mover the allocating `move(d)` from its `move_into(d, out)`, and
+/// `move_into` into the caller's own storage (derived movers bring it in with a using
+/// declaration, since their own move_into hides it).
 template <class Derived, int Dim>
 class MoveFromMoveInto {
  public:
+  /// move_into() into an Eigen::Map (or any Eigen::Ref) of the caller's Dim × n_nodes array.
+  void move_into(const Points<Dim>& d, Eigen::Ref<Points<Dim>> out) {
+    static_cast<Derived&>(*this).move_into(d, scratch_);
+    copy_to_caller<Dim>("move_into", scratch_, out);
+  }
   /// Displacement of every node (Dim × n_nodes) for boundary displacements `d`
   /// (Dim × boundary.size()); see the mover's move_into for what it throws.
   [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
@@ -91,6 +108,9 @@ class MoveFromMoveInto {
     static_cast<Derived&>(*this).move_into(d, out);
     return out;
   }
+
+ private:
+  Points<Dim> scratch_;
 };
 
 }  // namespace meshmotion::detail

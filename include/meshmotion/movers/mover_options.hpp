@@ -1,0 +1,278 @@
+#pragma once
+/// \file
+/// The typed options of every mover, by method name, and their one text form.
+///
+/// A mover chosen at run time is a MoverConfig: its method name and its typed options struct
+/// (RbfOptions, ElasticityOptions, ...). Text (command line, config file, Python keywords)
+/// reaches those structs through MoverConfig::set, which knows every key of the method and
+/// refuses any other (naming the known ones), refuses malformed values, and reads numbers
+/// exactly (core/option_text.hpp). MoverConfig::values() writes them back the same way.
+///
+/// \code
+/// MoverConfig<2> c = mover_config<2>("rbf", parse_key_values("support_radius=4.9e-6 kernel=wendland4"));
+/// std::get<RbfOptions>(c.options).polynomial = true;   // or typed, directly
+/// AnyMover<2> mover = make_mover(c);
+/// \endcode
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/option_text.hpp"
+#include "meshmotion/movers/delaunay_graph_options.hpp"
+#include "meshmotion/movers/dgm.hpp"
+#include "meshmotion/movers/dgrbf.hpp"
+#include "meshmotion/movers/dgrbf2.hpp"
+#include "meshmotion/movers/elasticity.hpp"
+#include "meshmotion/movers/improved_dgm.hpp"
+#include "meshmotion/movers/nonlinear_elasticity.hpp"
+#include "meshmotion/movers/rbf.hpp"
+#include "meshmotion/movers/spring.hpp"
+#include "meshmotion/movers/torsion_spring.hpp"
+#include "meshmotion/solvers/dense_solver.hpp"
+#include "meshmotion/solvers/solver_options.hpp"
+
+#include <array>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+namespace meshmotion {
+
+// visit_options(o, f) calls f(key, field, help) for every field of `o` that text may set.
+// Nested structs of a mover's options add their keys with a prefix ("rbf." in idgm).
+
+template <class F>
+void visit_options(SolverOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "solver", o.kind, "sparse solver of the system");
+  f(prefix + "tolerance", o.tolerance, "relative residual an iterative solver must reach");
+  f(prefix + "max_iterations", o.max_iterations, "iteration cap of an iterative solver (0: twice the size)");
+  f(prefix + "fallback_to_direct", o.fallback_to_direct, "solve with sparse LU when an iterative solver fails");
+  f(prefix + "diagonal_scaling", o.diagonal_scaling, "solve the diagonally scaled system");
+}
+
+template <class F>
+void visit_options(RbfOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "kernel", o.kernel, "radial function");
+  f(prefix + "support_radius", o.support_radius, "support radius (scale of global kernels), mesh units");
+  f(prefix + "support_radii", o.support_radii, "a radius per boundary entry (comma-separated), replacing support_radius");
+  f(prefix + "polynomial", o.polynomial, "add a linear polynomial (affine motions exact)");
+  visit_options(o.solver, f, prefix);
+  f(prefix + "dense_solver", o.dense_solver, "factorization of the dense system of global kernels");
+  f(prefix + "max_dense_centres", o.max_dense_centres, "largest centre count of a global kernel");
+  f(prefix + "coincidence_tolerance", o.coincidence_tolerance, "boundary nodes closer than this × the diagonal are one");
+  f(prefix + "max_evaluation_cache_bytes", o.max_evaluation_cache_bytes, "largest dense evaluation matrix kept");
+}
+
+template <class F>
+void visit_options(DgmOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "outside", o.outside, "nodes outside the graph's hull");
+  f(prefix + "check_inversion", o.check_inversion, "refuse when the moved graph inverts");
+}
+
+template <class F>
+void visit_options(SimplexRbfOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "kernel", o.kernel, "radial function of the per-simplex interpolation");
+  f(prefix + "simplex_support_radius", o.support_radius, "absolute per-simplex support radius (0: relative)");
+  f(prefix + "simplex_support", o.relative_support, "per-simplex support, × the simplex's longest edge");
+  f(prefix + "normalize", o.normalize, "divide the cardinal weights by their sum");
+}
+
+template <class F>
+void visit_options(DgrbfOptions& o, F&& f, const std::string& prefix = {}) {
+  visit_options(o.rbf, f, prefix);
+  f(prefix + "outside", o.outside, "nodes outside the graph's hull");
+}
+
+template <int Dim, class F>
+void visit_options(Dgrbf2Options<Dim>& o, F&& f, const std::string& prefix = {}) {
+  visit_options(o.rbf, f, prefix);
+  f(prefix + "outside", o.outside, "nodes outside the graph's hull");
+  f(prefix + "center", o.center, "centre of the rigid rotation (none: centroid of the moving nodes)");
+  if constexpr (Dim == 3) f(prefix + "axis", o.axis, "rotation axis");
+}
+
+template <class F>
+void visit_options(ImprovedDgmOptions& o, F&& f, const std::string& prefix = {}) {
+  visit_options(o.dgm, f, prefix);
+  f(prefix + "layer_offset", o.layer_offset, "layer distance from the wall, in wall spacings");
+  f(prefix + "layer_spacing", o.layer_spacing, "thinning of the layer, in wall spacings");
+  f(prefix + "auto_support_radius", o.auto_support_radius, "the layer RBF's radius from the layer's reach");
+  f(prefix + "relative_support_radius", o.relative_support_radius, "factor of the automatic radius");
+  visit_options(o.rbf, f, prefix + "rbf.");
+}
+
+template <class F>
+void visit_options(SpringOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "length_exponent", o.length_exponent, "p in k = length^-p");
+  visit_options(o.solver, f, prefix);
+}
+
+template <class F>
+void visit_options(TorsionSpringOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "torsion_weight", o.torsion_weight, "factor of every torsional stiffness");
+  f(prefix + "coupled_lineal", o.coupled_lineal, "lineal springs in the coupled truss form");
+  f(prefix + "vertex_facet_springs", o.vertex_facet_springs, "3D: vertex-facet springs too");
+  visit_options(o.solver, f, prefix);
+}
+
+template <class F>
+void visit_options(ElasticityOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "youngs_modulus", o.youngs_modulus, "Young's modulus E > 0 (scales K only)");
+  f(prefix + "poisson_ratio", o.poisson_ratio, "Poisson ratio in (-1, 0.5)");
+  f(prefix + "stiffening_exponent", o.stiffening_exponent, "chi of the Jacobian stiffening (J0/J)^chi");
+  f(prefix + "reference_jacobian", o.reference_jacobian, "J0 (<= 0: the mean cell measure)");
+  f(prefix + "distance_exponent", o.distance_exponent, "psi of the wall-distance stiffening");
+  visit_options(o.solver, f, prefix);
+  f(prefix + "active_radius", o.active_radius, "solve only within this distance of the moving walls (0: whole mesh)");
+}
+
+template <class F>
+void visit_options(NonlinearElasticityOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "youngs_modulus", o.youngs_modulus, "Young's modulus E > 0 (scales the energy only)");
+  f(prefix + "poisson_ratio", o.poisson_ratio, "Poisson ratio in (-1, 0.5)");
+  f(prefix + "load_steps", o.load_steps, "equal boundary increments");
+  f(prefix + "newton_iterations", o.max_newton_iterations, "Newton iterations per load step");
+  f(prefix + "newton_tolerance", o.tolerance, "largest update / bounding-box diagonal that stops Newton");
+  f(prefix + "min_step", o.min_step, "smallest line-search step");
+  visit_options(o.solver, f, prefix);
+}
+
+/// The typed options of every registered mover.
+template <int Dim>
+using MoverOptions = std::variant<RbfOptions, DgmOptions, ImprovedDgmOptions, DgrbfOptions, Dgrbf2Options<Dim>,
+                                  SpringOptions, TorsionSpringOptions, ElasticityOptions, NonlinearElasticityOptions>;
+
+/// Options a caller such as the curving pipeline sets from what it measured, when the
+/// mover's options have them (the pipeline asks through these instead of naming methods).
+template <class O>
+concept TakesSupportRadius = requires(O o) {
+  { o.support_radius } -> std::same_as<double&>;
+  { o.support_radii } -> std::same_as<std::vector<double>&>;
+};
+template <class O>
+concept TakesActiveRadius = requires(O o) {
+  { o.active_radius } -> std::same_as<double&>;
+};
+
+/// A registered method: its name, a line saying what it is, its default options.
+template <int Dim>
+struct MoverMethod {
+  std::string_view name;
+  std::string_view summary;
+  MoverOptions<Dim> (*defaults)();
+};
+
+/// Every method make_mover() builds, in the order programs list them.
+template <int Dim>
+[[nodiscard]] const std::array<MoverMethod<Dim>, 10>& mover_methods() {
+  static const std::array<MoverMethod<Dim>, 10> methods{{
+      {"rbf", "radial basis function interpolation (thesis 2.2.2)", [] { return MoverOptions<Dim>(RbfOptions{}); }},
+      {"dgm", "Delaunay graph mapping (thesis 2.2.1)", [] { return MoverOptions<Dim>(DgmOptions{}); }},
+      {"idgm", "Delaunay graph mapping with an RBF-moved layer", [] { return MoverOptions<Dim>(ImprovedDgmOptions{}); }},
+      {"dgrbf", "Delaunay graph with per-simplex RBF (thesis 2.2.3)", [] { return MoverOptions<Dim>(DgrbfOptions{}); }},
+      {"dgrbf2", "DGRBF with rigid rotations exact (thesis 2.2.4)", [] { return MoverOptions<Dim>(Dgrbf2Options<Dim>{}); }},
+      {"spring", "lineal springs (thesis 2.1.1)", [] { return MoverOptions<Dim>(SpringOptions{}); }},
+      {"torsion", "torsion springs (thesis 2.1.2)", [] { return MoverOptions<Dim>(TorsionSpringOptions{}); }},
+      {"le", "linear elasticity (thesis 2.1.3)", [] { return MoverOptions<Dim>(ElasticityOptions{}); }},
+      {"sle", "stiffened linear elasticity, chi 2.75 (thesis table 4.2)",
+       [] {
+         ElasticityOptions o;
+         o.stiffening_exponent = 2.75;
+         return MoverOptions<Dim>(o);
+       }},
+      {"nle", "neo-Hookean nonlinear elasticity (thesis 2.1.4)", [] { return MoverOptions<Dim>(NonlinearElasticityOptions{}); }},
+  }};
+  return methods;
+}
+
+/// "rbf, dgm, ..." for messages.
+template <int Dim>
+[[nodiscard]] std::string known_methods() {
+  std::string known;
+  for (const auto& m : mover_methods<Dim>()) {
+    if (!known.empty()) known += ", ";
+    known += m.name;
+  }
+  return known;
+}
+
+/// The registered method of that name; throws InputError listing the known ones otherwise.
+template <int Dim>
+[[nodiscard]] const MoverMethod<Dim>& mover_method(std::string_view method) {
+  for (const auto& m : mover_methods<Dim>())
+    if (m.name == method) return m;
+  throw InputError("unknown mover method '" + std::string(method) + "' (expected one of " + known_methods<Dim>() + ")");
+}
+
+/// A method and its typed options: what make_mover() builds.
+template <int Dim>
+struct MoverConfig {
+  std::string method = "rbf";
+  MoverOptions<Dim> options = RbfOptions{};
+
+  /// Every key this method takes, in a fixed order.
+  [[nodiscard]] std::vector<std::string> keys() const {
+    std::vector<std::string> out;
+    for_each_field([&](const std::string& key, auto&, std::string_view) { out.push_back(key); });
+    return out;
+  }
+  /// Every key with its value as text (numbers in their shortest exact form).
+  [[nodiscard]] KeyValues values() const {
+    KeyValues out;
+    for_each_field([&](const std::string& key, auto& value, std::string_view) {
+      out.emplace_back(key, format_option_value(value));
+    });
+    return out;
+  }
+  /// Every key with a line of help and its current value: "key (value): help".
+  [[nodiscard]] std::vector<std::string> describe() const {
+    std::vector<std::string> out;
+    for_each_field([&](const std::string& key, auto& value, std::string_view help) {
+      out.push_back(key + " (" + format_option_value(value) + "): " + std::string(help));
+    });
+    return out;
+  }
+  /// Sets one option from text. Throws InputError for a key this method does not take
+  /// (listing the ones it does) or a value its field cannot hold.
+  void set(std::string_view key, std::string_view text) {
+    check();
+    bool found = false;
+    std::visit(
+        [&](auto& o) {
+          visit_options(o, [&](const std::string& k, auto& field, std::string_view) {
+            if (k != key) return;
+            parse_option_value(key, text, field);
+            found = true;
+          });
+        },
+        options);
+    if (!found) throw InputError(unknown_key_message("method '" + method + "'", key, keys()));
+  }
+  /// Sets every pair in order (see set()).
+  void set(const KeyValues& values) {
+    for (const auto& [k, v] : values) set(k, v);
+  }
+  /// Throws InputError when `options` is not the options type of `method`.
+  void check() const {
+    const MoverMethod<Dim>& m = mover_method<Dim>(method);
+    if (m.defaults().index() != options.index())
+      throw InputError("MoverConfig: the options given are not those of method '" + method + "'");
+  }
+
+ private:
+  template <class F>
+  void for_each_field(F&& f) const {
+    check();
+    MoverOptions<Dim> copy = options;
+    std::visit([&](auto& o) { visit_options(o, f); }, copy);
+  }
+};
+
+/// The defaults of `method` with `values` set over them (see MoverConfig::set).
+template <int Dim>
+[[nodiscard]] MoverConfig<Dim> mover_config(std::string_view method, const KeyValues& values = {}) {
+  MoverConfig<Dim> c{std::string(method), mover_method<Dim>(method).defaults()};
+  c.set(values);
+  return c;
+}
+
+}  // namespace meshmotion
