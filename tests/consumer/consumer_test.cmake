@@ -20,7 +20,7 @@ if(STEP STREQUAL "install")
   file(REMOVE_RECURSE "${WORK_DIR}/meshmotion-build" "${prefix}")
   run(${CMAKE_COMMAND} -S "${SOURCE_DIR}" -B "${WORK_DIR}/meshmotion-build" ${common}
       -DMESHMOTION_BUILD_TESTS=OFF -DMESHMOTION_BUILD_EXAMPLES=OFF -DMESHMOTION_BUILD_BENCHMARKS=OFF
-      -DMESHMOTION_INSTALL=ON)
+      -DMESHMOTION_INSTALL=ON -DMESHMOTION_BUILD_COMPILED=OFF)
   run(${CMAKE_COMMAND} --install "${WORK_DIR}/meshmotion-build" --prefix "${prefix}")
   if(NOT EXISTS "${prefix}/include/meshmotion/meshmotion.hpp")
     message(FATAL_ERROR "consumer test (install): ${prefix}/include/meshmotion/meshmotion.hpp was not installed")

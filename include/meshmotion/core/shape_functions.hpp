@@ -18,6 +18,7 @@
 ///   û = u/(1-w), v̂ = v/(1-w), k ≤ p - max(i,j); pyramid13 drops (i,j) = (2,2).
 /// Since the interpolant in a space is unique, these are the functions Gmsh uses.
 
+#include "meshmotion/core/detail/table_kernels.hpp"
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/types.hpp"
 
@@ -176,7 +177,7 @@ inline ShapeBasis make_shape_basis(ElementType t) {
   for (Index i = 0; i < n; ++i)
     for (Index k = 0; k < n; ++k)
       vandermonde(i, k) = monomial_value(basis.monomials[static_cast<std::size_t>(k)], basis.nodes[static_cast<std::size_t>(i)]);
-  basis.coefficients = vandermonde.inverse();
+  basis.coefficients = table_inverse(vandermonde);
   return basis;
 }
 

@@ -193,3 +193,11 @@ template <int Dim>
 }
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template QuadraticConversion<2> convert_to_quadratic<2>(const Mesh<2>&, const P2Options&);
+extern template QuadraticConversion<3> convert_to_quadratic<3>(const Mesh<3>&, const P2Options&);
+}  // namespace meshmotion
+#endif

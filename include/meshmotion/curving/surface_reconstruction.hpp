@@ -47,15 +47,18 @@ struct SurfaceReconstructionOptions {
   double ridge_angle = 30.0;
 };
 
+// A template of nothing (SurfaceReconstruction is BasicSurfaceReconstruction<>): its least-squares
+// fits are then compiled only where a reconstruction is (docs/compiled.md).
 /// High-order reconstruction of a triangulated surface (WALF, with ridges kept sharp).
-class SurfaceReconstruction {
+template <class = void>
+class BasicSurfaceReconstruction {
  public:
   /// `points`: 3 × n_nodes; `triangles`: 3 node indices per triangle (flat, like
   /// ElementBlock::connectivity of a tri3 block). Throws InputError for a connectivity whose
   /// size is not a multiple of 3, an out-of-range node, a non-finite coordinate, a
   /// degenerate (zero-area) triangle, a degree other than 2 or 3 or a NaN ridge angle, and
   /// SolverError when a vertex has too few neighbours for its fitting.
-  SurfaceReconstruction(const Points<3>& points, std::span<const Index> triangles,
+  BasicSurfaceReconstruction(const Points<3>& points, std::span<const Index> triangles,
                         SurfaceReconstructionOptions options = {})
       : options_(options), triangles_(triangles.begin(), triangles.end()) {
     validate(points);
@@ -449,5 +452,7 @@ class SurfaceReconstruction {
   std::vector<Index> corner_fits_;  // per triangle corner: its (vertex, sector) fit
   std::vector<Fit> fits_;
 };
+using SurfaceReconstruction = BasicSurfaceReconstruction<>;
+
 
 }  // namespace meshmotion

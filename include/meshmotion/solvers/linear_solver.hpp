@@ -84,7 +84,9 @@ class IterativeBackend final : public SparseBackend {
   EigenSolver solver_;
 };
 
-inline std::unique_ptr<SparseBackend> make_backend(const SolverOptions& o) {
+// A template, so that only a LinearSolver that is compiled instantiates the six Eigen solvers.
+template <int = 0>
+std::unique_ptr<SparseBackend> make_backend(const SolverOptions& o) {
   constexpr int Lower = Eigen::Lower;
   constexpr int LowerUpper = Eigen::Lower | Eigen::Upper;
   switch (o.kind) {
@@ -117,9 +119,14 @@ inline std::unique_ptr<SparseBackend> make_backend(const SolverOptions& o) {
 /// the symbolic analysis. The solver keeps a copy of A (iterative solvers and residual
 /// checks need it). With SolverOptions::diagonal_scaling it keeps and solves the scaled
 /// matrix D^-1/2 A D^-1/2 and maps right-hand sides and solutions (callers see A's x).
-class LinearSolver {
+///
+/// A template of nothing (LinearSolver is BasicLinearSolver<>), so that its members are
+/// instantiated only where a solve is compiled: a program built on meshmotion::compiled then
+/// never compiles Eigen's factorizations itself (docs/compiled.md).
+template <class = void>
+class BasicLinearSolver {
  public:
-  explicit LinearSolver(SolverOptions options = {}) : options_(options) {}
+  explicit BasicLinearSolver(SolverOptions options = {}) : options_(options) {}
 
   [[nodiscard]] const SolverOptions& options() const noexcept { return options_; }
   [[nodiscard]] const SolverReport& report() const noexcept { return report_; }
@@ -285,5 +292,8 @@ class LinearSolver {
   Eigen::VectorXd rhs_;
   Eigen::VectorXd column_;
 };
+using LinearSolver = BasicLinearSolver<>;
+
 
 }  // namespace meshmotion
+

@@ -97,7 +97,9 @@ template <int Dim>
 /// Closest point of the quadrilateral x0 x1 x2 x3 to p: that of the triangles 012 and 023,
 /// mapped back to the bilinear reference square [-1, 1]^2 by Gauss-Newton (exact for planar
 /// parallelograms, close for the gently warped faces of real meshes). Returns (xi, point).
-[[nodiscard]] inline std::pair<RefPoint, Vec<3>> closest_on_quadrilateral(const Vec<3>& p, const Vec<3>& x0,
+// A template so that its Gauss-Newton solve is compiled only where WallDistance<3> is.
+template <int = 0>
+[[nodiscard]] std::pair<RefPoint, Vec<3>> closest_on_quadrilateral(const Vec<3>& p, const Vec<3>& x0,
                                                                          const Vec<3>& x1, const Vec<3>& x2,
                                                                          const Vec<3>& x3) {
   const auto [u1, v1] = closest_on_triangle(p, x0, x1, x2);

@@ -13,6 +13,7 @@
 /// coefficients, exactly, since children are affine images of the reference element).
 /// Pyramids are rational: they get a sampling lattice only (no Bézier bound).
 
+#include "meshmotion/core/detail/table_kernels.hpp"
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/shape_functions.hpp"
 #include "meshmotion/core/types.hpp"
@@ -200,9 +201,10 @@ inline BezierFactor bezier_factor(JacobianSpace f) {
     return e;
   };
   BezierFactor out;
-  out.to_bezier = values_at([&](Index j) { return f.points[static_cast<std::size_t>(j)]; }).inverse();
+  out.to_bezier = table_inverse(values_at([&](Index j) { return f.points[static_cast<std::size_t>(j)]; }));
   for (const auto& child : make_children(f))
-    out.child_bezier.push_back(out.to_bezier * values_at([&](Index j) { return map_child(child, f.points[static_cast<std::size_t>(j)]); }));
+    out.child_bezier.push_back(
+        table_product(out.to_bezier, values_at([&](Index j) { return map_child(child, f.points[static_cast<std::size_t>(j)]); })));
   return out;
 }
 

@@ -1,0 +1,20 @@
+// Reading, writing and quality reports of the compiled library, 2D and 3D.
+
+#include "meshmotion/io/mesh_io.hpp"
+#include "meshmotion/quality/cell_quality.hpp"
+#include "meshmotion/quality/quality_report.hpp"
+
+namespace meshmotion {
+
+template Mesh<2> read_mesh_as<2>(const std::filesystem::path&, const ReadOptions&);
+template Mesh<3> read_mesh_as<3>(const std::filesystem::path&, const ReadOptions&);
+template void write_mesh<2>(const std::filesystem::path&, const Mesh<2>&, const WriteOptions&);
+template void write_mesh<3>(const std::filesystem::path&, const Mesh<3>&, const WriteOptions&);
+template std::vector<CellQuality> evaluate_cells<2>(const Mesh<2>&, Metric, const QualityOptions&);
+template std::vector<CellQuality> evaluate_cells<3>(const Mesh<3>&, Metric, const QualityOptions&);
+template QualityReport make_report<2>(const Mesh<2>&, Metric, const std::vector<CellQuality>&, const ReportOptions&);
+template QualityReport make_report<3>(const Mesh<3>&, Metric, const std::vector<CellQuality>&, const ReportOptions&);
+template QualityReport quality_report<2>(const Mesh<2>&, Metric, const ReportOptions&);
+template QualityReport quality_report<3>(const Mesh<3>&, Metric, const ReportOptions&);
+
+}  // namespace meshmotion
