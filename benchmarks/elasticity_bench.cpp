@@ -23,7 +23,7 @@
 //   elasticity_bench [--quick]   (--quick: the default SLE rows of part 1 and part 2 without
 //                                 neo-Hookean)
 
-#include "meshmotion/core/detail/json.hpp"
+#include "meshmotion/core/json.hpp"
 #include "meshmotion/core/topology.hpp"
 #include "meshmotion/curving/curve_mesh.hpp"
 #include "meshmotion/io/mesh_io.hpp"
@@ -60,7 +60,7 @@ void print(const Row& r, double baseline_seconds) {
               r.parameters.c_str(), r.min_quality, r.mean_quality, static_cast<long long>(r.invalid), r.seconds,
               r.cpu_seconds, baseline_seconds > 0.0 ? r.seconds / baseline_seconds : 0.0, static_cast<long long>(r.iterations),
               r.thesis.c_str(), r.note.c_str());
-  detail::JsonWriter w(std::cout);
+  JsonWriter w(std::cout);
   w.begin_object()
       .key("benchmark").value("elasticity")
       .key("part").value(r.part)
@@ -96,11 +96,13 @@ Row start_row(const std::string& part, const std::string& method, const std::str
   return r;
 }
 
-Row curve(const Mesh<2>& linear, const std::string& method, const MoverParameters& parameters, const std::string& label,
-          const std::string& thesis) {
+// `active_factor`: the active region of elasticity in support radii of the walls (0: whole mesh).
+Row curve(const Mesh<2>& linear, const std::string& method, const KeyValues& options, const std::string& label,
+          const std::string& thesis, double active_factor = 4.0) {
   CurveOptions<2> o;
   o.method = method;
-  o.parameters = parameters;
+  o.mover_options = mover_config<2>(method, options).options;
+  o.active_radius_factor = active_factor;
   Row r = start_row("tab4.2", method, label, thesis);
   o.progress = [&](const std::string& line) {
     // The regularize step's CPU time: from its progress line to the certification's.
@@ -121,7 +123,7 @@ Row curve(const Mesh<2>& linear, const std::string& method, const MoverParameter
 }
 
 Row flap(const Mesh<2>& mesh, const BoundarySpec<2>& spec, const GroupNodes& groups, const std::string& method,
-         const MoverParameters& parameters, int steps, const std::string& label, const std::string& thesis) {
+         const KeyValues& parameters, int steps, const std::string& label, const std::string& thesis) {
   Row r = start_row("fig4.1-5", method, label, thesis);
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = cpu_now();
@@ -167,19 +169,15 @@ int main(int argc, char** argv) {
     print(rbf, rbf.seconds);
     for (const auto& [chi, thesis] : {std::pair{"2.75", "19.3s 324 it min 0.632 avg 0.9949"},
                                       std::pair{"2.9", "24.4s 423 it min 0.632 avg 0.9945"}}) {
-      MoverParameters p;
-      // Active region: 4 × the pipeline's support radius (its wall-layer estimate).
-      p.values = {{"stiffening_exponent", chi}, {"youngs_modulus", "1e6"}, {"poisson_ratio", "0.4"},
-                  {"active_radius_factor", "4"}};
+      // Active region: 4 × the pipeline's support radius (its wall-layer estimate), the default.
+      const KeyValues p{{"stiffening_exponent", chi}, {"youngs_modulus", "1e6"}, {"poisson_ratio", "0.4"}};
       print(curve(mesh, "sle", p, std::string("chi=") + chi + " direct, region 4x layer", thesis), rbf.seconds);
       if (quick) continue;
-      MoverParameters whole = p;
-      whole.values["active_radius"] = "0";
-      print(curve(mesh, "sle", whole, std::string("chi=") + chi + " direct, whole mesh", thesis), rbf.seconds);
-      MoverParameters cg = p;
-      cg.values.insert({{"solver", "cg_jacobi"}, {"tolerance", "1e-6"}});
+      print(curve(mesh, "sle", p, std::string("chi=") + chi + " direct, whole mesh", thesis, 0.0), rbf.seconds);
+      KeyValues cg = p;
+      cg.insert(cg.end(), {{"solver", "cg_jacobi"}, {"tolerance", "1e-6"}});
       print(curve(mesh, "sle", cg, std::string("chi=") + chi + " cg_jacobi 1e-6, region", thesis), rbf.seconds);
-      cg.values["solver"] = "cg_incomplete_cholesky";
+      cg[3].second = "cg_incomplete_cholesky";
       print(curve(mesh, "sle", cg, std::string("chi=") + chi + " cg_ichol 1e-6, region", thesis), rbf.seconds);
     }
   }
@@ -201,15 +199,12 @@ int main(int argc, char** argv) {
   spec.moving("flap", Rotation2D{mesh.points.col(leading), radians(60.0)});
   spec.fixed("walls");
   spec.fixed("farfield");
-  MoverParameters rbf_parameters;
-  rbf_parameters.values = {{"support_radius", "0.45"}};
-  const Row rbf = flap(mesh, spec, groups, "rbf", rbf_parameters, 3, "r=0.45, 3 steps", "valid, good (figs 4.8-4.10)");
+  const Row rbf = flap(mesh, spec, groups, "rbf", {{"support_radius", "0.45"}}, 3, "r=0.45, 3 steps", "valid, good (figs 4.8-4.10)");
   print(rbf, rbf.seconds);
   print(flap(mesh, spec, groups, "torsion", {}, 1, "1 step", "invalid cells (fig 4.2)"), rbf.seconds);
   print(flap(mesh, spec, groups, "le", {}, 1, "nu=0.3, 1 step", "valid, degenerate at flap TE (4.3-4.5)"), rbf.seconds);
   if (!quick) {
-    MoverParameters nle;
-    nle.values = {{"load_steps", "3"}, {"newton_iterations", "8"}, {"newton_tolerance", "1e-6"}};
+    const KeyValues nle{{"load_steps", "3"}, {"newton_iterations", "8"}, {"newton_tolerance", "1e-6"}};
     print(flap(mesh, spec, groups, "nle", nle, 1, "3 load steps, <= 8 Newton each", "-"), rbf.seconds);
   }
   return 0;

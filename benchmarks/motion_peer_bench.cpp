@@ -164,7 +164,7 @@ void print_rows(const Case<Dim>& c, const std::string& table, const std::vector<
 
 /// Runs a registered mover of ours (setup + one move, timed) and judges the result.
 template <int Dim>
-Row our_mover(const Case<Dim>& c, const ResolvedBoundary<Dim>& b, const std::string& method, const MoverParameters& p,
+Row our_mover(const Case<Dim>& c, const ResolvedBoundary<Dim>& b, const std::string& method, const KeyValues& p,
               const std::string& label) {
   AnyMover<Dim> mover = make_mover<Dim>(method, p);
   Points<Dim> u;
@@ -437,9 +437,7 @@ void foam_judge(const Case<2>& c, const fs::path& dir, double foam_seconds, cons
                 moved_file.string().c_str());
     reference_name = "openfoam(missing)";
   }
-  MoverParameters rbf;
-  rbf.values["support_radius"] = std::to_string(c.rbf_radius);
-  rows.push_back(our_mover(c, b, "rbf", rbf, "ours_rbf_wendland2"));
+  rows.push_back(our_mover(c, b, "rbf", {{"support_radius", format_option_value(c.rbf_radius)}}, "ours_rbf_wendland2"));
   rows.push_back(our_mover(c, b, "le", {}, "ours_elasticity"));
   rows.push_back(our_mover(c, b, "sle", {}, "ours_stiff_elasticity"));
   rows.push_back(our_mover(c, b, "spring", {}, "ours_spring"));

@@ -6,7 +6,7 @@
 //
 //   quality_bench [--quick]     (--quick: ~100k elements)
 
-#include "meshmotion/core/detail/json.hpp"
+#include "meshmotion/core/json.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/quality/scaled_jacobian.hpp"
 
@@ -145,7 +145,7 @@ void run_cases(const char* mesh_name, const Mesh<Dim>& mesh) {
       std::printf("%-6s %9lld  %-19s %2d thr  %8.3f s  %10.3g el/s  ratio %5.2f  min %.4f  invalid %lld\n", mesh_name,
                   static_cast<long long>(r.size()), mode.name, threads, sec, per_s, sec / baseline, min,
                   static_cast<long long>(invalid));
-      detail::JsonWriter w(std::cout);
+      JsonWriter w(std::cout);
       w.begin_object().key("benchmark").value("quality").key("mesh").value(mesh_name).key("elements").value(r.size());
       w.key("mode").value(mode.name).key("threads").value(threads).key("seconds").value(sec);
       w.key("elements_per_second").value(per_s).key("ratio_to_sampled").value(sec / baseline);

@@ -6,6 +6,8 @@
 #include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/core/topology.hpp"
 
+#include "program.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -57,6 +59,7 @@ static_assert(meshmotion::MeshLike<solver::FlowMesh>);
 
 int main(int argc, char** argv) {
   CLI::App app{"Adapt a flow solver's own mesh arrays to meshmotion through MeshTraits"};
+  meshmotion::examples::add_version_flag(app);
   int nx = 40, ny = 10;
   double length = 4.0;
   bool json = false;
@@ -66,8 +69,8 @@ int main(int argc, char** argv) {
   app.add_flag("--json", json, "print one JSON object");
   CLI11_PARSE(app, argc, argv);
 
-  const solver::FlowMesh flow = solver::channel(nx, ny, length);
-  try {
+  return meshmotion::examples::guarded(json, [&] {
+    const solver::FlowMesh flow = solver::channel(nx, ny, length);
     // Library algorithms read the solver's arrays in place.
     const meshmotion::EdgeTopology edges = meshmotion::unique_edges(flow);
     const auto boundary = meshmotion::boundary_facets(flow);
@@ -90,14 +93,6 @@ int main(int argc, char** argv) {
                 << "largest node degree: " << max_degree << "\n"
                 << "copied into Mesh<2>: " << copy.num_cells() << " cells\n";
     }
-  } catch (const meshmotion::Error& e) {
-    if (json) {
-      std::string message;
-      for (char c : std::string(e.what())) message += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
-      std::cout << "{\"error\":\"" << message << "\"}\n";
-    }
-    std::cerr << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+    return meshmotion::examples::exit_ok;
+  });
 }

@@ -7,9 +7,11 @@
 // Writes OUTPUT (.msh/.su2), OUTPUT's .vtu beside it (per-cell certified scaled Jacobian),
 // and in 2D an SVG picture coloured by quality when --svg is given (always in the demo), with
 // a red ring on every invalid cell (too thin to see at a zoom that shows the body).
-// The input file is never modified.
+// The input file is never modified. Exit codes: 0 curved and valid, 1 error (nothing
+// written), 2 written with invalid cells (the last line says so) or refused by --strict.
 
-#include "meshmotion/core/detail/json.hpp"
+#include "meshmotion/core/json.hpp"
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/curving/curve_mesh.hpp"
 #include "meshmotion/curving/function_graph.hpp"
@@ -19,7 +21,8 @@
 #include "meshmotion/io/vtu_writer.hpp"
 #include "meshmotion/quality/svg_picture.hpp"
 
-#include "mechanics_arguments.hpp"
+#include "mover_arguments.hpp"
+#include "program.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -42,9 +45,8 @@ struct Arguments {
   std::string input;
   std::string output;
   bool demo = false;
-  std::string method = "rbf";
-  std::string kernel = "wendland2";
   double support_radius = 0.0;
+  std::optional<double> active_factor;
   bool single_radius = false;
   double support_factor = 0.0;  // unset: the library's default for the dimension
   double blending_length = 0.0;
@@ -57,10 +59,12 @@ struct Arguments {
   bool arc_length = false;
   bool strict = false;
   bool json = false;
+  bool overwrite = false;
+  bool keep_orientation = false;
   std::string svg;
   std::vector<double> zoom;
   bool svg_no_markers = false;
-  examples::MechanicsArguments mechanics;
+  examples::MoverArguments mover;
 };
 
 std::vector<double> numbers(const std::string& text, const std::string& spec) {
@@ -127,15 +131,21 @@ BoundaryGeometry<Dim> parse_geometry(const std::string& spec) {
 template <int Dim>
 CurveOptions<Dim> curve_options(const Arguments& args) {
   CurveOptions<Dim> options;
-  options.method = args.method;
-  options.kernel = rbf_kernel_from_name(args.kernel);
+  options.method = args.mover.method;
+  const KeyValues given = examples::given_options(args.mover);
+  if (options.method == "blend" || options.method == "none") {
+    if (!given.empty())
+      throw InputError("curve_mesh: method '" + options.method + "' takes no mover option (got '" + given.front().first + "')");
+  } else {
+    options.mover_options = mover_config<Dim>(options.method, given).options;
+  }
+  if (args.active_factor) options.active_radius_factor = *args.active_factor;
   options.support_radius = args.support_radius;
   options.per_wall_radius = !args.single_radius;
   if (args.support_factor > 0.0) options.support_radius_factor = args.support_factor;
   options.blending_length = args.blending_length;
   if (args.blending_factor > 0.0) options.blending_factor = args.blending_factor;
   options.steps = args.steps;
-  examples::add_mechanics_parameters(args.mechanics, options.parameters);
   options.sliding = args.sliding;
   options.strict = args.strict;
   options.snap.corner_angle = args.corner_angle;
@@ -161,7 +171,11 @@ std::filesystem::path with_extension(const std::filesystem::path& file, const ch
 }
 
 template <int Dim>
-void run(const Mesh<Dim>& linear, const Arguments& args) {
+void print_summary(const CurveResult<Dim>& result, const Arguments& args, const std::filesystem::path& vtu);
+
+template <int Dim>
+int run(Mesh<Dim> linear, const Arguments& args) {
+  if (!args.demo) examples::handle_orientation(linear, args.input, args.keep_orientation);
   const CurveOptions<Dim> options = curve_options<Dim>(args);
   const CurveResult<Dim> result = curve_mesh(linear, options);
   const auto values = [&] {
@@ -193,7 +207,7 @@ void run(const Mesh<Dim>& linear, const Arguments& args) {
   }
   const QualityReport& q = result.quality;
   if (args.json) {
-    detail::JsonWriter w(std::cout);
+    JsonWriter w(std::cout);
     w.begin_object();
     w.key("input").value(args.demo ? std::string("demo: boundary-layer O-mesh around a cylinder") : args.input);
     w.key("output").value(args.output).key("vtu").value(vtu.string());
@@ -220,14 +234,27 @@ void run(const Mesh<Dim>& linear, const Arguments& args) {
     write_json(w, q);
     w.end_object();
     std::cout << "\n";
-    return;
+  } else {
+    print_summary(result, args, vtu);
   }
+  if (q.num_invalid > 0) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "wrote %s WITH %lld INVALID CELLS of %lld\n", args.output.c_str(),
+                 static_cast<long long>(q.num_invalid), static_cast<long long>(q.num_elements));
+    return examples::exit_invalid;
+  }
+  return examples::exit_ok;
+}
+
+template <int Dim>
+void print_summary(const CurveResult<Dim>& result, const Arguments& args, const std::filesystem::path& vtu) {
+  const QualityReport& q = result.quality;
   std::printf("curved %lld cells, %lld nodes (%lld linear) with %s", static_cast<long long>(result.curved.num_cells()),
               static_cast<long long>(result.curved.num_nodes()), static_cast<long long>(result.num_linear_nodes),
               result.method.c_str());
   if (!result.wall_support_radii.empty())
     std::printf(", a support radius per wall%s", result.support_radius_limited ? " (limited to keep the system sparse)" : "");
-  else if (result.method == "rbf")
+  else if (result.support_radius > 0.0)
     std::printf(", support radius %.4g%s", result.support_radius,
                 result.support_radius_limited ? " (limited to keep the system sparse)" : "");
   std::printf(", %d step(s)\n", args.steps);
@@ -251,16 +278,9 @@ void run(const Mesh<Dim>& linear, const Arguments& args) {
   std::printf("  seconds: P2 %.3f, snap %.3f, layer %.3f, regularize %.3f, certify %.3f, total %.3f\n",
               result.seconds.quadratic, result.seconds.snap, result.seconds.layer, result.seconds.regularize,
               result.seconds.certify, result.seconds.total);
-  std::printf("wrote %s, %s%s%s\n", args.output.c_str(), vtu.string().c_str(), args.svg.empty() ? "" : ", ",
-              args.svg.c_str());
-}
-
-void print_error_json(const char* what, bool invalid) {
-  detail::JsonWriter w(std::cout);
-  w.begin_object().key("error").value(what);
-  if (invalid) w.key("invalid").value(true);
-  w.end_object();
-  std::cout << "\n";
+  if (q.num_invalid == 0)
+    std::printf("wrote %s, %s%s%s\n", args.output.c_str(), vtu.string().c_str(), args.svg.empty() ? "" : ", ",
+                args.svg.c_str());
 }
 
 }  // namespace
@@ -270,10 +290,13 @@ int main(int argc, char** argv) {
   Arguments args;
   app.add_option("input", args.input, "linear mesh (.msh, .su2); none: the built-in demo");
   app.add_option("-o,--output", args.output, "curved mesh to write (.msh, .su2); a .vtu is written beside it");
+  examples::add_version_flag(app);
   app.add_flag("--demo", args.demo, "curve the built-in boundary-layer mesh around a cylinder");
-  app.add_option("--method", args.method, "interior regularization: rbf, blend, none, or a mover (sle, le, nle, torsion, spring, ...)")->capture_default_str();
-  app.add_option("--kernel", args.kernel, "RBF kernel (wendland2, wendland0/4/6, tps, gaussian, ...)")->capture_default_str();
-  app.add_option("--support-radius", args.support_radius, "RBF support radius (0: from the boundary-layer thickness)");
+  examples::add_mover_options(app, args.mover, "interior regularization: blend, none, or ");
+  app.add_option("--support-radius", args.support_radius,
+                 "support radius of the movers with one (rbf; 0: from the boundary-layer thickness)");
+  app.add_option("--active-factor", args.active_factor,
+                 "le/sle: solve within this x the support radius of the curved walls (default 4; 0: whole mesh)");
   const auto positive = [](const std::string& value) {
     char* end = nullptr;
     const double x = std::strtod(value.c_str(), &end);
@@ -292,11 +315,13 @@ int main(int argc, char** argv) {
   app.add_option("--group", args.groups, "groups the --geometry applies to (default: wall)");
   app.add_option("--sliding", args.sliding, "groups sliding in their plane (symmetry)");
   app.add_option("--corner-angle", args.corner_angle, "spline corners above this angle (degrees)")->capture_default_str();
-  examples::add_mechanics_options(app, args.mechanics);
   app.add_flag("--arc-length", args.arc_length, "spline: arc-length midpoint instead of the parameter midpoint");
   app.add_flag("--single-radius", args.single_radius,
                "rbf default radius: the thickest wall layer's for every wall, not each wall's own");
-  app.add_flag("--strict", args.strict, "fail (exit 2) when invalid cells remain");
+  app.add_flag("--strict", args.strict, "write nothing when invalid cells remain (exit 2)");
+  app.add_flag("--overwrite", args.overwrite, "allow the output to be the input file");
+  app.add_flag("--keep-orientation", args.keep_orientation,
+               "refuse a mesh whose cells are all negatively oriented instead of reorienting it");
   app.add_flag("--json", args.json, "print one JSON object");
   app.add_option("--svg", args.svg, "2D: write an SVG picture coloured by quality");
   app.add_option("--zoom", args.zoom, "SVG zoom box x0,x1,y0,y1 (only cells reaching into it are written)")
@@ -308,7 +333,9 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   args.demo = args.demo || args.input.empty();
-  try {
+  return examples::guarded(args.json, [&] {
+    if (args.mover.method != "blend" && args.mover.method != "none" && examples::list_options<2>(args.mover))
+      return examples::exit_ok;
     if (args.demo) {
       if (args.output.empty()) args.output = "cylinder_p2.msh";
       if (args.svg.empty()) args.svg = with_extension(args.output, ".svg").string();
@@ -317,22 +344,14 @@ int main(int argc, char** argv) {
         args.groups = {"wall"};
         args.geometry = {"circle:0,0,0.5"};
       }
-      const Mesh<2> linear = o_mesh({});  // 128 x 64 quads, first cell 1e-5 for a 0.025 wall spacing
-      run(linear, args);
-      return 0;
+      examples::check_output({}, args.output, 2, args.overwrite);
+      return run(o_mesh({}), args);  // 128 x 64 quads, first cell 1e-5 for a 0.025 wall spacing
     }
     if (args.output.empty()) throw InputError("curve_mesh: no output file (expected -o OUTPUT)");
-    if (std::filesystem::exists(args.output) && std::filesystem::equivalent(args.input, args.output))
-      throw InputError("curve_mesh: output is the input file (the input is never modified)");
-    std::visit([&](const auto& mesh) { run(mesh, args); }, read_mesh(args.input));
-  } catch (const InvalidMeshError& e) {
-    if (args.json) print_error_json(e.what(), true);
-    std::cerr << e.what() << "\n";
-    return 2;
-  } catch (const Error& e) {
-    if (args.json) print_error_json(e.what(), false);
-    std::cerr << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+    // The curved mesh is quadratic, and a .vtu goes beside it: both are checked before any work.
+    examples::check_output(args.input, args.output, 2, args.overwrite);
+    examples::check_output(args.input, with_extension(args.output, ".vtu"), 2, args.overwrite);
+    AnyMesh mesh = read_mesh(args.input);
+    return std::visit([&](auto& m) { return run(std::move(m), args); }, mesh);
+  });
 }

@@ -4,9 +4,11 @@
 //
 //   mesh_quality wing.msh --metric shape --metric jacobian --svg q.svg --zoom 0.9,1.1,-0.05,0.05
 
-#include "meshmotion/core/detail/json.hpp"
+#include "meshmotion/core/json.hpp"
 #include "meshmotion/io.hpp"
 #include "meshmotion/quality.hpp"
+
+#include "program.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -26,11 +28,13 @@ struct Settings {
   std::string vtu, svg;
   std::vector<double> zoom;
   bool svg_no_markers = false;
+  bool keep_orientation = false;
   int worst = 5;
 };
 
 template <int Dim>
-int run(const Mesh<Dim>& mesh, const Settings& s) {
+int run(Mesh<Dim>& mesh, const Settings& s) {
+  examples::handle_orientation(mesh, s.file, s.keep_orientation);
   std::vector<Metric> metrics;
   for (const auto& m : s.metrics) metrics.push_back(metric_from_name(m));
   if (metrics.empty()) metrics = {Metric::shape, Metric::skew, Metric::relative_size, Metric::scaled_jacobian};
@@ -64,7 +68,7 @@ int run(const Mesh<Dim>& mesh, const Settings& s) {
     }
   }
   if (s.json) {
-    detail::JsonWriter w(std::cout);
+    JsonWriter w(std::cout);
     w.begin_object().key("file").value(s.file).key("dim").value(Dim);
     w.key("nodes").value(mesh.num_nodes()).key("elements").value(mesh.num_cells());
     w.key("metrics").begin_object();
@@ -85,6 +89,7 @@ int run(const Mesh<Dim>& mesh, const Settings& s) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Mesh quality report: Knupp size/shape/skew metrics and the certified scaled Jacobian of P1/P2 cells"};
+  examples::add_version_flag(app);
   Settings s;
   app.add_option("file", s.file, "mesh file (.msh, .su2)")->required()->check(CLI::ExistingFile);
   app.add_option("--metric", s.metrics, "shape, skew, size, size-shape, size-skew or jacobian (repeatable; default shape, skew, size, jacobian)");
@@ -96,12 +101,12 @@ int main(int argc, char** argv) {
   app.add_flag("--svg-no-markers", s.svg_no_markers, "SVG: no rings on invalid cells");
   app.add_option("--zoom", s.zoom, "picture box xmin,xmax,ymin,ymax")->delimiter(',');
   app.add_option("--worst", s.worst, "how many worst cells to list per metric");
+  app.add_flag("--keep-orientation", s.keep_orientation,
+               "refuse a mesh whose cells are all negatively oriented instead of reorienting it");
   CLI11_PARSE(app, argc, argv);
-  try {
-    const AnyMesh mesh = read_mesh(s.file);
-    return std::visit([&](const auto& m) { return run(m, s); }, mesh);
-  } catch (const Error& e) {
-    std::cerr << e.what() << '\n';
-    return 1;
-  }
+  return examples::guarded(s.json, [&] {
+    if (!s.vtu.empty()) examples::check_output(s.file, s.vtu, 2, false);
+    AnyMesh mesh = read_mesh(s.file);
+    return std::visit([&](auto& m) { return run(m, s); }, mesh);
+  });
 }

@@ -5,8 +5,9 @@
 # mesh_info, mesh_quality and move_mesh on its output.
 #
 # This file is also the checker the tests run, in CMake script mode:
-#   cmake -DKEYS=a,b/c [-DEXPECT_RC=n] -P smoke_tests.cmake -- <program> <arguments...>
-# KEYS are JSON paths ("/" between nested keys) that must exist in the program's stdout.
+#   cmake -DKEYS=a,b/c [-DVALUES=a/b=text,...] [-DEXPECT_RC=n] -P smoke_tests.cmake -- <program> <arguments...>
+# KEYS are JSON paths ("/" between nested keys) that must exist in the program's stdout;
+# VALUES are paths whose value must read exactly as the text given.
 
 if(CMAKE_SCRIPT_MODE_FILE)
   set(command "")
@@ -40,6 +41,18 @@ if(CMAKE_SCRIPT_MODE_FILE)
     endif()
     message(STATUS "${key} = ${value}")
   endforeach()
+  string(REPLACE "," ";" values "${VALUES}")
+  foreach(pair ${values})
+    string(FIND "${pair}" "=" eq)
+    string(SUBSTRING "${pair}" 0 ${eq} key)
+    math(EXPR after "${eq} + 1")
+    string(SUBSTRING "${pair}" ${after} -1 expected)
+    string(REPLACE "/" ";" path "${key}")
+    string(JSON value ERROR_VARIABLE problem GET "${out}" ${path})
+    if(problem OR NOT value STREQUAL expected)
+      message(FATAL_ERROR "${shown}\nJSON key '${key}' is '${value}' (expected '${expected}')\nstdout:\n${out}")
+    endif()
+  endforeach()
   return()
 endif()
 
@@ -51,16 +64,17 @@ set(smoke_dir "${CMAKE_CURRENT_BINARY_DIR}/smoke")
 file(MAKE_DIRECTORY "${smoke_dir}")
 set(smoke_checker "${CMAKE_CURRENT_LIST_FILE}")
 
-# smoke_test(NAME name KEYS a,b/c [EXPECT_RC n] [SETUP fixture] [REQUIRES fixtures...]
-#            COMMAND program args...)
+# smoke_test(NAME name KEYS a,b/c [VALUES a/b=text,...] [EXPECT_RC n] [SETUP fixture]
+#            [REQUIRES fixtures...] COMMAND program args...)
 function(smoke_test)
-  cmake_parse_arguments(PARSE_ARGV 0 arg "" "NAME;KEYS;EXPECT_RC;SETUP" "REQUIRES;COMMAND")
+  cmake_parse_arguments(PARSE_ARGV 0 arg "" "NAME;KEYS;VALUES;EXPECT_RC;SETUP" "REQUIRES;COMMAND")
   if(NOT DEFINED arg_EXPECT_RC)
     set(arg_EXPECT_RC 0)
   endif()
   list(POP_FRONT arg_COMMAND program)
   add_test(NAME examples.${arg_NAME}
-           COMMAND "${CMAKE_COMMAND}" -DKEYS=${arg_KEYS} -DEXPECT_RC=${arg_EXPECT_RC} -P "${smoke_checker}"
+           COMMAND "${CMAKE_COMMAND}" -DKEYS=${arg_KEYS} "-DVALUES=${arg_VALUES}" -DEXPECT_RC=${arg_EXPECT_RC}
+                   -P "${smoke_checker}"
                    -- $<TARGET_FILE:${program}> ${arg_COMMAND}
            WORKING_DIRECTORY "${smoke_dir}")
   set_tests_properties(examples.${arg_NAME} PROPERTIES LABELS examples)
@@ -72,11 +86,14 @@ function(smoke_test)
   endif()
 endfunction()
 
-# --help of every program (new examples are covered as they are added).
+# --help and --version of every program (new examples are covered as they are added).
 foreach(source ${example_sources})
   get_filename_component(program ${source} NAME_WE)
   add_test(NAME examples.${program}.help COMMAND ${program} --help)
   set_tests_properties(examples.${program}.help PROPERTIES LABELS examples PASS_REGULAR_EXPRESSION "Usage:")
+  add_test(NAME examples.${program}.version COMMAND ${program} --version)
+  set_tests_properties(examples.${program}.version PROPERTIES LABELS examples
+                       PASS_REGULAR_EXPRESSION "meshmotion ${PROJECT_VERSION}")
 endforeach()
 
 # The tutorials, on small meshes and few steps.
@@ -130,7 +147,7 @@ smoke_test(NAME curve_mesh.bad_blending_factor EXPECT_RC 105
            COMMAND curve_mesh --demo -o "${smoke_dir}/demo_bad_blend.msh" --method blend --blending-factor 0)
 
 # SVG pictures: invalid cells ringed (the default) or not; snapping alone leaves invalid cells.
-smoke_test(NAME curve_mesh.svg_no_markers.json
+smoke_test(NAME curve_mesh.svg_no_markers.json EXPECT_RC 2
            KEYS output,min_scaled_jacobian,invalid
            COMMAND curve_mesh --demo -o "${smoke_dir}/demo_none.msh" --method none --svg "${smoke_dir}/demo_none.svg"
                    --zoom -0.8,0.8,-0.8,0.8 --svg-no-markers --json)
@@ -143,3 +160,64 @@ smoke_test(NAME mesh_quality.svg_no_markers.json REQUIRES examples_demo_mesh
 smoke_test(NAME mesh_info.missing_file.json EXPECT_RC 1
            KEYS error
            COMMAND mesh_info "${smoke_dir}/no_such_mesh.msh" --json)
+
+# No silent wrong answer (issue 17). Small inputs written here: a unit square of two
+# triangles listed clockwise in SU2 (every cell negative), and displacement files by node.
+file(WRITE "${smoke_dir}/clockwise.su2" "NDIME= 2\nNELEM= 2\n5 0 2 1 0\n5 0 3 2 1\nNPOIN= 4\n0 0 0\n1 0 1\n1 1 2\n0 1 3\n"
+     "NMARK= 2\nMARKER_TAG= bottom\nMARKER_ELEMS= 1\n3 0 1\nMARKER_TAG= rest\nMARKER_ELEMS= 3\n3 1 2\n3 2 3\n3 3 0\n")
+# The demo's wall: every node of group 'wall' is listed by mesh_info; a file naming a node
+# outside the group must be refused, naming it.
+file(WRITE "${smoke_dir}/outside_node.txt" "# node dx dy\n1 0.0 0.0\n")
+file(WRITE "${smoke_dir}/bad_line.txt" "0.001 0.002\n")
+
+# A consistently reversed mesh is reoriented (and said so), so no cell counts as invalid;
+# --keep-orientation refuses it instead.
+smoke_test(NAME mesh_quality.reversed.json
+           KEYS metrics/scaled_jacobian/min VALUES metrics/scaled_jacobian/invalid=0
+           COMMAND mesh_quality "${smoke_dir}/clockwise.su2" --metric jacobian --json)
+smoke_test(NAME mesh_quality.keep_orientation.json EXPECT_RC 1 KEYS error VALUES kind=input
+           COMMAND mesh_quality "${smoke_dir}/clockwise.su2" --keep-orientation --json)
+smoke_test(NAME mesh_info.reversed.json KEYS mesh/negative_cells VALUES mesh/orientation=reversed
+           COMMAND mesh_info "${smoke_dir}/clockwise.su2" --json)
+smoke_test(NAME move_mesh.reversed.json VALUES after/invalid=0,before/invalid=0
+           KEYS output
+           COMMAND move_mesh "${smoke_dir}/clockwise.su2" -o "${smoke_dir}/clockwise_moved.su2" --group bottom
+                   --translate 0.01,0 --fixed rest --json)
+
+# Options are typed end to end: a misspelled key is refused naming the known ones, a number
+# keeps every digit, and a method refuses keys it does not take.
+smoke_test(NAME move_mesh.misspelled_option.json REQUIRES examples_demo_mesh EXPECT_RC 1 KEYS error VALUES kind=input
+           COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_typo.msh" --group wall --rotate 1
+                   --fixed farfield --option suport_radius=0.5 --json)
+smoke_test(NAME move_mesh.exact_radius.json REQUIRES examples_demo_mesh
+           KEYS output VALUES options/support_radius=4.9e-06,options/tolerance=1e-07
+           COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_exact.msh" --group wall --rotate 0.001
+                   --fixed farfield --support-radius 4.9e-6 --option tolerance=1e-7 --json)
+smoke_test(NAME move_mesh.option_of_another_method.json REQUIRES examples_demo_mesh EXPECT_RC 1 KEYS error
+           COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_other.msh" --group wall --rotate 1
+                   --fixed farfield --poisson-ratio 0.3 --json)
+smoke_test(NAME move_mesh.malformed_number.json REQUIRES examples_demo_mesh EXPECT_RC 1 KEYS error
+           COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_nan.msh" --group wall --rotate 1
+                   --fixed farfield --option support_radius=0.5x --json)
+
+# Displacements by node: lines without a node id and nodes outside the group are refused.
+smoke_test(NAME move_mesh.displacements_without_node.json REQUIRES examples_demo_mesh EXPECT_RC 1 KEYS error
+           VALUES kind=parse
+           COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_bad.msh" --group wall
+                   --displacements "${smoke_dir}/bad_line.txt" --fixed farfield --json)
+smoke_test(NAME move_mesh.displacements_outside_group.json REQUIRES examples_demo_mesh EXPECT_RC 1 KEYS error
+           COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_outside.msh" --group farfield
+                   --displacements "${smoke_dir}/outside_node.txt" --fixed wall --json)
+
+# Outputs are checked before any work, and an input is never overwritten unasked.
+smoke_test(NAME curve_mesh.su2_output.json EXPECT_RC 1 KEYS error
+           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_curved.su2" --json)
+smoke_test(NAME move_mesh.unknown_output.json REQUIRES examples_demo_mesh EXPECT_RC 1 KEYS error
+           COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved.cgnx" --group wall --rotate 1 --json)
+smoke_test(NAME move_mesh.output_is_input.json EXPECT_RC 1 KEYS error
+           COMMAND move_mesh "${smoke_dir}/clockwise.su2" -o "${smoke_dir}/clockwise.su2" --group bottom
+                   --translate 0.01,0 --fixed rest --json)
+smoke_test(NAME move_mesh.json_file_name_with_quote.json
+           KEYS output VALUES output=${smoke_dir}/moved\"quote.su2
+           COMMAND move_mesh "${smoke_dir}/clockwise.su2" -o "${smoke_dir}/moved\"quote.su2" --group bottom
+                   --translate 0.01,0 --fixed rest --json)

@@ -18,13 +18,15 @@
 //   tutorial_1_time_loop --steps 400 --amplitude 20 --print-every 20
 //   tutorial_1_time_loop --json
 
-#include "meshmotion/core/detail/json.hpp"
+#include "meshmotion/core/json.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/rbf.hpp"
 #include "meshmotion/quality/knupp.hpp"
 #include "meshmotion/quality/quality_report.hpp"
+
+#include "program.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -233,7 +235,7 @@ int run(const Settings& s) {
   const QualityReport jacobian_report = quality_report(final_mesh, Metric::scaled_jacobian);
   const double per_move = moves > 0 ? move_seconds / static_cast<double>(moves) : 0.0;
   if (s.json) {
-    detail::JsonWriter w(std::cout);
+    JsonWriter w(std::cout);
     w.begin_object();
     w.key("nodes").value(n).key("cells").value(static_cast<Index>(grid.num_quads())).key("boundary_nodes").value(m);
     w.key("steps").value(s.steps).key("amplitude_degrees").value(s.amplitude).key("support_radius").value(s.support_radius);
@@ -262,6 +264,7 @@ int run(const Settings& s) {
 int main(int argc, char** argv) {
   CLI::App app{"Tutorial 1: a pitching airfoil-like body in a solver's time loop (setup once, move_into each step, "
                "re-setup when the quality drops)"};
+  meshmotion::examples::add_version_flag(app);
   Settings s;
   app.add_option("--steps", s.steps, "time steps")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--period-steps", s.period_steps, "time steps per pitch period")->check(CLI::PositiveNumber)->capture_default_str();
@@ -275,10 +278,5 @@ int main(int argc, char** argv) {
   app.add_option("--print-every", s.print_every, "print a table line every N steps")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_flag("--json", s.json, "print one JSON object instead of the table");
   CLI11_PARSE(app, argc, argv);
-  try {
-    return run(s);
-  } catch (const Error& e) {
-    std::cerr << e.what() << "\n";
-    return 1;
-  }
+  return meshmotion::examples::guarded(s.json, [&] { return run(s); });
 }

@@ -21,10 +21,12 @@
 //   tutorial_2_optimization_loop --iterations 8
 //   tutorial_2_optimization_loop --json
 
-#include "meshmotion/core/detail/json.hpp"
+#include "meshmotion/core/json.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/rbf.hpp"
+
+#include "program.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -228,7 +230,7 @@ int run(const Settings& s) {
   const bool passed = worst <= s.tolerance;
   const bool decreased = history.back().objective < history.front().objective;
   if (s.json) {
-    detail::JsonWriter w(std::cout);
+    JsonWriter w(std::cout);
     w.begin_object();
     w.key("nodes").value(design.mesh().num_nodes()).key("cells").value(design.mesh().num_cells());
     w.key("start").begin_array().value(s.start[0]).value(s.start[1]).end_array();
@@ -263,6 +265,7 @@ int run(const Settings& s) {
 int main(int argc, char** argv) {
   CLI::App app{"Tutorial 2: shape optimization of an ellipse's semi-axes with the RBF reverse derivative, "
                "checked against finite differences"};
+  meshmotion::examples::add_version_flag(app);
   Settings s;
   std::vector<double> start{s.start[0], s.start[1]}, target{s.target[0], s.target[1]};
   app.add_option("--start", start, "initial semi-axes A,B")->delimiter(',')->expected(2)->capture_default_str();
@@ -275,7 +278,7 @@ int main(int argc, char** argv) {
   app.add_option("--tolerance", s.tolerance, "largest accepted relative difference reverse vs FD")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_flag("--json", s.json, "print one JSON object instead of the tables");
   CLI11_PARSE(app, argc, argv);
-  try {
+  return meshmotion::examples::guarded(s.json, [&] {
     s.start = {start[0], start[1]};
     s.target = {target[0], target[1]};
     if (!(s.start[0] > 0 && s.start[1] > 0 && s.target[0] > 0 && s.target[1] > 0))
@@ -283,8 +286,5 @@ int main(int argc, char** argv) {
                        "," + std::to_string(s.start[1]) + ", target " + std::to_string(s.target[0]) + "," +
                        std::to_string(s.target[1]) + ")");
     return run(s);
-  } catch (const Error& e) {
-    std::cerr << e.what() << "\n";
-    return 1;
-  }
+  });
 }

@@ -1,0 +1,100 @@
+#pragma once
+// What every example program shares: --version, the checks made before any work (output
+// format and folder, input never overwritten unasked), the orientation handling, and one way
+// of reporting errors (a message on stderr, and with --json the same {"error": ...} object on
+// stdout) with one set of exit codes.
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/json.hpp"
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/orientation.hpp"
+#include "meshmotion/io/mesh_io.hpp"
+#include "meshmotion/version.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <new>
+#include <string>
+#include <string_view>
+
+namespace meshmotion::examples {
+
+// Exit codes of every program.
+inline constexpr int exit_ok = 0;
+inline constexpr int exit_error = 1;    // bad input, unreadable file, solver failure: nothing written
+inline constexpr int exit_invalid = 2;  // invalid cells: written with them (the last line says so), or refused by --strict
+
+inline void add_version_flag(CLI::App& app) { app.set_version_flag("--version", "meshmotion " MESHMOTION_VERSION_STRING); }
+
+/// The error object every program prints on stdout under --json.
+inline void print_error_json(std::string_view message, std::string_view kind, int exit_code) {
+  JsonWriter w(std::cout);
+  w.begin_object().key("error").value(message).key("kind").value(kind).key("exit_code").value(exit_code).end_object();
+  std::cout << "\n";
+}
+
+/// Runs body() (which returns the exit code) and turns what it throws into a message on
+/// stderr (and the error object on stdout under --json) and an exit code.
+template <class Body>
+int guarded(bool json, Body&& body) {
+  const auto fail = [&](const char* what, std::string_view kind, int code) {
+    if (json) print_error_json(what, kind, code);
+    std::cerr << what << "\n";
+    return code;
+  };
+  try {
+    return body();
+  } catch (const InvalidMeshError& e) {
+    return fail(e.what(), "invalid_mesh", exit_invalid);
+  } catch (const ParseError& e) {
+    return fail(e.what(), "parse", exit_error);
+  } catch (const InputError& e) {
+    return fail(e.what(), "input", exit_error);
+  } catch (const IoError& e) {
+    return fail(e.what(), "io", exit_error);
+  } catch (const SolverError& e) {
+    return fail(e.what(), "solver", exit_error);
+  } catch (const Error& e) {
+    return fail(e.what(), "error", exit_error);
+  } catch (const std::bad_alloc&) {
+    return fail("out of memory", "memory", exit_error);
+  }
+}
+
+/// Refuses, before any work, an output the program could not write (unknown format, a format
+/// without elements of `order`, a missing folder) and an output that is the input unless
+/// `overwrite`.
+inline void check_output(const std::filesystem::path& input, const std::filesystem::path& output, int order,
+                         bool overwrite) {
+  check_mesh_output(output, order);
+  std::error_code ec;
+  if (!overwrite && !input.empty() && std::filesystem::exists(output, ec) && std::filesystem::equivalent(input, output, ec))
+    throw InputError("output " + output.string() + " is the input file (give --overwrite to replace it)");
+}
+
+/// A consistently reversed mesh (every cell negative: the file's convention) is mirrored and
+/// the program says so on stderr; with `keep` it is refused instead. A mixed one is reported
+/// as such: its negative cells count as invalid.
+template <int Dim>
+void handle_orientation(Mesh<Dim>& mesh, const std::filesystem::path& file, bool keep) {
+  if (keep) {
+    const OrientationReport r = orientation_report(mesh);
+    if (r.num_negative > 0 && r.num_negative + r.num_degenerate == r.num_cells)
+      throw InputError(file.string() + ": every cell is negatively oriented (the file's convention is reversed; "
+                       "without --keep-orientation the program reorients them)");
+  } else {
+    const OrientationFix fix = orient_consistently(mesh);
+    if (fix.found == OrientationFix::Found::reversed)
+      std::cerr << "note: " << file.string() << " lists every cell negatively oriented (reversed convention): reoriented "
+                << fix.reoriented << " of " << fix.num_cells << " cells\n";
+  }
+  const OrientationReport r = orientation_report(mesh);
+  if (r.num_negative > 0 && r.num_negative + r.num_degenerate < r.num_cells)
+    std::cerr << "warning: " << file.string() << " has mixed orientation: " << r.num_negative << " of " << r.num_cells
+              << " cells are negative (inverted, or listed in the opposite order); they count as invalid\n";
+}
+
+}  // namespace meshmotion::examples
