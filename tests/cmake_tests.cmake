@@ -45,3 +45,21 @@ set_tests_properties("cmake: consumer through find_package" PROPERTIES
 set_tests_properties("cmake: consumer through add_subdirectory" PROPERTIES
   LABELS cmake PASS_REGULAR_EXPRESSION "consumer: 20 nodes")
 set_tests_properties("cmake: every public header compiles alone" PROPERTIES LABELS cmake)
+
+# The exact predicates and certified bounds need IEEE arithmetic: -ffast-math is an #error.
+set(_fast_math_includes -I "${PROJECT_SOURCE_DIR}/include")
+foreach(dir ${_meshmotion_system_dirs})
+  # The compiler's own folders must not be re-added (libstdc++'s #include_next breaks).
+  if(NOT dir MATCHES "^/usr(/local)?/include/?$")
+    list(APPEND _fast_math_includes -isystem "${dir}")
+  endif()
+endforeach()
+add_test(NAME "cmake: -ffast-math is refused"
+  COMMAND ${CMAKE_CXX_COMPILER} -std=c++20 -ffast-math -fsyntax-only ${_fast_math_includes}
+          "${CMAKE_CURRENT_SOURCE_DIR}/consumer/fast_math.cpp")
+set_tests_properties("cmake: -ffast-math is refused" PROPERTIES LABELS cmake
+                     PASS_REGULAR_EXPRESSION "cannot be compiled with -ffast-math")
+add_test(NAME "cmake: the same header compiles without -ffast-math"
+  COMMAND ${CMAKE_CXX_COMPILER} -std=c++20 -fsyntax-only ${_fast_math_includes}
+          "${CMAKE_CURRENT_SOURCE_DIR}/consumer/fast_math.cpp")
+set_tests_properties("cmake: the same header compiles without -ffast-math" PROPERTIES LABELS cmake)

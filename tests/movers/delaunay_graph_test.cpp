@@ -10,6 +10,8 @@
 #include "meshmotion/movers/improved_dgm.hpp"
 #include "meshmotion/quality/quality_report.hpp"
 
+#include "messages.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <limits>
@@ -78,16 +80,6 @@ struct Affine {
   }
 };
 
-/// The message of the E that f throws ("(no exception)" when none; other types propagate).
-template <class E, class F>
-std::string message_of(F&& f) {
-  try {
-    f();
-  } catch (const E& e) {
-    return e.what();
-  }
-  return "(no exception)";
-}
 
 }  // namespace
 
@@ -217,7 +209,7 @@ TEST_CASE("DGM refuses an inverted graph; run_steps rebuilds it each step", "[mo
   const auto b = spec.resolve(mesh);
   DgmMover<2> mover;
   mover.setup(mesh, b);
-  CHECK_THAT(message_of<InvalidMeshError>([&] { (void)mover.move(b.displacements); }), Catch::Matchers::Contains("inverts") && Catch::Matchers::Contains("more steps") &&
+  CHECK_THAT(test::message_of<InvalidMeshError>([&] { (void)mover.move(b.displacements); }), Catch::Matchers::Contains("inverts") && Catch::Matchers::Contains("more steps") &&
                            Catch::Matchers::Contains("mesh nodes"));
   DgmOptions unchecked;
   unchecked.check_inversion = false;
@@ -288,15 +280,15 @@ TEST_CASE("Delaunay-graph movers in the registry", "[movers]") {
   BoundarySpec<2> spec;
   spec.moving("wall", Rotation2D{Vec<2>(0.1, 0.0), radians(30.0)}).fixed("farfield");
   for (const char* method : {"dgm", "dgrbf", "dgrbf2", "idgm"}) {
-    MoverParameters p;
-    p.values["center"] = "0.1,0";
-    AnyMover<2> mover = make_mover<2>(method, p);
+    AnyMover<2> mover = make_mover<2>(method, std::string(method) == "dgrbf2" ? KeyValues{{"center", "0.1,0"}} : KeyValues{});
     const StepResult<2> r = run_steps(mover, mesh, spec, StepOptions{3, Metric::skew});
     CHECK(r.steps.back().quality->num_invalid == 0);
   }
-  MoverParameters bad;
-  bad.values["center"] = "0.1;0";
-  CHECK_THAT(message_of<InputError>([&] { (void)make_mover<2>("dgrbf2", bad); }), Catch::Matchers::Contains("center"));
+  CHECK_THAT(test::message_of<InputError>([&] { (void)make_mover<2>("dgrbf2", KeyValues{{"center", "0.1;0"}}); }),
+             Catch::Matchers::Contains("center"));
+  // A key another method takes is refused by this one, naming it.
+  CHECK_THAT(test::message_of<InputError>([&] { (void)make_mover<2>("dgm", KeyValues{{"center", "0.1,0"}}); }),
+             Catch::Matchers::Contains("'center'"));
 }
 
 TEST_CASE("Delaunay-graph movers: bad input", "[movers]") {
@@ -305,44 +297,44 @@ TEST_CASE("Delaunay-graph movers: bad input", "[movers]") {
   spec.moving("top", Translation<2>{Vec<2>(0.1, 0.0)}).fixed("bottom");
   const auto b = spec.resolve(mesh);
   DgmMover<2> mover;
-  CHECK_THAT(message_of<InputError>([&] { (void)mover.move(b.displacements); }), Catch::Matchers::Contains("setup() was not called"));
+  CHECK_THAT(test::message_of<InputError>([&] { (void)mover.move(b.displacements); }), Catch::Matchers::Contains("setup() was not called"));
 
   ResolvedBoundary<2> collinear;
   collinear.nodes = mesh.group_nodes("bottom");
   collinear.kinds.assign(collinear.nodes.size(), BoundaryKind::fixed);
   collinear.displacements.setZero(2, static_cast<Index>(collinear.nodes.size()));
   collinear.normals = collinear.displacements;
-  CHECK_THAT(message_of<InputError>([&] { (void)mover.setup(mesh, collinear); }), Catch::Matchers::Contains("Delaunay graph"));
+  CHECK_THAT(test::message_of<InputError>([&] { (void)mover.setup(mesh, collinear); }), Catch::Matchers::Contains("Delaunay graph"));
 
   ResolvedBoundary<2> two = collinear;
   two.nodes.resize(2);
   two.kinds.resize(2);
   two.displacements.resize(2, 2);
   two.normals.setZero(2, 2);
-  CHECK_THAT(message_of<InputError>([&] { (void)mover.setup(mesh, two); }), Catch::Matchers::Contains("at least 3"));
+  CHECK_THAT(test::message_of<InputError>([&] { (void)mover.setup(mesh, two); }), Catch::Matchers::Contains("at least 3"));
 
   ResolvedBoundary<2> unsorted = b;
   std::swap(unsorted.nodes[0], unsorted.nodes[1]);
-  CHECK_THAT(message_of<InputError>([&] { (void)mover.setup(mesh, unsorted); }), Catch::Matchers::Contains("sorted"));
+  CHECK_THAT(test::message_of<InputError>([&] { (void)mover.setup(mesh, unsorted); }), Catch::Matchers::Contains("sorted"));
   ResolvedBoundary<2> outside = b;
   outside.nodes.back() = mesh.num_nodes();
-  CHECK_THAT(message_of<InputError>([&] { (void)mover.setup(mesh, outside); }), Catch::Matchers::Contains("out of range"));
+  CHECK_THAT(test::message_of<InputError>([&] { (void)mover.setup(mesh, outside); }), Catch::Matchers::Contains("out of range"));
 
   mover.setup(mesh, b);
-  CHECK_THAT(message_of<InputError>([&] { (void)mover.move(Points<2>::Zero(2, b.size() - 1)); }), Catch::Matchers::Contains("expected"));
+  CHECK_THAT(test::message_of<InputError>([&] { (void)mover.move(Points<2>::Zero(2, b.size() - 1)); }), Catch::Matchers::Contains("expected"));
   Points<2> nan = b.displacements;
   nan(0, 0) = std::numeric_limits<double>::quiet_NaN();
-  CHECK_THAT(message_of<InputError>([&] { (void)mover.move(nan); }), Catch::Matchers::Contains("not finite"));
+  CHECK_THAT(test::message_of<InputError>([&] { (void)mover.move(nan); }), Catch::Matchers::Contains("not finite"));
 
   DgrbfOptions negative;
   negative.rbf.relative_support = -1.0;
   DgrbfMover<2> dgrbf(negative);
-  CHECK_THAT(message_of<InputError>([&] { (void)dgrbf.setup(mesh, b); }), Catch::Matchers::Contains("support"));
+  CHECK_THAT(test::message_of<InputError>([&] { (void)dgrbf.setup(mesh, b); }), Catch::Matchers::Contains("support"));
   Dgrbf2Options<3> zero_axis;
   zero_axis.axis.setZero();
-  CHECK_THAT(message_of<InputError>([&] { (void)Dgrbf2Mover<3>(zero_axis); }), Catch::Matchers::Contains("axis"));
+  CHECK_THAT(test::message_of<InputError>([&] { (void)Dgrbf2Mover<3>(zero_axis); }), Catch::Matchers::Contains("axis"));
   ImprovedDgmOptions no_hops;
   no_hops.layer_offset = 0.0;
   ImprovedDgmMover<2> idgm(no_hops);
-  CHECK_THAT(message_of<InputError>([&] { (void)idgm.setup(mesh, b); }), Catch::Matchers::Contains("layer_offset"));
+  CHECK_THAT(test::message_of<InputError>([&] { (void)idgm.setup(mesh, b); }), Catch::Matchers::Contains("layer_offset"));
 }

@@ -444,7 +444,7 @@ TEST_CASE("step driver: a rotated ellipse O-mesh, wall rotated rigidly, quality 
   BoundarySpec<2> spec;
   spec.moving("wall", Rotation2D{Vec<2>::Zero(), radians(60.0)}).fixed("farfield");
   for (const int steps : {1, 3}) {
-    auto mover = make_mover<2>("rbf", MoverParameters{{{"support_radius", "3.0"}}});
+    auto mover = make_mover<2>("rbf", KeyValues{{"support_radius", "3.0"}});
     const StepResult<2> r = run_steps(mover, mesh, spec, StepOptions{steps, Metric::skew});
     REQUIRE(r.steps.size() == std::size_t(steps));
     for (const Index v : mesh.group_nodes("wall")) {

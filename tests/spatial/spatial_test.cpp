@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <random>
+#include <type_traits>
+#include <utility>
 
 using namespace meshmotion;
 
@@ -47,6 +49,14 @@ void check_against_brute_force(Index n) {
 }
 
 }  // namespace
+
+// The nanoflann switch picks the installed version's result type (1.4: std::pair; 1.5+: its
+// ResultItem, renamed with SearchParameters).
+#if NANOFLANN_VERSION >= 0x150
+static_assert(std::is_same_v<meshmotion::Neighbor, nanoflann::ResultItem<std::size_t, double>>);
+#else
+static_assert(std::is_same_v<meshmotion::Neighbor, std::pair<std::size_t, double>>);
+#endif
 
 TEST_CASE("k-d tree radius and k-nearest queries match brute force", "[spatial]") {
   check_against_brute_force<2>(500);

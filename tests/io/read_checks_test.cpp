@@ -1,0 +1,125 @@
+// What the readers make of inputs that used to read wrong or not at all (issue 17): a
+// consistently reversed mesh, a mixed one, a UTF-8 byte-order mark; output checks; the
+// worst cell's id as the written file gives it.
+
+#include "meshmotion/core/generators.hpp"
+#include "meshmotion/core/orientation.hpp"
+#include "meshmotion/io.hpp"
+#include "meshmotion/quality/quality_report.hpp"
+
+#include "test_data.hpp"
+
+#include "messages.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <utility>
+
+using namespace meshmotion;
+namespace fs = std::filesystem;
+
+namespace {
+
+void write_file(const fs::path& file, const std::string& text) {
+  std::ofstream out(file, std::ios::binary);
+  out << text;
+}
+
+// A unit square of two triangles, both listed clockwise (or the second one counterclockwise).
+std::string square_su2(bool mixed) {
+  return std::string("NDIME= 2\nNELEM= 2\n5 0 2 1 0\n") + (mixed ? "5 0 2 3 1\n" : "5 0 3 2 1\n") +
+         "NPOIN= 4\n0 0 0\n1 0 1\n1 1 2\n0 1 3\nNMARK= 1\nMARKER_TAG= wall\nMARKER_ELEMS= 1\n3 0 1\n";
+}
+
+template <class F>
+std::string input_error_of(F&& f) {
+  return test::message_of<InputError>(std::forward<F>(f));
+}
+
+}  // namespace
+
+TEST_CASE("orientation at read time: reversed meshes fixed or refused, mixed ones named", "[io][orientation]") {
+  const fs::path reversed = test::scratch_path("reversed.su2");
+  write_file(reversed, square_su2(false));
+  CHECK(orientation_report(read_mesh_as<2>(reversed)).num_negative == 2);  // keep: as the file lists them
+  const Mesh<2> fixed = read_mesh_as<2>(reversed, {ReadOrientation::fix_reversed});
+  CHECK(orientation_report(fixed).num_negative == 0);
+  CHECK(quality_report(fixed, Metric::scaled_jacobian).num_invalid == 0);
+  CHECK_THAT(input_error_of([&] { (void)read_mesh(reversed, {ReadOrientation::require_positive}); }),
+             Catch::Contains("every cell") && Catch::Contains("element"));
+
+  const fs::path mixed = test::scratch_path("mixed.su2");
+  write_file(mixed, square_su2(true));
+  Mesh<2> m = read_mesh_as<2>(mixed, {ReadOrientation::fix_reversed});
+  CHECK(orientation_report(m).num_negative == 1);  // a mixed mesh is not "fixed" behind the user's back
+  const OrientationFix fix = orient_consistently(m);
+  CHECK(fix.found == OrientationFix::Found::mixed);
+  CHECK(fix.reoriented == 0);
+  CHECK(name(fix.found) == "mixed");
+  CHECK_THAT(input_error_of([&] { (void)read_mesh(mixed, {ReadOrientation::require_positive}); }),
+             Catch::Contains("mixed orientation"));
+  CHECK(to_json(summarize(m)).find("\"orientation\":\"mixed\"") != std::string::npos);
+}
+
+TEST_CASE("orientation at read time: the clockwise SU2 test mesh", "[io][orientation]") {
+  MESHMOTION_REQUIRE_DATA(file, "su2_naca64a010_aeroelastic_hybrid.su2");
+  const Mesh<2> as_is = read_mesh_as<2>(file);
+  const OrientationReport before = orientation_report(as_is);
+  CHECK(before.num_negative == before.num_cells);
+  const Mesh<2> fixed = read_mesh_as<2>(file, {ReadOrientation::fix_reversed});
+  CHECK(orientation_report(fixed).num_negative == 0);
+  CHECK(quality_report(fixed, Metric::scaled_jacobian).num_invalid == 0);
+  CHECK(fixed.points == as_is.points);  // numbering kept
+}
+
+TEST_CASE("a UTF-8 byte-order mark is skipped", "[io]") {
+  const std::string bom = "\xEF\xBB\xBF";
+  const fs::path su2 = test::scratch_path("bom.su2");
+  write_file(su2, bom + square_su2(false));
+  CHECK(read_mesh_as<2>(su2).num_nodes() == 4);
+  const fs::path msh = test::scratch_path("bom.msh");
+  write_file(msh, bom + "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
+                        "$Elements\n1\n1 2 2 0 1 1 2 3\n$EndElements\n");
+  CHECK(read_mesh_as<2>(msh).num_cells() == 1);
+}
+
+TEST_CASE("outputs are checked before any work", "[io]") {
+  CHECK_NOTHROW(check_mesh_output(test::scratch_path("a.msh"), 2));
+  CHECK_NOTHROW(check_mesh_output(test::scratch_path("a.su2"), 1));
+  CHECK_THAT(input_error_of([] { check_mesh_output(test::scratch_path("a.su2"), 2); }), Catch::Contains("linear"));
+  CHECK_THAT(input_error_of([] { check_mesh_output(test::scratch_path("a.cgns"), 1); }), Catch::Contains(".cgns"));
+  CHECK_THAT(input_error_of([] { check_mesh_output(test::scratch_path("no/such/folder/a.msh"), 1); }),
+             Catch::Contains("does not exist"));
+}
+
+TEST_CASE("the worst cell is named by the id the written .msh gives it", "[io][quality]") {
+  Mesh<2> mesh = rectangle_mesh({});
+  const ElementBlock& quads = mesh.cells.front();
+  const Index bad = 37;
+  mesh.points.col(quads.element(bad)[2]) = mesh.points.col(quads.element(bad)[0]);  // collapse a cell
+  const QualityReport q = quality_report(mesh, Metric::scaled_jacobian);
+  REQUIRE(!q.worst.empty());
+  const fs::path file = test::scratch_path("worst.msh");
+  write_mesh(file, mesh, WriteOptions{MshVersion::v2_2});
+  // Read the element line of that id back and find the cell's nodes on it.
+  std::ifstream in(file);
+  std::string line;
+  bool found = false;
+  while (std::getline(in, line))
+    if (line.rfind(std::to_string(q.worst[0].file_id) + " 3 ", 0) == 0) {
+      found = true;
+      std::istringstream s(line);
+      std::int64_t id = 0, type = 0, ntags = 0, tag = 0, entity = 0;
+      s >> id >> type >> ntags >> tag >> entity;
+      std::vector<std::int64_t> nodes(4);
+      for (auto& n : nodes) s >> n;
+      const auto cell = mesh.cells.front().element(q.worst[0].id);
+      for (int k = 0; k < 4; ++k) CHECK(nodes[static_cast<std::size_t>(k)] == mesh.node_id(cell[static_cast<std::size_t>(k)]));
+    }
+  CHECK(found);
+  CHECK(q.worst[0].file_id == static_cast<std::int64_t>(mesh.num_facets()) + q.worst[0].id + 1);
+}

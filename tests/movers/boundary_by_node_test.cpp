@@ -1,0 +1,147 @@
+// Displacements given with their nodes (issue 17): a solver's own marker order must give the
+// same wall as the sorted order, and every kind of bad node list is refused, naming the node.
+
+#include "meshmotion/core/generators.hpp"
+#include "meshmotion/core/mesh_like.hpp"
+#include "meshmotion/movers/any_mover.hpp"
+#include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/rbf.hpp"
+#include "meshmotion/movers/step_driver.hpp"
+
+#include "messages.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <random>
+#include <utility>
+
+using namespace meshmotion;
+
+namespace {
+
+template <class F>
+std::string input_error_of(F&& f) {
+  return test::message_of<InputError>(std::forward<F>(f));
+}
+
+// A 0-to-0.05 ramp in y along the bottom wall, node by node, in a shuffled (solver's) order.
+struct Ramp {
+  std::vector<Index> nodes;
+  Points<2> displacements;
+};
+Ramp shuffled_ramp(const Mesh<2>& mesh) {
+  Ramp r{mesh.group_nodes("bottom"), {}};
+  std::shuffle(r.nodes.begin(), r.nodes.end(), std::mt19937(5));
+  r.displacements.setZero(2, static_cast<Index>(r.nodes.size()));
+  for (std::size_t k = 0; k < r.nodes.size(); ++k) r.displacements(1, static_cast<Index>(k)) = 0.05 * mesh.points(0, r.nodes[k]);
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("displacements by node: any order gives the intended wall", "[movers][boundary]") {
+  const Mesh<2> mesh = rectangle_mesh({});
+  const Ramp ramp = shuffled_ramp(mesh);
+  BoundarySpec<2> spec;
+  spec.moving("bottom", ramp.nodes, ramp.displacements).fixed("top");
+  const ResolvedBoundary<2> b = spec.resolve(mesh);
+  for (std::size_t k = 0; k < ramp.nodes.size(); ++k)
+    CHECK(b.displacements.col(b.column(ramp.nodes[k])) == ramp.displacements.col(static_cast<Index>(k)));
+
+  // The same array through the sorted-order overload is the silent wrong wall this API avoids.
+  BoundarySpec<2> sorted;
+  sorted.moving("bottom", ramp.displacements).fixed("top");
+  const ResolvedBoundary<2> wrong = sorted.resolve(mesh);
+  double largest = 0.0;
+  for (std::size_t k = 0; k < ramp.nodes.size(); ++k)
+    largest = std::max(largest, (wrong.displacements.col(wrong.column(ramp.nodes[k])) - ramp.displacements.col(static_cast<Index>(k))).norm());
+  CHECK(largest > 0.01);
+
+  // The moved wall is the ramp exactly; steps split it linearly.
+  RbfOptions o;
+  o.support_radius = 0.5;
+  RbfMover<2> rbf(o);
+  const StepResult<2> r = run_steps(rbf, mesh, spec, StepOptions{2, Metric::skew});
+  for (std::size_t k = 0; k < ramp.nodes.size(); ++k)
+    CHECK((r.displacements.col(ramp.nodes[k]) - ramp.displacements.col(static_cast<Index>(k))).norm() < 1e-14);
+}
+
+TEST_CASE("displacements by node: bad node lists are refused, naming the node", "[movers][boundary]") {
+  const Mesh<2> mesh = rectangle_mesh({});
+  Ramp ramp = shuffled_ramp(mesh);
+  const auto resolve = [&](std::vector<Index> nodes, Points<2> d) {
+    BoundarySpec<2> spec;
+    spec.moving("bottom", std::move(nodes), std::move(d));
+    (void)spec.resolve(mesh);
+  };
+  CHECK_NOTHROW(resolve(ramp.nodes, ramp.displacements));
+  auto nodes = ramp.nodes;
+  nodes[3] = mesh.num_nodes() + 7;
+  CHECK_THAT(input_error_of([&] { resolve(nodes, ramp.displacements); }),
+             Catch::Contains("node " + std::to_string(mesh.num_nodes() + 7)) && Catch::Contains("not a node of the mesh"));
+  const Index top_node = mesh.group_nodes("top").front();
+  nodes = ramp.nodes;
+  nodes[3] = top_node;
+  CHECK_THAT(input_error_of([&] { resolve(nodes, ramp.displacements); }),
+             Catch::Contains("node " + std::to_string(top_node)) && Catch::Contains("not in the group"));
+  nodes = ramp.nodes;
+  nodes[3] = nodes[4];
+  CHECK_THAT(input_error_of([&] { resolve(nodes, ramp.displacements); }),
+             Catch::Contains("node " + std::to_string(nodes[4])) && Catch::Contains("twice"));
+  nodes = ramp.nodes;
+  nodes.pop_back();
+  CHECK_THAT(input_error_of([&] { resolve(nodes, ramp.displacements.leftCols(ramp.displacements.cols() - 1)); }),
+             Catch::Contains("node " + std::to_string(ramp.nodes.back())) && Catch::Contains("no displacement"));
+  CHECK_THROWS_AS(resolve(ramp.nodes, ramp.displacements.leftCols(2)), InputError);  // sizes differ
+  Points<2> nan = ramp.displacements;
+  nan(0, 2) = std::nan("");
+  CHECK_THAT(input_error_of([&] { resolve(ramp.nodes, nan); }), Catch::Contains("non-finite"));
+}
+
+TEST_CASE("prescribed group: displacements given to move() by node", "[movers][boundary]") {
+  const Mesh<2> mesh = rectangle_mesh({});
+  const Ramp ramp = shuffled_ramp(mesh);
+  BoundarySpec<2> spec;
+  spec.prescribed("bottom").fixed("top").sliding("left").sliding("right");
+  const ResolvedBoundary<2> b = spec.resolve(mesh);
+  CHECK(b.displacements.isZero());
+  Points<2> d;
+  b.scatter(ramp.nodes, ramp.displacements, d);
+  REQUIRE(d.cols() == b.size());
+  for (std::size_t k = 0; k < ramp.nodes.size(); ++k)
+    CHECK(d.col(b.column(ramp.nodes[k])) == ramp.displacements.col(static_cast<Index>(k)));
+  RbfOptions o;
+  o.support_radius = 0.5;
+  AnyMover<2> mover = make_mover(MoverConfig<2>{"rbf", o});
+  mover.setup(mesh, b);
+  // Into the caller's own storage: an Eigen::Map over a solver's array.
+  std::vector<double> solver_array(static_cast<std::size_t>(2 * mesh.num_nodes()), -1.0);
+  Eigen::Map<Points<2>> out(solver_array.data(), 2, mesh.num_nodes());
+  mover.move_into(d, out);
+  for (std::size_t k = 0; k < ramp.nodes.size(); ++k)
+    CHECK((out.col(ramp.nodes[k]) - ramp.displacements.col(static_cast<Index>(k))).norm() < 1e-14);
+  std::vector<double> short_array(4);
+  Eigen::Map<Points<2>> too_small(short_array.data(), 2, 2);
+  CHECK_THROWS_AS(mover.move_into(d, too_small), InputError);
+
+  const Index fixed = mesh.group_nodes("top")[2];
+  CHECK_THAT(input_error_of([&] { b.scatter({fixed}, Points<2>::Zero(2, 1), d); }), Catch::Contains("fixed"));
+  CHECK_THAT(input_error_of([&] { b.scatter({ramp.nodes[0], ramp.nodes[0]}, Points<2>::Zero(2, 2), d); }),
+             Catch::Contains("twice"));
+  Index interior = 0;
+  while (std::binary_search(b.nodes.begin(), b.nodes.end(), interior)) ++interior;
+  CHECK_THAT(input_error_of([&] { (void)b.column(interior); }), Catch::Contains("not a boundary node"));
+}
+
+TEST_CASE("file node ids map to node indices", "[movers][boundary]") {
+  Mesh<2> mesh = rectangle_mesh({});
+  const std::vector<std::int64_t> ids{1, 5, 3};
+  CHECK(mesh.node_indices(ids) == std::vector<Index>{0, 4, 2});
+  CHECK_THROWS_AS(mesh.node_indices(std::vector<std::int64_t>{0}), InputError);
+  mesh.node_ids.resize(static_cast<std::size_t>(mesh.num_nodes()));
+  for (Index i = 0; i < mesh.num_nodes(); ++i) mesh.node_ids[static_cast<std::size_t>(i)] = 1000 - 3 * i;
+  CHECK(mesh.node_indices(std::vector<std::int64_t>{1000, 997, 1000 - 3 * (mesh.num_nodes() - 1)}) ==
+        std::vector<Index>{0, 1, mesh.num_nodes() - 1});
+  CHECK_THAT(input_error_of([&] { (void)mesh.node_indices(std::vector<std::int64_t>{999}); }), Catch::Contains("999"));
+}
