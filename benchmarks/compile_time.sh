@@ -45,8 +45,9 @@ for opt in O0 O2; do
   done
   h=$(median < "$work/header_only.s"); c=$(median < "$work/compiled.s")
   hm=$(median < "$work/header_only.m"); cm=$(median < "$work/compiled.m")
-  ratio=$(echo "scale=3; $c / $h" | bc)
+  ratio=$(printf "%.3f" "$(echo "scale=6; $c / $h" | bc)")
   printf "%-4s %-12s %10.2f %10.0f %8s\n" "$opt" header_only "$h" "$(echo "$hm / 1024" | bc)" 1
   printf "%-4s %-12s %10.2f %10.0f %8s\n" "$opt" compiled "$c" "$(echo "$cm / 1024" | bc)" "$ratio"
+  h=$(printf "%.2f" "$h"); c=$(printf "%.2f" "$c")
   echo "{\"bench\":\"compile_time\",\"case\":\"consumer_${opt}\",\"runs\":$runs,\"header_only_seconds\":$h,\"compiled_seconds\":$c,\"header_only_peak_kb\":$hm,\"compiled_peak_kb\":$cm,\"ratio\":$ratio,\"target_seconds\":15}"
 done
