@@ -1,0 +1,201 @@
+"""Tests of the Python layer: numpy views without copies, typed keyword options refused as the
+C++ parser refuses them, exact interpolation at the boundary, derivatives against finite
+differences, the Warp class, errors mapped to Python exceptions."""
+
+import os
+import pathlib
+
+import numpy as np
+import pytest
+
+mm = pytest.importorskip("meshmotion", reason="the meshmotion module was not built (pybind11 absent?)")
+
+
+def grid(nx=8, ny=6, size=1.0):
+    """A structured square of quadrilaterals with groups bottom, top, left, right."""
+    x, y = np.meshgrid(np.linspace(0.0, size, nx + 1), np.linspace(0.0, size, ny + 1), indexing="ij")
+    points = np.column_stack([x.ravel(), y.ravel()])
+    node = lambda i, j: i * (ny + 1) + j  # noqa: E731
+    quads = [[node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)] for i in range(nx) for j in range(ny)]
+    lines = lambda pairs: np.array(pairs, dtype=np.int64)  # noqa: E731
+    groups = {
+        "bottom": ("line2", lines([[node(i, 0), node(i + 1, 0)] for i in range(nx)])),
+        "top": ("line2", lines([[node(i, ny), node(i + 1, ny)] for i in range(nx)])),
+        "left": ("line2", lines([[node(0, j), node(0, j + 1)] for j in range(ny)])),
+        "right": ("line2", lines([[node(nx, j), node(nx, j + 1)] for j in range(ny)])),
+    }
+    return mm.from_arrays(points, {"quad4": np.array(quads)}, groups)
+
+
+def scratch(name):
+    folder = pathlib.Path(os.environ.get("MESHMOTION_TEST_TMP_DIR", "/tmp"))
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder / name
+
+
+def test_points_are_a_view_without_copy():
+    mesh = grid()
+    p = mesh.points
+    assert p.shape == (mesh.num_nodes, 2) and p.dtype == np.float64 and p.flags["C_CONTIGUOUS"]
+    p[3, 1] = 7.5
+    assert mesh.points[3, 1] == 7.5  # the same memory
+    assert np.shares_memory(p, mesh.points)
+    name, quads = mesh.cells[0]
+    assert name == "quad4" and quads.shape == (mesh.num_cells, 4) and quads.dtype == np.int64
+    assert sorted(mesh.groups) == ["bottom", "left", "right", "top"]
+    assert list(mesh.groups["bottom"]) == list(range(0, mesh.num_nodes, 7))
+
+
+def test_write_and_read_back(tmp_path=None):
+    mesh = grid()
+    file = scratch("python_grid.msh")
+    mm.write_mesh(file, mesh)
+    back = mm.read_mesh(str(file))
+    assert isinstance(back, mm._core.Mesh2)
+    np.testing.assert_array_equal(back.points, mesh.points)
+    np.testing.assert_array_equal(back.cells[0][1], mesh.cells[0][1])
+    assert back.groups.keys() == mesh.groups.keys()
+
+
+def test_typed_options_refused_like_the_cpp_parser():
+    with pytest.raises(ValueError, match="did you mean 'support_radius'"):
+        mm.Mover("rbf", 2, suport_radius=0.5)
+    with pytest.raises(mm.InputError, match="poisson_ratio"):
+        mm.Mover("rbf", 2, poisson_ratio=0.3)
+    with pytest.raises(ValueError, match="finite number"):
+        mm.Mover("rbf", 2, support_radius=float("nan"))
+    with pytest.raises(ValueError, match="wendland"):
+        mm.Mover("rbf", 2, kernel="wendland3")
+    with pytest.raises(ValueError, match="unknown mover method"):
+        mm.Mover("rfb", 2)
+    assert ("support_radius", "1") in mm.mover_options("rbf")
+    mm.Mover("sle", 3, poisson_ratio=0.4, solver="cg_jacobi", tolerance=1e-9)
+
+
+def test_rbf_moves_the_boundary_exactly_and_into_a_callers_array():
+    mesh = grid()
+    spec = mm.Boundary(2).prescribed("bottom").fixed("top").sliding("left").sliding("right")
+    b = spec.resolve(mesh)
+    d = np.zeros((b.size, 2))
+    bottom = mesh.groups["bottom"]
+    ramp = np.column_stack([np.zeros(len(bottom)), 0.05 * mesh.points[bottom, 0]])
+    b.scatter(list(bottom), ramp, d)
+    mover = mm.Mover("rbf", 2, support_radius=0.6)
+    mover.setup(mesh, b)
+    u = mover.move(d)
+    np.testing.assert_allclose(u[bottom], ramp, rtol=0, atol=1e-15)
+    assert np.all(u[mesh.groups["top"]] == 0.0)
+    out = np.full((mesh.num_nodes, 2), -1.0)
+    mover.move_into(d, out)
+    np.testing.assert_array_equal(out, u)
+    assert mover.stats["moves"] == 2
+
+
+def test_bad_arrays_are_refused():
+    mesh = grid()
+    b = mm.Boundary(2).prescribed("bottom").fixed("top").resolve(mesh)
+    mover = mm.Mover("rbf", 2, support_radius=0.6)
+    mover.setup(mesh, b)
+    with pytest.raises(ValueError, match="float64"):
+        mover.move(np.zeros((b.size, 2), dtype=np.float32))
+    with pytest.raises(ValueError, match="shape"):
+        mover.move(np.zeros((b.size, 3)))
+    with pytest.raises(ValueError, match="C-contiguous"):
+        mover.move(np.zeros((2, b.size)).T)
+    with pytest.raises(ValueError, match="not finite"):
+        d = np.zeros((b.size, 2))
+        d[0, 0] = np.nan
+        mover.move(d)
+    with pytest.raises(ValueError):
+        mover.move_into(np.zeros((b.size, 2)), np.zeros((3, 2)))
+
+
+def test_rbf_derivatives_match_finite_differences_and_each_other():
+    mesh = grid()
+    b = mm.Boundary(2).prescribed("bottom").fixed("top").sliding("left").resolve(mesh)
+    mover = mm.Mover("rbf", 2, support_radius=0.6)
+    mover.setup(mesh, b)
+    assert mover.has_derivatives
+    rng = np.random.default_rng(1)
+    d = 0.01 * rng.standard_normal((b.size, 2))
+    w = rng.standard_normal((b.size, 2))
+    for k, kind in enumerate(b.kinds):
+        if kind != "prescribed":
+            d[k] = w[k] = 0.0
+    h = 1e-6
+    fd = (mover.move(d + h * w) - mover.move(d - h * w)) / (2 * h)
+    np.testing.assert_allclose(mover.derivative_forward(w), fd, atol=1e-8)
+    v = rng.standard_normal((mesh.num_nodes, 2))
+    assert abs(np.sum(v * mover.derivative_forward(w)) - np.sum(mover.derivative_reverse(v) * w)) < 1e-10
+
+
+def test_movers_without_derivatives_say_so():
+    mesh = grid()
+    b = mm.Boundary(2).prescribed("bottom").fixed("top").resolve(mesh)
+    mover = mm.Mover("spring", 2)
+    mover.setup(mesh, b)
+    assert not mover.has_derivatives
+    with pytest.raises(ValueError, match="no derivatives"):
+        mover.derivative_reverse(np.zeros((mesh.num_nodes, 2)))
+
+
+def test_warp_in_an_optimization_loop():
+    mesh = grid()
+    w = mm.Warp(mesh, design=["bottom"], symmetry=["left", "right"], fixed=["top"], support_radius=0.6)
+    xs = w.surface_coordinates()
+    assert xs.shape == (len(mesh.groups["bottom"]), 2)
+    bump = xs.copy()
+    bump[:, 1] += 0.02 * np.sin(np.pi * xs[:, 0])
+    w.set_surface_coordinates(bump)
+    first = w.warp().copy()
+    w.set_surface_coordinates(bump)
+    np.testing.assert_array_equal(w.warp(), first)  # always from the reference
+    np.testing.assert_allclose(w.volume_coordinates()[w.design_nodes], bump, atol=1e-15)
+    assert w.verify_derivative(verbose=False) < 1e-6
+    g = w.warp_derivative(np.ones((mesh.num_nodes, 2)))
+    assert g.shape == xs.shape  # sized like the design surface, no sliding or fixed rows
+    # The solver's own order of the design nodes.
+    order = w.design_nodes[::-1].copy()
+    w.set_surface_order(order)
+    np.testing.assert_array_equal(w.design_nodes, order)
+    np.testing.assert_array_equal(w.surface_coordinates(), bump[::-1])
+    with pytest.raises(ValueError, match="design surface"):
+        w.set_surface_order(np.concatenate([order[:-1], [mesh.groups["top"][3]]]))
+    with pytest.raises(ValueError, match="shape"):
+        w.set_surface_coordinates(bump[:-1])
+
+
+def test_errors_map_to_python_exceptions():
+    with pytest.raises(OSError):
+        mm.read_mesh("/no/such/mesh.msh")
+    with pytest.raises(ValueError, match="unknown mesh format"):
+        mm.read_mesh("mesh.cgnx")
+    bad = scratch("python_bad.su2")
+    bad.write_text("NDIME= 2\nNELEM= x\n")
+    with pytest.raises(mm.InputError, match="python_bad.su2:2"):
+        mm.read_mesh(str(bad))
+    assert issubclass(mm.InputError, ValueError) and issubclass(mm.IoError, OSError)
+    assert issubclass(mm.SolverError, RuntimeError)
+
+
+def test_reversed_mesh_is_reoriented_at_read_time():
+    file = scratch("python_clockwise.su2")
+    file.write_text("NDIME= 2\nNELEM= 2\n5 0 2 1 0\n5 0 3 2 1\nNPOIN= 4\n0 0 0\n1 0 1\n1 1 2\n0 1 3\n"
+                    "NMARK= 1\nMARKER_TAG= wall\nMARKER_ELEMS= 1\n3 0 1\n")
+    assert mm.quality_report(mm.read_mesh(str(file)))["invalid"] == 2
+    assert mm.quality_report(mm.read_mesh(str(file), "fix_reversed"))["invalid"] == 0
+    with pytest.raises(ValueError, match="negatively oriented"):
+        mm.read_mesh(str(file), "require_positive")
+
+
+def test_real_mesh_from_shared_data():
+    folder = pathlib.Path(os.environ.get("MESHMOTION_SHARED_DATA_DIR", ""))
+    file = folder / "su2_naca0012_inviscid_tri.su2"
+    if not file.exists():
+        pytest.skip(f"{file} not found (../shared/data is absent here)")
+    mesh = mm.read_mesh(str(file))
+    assert mesh.points.shape[1] == 2 and mesh.num_cells > 0
+    wall = [g for g in mesh.groups if g.lower() in ("airfoil", "wall")]
+    assert wall, f"no wall group among {list(mesh.groups)}"
+    w = mm.Warp(mesh, design=wall, fixed=[g for g in mesh.groups if g not in wall], support_radius=0.5)
+    assert w.verify_derivative(verbose=False) < 1e-6
