@@ -80,21 +80,18 @@ inline void check_output(const std::filesystem::path& input, const std::filesyst
 /// as such: its negative cells count as invalid.
 template <int Dim>
 void handle_orientation(Mesh<Dim>& mesh, const std::filesystem::path& file, bool keep) {
-  if (keep) {
-    const OrientationReport r = orientation_report(mesh);
-    if (r.num_negative > 0 && r.num_negative + r.num_degenerate == r.num_cells)
+  const OrientationReport r = orientation_report(mesh);
+  if (r.orientation() == CellOrientation::reversed) {
+    if (keep)
       throw InputError(file.string() + ": every cell is negatively oriented (the file's convention is reversed; "
                        "without --keep-orientation the program reorients them)");
-  } else {
-    const OrientationFix fix = orient_consistently(mesh);
-    if (fix.found == OrientationFix::Found::reversed)
-      std::cerr << "note: " << file.string() << " lists every cell negatively oriented (reversed convention): reoriented "
-                << fix.reoriented << " of " << fix.num_cells << " cells\n";
-  }
-  const OrientationReport r = orientation_report(mesh);
-  if (r.num_negative > 0 && r.num_negative + r.num_degenerate < r.num_cells)
+    const Index reoriented = fix_orientation(mesh);
+    std::cerr << "note: " << file.string() << " lists every cell negatively oriented (reversed convention): reoriented "
+              << reoriented << " of " << r.num_cells << " cells\n";
+  } else if (r.orientation() == CellOrientation::mixed) {
     std::cerr << "warning: " << file.string() << " has mixed orientation: " << r.num_negative << " of " << r.num_cells
               << " cells are negative (inverted, or listed in the opposite order); they count as invalid\n";
+  }
 }
 
 }  // namespace meshmotion::examples

@@ -50,12 +50,34 @@ template <int Dim>
   }
 }
 
+/// How a mesh's cells are listed, from the signs of their measures.
+enum class CellOrientation {
+  positive,  ///< every cell of nonzero measure positive
+  reversed,  ///< every cell of nonzero measure negative: the file's convention, reversed
+  mixed,     ///< some of each: inverted cells, or a file listing cells inconsistently
+};
+
+/// "positive", "reversed", "mixed".
+[[nodiscard]] constexpr std::string_view name(CellOrientation o) {
+  switch (o) {
+    case CellOrientation::positive: return "positive";
+    case CellOrientation::reversed: return "reversed";
+    case CellOrientation::mixed: return "mixed";
+  }
+  return "unknown";
+}
+
 /// Orientation count of a mesh's cells.
 struct OrientationReport {
   Index num_cells = 0;
   Index num_negative = 0;     ///< cells with negative signed measure
   Index num_degenerate = 0;   ///< cells with zero signed measure
   Index first_negative = -1;  ///< position in cell order of the first negative cell, -1 if none
+
+  [[nodiscard]] CellOrientation orientation() const noexcept {
+    if (num_negative == 0) return CellOrientation::positive;
+    return num_negative + num_degenerate == num_cells ? CellOrientation::reversed : CellOrientation::mixed;
+  }
 };
 
 /// Counts the cells whose signed_measure() is negative or zero.
@@ -152,29 +174,15 @@ Index fix_orientation(Mesh<Dim>& mesh) {
   return changed;
 }
 
-/// How a mesh's cells are listed, as orient_consistently() found and left them.
+/// What orient_consistently() found and did.
 struct OrientationFix {
-  enum class Found {
-    positive,  ///< every cell of nonzero measure positive: nothing to do
-    reversed,  ///< every cell of nonzero measure negative: the file's convention, reversed
-    mixed,     ///< some of each: inverted cells, or a file listing cells inconsistently
-  };
+  using Found = CellOrientation;
   Found found = Found::positive;
   Index num_cells = 0;
   Index num_negative = 0;      ///< before any fix
   Index first_negative = -1;   ///< position in cell order, -1 if none
   Index reoriented = 0;        ///< cells whose nodes were reordered
 };
-
-/// "positive", "reversed", "mixed".
-[[nodiscard]] constexpr std::string_view name(OrientationFix::Found f) {
-  switch (f) {
-    case OrientationFix::Found::positive: return "positive";
-    case OrientationFix::Found::reversed: return "reversed";
-    case OrientationFix::Found::mixed: return "mixed";
-  }
-  return "unknown";
-}
 
 /// Makes a consistently reversed mesh positive (every cell mirrored, as fix_orientation()),
 /// and leaves a positive or a mixed mesh as it is: a consistently reversed mesh is a
@@ -188,13 +196,8 @@ OrientationFix orient_consistently(Mesh<Dim>& mesh) {
   fix.num_cells = r.num_cells;
   fix.num_negative = r.num_negative;
   fix.first_negative = r.first_negative;
-  const Index signed_cells = r.num_cells - r.num_degenerate;
-  if (r.num_negative == 0) return fix;
-  if (r.num_negative < signed_cells) {
-    fix.found = OrientationFix::Found::mixed;
-    return fix;
-  }
-  fix.found = OrientationFix::Found::reversed;
+  fix.found = r.orientation();
+  if (fix.found != CellOrientation::reversed) return fix;
   fix.reoriented = fix_orientation(mesh);
   return fix;
 }

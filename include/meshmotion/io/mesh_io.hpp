@@ -59,8 +59,8 @@ void apply_orientation(Mesh<Dim>& mesh, const std::filesystem::path& file, ReadO
     if (local < b.size()) {
       throw InputError("read_mesh: " + file.string() + ": " + std::to_string(r.num_negative) + " of " +
                        std::to_string(r.num_cells) + " cells are negatively oriented (" +
-                       (r.num_negative + r.num_degenerate == r.num_cells ? "every cell: the file's convention is reversed"
-                                                                         : "mixed orientation") +
+                       (r.orientation() == CellOrientation::reversed ? "every cell: the file's convention is reversed"
+                                                                                   : "mixed orientation") +
                        "; first: " + std::string(name(b.type)) + " element " +
                        std::to_string(msh_element_id(mesh, b, local)) + ")");
     }

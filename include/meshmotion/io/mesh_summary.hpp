@@ -125,12 +125,10 @@ namespace detail {
   out += "] to [";
   for (int d = 0; d < s.dim; ++d) (out += d ? ", " : "") += detail::format_real(s.bbox_max[static_cast<std::size_t>(d)]);
   out += "]\nedge length: min " + detail::format_real(s.min_edge) + ", max " + detail::format_real(s.max_edge) + "\n";
-  const Index signed_cells = s.orientation.num_cells - s.orientation.num_degenerate;
-  out += std::string("orientation: ") +
-         (s.orientation.num_negative == 0              ? "positive"
-          : s.orientation.num_negative == signed_cells ? "reversed (every cell negative: the file's convention)"
-                                                       : "mixed") +
-         ", " + std::to_string(s.orientation.num_negative) + " of " + std::to_string(s.orientation.num_cells) +
+  const CellOrientation o = s.orientation.orientation();
+  out += "orientation: " + std::string(name(o)) +
+         (o == CellOrientation::reversed ? " (every cell negative: the file's convention)" : "") + ", " +
+         std::to_string(s.orientation.num_negative) + " of " + std::to_string(s.orientation.num_cells) +
          " cells negative, " + std::to_string(s.orientation.num_degenerate) + " degenerate\n";
   return out;
 }
@@ -161,10 +159,7 @@ inline void write_json(JsonWriter& w, const MeshSummary& s) {
   point("bbox_max", s.bbox_max);
   w.key("min_edge").value(s.min_edge).key("max_edge").value(s.max_edge);
   w.key("negative_cells").value(s.orientation.num_negative).key("degenerate_cells").value(s.orientation.num_degenerate);
-  const Index signed_cells = s.orientation.num_cells - s.orientation.num_degenerate;
-  w.key("orientation").value(s.orientation.num_negative == 0              ? "positive"
-                             : s.orientation.num_negative == signed_cells ? "reversed"
-                                                                          : "mixed");
+  w.key("orientation").value(name(s.orientation.orientation()));
   w.end_object();
 }
 
