@@ -1,5 +1,7 @@
 #include "meshmotion/movers.hpp"
 
+#include "random_field.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <random>
@@ -57,15 +59,7 @@ GroupNodes with_outer(GroupNodes groups) {
   return groups;
 }
 
-template <int Dim>
-Points<Dim> random_displacements(Index m, unsigned seed, double scale = 0.01) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-scale, scale);
-  Points<Dim> d(Dim, m);
-  for (Index i = 0; i < m; ++i)
-    for (int k = 0; k < Dim; ++k) d(k, i) = u(rng);
-  return d;
-}
+using test::random_displacements;
 
 template <int Dim>
 void check_properties(int n) {

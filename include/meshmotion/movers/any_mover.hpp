@@ -53,60 +53,69 @@ class AnyMover {
   }
   void move_into(const Points<Dim>& d, Points<Dim>& out) { self_->move_into(d, out); }
   /// Into the caller's own storage (an Eigen::Map over a solver's array of Dim × n_nodes
-  /// doubles): no allocation after the first move. Throws InputError when its shape is not
-  /// Dim × n_nodes.
-  void move_into(const Points<Dim>& d, Eigen::Ref<Points<Dim>> out) {
-    self_->move_into(d, scratch_);
-    detail::copy_to_caller<Dim>("AnyMover::move_into", scratch_, out);
-  }
+  /// doubles): the RBF mover writes there directly, the others through a buffer of their own
+  /// (no allocation after the first move). Throws InputError when its shape is not Dim × n_nodes.
+  void move_into(const Points<Dim>& d, Eigen::Ref<Points<Dim>> out) { self_->move_into_storage(d, out); }
   [[nodiscard]] MoverStats stats() const { return self_->stats(); }
 
   /// True when the mover offers derivative_forward and derivative_reverse (the movers linear
   /// in the boundary displacements that implement them).
   [[nodiscard]] bool has_derivatives() const { return self_->has_derivatives(); }
-  /// J w for a boundary displacement change w (Dim × boundary size); see RbfMover.
+  /// J w for a boundary displacement change w (Dim × boundary size): the movers linear in the
+  /// displacements (RBF, springs, torsion springs, linear and stiffened elasticity, DGM,
+  /// improved DGM, DGRBF).
   /// Throws InputError when the mover has no derivatives.
   [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w) { return self_->derivative_forward(w); }
   /// Jᵀ v for v (Dim × n_nodes): the gradient of ⟨v, move(d)⟩ with respect to d.
   /// Throws InputError when the mover has no derivatives.
-  [[nodiscard]] Points<Dim> derivative_reverse(const Points<Dim>& v) { return self_->derivative_reverse(v); }
+  [[nodiscard]] Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>> v) { return self_->derivative_reverse(v); }
 
  private:
   struct Concept {
     virtual ~Concept() = default;
     virtual void setup(const Mesh<Dim>&, const ResolvedBoundary<Dim>&) = 0;
     virtual void move_into(const Points<Dim>&, Points<Dim>&) = 0;
+    virtual void move_into_storage(const Points<Dim>&, Eigen::Ref<Points<Dim>>) = 0;
     [[nodiscard]] virtual MoverStats stats() const = 0;
     [[nodiscard]] virtual bool has_derivatives() const = 0;
     [[nodiscard]] virtual Points<Dim> derivative_forward(const Points<Dim>&) = 0;
-    [[nodiscard]] virtual Points<Dim> derivative_reverse(const Points<Dim>&) = 0;
+    [[nodiscard]] virtual Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>>) = 0;
   };
   template <class M>
   struct Model final : Concept {
-    static constexpr bool differentiable = requires(M& m, const Points<Dim>& v) {
+    static constexpr bool differentiable = requires(M& m, const Points<Dim>& v, Eigen::Ref<const Points<Dim>> r) {
       { m.derivative_forward(v) } -> std::same_as<Points<Dim>>;
-      { m.derivative_reverse(v) } -> std::same_as<Points<Dim>>;
+      { m.derivative_reverse(r) } -> std::same_as<Points<Dim>>;
     };
     explicit Model(M m) : mover(std::move(m)) {}
     void setup(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& b) override { mover.setup(mesh, b); }
     void move_into(const Points<Dim>& d, Points<Dim>& out) override { mover.move_into(d, out); }
+    void move_into_storage(const Points<Dim>& d, Eigen::Ref<Points<Dim>> out) override {
+      if constexpr (requires { mover.move_into(d, out); }) {
+        mover.move_into(d, out);
+      } else {  // a user's mover with only the Points<Dim> form
+        mover.move_into(d, scratch);
+        detail::copy_to_caller<Dim>("AnyMover::move_into", scratch, out);
+      }
+    }
     [[nodiscard]] MoverStats stats() const override { return mover.stats(); }
     [[nodiscard]] bool has_derivatives() const override { return differentiable; }
     [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w) override {
       if constexpr (differentiable) return mover.derivative_forward(w);
       else no_derivatives();
     }
-    [[nodiscard]] Points<Dim> derivative_reverse(const Points<Dim>& v) override {
+    [[nodiscard]] Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>> v) override {
       if constexpr (differentiable) return mover.derivative_reverse(v);
       else no_derivatives();
     }
     [[noreturn]] static void no_derivatives() {
-      throw InputError("AnyMover: this mover has no derivatives (RBF has them; see has_derivatives())");
+      throw InputError("AnyMover: this mover has no derivatives (the movers linear in the displacements have them: rbf, "
+                       "spring, torsion, le, sle, dgm, idgm, dgrbf; see has_derivatives())");
     }
     M mover;
+    Points<Dim> scratch;
   };
   std::shared_ptr<Concept> self_;
-  Points<Dim> scratch_;
 };
 
 /// The mover `config` describes, with its typed options. Throws InputError when the options

@@ -67,6 +67,12 @@ class DgmMover : public detail::MoveFromMoveInto<DgmMover<Dim>, Dim> {
     base_.move_displacements(d, Points<Dim>(Dim, 0), options_.check_inversion, out);
   }
 
+  /// Forward derivative J w (Dim × n_nodes) for a boundary displacement change w: the mover is
+  /// linear, so this is the interpolation of w (no inversion check, not counted as a move).
+  [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w) { return base_.derivative_forward(w, Points<Dim>(Dim, 0)); }
+  /// Reverse derivative Jᵀ v (Dim × boundary.size()) for v (Dim × n_nodes); sliding entries zero.
+  [[nodiscard]] Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>> v) const { return base_.derivative_reverse(v); }
+
  private:
   DgmOptions options_;
   detail::GraphMoverBase<Dim> base_{"DgmMover"};

@@ -133,6 +133,27 @@ class ImprovedDgmMover : public detail::MoveFromMoveInto<ImprovedDgmMover<Dim>, 
     });
   }
 
+  /// Forward derivative J w (Dim × n_nodes) for a boundary displacement change w: both stages
+  /// are linear, so this is the RBF stage's change at the layer followed by the graph's
+  /// interpolation (no inversion check, not counted as a move). Throws as move().
+  [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w) {
+    if (!base_.ready()) throw InputError("ImprovedDgmMover::derivative_forward: setup() was not called");
+    const Points<Dim> stage = rbf_.derivative_forward(w);
+    return base_.derivative_forward(w, Points<Dim>(stage.rightCols(static_cast<Index>(layer_.size()))));
+  }
+  /// Reverse derivative Jᵀ v (Dim × boundary.size()) for v (Dim × n_nodes): the graph's
+  /// transpose, whose layer share goes back through the RBF stage's. Sliding entries zero.
+  [[nodiscard]] Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>> v) {
+    if (!base_.ready()) throw InputError("ImprovedDgmMover::derivative_reverse: setup() was not called");
+    const Points<Dim> graph_bar = base_.derivative_reverse(v);
+    const Index m = base_.boundary().size(), n_layer = static_cast<Index>(layer_.size());
+    Points<Dim> stage_bar = Points<Dim>::Zero(Dim, m + n_layer);
+    stage_bar.rightCols(n_layer) = graph_bar.rightCols(n_layer);
+    Points<Dim> gradient = graph_bar.leftCols(m);
+    gradient += rbf_.derivative_reverse(stage_bar);
+    return gradient;
+  }
+
  private:
   /// For each prescribed node, the node k steps along its outward mesh path (k: the median
   /// number of steps reaching layer_offset wall spacings); boundary nodes excluded; thinned.

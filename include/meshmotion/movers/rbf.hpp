@@ -42,6 +42,7 @@
 #include "meshmotion/solvers/solver_options.hpp"
 
 #include <algorithm>
+#include <concepts>
 #include <cmath>
 #include <cstddef>
 #include <string>
@@ -83,7 +84,6 @@ struct RbfOptions {
 template <int Dim>
 class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
  public:
-  using detail::MoveFromMoveInto<RbfMover<Dim>, Dim>::move_into;  // into the caller's storage
   static constexpr int dim = Dim;
   using Coefficients = Eigen::MatrixXd;
 
@@ -116,6 +116,10 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   /// move() (inherited) returns the same; move_into writes into `out`, resized only when its
   /// shape differs.
   void move_into(const Points<Dim>& d, Points<Dim>& out);
+  /// move_into() straight into the caller's own Dim × n_nodes storage (an Eigen::Map over a
+  /// solver's or numpy's array), with no intermediate copy. Throws InputError when its shape
+  /// is not Dim × n_nodes.
+  void move_into(const Points<Dim>& d, Eigen::Ref<Points<Dim>> out);
 
   /// Forward derivative J w: the displacement change of every node (Dim × n_nodes) for a
   /// boundary displacement change w (Dim × boundary.size()). The mover is linear in the
@@ -126,7 +130,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   /// boundary displacements (Dim × boundary.size()) of ⟨v, move(d)⟩. Sliding nodes' entries are
   /// zero (their input is ignored); a merged centre's gradient goes to its first constrained
   /// node. Throws InputError for a wrong shape or a non-finite value.
-  [[nodiscard]] Points<Dim> derivative_reverse(const Points<Dim>& v);
+  [[nodiscard]] Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>> v);
 
  private:
   using Operator = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
@@ -188,8 +192,22 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
     return samples == 0 ? 0.0 : covered / (static_cast<double>(samples) * static_cast<double>(all_.size()));
   }
 
-  /// The linear map boundary displacements → node displacements.
-  void apply(const Points<Dim>& d, Points<Dim>& out) {
+  /// A move: apply() checked, timed and counted, with the solver's report in stats_.
+  template <class Out>
+  void timed_apply(const Points<Dim>& d, Out& out) {
+    detail::timed_move<Dim>("RbfMover::move", ready_, d, boundary_nodes_, stats_, [&] {
+      apply(d, out);
+      const SolverReport& r = all_.report();
+      stats_.iterations = r.iterations;
+      stats_.residual = r.residual;
+      stats_.fell_back = r.fell_back;
+    });
+  }
+
+  /// The linear map boundary displacements → node displacements, into a Points<Dim> (resized)
+  /// or an Eigen::Ref of the right shape.
+  template <class Out>
+  void apply(const Points<Dim>& d, Out& out) {
     const Index k = all_.size();
     const auto m = static_cast<Index>(boundary_nodes_.size());
     values_.resize(k, Dim);
@@ -216,7 +234,12 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
     all_.solve(values_, alpha_, beta_);
 
     const Index n = points_.cols();
-    if (out.cols() != n) out.resize(Dim, n);
+    if constexpr (std::same_as<Out, Points<Dim>>) {
+      if (out.cols() != n) out.resize(Dim, n);
+    } else if (out.cols() != n) {
+      throw InputError("RbfMover::move_into: the output has " + std::to_string(out.cols()) + " columns (expected " +
+                       std::to_string(n) + ", one per node)");
+    }
     out.setZero();
     evaluate_interior(out);
     for (Index b = 0; b < m; ++b) {
@@ -227,7 +250,8 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
     }
   }
 
-  void evaluate_interior(Points<Dim>& out) {
+  template <class Out>
+  void evaluate_interior(Out& out) {
     const auto n_eval = static_cast<Index>(evaluated_.size());
     if (is_compact(options_.kernel) || evaluation_cached()) {
       if (evaluation_cached())
@@ -253,7 +277,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   }
 
   /// Transpose of evaluate_interior: ᾱ = Eᵀ v_eval, β̄ = Σ q(x_i) v_iᵀ over interior nodes.
-  void interior_transpose(const Points<Dim>& v, Eigen::MatrixXd& alpha_bar, Poly& beta_bar) const {
+  void interior_transpose(const Eigen::Ref<const Points<Dim>>& v, Eigen::MatrixXd& alpha_bar, Poly& beta_bar) const {
     const Index k = all_.size();
     Eigen::MatrixXd v_eval(static_cast<Index>(evaluated_.size()), Dim);
     for (std::size_t r = 0; r < evaluated_.size(); ++r) v_eval.row(static_cast<Index>(r)) = v.col(evaluated_[r]).transpose();
@@ -422,13 +446,12 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
 
 template <int Dim>
 void RbfMover<Dim>::move_into(const Points<Dim>& d, Points<Dim>& out) {
-  detail::timed_move<Dim>("RbfMover::move", ready_, d, boundary_nodes_, stats_, [&] {
-    apply(d, out);
-    const SolverReport& r = all_.report();
-    stats_.iterations = r.iterations;
-    stats_.residual = r.residual;
-    stats_.fell_back = r.fell_back;
-  });
+  timed_apply(d, out);
+}
+
+template <int Dim>
+void RbfMover<Dim>::move_into(const Points<Dim>& d, Eigen::Ref<Points<Dim>> out) {
+  timed_apply(d, out);
 }
 
 template <int Dim>
@@ -441,11 +464,9 @@ Points<Dim> RbfMover<Dim>::derivative_forward(const Points<Dim>& w) {
 }
 
 template <int Dim>
-Points<Dim> RbfMover<Dim>::derivative_reverse(const Points<Dim>& v) {
+Points<Dim> RbfMover<Dim>::derivative_reverse(Eigen::Ref<const Points<Dim>> v) {
   require_ready("derivative_reverse");
-  if (v.cols() != points_.cols() || !v.allFinite())
-    throw InputError("RbfMover::derivative_reverse: v must be finite and " + std::to_string(Dim) + " × " +
-                     std::to_string(points_.cols()) + " (got " + std::to_string(v.cols()) + " columns)");
+  detail::check_node_field<Dim>("RbfMover::derivative_reverse", v, points_.cols());
   const Index m = static_cast<Index>(boundary_nodes_.size());
   const Index k = all_.size();
   Points<Dim> grad = Points<Dim>::Zero(Dim, m);

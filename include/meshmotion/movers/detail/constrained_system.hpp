@@ -111,6 +111,31 @@ class ConstrainedSystem {
       for (Index a = 0; a < Dim; ++a) out(a, i) = c == 1 ? full_(i, a) : full_(i * Dim + a, 0);
   }
 
+  /// The transpose of solve(): for v (Dim × n_nodes), the gradient (Dim × m, boundary order)
+  /// of ⟨v, solve(d)⟩ with respect to d. With u = S d − P A⁻¹ C d (A = Pᵀ K P symmetric,
+  /// C = Pᵀ K S) it is Sᵀ v − Cᵀ A⁻¹ Pᵀ v: one more solve with the same factorization.
+  /// Sliding columns are zero (solve() ignores them).
+  void solve_transpose(const Eigen::Ref<const Points<Dim>>& v, Points<Dim>& gradient) {
+    const auto m = static_cast<Index>(boundary_nodes_.size());
+    const Index c = components_;
+    const Index columns = c == 1 ? Dim : 1;
+    const Index n = p_.rows() / c;
+    adjoint_full_.resize(n * c, columns);
+    for (Index i = 0; i < n; ++i)
+      for (Index a = 0; a < Dim; ++a) (c == 1 ? adjoint_full_(i, a) : adjoint_full_(i * Dim + a, 0)) = v(a, i);
+    adjoint_values_.noalias() = s_.transpose() * adjoint_full_;
+    if (p_.cols() > 0) {
+      adjoint_rhs_.noalias() = p_.transpose() * adjoint_full_;
+      solver_.solve(adjoint_rhs_, adjoint_x_);
+      adjoint_values_.noalias() -= coupling_.transpose() * adjoint_x_;
+    }
+    gradient.setZero(Dim, m);
+    for (Index k = 0; k < m; ++k) {
+      if (kinds_[static_cast<std::size_t>(k)] == BoundaryKind::sliding) continue;
+      for (Index a = 0; a < Dim; ++a) gradient(a, k) = c == 1 ? adjoint_values_(k, a) : adjoint_values_(k * Dim + a, 0);
+    }
+  }
+
   [[nodiscard]] const SolverReport& report() const noexcept { return solver_.report(); }
   [[nodiscard]] Index nonzeros() const noexcept { return nonzeros_; }
   [[nodiscard]] Index unknowns() const noexcept { return p_.cols(); }
@@ -131,6 +156,8 @@ class ConstrainedSystem {
   LinearSolver solver_;
   Index nonzeros_ = 0;
   Eigen::MatrixXd values_, rhs_, x_, full_;
+  // The transposed solve's own vectors, so the iterative solvers' warm start of solve() is kept.
+  Eigen::MatrixXd adjoint_full_, adjoint_values_, adjoint_rhs_, adjoint_x_;
 };
 
 }  // namespace meshmotion::detail

@@ -122,6 +122,16 @@ class GraphInterpolation {
     }
   }
 
+  /// The transpose of interpolate(): values_bar.col(vertex_jk) += w_jk out_bar.col(k) for every
+  /// query k (`out_bar` Rows × q, `values_bar` Rows × m, accumulated into).
+  template <int Rows>
+  void interpolate_transpose(const Eigen::Matrix<double, Rows, Eigen::Dynamic>& out_bar,
+                             Eigen::Matrix<double, Rows, Eigen::Dynamic>& values_bar) const {
+    // Serial: queries share vertices, and a scatter per query is a few flops.
+    for (Index k = 0; k < num_queries(); ++k)
+      for (int j = 0; j < corners; ++j) values_bar.col(vertices_(j, k)) += weights_(j, k) * out_bar.col(k);
+  }
+
   /// Graph simplices inverted or flattened with the graph points at `moved` (Dim × m).
   [[nodiscard]] std::vector<Index> inverted_simplices(const Points<Dim>& moved) const {
     return mapping_->inverted_simplices(moved);

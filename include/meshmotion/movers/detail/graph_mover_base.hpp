@@ -119,6 +119,45 @@ class GraphMoverBase {
         [](const Vec<Dim>&, const Vec<Dim>& u) { return u; }, check_inversion, out);
   }
 
+  /// Forward derivative of interpolate_displacements() (linear in the boundary change `w`,
+  /// Dim × boundary.size(), and the extra nodes' change `extra`, Dim × extra.size()): their
+  /// interpolation, without the inversion check.
+  [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w, const Points<Dim>& extra) {
+    if (!ready_) throw InputError(who_ + "::derivative_forward: setup() was not called");
+    check_displacements<Dim>(who_ + "::derivative_forward", w, boundary_.nodes);
+    Points<Dim> out;
+    interpolate_displacements(w, extra, false, out);
+    return out;
+  }
+
+  /// Reverse derivative of interpolate_displacements(): for v (Dim × n_nodes), the gradient of
+  /// ⟨v, move(d)⟩ with respect to the graph nodes' displacements (Dim × graph size: the
+  /// boundary entries, then the extra nodes). Sliding entries are zero (move() ignores them);
+  /// their share reaches the nodes they are interpolated from.
+  [[nodiscard]] Points<Dim> derivative_reverse(const Eigen::Ref<const Points<Dim>>& v) const {
+    if (!ready_) throw InputError(who_ + "::derivative_reverse: setup() was not called");
+    check_node_field<Dim>(who_ + "::derivative_reverse", v, points_.cols());
+    const auto n_graph = static_cast<Index>(graph_nodes_.size());
+    Points<Dim> graph_bar(Dim, n_graph);
+    for (Index g = 0; g < n_graph; ++g) graph_bar.col(g) = v.col(graph_nodes_[static_cast<std::size_t>(g)]);
+    Points<Dim> query_bar(Dim, static_cast<Index>(queries_.size()));
+    for (std::size_t k = 0; k < queries_.size(); ++k) query_bar.col(static_cast<Index>(k)) = v.col(queries_[k]);
+    graph_.interpolate_transpose(query_bar, graph_bar);
+    if (!sliding_.empty()) {
+      // A sliding entry was overwritten by the projection of the sliding graph's value.
+      Points<Dim> sliding_bar(Dim, static_cast<Index>(sliding_.size()));
+      for (std::size_t s = 0; s < sliding_.size(); ++s) {
+        const Index g = sliding_[s];
+        sliding_bar.col(static_cast<Index>(s)) = boundary_.project(g, Vec<Dim>(graph_bar.col(g)));  // symmetric projector
+        graph_bar.col(g).setZero();
+      }
+      Points<Dim> constrained_bar = Points<Dim>::Zero(Dim, static_cast<Index>(constrained_.size()));
+      sliding_graph_.interpolate_transpose(sliding_bar, constrained_bar);
+      for (std::size_t c = 0; c < constrained_.size(); ++c) graph_bar.col(constrained_[c]) += constrained_bar.col(static_cast<Index>(c));
+    }
+    return graph_bar;
+  }
+
   /// The interpolation of move() without its checks and timing (for movers that time a
   /// larger move themselves).
   template <int Rows, class Encode, class Decode>

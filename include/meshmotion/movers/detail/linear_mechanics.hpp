@@ -76,6 +76,17 @@ class LinearMechanicsMover {
     copy_to_caller<Dim>((name_ + "::move_into").c_str(), scratch_, out);
   }
 
+  /// Forward derivative J w (Dim × n_nodes) for a boundary displacement change w (Dim ×
+  /// boundary.size()): the mover is linear in the displacements, so this is move(w), without
+  /// counting as a move. Throws as move().
+  [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w);
+
+  /// Reverse derivative Jᵀ v: for v (Dim × n_nodes), the gradient of ⟨v, move(d)⟩ with respect
+  /// to d (Dim × boundary.size()); one solve with the factorization of setup (the reduced
+  /// matrix is symmetric). Sliding nodes' entries are zero (move() ignores their input).
+  /// Throws InputError for a missing setup, a wrong shape or a non-finite value.
+  [[nodiscard]] Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>> v);
+
  protected:
   explicit LinearMechanicsMover(std::string name) : name_(std::move(name)) {}
 
@@ -94,6 +105,7 @@ class LinearMechanicsMover {
                     const SolverOptions& solver, const Stopwatch& watch, const std::vector<bool>* free_nodes = nullptr) {
     stiffness_ = std::move(k);
     boundary_nodes_ = boundary.nodes;
+    num_nodes_ = mesh.num_nodes();
     system_.build(components, free_nodes != nullptr ? *free_nodes : cell_nodes(mesh), boundary, solver);
     system_.factorize(stiffness_);
     stats_ = MoverStats{};
@@ -111,6 +123,7 @@ class LinearMechanicsMover {
  private:
   SparseMatrix stiffness_;
   std::vector<Index> boundary_nodes_;
+  Index num_nodes_ = 0;
   ConstrainedSystem<Dim> system_;
   bool ready_ = false;
   Points<Dim> scratch_;  // a move into the caller's storage
@@ -122,6 +135,24 @@ void LinearMechanicsMover<Dim>::move_into(const Points<Dim>& d, Points<Dim>& out
     system_.solve(d, out);
     system_.record(stats_);
   });
+}
+
+template <int Dim>
+Points<Dim> LinearMechanicsMover<Dim>::derivative_forward(const Points<Dim>& w) {
+  if (!ready_) throw InputError(name_ + "::derivative_forward: setup() was not called");
+  check_displacements<Dim>(name_ + "::derivative_forward", w, boundary_nodes_);
+  Points<Dim> out;
+  system_.solve(w, out);
+  return out;
+}
+
+template <int Dim>
+Points<Dim> LinearMechanicsMover<Dim>::derivative_reverse(Eigen::Ref<const Points<Dim>> v) {
+  if (!ready_) throw InputError(name_ + "::derivative_reverse: setup() was not called");
+  check_node_field<Dim>(name_ + "::derivative_reverse", v, num_nodes_);
+  Points<Dim> gradient;
+  system_.solve_transpose(v, gradient);
+  return gradient;
 }
 
 }  // namespace meshmotion::detail

@@ -67,6 +67,17 @@ void check_displacements(std::string_view where, const Points<Dim>& d, const std
                        " is not finite");
 }
 
+/// Throws InputError unless v (a field over the nodes, e.g. a reverse derivative's seed) is
+/// finite and Dim × n_nodes, naming the first non-finite node.
+template <int Dim>
+void check_node_field(std::string_view where, const Eigen::Ref<const Points<Dim>>& v, Index n_nodes) {
+  if (v.cols() != n_nodes)
+    throw InputError(std::string(where) + ": got " + std::to_string(v.cols()) + " columns (expected " +
+                     std::to_string(n_nodes) + ", one per node)");
+  for (Index i = 0; i < n_nodes; ++i)
+    if (!v.col(i).allFinite()) throw InputError(std::string(where) + ": value of node " + std::to_string(i) + " is not finite");
+}
+
 /// One move: throws InputError unless `ready` (setup ran) and `d` fits `nodes`
 /// (check_displacements), runs body(), then counts the move and records its time in `stats`.
 template <int Dim, class Body>
