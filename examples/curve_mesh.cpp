@@ -14,9 +14,7 @@
 #include "meshmotion/core/option_text.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/curving/curve_mesh.hpp"
-#include "meshmotion/curving/function_graph.hpp"
-#include "meshmotion/curving/geometry.hpp"
-#include "meshmotion/curving/naca_section.hpp"
+#include "meshmotion/curving/geometry_text.hpp"
 #include "meshmotion/io/mesh_io.hpp"
 #include "meshmotion/io/vtu_writer.hpp"
 #include "meshmotion/quality/svg_picture.hpp"
@@ -32,7 +30,6 @@
 #include <filesystem>
 #include <iostream>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <variant>
 #include <vector>
@@ -67,67 +64,6 @@ struct Arguments {
   examples::MoverArguments mover;
 };
 
-std::vector<double> numbers(const std::string& text, const std::string& spec) {
-  std::vector<double> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    try {
-      std::size_t used = 0;
-      out.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw InputError("--geometry " + spec + ": '" + item + "' is not a number");
-    }
-  }
-  return out;
-}
-
-// "spline" (2D) / "reconstruct" (3D triangles): from the linear mesh; "straight";
-// "circle:X,Y,R", "sphere:X,Y,Z,R", "naca:XXXX[,chord,x0,y0]", "bump".
-template <int Dim>
-BoundaryGeometry<Dim> parse_geometry(const std::string& spec) {
-  const auto colon = spec.find(':');
-  const std::string kind = spec.substr(0, colon);
-  const std::string rest = colon == std::string::npos ? "" : spec.substr(colon + 1);
-  const auto expect = [&](const std::vector<double>& v, std::size_t n, const char* form) {
-    if (v.size() != n) throw InputError("--geometry " + spec + ": expected " + form);
-  };
-  if (kind == "spline" || kind == "reconstruct") return BoundaryGeometry<Dim>::spline();
-  if (kind == "straight") return BoundaryGeometry<Dim>::straight();
-  if (kind == "bump") {
-    if constexpr (Dim == 2) return BoundaryGeometry<Dim>::project(nasa_bump_2d());
-    else return BoundaryGeometry<Dim>::project(nasa_bump_3d());
-  }
-  if constexpr (Dim == 2) {
-    if (kind == "circle") {
-      const auto v = numbers(rest, spec);
-      expect(v, 3, "circle:X,Y,R");
-      return BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>(v[0], v[1]), v[2]));
-    }
-    if (kind == "naca") {
-      const std::string digits = rest.substr(0, rest.find(','));
-      NacaParameters params = naca4(digits);
-      if (rest.size() > digits.size()) {
-        const auto v = numbers(rest.substr(digits.size() + 1), spec);
-        expect(v, 3, "naca:XXXX,CHORD,X0,Y0");
-        params.chord = v[0];
-        params.leading_edge = Vec<2>(v[1], v[2]);
-      }
-      return BoundaryGeometry<2>::project(NacaProjection(params));
-    }
-  } else {
-    if (kind == "sphere") {
-      const auto v = numbers(rest, spec);
-      expect(v, 4, "sphere:X,Y,Z,R");
-      return BoundaryGeometry<3>::project(SphereProjection<3>(Vec<3>(v[0], v[1], v[2]), v[3]));
-    }
-  }
-  throw InputError("--geometry: unknown or wrong-dimension geometry '" + spec +
-                   "' (expected spline, straight, bump, circle:X,Y,R or naca:XXXX[,CHORD,X0,Y0] in 2D, "
-                   "sphere:X,Y,Z,R in 3D)");
-}
-
 template <int Dim>
 CurveOptions<Dim> curve_options(const Arguments& args) {
   CurveOptions<Dim> options;
@@ -156,7 +92,7 @@ CurveOptions<Dim> curve_options(const Arguments& args) {
     throw InputError("--geometry: " + std::to_string(args.geometry.size()) + " geometries for " +
                      std::to_string(groups.size()) + " groups (expected one for all, or one per --group)");
   for (std::size_t g = 0; g < groups.size() && !args.geometry.empty(); ++g)
-    options.geometry.insert_or_assign(groups[g], parse_geometry<Dim>(args.geometry[args.geometry.size() == 1 ? 0 : g]));
+    options.geometry.insert_or_assign(groups[g], geometry_from_text<Dim>(args.geometry[args.geometry.size() == 1 ? 0 : g]));
   if (!args.json)
     options.progress = [start = std::chrono::steady_clock::now()](const std::string& line) {
       const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -11,5 +11,6 @@
 #include "meshmotion/curving/curve_mesh.hpp"
 #include "meshmotion/curving/function_graph.hpp"
 #include "meshmotion/curving/geometry.hpp"
+#include "meshmotion/curving/geometry_text.hpp"
 #include "meshmotion/curving/naca_section.hpp"
 #include "meshmotion/curving/p2_conversion.hpp"
