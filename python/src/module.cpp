@@ -12,10 +12,13 @@
 #include "meshmotion/core/option_text.hpp"
 #include "meshmotion/core/orientation.hpp"
 #include "meshmotion/core/threads.hpp"
+#include "meshmotion/curving/curve_mesh.hpp"
+#include "meshmotion/curving/geometry_text.hpp"
 #include "meshmotion/io/mesh_io.hpp"
 #include "meshmotion/movers/any_mover.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/mover_options.hpp"
+#include "meshmotion/quality/cell_quality.hpp"
 #include "meshmotion/quality/quality_report.hpp"
 #include "meshmotion/version.hpp"
 
@@ -25,6 +28,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <cmath>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -79,6 +83,26 @@ py::array_t<double> to_rows(Points<Dim> p) {
                              owner->data(), free_when_done);
 }
 
+py::dict report_dict(const QualityReport& r);
+
+// The per-cell values and validity (cell order) beside the report's summary.
+template <int Dim>
+py::dict quality_dict(const Mesh<Dim>& mesh, Metric metric) {
+  const std::vector<CellQuality> cells = evaluate_cells(mesh, metric);
+  py::dict d = report_dict(make_report(mesh, metric, cells));
+  py::array_t<double> values(static_cast<py::ssize_t>(cells.size()));
+  py::array_t<bool> valid(static_cast<py::ssize_t>(cells.size()));
+  auto v = values.mutable_unchecked<1>();
+  auto ok = valid.mutable_unchecked<1>();
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    v(static_cast<py::ssize_t>(c)) = cells[c].value;
+    ok(static_cast<py::ssize_t>(c)) = cells[c].valid;
+  }
+  d["values"] = values;
+  d["valid"] = valid;
+  return d;
+}
+
 py::dict report_dict(const QualityReport& r) {
   py::dict d;
   d["metric"] = std::string(metric_name(r.metric));
@@ -126,6 +150,96 @@ ElementType element_type_named(const std::string& type_name) {
   throw InputError("unknown element type '" + type_name + "' (expected one of " + known + ")");
 }
 
+// The connectivity of a block as an (n_cells, nodes_per_cell) int64 view kept alive by `owner`.
+py::array_t<Index> connectivity_view(ElementBlock& b, const py::object& owner) {
+  const auto npc = static_cast<py::ssize_t>(b.nodes_per_element());
+  return py::array_t<Index>({static_cast<py::ssize_t>(b.size()), npc},
+                            {static_cast<py::ssize_t>(npc * sizeof(Index)), static_cast<py::ssize_t>(sizeof(Index))},
+                            b.connectivity.data(), owner);
+}
+
+// Python number → double, refusing anything else (a bool, a string) with the key's name.
+double number_option(const std::string& key, const py::handle& value) {
+  if (py::isinstance<py::bool_>(value) || !(py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value)))
+    throw InputError("curve_mesh: option '" + key + "' expects a number (got " + py::repr(value).cast<std::string>() + ")");
+  return value.cast<double>();
+}
+
+bool bool_option(const std::string& key, const py::handle& value) {
+  if (!py::isinstance<py::bool_>(value))
+    throw InputError("curve_mesh: option '" + key + "' expects True or False (got " + py::repr(value).cast<std::string>() + ")");
+  return value.cast<bool>();
+}
+
+// curve_mesh's keywords: the pipeline's own (CurveOptions) by name, every other one a typed
+// option of the mover, checked by the library's parser.
+template <int Dim>
+CurveOptions<Dim> curve_options(const py::kwargs& kwargs) {
+  CurveOptions<Dim> o;
+  KeyValues mover;
+  const std::map<std::string, double*> numbers{
+      {"support_radius", &o.support_radius},         {"support_radius_factor", &o.support_radius_factor},
+      {"active_radius_factor", &o.active_radius_factor}, {"max_support_nodes", &o.max_support_nodes},
+      {"centre_reach", &o.centre_reach},             {"blending_length", &o.blending_length},
+      {"blending_factor", &o.blending_factor},       {"corner_angle", &o.snap.corner_angle}};
+  const std::map<std::string, bool*> flags{
+      {"per_wall_radius", &o.per_wall_radius}, {"spline_by_default", &o.spline_by_default}, {"strict", &o.strict}};
+  for (const auto& [key_handle, value] : kwargs) {
+    const auto key = py::cast<std::string>(key_handle);
+    if (const auto n = numbers.find(key); n != numbers.end()) {
+      *n->second = number_option(key, value);
+    } else if (const auto f = flags.find(key); f != flags.end()) {
+      *f->second = bool_option(key, value);
+    } else if (key == "method") {
+      o.method = py::cast<std::string>(value);
+    } else if (key == "steps") {
+      const double steps = number_option(key, value);
+      if (!(steps >= 1.0) || steps != std::floor(steps) || steps > 1e6)
+        throw InputError("curve_mesh: option 'steps' expects a positive integer (got " + py::cast<std::string>(py::repr(value)) + ")");
+      o.steps = static_cast<int>(steps);
+    } else if (key == "sliding") {
+      o.sliding = py::cast<std::vector<std::string>>(value);
+    } else if (key == "geometry") {
+      for (const auto& [group, spec] : py::cast<py::dict>(value))
+        o.geometry.insert_or_assign(py::cast<std::string>(group), geometry_from_text<Dim>(py::cast<std::string>(spec)));
+    } else {
+      mover.emplace_back(key, option_text(key, value));
+    }
+  }
+  if (o.method == "blend" || o.method == "none") {
+    if (!mover.empty())
+      throw InputError("curve_mesh: method '" + o.method + "' takes no mover option (got '" + mover.front().first + "')");
+  } else {
+    o.mover_options = mover_config<Dim>(o.method, mover).options;
+  }
+  return o;
+}
+
+template <int Dim>
+py::dict curve_report(const CurveResult<Dim>& r) {
+  py::dict d;
+  d["method"] = r.method;
+  d["num_linear_nodes"] = r.num_linear_nodes;
+  d["support_radius"] = r.support_radius;
+  d["wall_support_radii"] = r.wall_support_radii;
+  d["snapped_nodes"] = r.snapped_nodes;
+  d["moved_vertices"] = r.moved_vertices;
+  d["max_boundary_displacement"] = r.max_boundary_displacement;
+  d["moved_nodes"] = r.moved_nodes;
+  d["solver_iterations"] = r.solver_iterations;
+  d["invalid"] = r.invalid();
+  d["quality"] = report_dict(r.quality);
+  py::dict seconds;
+  seconds["quadratic"] = r.seconds.quadratic;
+  seconds["snap"] = r.seconds.snap;
+  seconds["layer"] = r.seconds.layer;
+  seconds["regularize"] = r.seconds.regularize;
+  seconds["certify"] = r.seconds.certify;
+  seconds["total"] = r.seconds.total;
+  d["seconds"] = seconds;
+  return d;
+}
+
 template <int Dim>
 void bind_dimension(py::module_& m) {
   const std::string suffix = std::to_string(Dim);
@@ -150,19 +264,28 @@ void bind_dimension(py::module_& m) {
       .def_property_readonly(
           "cells",
           [](py::object self) {
-            M& mesh = self.cast<M&>();
             py::list out;
-            for (auto& b : mesh.cells) {
-              const auto npc = static_cast<py::ssize_t>(b.nodes_per_element());
-              out.append(py::make_tuple(std::string(name(b.type)),
-                                        py::array_t<Index>({static_cast<py::ssize_t>(b.size()), npc},
-                                                           {static_cast<py::ssize_t>(npc * sizeof(Index)),
-                                                            static_cast<py::ssize_t>(sizeof(Index))},
-                                                           b.connectivity.data(), self)));
-            }
+            for (auto& b : self.cast<M&>().cells) out.append(py::make_tuple(std::string(name(b.type)), connectivity_view(b, self)));
             return out;
           },
           "cell blocks as (type name, (n_cells, nodes_per_cell) int64 view) pairs")
+      .def_property_readonly(
+          "facets",
+          [](py::object self) {
+            py::list out;
+            for (auto& b : self.cast<M&>().facets)
+              out.append(py::make_tuple(std::string(name(b.type)), connectivity_view(b, self), py::array(py::cast(b.tags))));
+            return out;
+          },
+          "boundary facet blocks as (type name, (n_facets, nodes_per_facet) int64 view, group tag per facet)")
+      .def_property_readonly("group_tags",
+                             [](const M& mesh) {
+                               py::dict out;
+                               for (const auto& g : mesh.groups)
+                                 if (!g.name.empty()) out[py::str(g.name)] = py::make_tuple(g.dim, g.tag);
+                               return out;
+                             },
+                             "named groups: name → (dimension, tag) of the blocks' tags")
       .def_property_readonly("groups",
                              [](const M& mesh) {
                                py::dict out;
@@ -198,13 +321,15 @@ void bind_dimension(py::module_& m) {
             b.tags.insert(b.tags.end(), static_cast<std::size_t>(a.shape(0)), tag);
           };
           for (const auto& [type_name, a] : cells) add(type_name, a, 0, "cell");
-          int tag = 0;
+          // A group given as several facet blocks (triangles and quadrilaterals) keeps one tag.
+          std::map<std::string, int> tag_of;
           for (const auto& [group, type_name, a] : groups) {
             if (dimension(element_type_named(type_name)) != Dim - 1)
               throw InputError("from_arrays: group '" + group + "': " + type_name + " is not a facet type of a " +
                                std::to_string(Dim) + "D mesh");
-            add(type_name, a, ++tag, "group");
-            mesh.groups.push_back({Dim - 1, tag, group});
+            const auto [it, added] = tag_of.try_emplace(group, static_cast<int>(tag_of.size()) + 1);
+            add(type_name, a, it->second, "group");
+            if (added) mesh.groups.push_back({Dim - 1, it->second, group});
           }
           validate(mesh);
           return mesh;
@@ -297,15 +422,44 @@ void bind_dimension(py::module_& m) {
       .def_property_readonly("stats", [](const A& a) { return stats_dict(a.stats()); })
       .def_property_readonly("has_derivatives", &A::has_derivatives)
       .def("derivative_forward",
-           [](A& a, const py::array& w) { return to_rows<Dim>(a.derivative_forward(Points<Dim>(rows_of<Dim>(w, "derivative_forward: w")))); },
-           py::arg("w"))
+           [](A& a, const py::array& w) {
+             const Points<Dim> in = rows_of<Dim>(w, "derivative_forward: w");
+             Points<Dim> out;
+             {
+               py::gil_scoped_release release;
+               out = a.derivative_forward(in);
+             }
+             return to_rows<Dim>(std::move(out));
+           },
+           py::arg("w"), "J w: node displacement changes (n, dim) for boundary changes w (boundary size, dim)")
       .def("derivative_reverse",
-           [](A& a, const py::array& v) { return to_rows<Dim>(a.derivative_reverse(Points<Dim>(rows_of<Dim>(v, "derivative_reverse: v")))); },
-           py::arg("v"));
+           [](A& a, const py::array& v) {
+             // v is read in place (no copy of the (n, dim) seed).
+             const Eigen::Map<const Points<Dim>> seed = rows_of<Dim>(v, "derivative_reverse: v");
+             Points<Dim> out;
+             {
+               py::gil_scoped_release release;
+               out = a.derivative_reverse(seed);
+             }
+             return to_rows<Dim>(std::move(out));
+           },
+           py::arg("v"), "Jᵀ v: the gradient (boundary size, dim) of <v, move(d)> for v (n, dim)");
 
-  m.def("quality_report",
-        [](const M& mesh, const std::string& metric) { return report_dict(quality_report(mesh, metric_from_name(metric))); },
+  m.def("quality_report", [](const M& mesh, const std::string& metric) { return quality_dict(mesh, metric_from_name(metric)); },
         py::arg("mesh"), py::arg("metric") = "jacobian");
+  m.def(
+      "curve_mesh",
+      [](const M& mesh, const py::kwargs& kwargs) {
+        const CurveOptions<Dim> options = curve_options<Dim>(kwargs);
+        CurveResult<Dim> result;
+        {
+          py::gil_scoped_release release;
+          result = curve_mesh(mesh, options);
+        }
+        py::dict report = curve_report(result);
+        return py::make_tuple(py::cast(std::move(result.curved)), report);
+      },
+      py::arg("mesh"));
   m.def("write_mesh", [](const std::filesystem::path& file, const M& mesh) { write_mesh(file, mesh); }, py::arg("file"),
         py::arg("mesh"));
 }
@@ -362,6 +516,13 @@ PYBIND11_MODULE(_core, m) {
   m.def("mover_options", [](const std::string& method, int dim) {
     return dim == 2 ? mover_config<2>(method).values() : mover_config<3>(method).values();
   }, py::arg("method"), py::arg("dim") = 3, "the keys of a method with their default values (as text)");
+  m.def(
+      "vtk_order",
+      [](const std::string& type_name) {
+        const auto order = vtk_order(element_type_named(type_name));
+        return std::vector<int>(order.begin(), order.end());
+      },
+      py::arg("type"), "VTK's node i is our local node order[i] (classic VTK cells); empty: the same order");
   m.def("set_num_threads", &set_num_threads, py::arg("n"));
   m.def("num_threads", &num_threads);
 }
