@@ -71,7 +71,7 @@ for name in "${order[@]}"; do
   [[ -f "$here/$name.cpp" ]] && benches+=("$name")
 done
 targets=("${benches[@]}")
-[[ $peers == 1 ]] && targets+=(motion_peer_bench)
+[[ $peers == 1 ]] && targets+=(motion_peer_bench python_overhead_peer meshmotion_python)
 
 {
   echo "# $(date -u +%FT%TZ)  nproc=$(nproc)  $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //')"
@@ -119,6 +119,13 @@ if [[ $peers == 1 ]]; then
   for name in "${peer_scripts[@]}"; do
     run "$name" "$here/$name.sh" "$build_dir" "$build_dir/$name"
   done
+  # Python against C++ on the same job, for Debian's interpreter (docs/python.md).
+  if [[ -f "$build_dir/python/meshmotion/__init__.py" ]]; then
+    run python_overhead env PYTHONPATH="$build_dir/python" /usr/bin/python3 "$here/python_overhead.py" \
+      --peer "$build_dir/benchmarks/python_overhead_peer"
+  else
+    echo "run_all.sh: the Python module was not built (pybind11 absent?): python_overhead skipped" | tee -a "$log" >&2
+  fi
 fi
 
 python3 "$here/plot_results.py" "$out" --out-dir "$build_dir/plots" | tee -a "$log"

@@ -277,22 +277,28 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   }
 
   /// Transpose of evaluate_interior: ᾱ = Eᵀ v_eval, β̄ = Σ q(x_i) v_iᵀ over interior nodes.
-  void interior_transpose(const Eigen::Ref<const Points<Dim>>& v, Eigen::MatrixXd& alpha_bar, Poly& beta_bar) const {
+  /// The seed's rows are gathered into a buffer kept across calls (a reverse product per
+  /// optimization iteration should not pay fresh pages for a volume-sized array).
+  void interior_transpose(const Eigen::Ref<const Points<Dim>>& v, Eigen::MatrixXd& alpha_bar, Poly& beta_bar) {
     const Index k = all_.size();
-    Eigen::MatrixXd v_eval(static_cast<Index>(evaluated_.size()), Dim);
-    for (std::size_t r = 0; r < evaluated_.size(); ++r) v_eval.row(static_cast<Index>(r)) = v.col(evaluated_[r]).transpose();
+    const auto gather = [&](const std::vector<Index>& nodes) {
+      seed_rows_.resize(static_cast<Index>(nodes.size()), Dim);
+      for (std::size_t r = 0; r < nodes.size(); ++r) seed_rows_.row(static_cast<Index>(r)) = v.col(nodes[r]).transpose();
+    };
+    gather(evaluated_);
     if (evaluation_cached()) {
-      alpha_bar = dense_operator_.transpose() * v_eval;
+      alpha_bar.noalias() = dense_operator_.transpose() * seed_rows_;
     } else if (is_compact(options_.kernel)) {
-      alpha_bar = operator_.transpose() * v_eval;
+      alpha_bar.noalias() = operator_.transpose() * seed_rows_;
     } else {
       alpha_bar.setZero(k, Dim);
       for (std::size_t r = 0; r < evaluated_.size(); ++r)
-        alpha_bar += kernel_row(points_.col(evaluated_[r])).transpose() * v_eval.row(static_cast<Index>(r));
+        alpha_bar += kernel_row(points_.col(evaluated_[r])).transpose() * seed_rows_.row(static_cast<Index>(r));
     }
-    Eigen::MatrixXd v_interior(static_cast<Index>(interior_.size()), Dim);
-    for (std::size_t r = 0; r < interior_.size(); ++r) v_interior.row(static_cast<Index>(r)) = v.col(interior_[r]).transpose();
-    beta_bar = polynomial_transpose(all_, interior_, points_, v_interior);
+    beta_bar = Poly::Zero();
+    if (!options_.polynomial) return;
+    gather(interior_);
+    beta_bar = polynomial_transpose(all_, interior_, points_, seed_rows_);
   }
 
   RbfOptions options_;
@@ -315,6 +321,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   Operator operator_;                       ///< evaluated_ × centres (compact kernels)
   Eigen::MatrixXd dense_operator_;          ///< evaluated_ × centres, when cached
   Eigen::MatrixXd values_, alpha_, evaluated_values_;
+  Eigen::MatrixXd seed_rows_;               ///< a reverse product's seed, gathered by rows
   Poly beta_ = Poly::Zero();
 };
 
