@@ -354,8 +354,11 @@ TEST_CASE("VTK Lagrange node orders put each VTK node where VTK expects it", "[i
     REQUIRE(static_cast<std::size_t>(num_nodes(type)) == expected.size());
     for (std::size_t k = 0; k < expected.size(); ++k) {
       std::array<double, 3> centroid{};
-      for (const int v : expected[k])
+      for (const int vtk_vertex : expected[k]) {
+        // VTK's vertex v is our node order[v]: the vertices come first in both orders.
+        const int v = order.empty() ? vtk_vertex : order[static_cast<std::size_t>(vtk_vertex)];
         for (int d = 0; d < 3; ++d) centroid[static_cast<std::size_t>(d)] += ref[static_cast<std::size_t>(v)][static_cast<std::size_t>(d)] / static_cast<double>(expected[k].size());
+      }
       const auto ours = ref[static_cast<std::size_t>(order.empty() ? static_cast<int>(k) : order[k])];
       INFO("VTK node " << k);
       for (int d = 0; d < 3; ++d) CHECK(ours[static_cast<std::size_t>(d)] == Approx(centroid[static_cast<std::size_t>(d)]).margin(1e-14));

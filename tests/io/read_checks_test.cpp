@@ -123,3 +123,50 @@ TEST_CASE("the worst cell is named by the id the written .msh gives it", "[io][q
   CHECK(found);
   CHECK(q.worst[0].file_id == static_cast<std::int64_t>(mesh.num_facets()) + q.worst[0].id + 1);
 }
+
+TEST_CASE("SU2 prisms are in VTK's order: the base turns away from the top (issue 21)", "[io][orientation]") {
+  // One prism as SU2 (VTK) lists it: base (0,1,2) clockwise seen from the top triangle (3,4,5).
+  const std::string prism = "NDIME= 3\nNELEM= 1\n13 0 1 2 3 4 5 0\nNPOIN= 6\n"
+                            "0 0 0 0\n0 1 0 1\n1 0 0 2\n0 0 1 3\n0 1 1 4\n1 0 1 5\n"
+                            "NMARK= 1\nMARKER_TAG= bottom\nMARKER_ELEMS= 1\n5 0 1 2\n";
+  const fs::path file = test::scratch_path("vtk_prism.su2");
+  write_file(file, prism);
+  const Mesh<3> mesh = read_mesh_as<3>(file);
+  CHECK(orientation_report(mesh).num_negative == 0);
+  CHECK(quality_report(mesh, Metric::scaled_jacobian).num_invalid == 0);
+
+  // Every type of a positive mixed mesh keeps its orientation and numbering through a file.
+  for (const auto cells : {BoxCells::prism6, BoxCells::tet_pyramid_prism, BoxCells::hex_prism}) {
+    const Mesh<3> box = box_mesh({.nx = 3, .ny = 2, .nz = 2, .cells = cells});
+    REQUIRE(orientation_report(box).num_negative == 0);
+    const fs::path out = test::scratch_path("box_prisms.su2");
+    write_mesh(out, box);
+    const Mesh<3> back = read_mesh_as<3>(out);
+    CHECK(orientation_report(back).num_negative == 0);
+    for (std::size_t b = 0; b < box.cells.size(); ++b) CHECK(back.cells[b].connectivity == box.cells[b].connectivity);
+  }
+  // The writer lists a prism in VTK's order, as SU2 reads it.
+  const std::string text = format_su2(box_mesh({.nx = 1, .ny = 1, .nz = 1, .cells = BoxCells::prism6}));
+  const Mesh<3> one = box_mesh({.nx = 1, .ny = 1, .nz = 1, .cells = BoxCells::prism6});
+  const auto p = one.cells.front().element(0);
+  std::ostringstream line;
+  line << "\n13\t" << p[0] << '\t' << p[2] << '\t' << p[1] << '\t' << p[3] << '\t' << p[5] << '\t' << p[4] << "\t0\n";
+  CHECK(text.find(line.str()) != std::string::npos);
+}
+
+TEST_CASE("SU2 sections after the markers (periodic transformations, FFD boxes) are read past", "[io]") {
+  const std::string extra = "NPERIODIC= 1\nPERIODIC_INDEX= 0\n0 0 0\n0 0 0\n0 0 0\n"
+                            "FFD_NBOX= 1\nFFD_NLEVEL= 1\nFFD_TAG= BOX\nFFD_LEVEL= 0\nFFD_DEGREE_I= 1\nFFD_DEGREE_J= 1\n"
+                            "FFD_BLENDING= BEZIER\nFFD_PARENTS= 0\nFFD_CHILDREN= 0\nFFD_CORNER_POINTS= 4\n"
+                            "-0.1\t-0.1\n1.1\t-0.1\n1.1\t1.1\n-0.1\t1.1\nFFD_CONTROL_POINTS= 2\n0\t0\t0\t-0.1\t-0.1\t-0.5\n"
+                            "1\t0\t0\t1.1\t-0.1\t-0.5\nFFD_SURFACE_POINTS= 1\nwall\t1\t0.5\t0.5\t0.5\n";
+  const fs::path file = test::scratch_path("ffd.su2");
+  write_file(file, square_su2(false) + extra);
+  const Mesh<2> mesh = read_mesh_as<2>(file);
+  CHECK(mesh.num_nodes() == 4);
+  CHECK(mesh.num_cells() == 2);
+  CHECK(mesh.group_nodes("wall") == std::vector<Index>{0, 1});
+  // A keyword line after the skipped data is still read: a marker section after an FFD box.
+  write_file(file, "NDIME= 2\nFFD_NBOX= 1\nFFD_CORNER_POINTS= 1\n0 0\n" + square_su2(false).substr(9));
+  CHECK(read_mesh_as<2>(file).num_cells() == 2);
+}

@@ -128,8 +128,16 @@ inline constexpr std::array<int, 27> hex27_vtk{0,  1,  2,  3,  4,  5,  6,  7,  8
 // VTK_LAGRANGE_HEXAHEDRON lists the vertical edges as (0,4) (1,5) (3,7) (2,6).
 inline constexpr std::array<int, 27> hex27_vtk_lagrange{0,  1,  2,  3,  4,  5,  6,  7,  8,  11, 13, 9,  16, 18,
                                                         19, 17, 10, 12, 15, 14, 22, 23, 21, 24, 20, 25, 26};
-inline constexpr std::array<int, 15> prism15_vtk{0, 1, 2, 3, 4, 5, 6, 9, 7, 12, 14, 13, 8, 10, 11};
-inline constexpr std::array<int, 18> prism18_vtk{0, 1, 2, 3, 4, 5, 6, 9, 7, 12, 14, 13, 8, 10, 11, 15, 17, 16};
+// VTK's classic wedges (linear, quadratic, biquadratic) turn their base (0,1,2) the other way:
+// by the right-hand rule its normal points away from (3,4,5), Gmsh's towards it. VTK vertex i
+// is our vertex {0,2,1,3,5,4}[i]; its edges (0,1) (1,2) (2,0) (3,4) (4,5) (5,3) (0,3) (1,4)
+// (2,5) and quadrilateral faces (0,1,4,3) (1,2,5,4) (2,0,3,5) are ours through that
+// relabelling. VTK's Lagrange wedge turns its base as Gmsh does (checked against VTK's signed
+// cell sizes in python/tests/test_vtk_orientation.py).
+inline constexpr std::array<int, 6> prism6_vtk{0, 2, 1, 3, 5, 4};
+inline constexpr std::array<int, 15> prism15_vtk{0, 2, 1, 3, 5, 4, 7, 9, 6, 13, 14, 12, 8, 11, 10};
+inline constexpr std::array<int, 18> prism18_vtk{0, 2, 1, 3, 5, 4, 7, 9, 6, 13, 14, 12, 8, 11, 10, 16, 17, 15};
+inline constexpr std::array<int, 18> prism18_vtk_lagrange{0, 1, 2, 3, 4, 5, 6, 9, 7, 12, 14, 13, 8, 10, 11, 15, 17, 16};
 inline constexpr std::array<int, 13> pyramid13_vtk{0, 1, 2, 3, 4, 5, 8, 10, 6, 7, 9, 11, 12};
 
 template <class T, std::size_t N>
@@ -260,15 +268,16 @@ constexpr int facet_nodes(ElementType t, int f, std::array<int, 9>& out) {
     case ElementType::tet10: return detail::as_span(detail::tet10_vtk);
     case ElementType::hex20: return detail::as_span(detail::hex20_vtk);
     case ElementType::hex27: return lagrange ? detail::as_span(detail::hex27_vtk_lagrange) : detail::as_span(detail::hex27_vtk);
+    case ElementType::prism6: return detail::as_span(detail::prism6_vtk);
     case ElementType::prism15: return detail::as_span(detail::prism15_vtk);
-    case ElementType::prism18: return detail::as_span(detail::prism18_vtk);
+    case ElementType::prism18: return lagrange ? detail::as_span(detail::prism18_vtk_lagrange) : detail::as_span(detail::prism18_vtk);
     case ElementType::pyramid13:
     case ElementType::pyramid14: return detail::as_span(detail::pyramid13_vtk);
     default: return {};
   }
 }
 
-/// SU2 uses VTK type numbers and VTK's order for its (linear) elements, which is ours.
+/// SU2 uses VTK type numbers and VTK's node order (vtk_order()) for its linear elements.
 [[nodiscard]] constexpr int su2_id(ElementType t) { return element_info(t).order <= 1 ? element_info(t).vtk_id : -1; }
 
 /// The type with the given Gmsh number; throws InputError for unknown numbers.

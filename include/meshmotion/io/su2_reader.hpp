@@ -1,8 +1,10 @@
 #pragma once
 /// \file
-/// SU2 native mesh (.su2) reader: NDIME 2 or 3, mixed elements (VTK type numbers, 0-based
-/// node indices), NPOIN before or after NELEM, an optional trailing index on point and element
-/// lines, and markers, each becoming a facet group (tag = position of the marker, from 1).
+/// SU2 native mesh (.su2) reader: NDIME 2 or 3, mixed elements (VTK type numbers and node
+/// order, 0-based node indices), NPOIN before or after NELEM, an optional trailing index on
+/// point and element lines, and markers, each becoming a facet group (tag = position of the
+/// marker, from 1). Sections that are not mesh data (NZONE/IZONE, the periodic
+/// transformations of NPERIODIC/PERIODIC_INDEX, SU2_DEF's FFD boxes) are skipped.
 /// Elements keep the file's orientation: check it with orientation_report() (core/orientation.hpp).
 
 #include "meshmotion/core/element.hpp"
@@ -49,7 +51,7 @@ class Su2Parser {
         require_dim();
         read_markers(pending);
       } else {
-        text_.next_line();  // other keywords (NZONE, IZONE, FFD boxes ...) are not mesh data
+        skip_section();  // NZONE, IZONE, NPERIODIC/PERIODIC_INDEX, FFD_* boxes: not mesh data
       }
     }
     if (dim_ < 0) text_.fail("no NDIME keyword (expected NDIME= 2 or 3)");
@@ -88,6 +90,23 @@ class Su2Parser {
                  TextCursor::shorten(rest.substr(0, rest.find('\n'))) + "')");
     text_.seek(text_.offset() + eq + 1);
     return rest.substr(0, k);
+  }
+
+  // True when the current line starts with a keyword ("KEY=" or "KEY ="), not data.
+  [[nodiscard]] bool at_keyword_line() const {
+    const std::string_view rest = text_.remaining();
+    std::size_t k = 0;
+    while (k < rest.size() && rest[k] != '=' && rest[k] != '\n' && rest[k] != ' ' && rest[k] != '\t') ++k;
+    while (k < rest.size() && (rest[k] == ' ' || rest[k] == '\t')) ++k;
+    return k < rest.size() && rest[k] == '=';
+  }
+
+  // Skips the line of a keyword the reader does not use and the data lines under it (SU2's
+  // periodic transformations, the FFD boxes' corner, control and surface points), up to the
+  // next keyword line.
+  void skip_section() {
+    text_.next_line();
+    while (!text_.at_end() && !at_keyword_line()) text_.next_line();
   }
 
   void require_dim() {
@@ -146,11 +165,16 @@ class Su2Parser {
       int index = 0;
       ElementBlock& block = block_for(text_.integer<int>("element type"), element_dim, line, index);
       const std::size_t first = block.connectivity.size();
-      for (int k = 0; k < block.nodes_per_element(); ++k) {
+      const int nodes = block.nodes_per_element();
+      block.connectivity.resize(first + static_cast<std::size_t>(nodes));
+      // The file lists nodes in VTK's order: its node k is our local node order[k].
+      const auto order = vtk_order(block.type);
+      for (int k = 0; k < nodes; ++k) {
         if (text_.at_line_end())
           text_.fail(std::string(name(block.type)) + " element with " + std::to_string(k) + " nodes (expected " +
-                     std::to_string(block.nodes_per_element()) + ")");
-        block.connectivity.push_back(text_.integer<Index>("node index", 0));
+                     std::to_string(nodes) + ")");
+        const int local = order.empty() ? k : order[static_cast<std::size_t>(k)];
+        block.connectivity[first + static_cast<std::size_t>(local)] = text_.integer<Index>("node index", 0);
       }
       block.tags.push_back(tag);
       pending.push_back({index, first, line});

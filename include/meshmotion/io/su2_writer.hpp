@@ -29,9 +29,11 @@ template <int Dim>
   std::string out;
   const auto element_line = [&](const ElementBlock& b, Index e) {
     detail::append_number(out, su2_id(b.type));
-    for (const Index v : b.element(e)) {
+    const auto nodes = b.element(e);
+    const auto order = vtk_order(b.type);  // SU2 lists nodes in VTK's order
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
       out.push_back('\t');
-      detail::append_number(out, v);
+      detail::append_number(out, nodes[order.empty() ? k : static_cast<std::size_t>(order[k])]);
     }
   };
   out += "NDIME= " + std::to_string(Dim) + "\nNELEM= " + std::to_string(mesh.num_cells()) + "\n";
