@@ -158,11 +158,26 @@ py::array_t<Index> connectivity_view(ElementBlock& b, const py::object& owner) {
                             b.connectivity.data(), owner);
 }
 
+// {name: value(group)} over the named groups of a mesh.
+template <int Dim, class Value>
+py::dict by_group(const Mesh<Dim>& mesh, Value&& value) {
+  py::dict out;
+  for (const auto& g : mesh.groups)
+    if (!g.name.empty()) out[py::str(g.name)] = value(g);
+  return out;
+}
+
 // Python number → double, refusing anything else (a bool, a string) with the key's name.
 double number_option(const std::string& key, const py::handle& value) {
   if (py::isinstance<py::bool_>(value) || !(py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value)))
     throw InputError("curve_mesh: option '" + key + "' expects a number (got " + py::repr(value).cast<std::string>() + ")");
   return value.cast<double>();
+}
+
+std::string text_option(const std::string& key, const py::handle& value) {
+  if (!py::isinstance<py::str>(value))
+    throw InputError("curve_mesh: option '" + key + "' expects a string (got " + py::repr(value).cast<std::string>() + ")");
+  return value.cast<std::string>();
 }
 
 bool bool_option(const std::string& key, const py::handle& value) {
@@ -191,17 +206,23 @@ CurveOptions<Dim> curve_options(const py::kwargs& kwargs) {
     } else if (const auto f = flags.find(key); f != flags.end()) {
       *f->second = bool_option(key, value);
     } else if (key == "method") {
-      o.method = py::cast<std::string>(value);
+      o.method = text_option(key, value);
     } else if (key == "steps") {
       const double steps = number_option(key, value);
       if (!(steps >= 1.0) || steps != std::floor(steps) || steps > 1e6)
         throw InputError("curve_mesh: option 'steps' expects a positive integer (got " + py::cast<std::string>(py::repr(value)) + ")");
       o.steps = static_cast<int>(steps);
     } else if (key == "sliding") {
-      o.sliding = py::cast<std::vector<std::string>>(value);
+      if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value))
+        throw InputError("curve_mesh: option 'sliding' expects a list of group names (got " +
+                         py::cast<std::string>(py::repr(value)) + ")");
+      for (const auto group : py::cast<py::sequence>(value)) o.sliding.push_back(text_option("sliding", group));
     } else if (key == "geometry") {
+      if (!py::isinstance<py::dict>(value))
+        throw InputError("curve_mesh: option 'geometry' expects a dict {group: geometry text} (got " +
+                         py::cast<std::string>(py::repr(value)) + ")");
       for (const auto& [group, spec] : py::cast<py::dict>(value))
-        o.geometry.insert_or_assign(py::cast<std::string>(group), geometry_from_text<Dim>(py::cast<std::string>(spec)));
+        o.geometry.insert_or_assign(text_option("geometry", group), geometry_from_text<Dim>(text_option("geometry", spec)));
     } else {
       mover.emplace_back(key, option_text(key, value));
     }
@@ -278,22 +299,12 @@ void bind_dimension(py::module_& m) {
             return out;
           },
           "boundary facet blocks as (type name, (n_facets, nodes_per_facet) int64 view, group tag per facet)")
-      .def_property_readonly("group_tags",
-                             [](const M& mesh) {
-                               py::dict out;
-                               for (const auto& g : mesh.groups)
-                                 if (!g.name.empty()) out[py::str(g.name)] = py::make_tuple(g.dim, g.tag);
-                               return out;
-                             },
-                             "named groups: name → (dimension, tag) of the blocks' tags")
-      .def_property_readonly("groups",
-                             [](const M& mesh) {
-                               py::dict out;
-                               for (const auto& g : mesh.groups)
-                                 if (!g.name.empty()) out[py::str(g.name)] = py::cast(mesh.group_nodes(g.name));
-                               return out;
-                             },
-                             "named groups: name → sorted node indices (0-based)")
+      .def_property_readonly(
+          "group_tags", [](const M& mesh) { return by_group(mesh, [](const PhysicalGroup& g) { return py::make_tuple(g.dim, g.tag); }); },
+          "named groups: name → (dimension, tag) of the blocks' tags")
+      .def_property_readonly(
+          "groups", [](const M& mesh) { return by_group(mesh, [&](const PhysicalGroup& g) { return py::cast(mesh.group_nodes(g.name)); }); },
+          "named groups: name → sorted node indices (0-based)")
       .def("group_nodes", [](const M& mesh, const std::string& g) { return mesh.group_nodes(g); }, py::arg("group"))
       .def("node_indices", [](const M& mesh, const std::vector<std::int64_t>& ids) { return mesh.node_indices(ids); },
            py::arg("file_ids"), "node indices of the file's node ids")

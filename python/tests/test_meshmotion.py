@@ -249,6 +249,12 @@ def test_curve_mesh_puts_the_high_order_nodes_on_the_circle():
         mm.curve_mesh(mesh, geometry={"wall": "circle:0,0"})
     with pytest.raises(ValueError, match="expects a number"):
         mm.curve_mesh(mesh, support_radius="big")
+    with pytest.raises(ValueError, match="expects a string"):
+        mm.curve_mesh(mesh, method=5)
+    with pytest.raises(ValueError, match="list of group names"):
+        mm.curve_mesh(mesh, sliding="wall")
+    with pytest.raises(ValueError, match="expects a dict"):
+        mm.curve_mesh(mesh, geometry="circle:0,0,0.5")
     with pytest.raises(ValueError, match="takes no mover option"):
         mm.curve_mesh(mesh, method="blend", kernel="wendland4")
     _, sle = mm.curve_mesh(mesh, method="sle", geometry={"wall": "circle:0,0,0.5"}, poisson_ratio=0.3)
