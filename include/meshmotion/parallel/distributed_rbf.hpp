@@ -1,0 +1,261 @@
+#pragma once
+/// \file
+/// DistributedRbfMover: the RBF mover on a partitioned mesh, with the serial result.
+///
+/// - setup: every rank's owned boundary entries (global id, position, kind, sliding plane or
+///   line, radius) are gathered on all ranks (allgatherv) and sorted by global id, so every
+///   rank holds the same centres in the same order as a serial RbfMover given the boundary of
+///   the whole mesh by ascending node index; the interpolation system is factorized on every
+///   rank (replicated: no communication per move beyond the boundary displacements). Each
+///   rank then builds the evaluation operator of its own local nodes (owned and ghost) with
+///   its own k-d tree over the centres.
+/// - move: one allgatherv of the owned entries' displacements (Dim doubles per boundary node),
+///   then one solve and the local evaluation. Ghost nodes get the values their owners compute.
+/// - derivative_reverse: the transposed evaluation on each rank's owned nodes, summed over the
+///   ranks (allreduce of Dim × boundary doubles), then one transposed solve.
+///
+/// Memory per rank: the boundary's centres and factorization (as serial) plus the evaluation
+/// operator of its local nodes. What grows with the boundary is replicated; what grows with
+/// the volume is split (docs/parallel.md measures both).
+///
+/// The owner's entry decides: a ghost's boundary entry on another rank is ignored (its kind,
+/// plane and displacement come from its owner), so parts need not agree on ghosts.
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/detail/mover_support.hpp"
+#include "meshmotion/movers/rbf.hpp"
+#include "meshmotion/parallel/communicator.hpp"
+#include "meshmotion/parallel/distributed_mesh.hpp"
+#include "meshmotion/solvers/detail/stopwatch.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <numeric>
+#include <string>
+#include <vector>
+
+namespace meshmotion::parallel {
+
+template <int Dim>
+class DistributedRbfMover {
+ public:
+  static constexpr int dim = Dim;
+
+  explicit DistributedRbfMover(RbfOptions options = {}) : inner_(std::move(options)) {}
+
+  [[nodiscard]] const RbfOptions& options() const noexcept { return inner_.options(); }
+  /// This rank's figures; boundary_nodes counts the whole boundary's centres.
+  [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
+  /// Entries of the whole boundary (before merging coincident nodes).
+  [[nodiscard]] Index global_boundary_size() const noexcept { return static_cast<Index>(sorted_ids_.size()); }
+
+  /// Collective. `part`: this rank's nodes; `boundary`: entries of local nodes (owned and
+  /// ghost; may be empty on a rank). RbfOptions::support_radii, when given, has one radius per
+  /// entry of this rank's `boundary`. Throws on every rank what any rank finds wrong: a part
+  /// whose arrays disagree, a global id owned by two ranks, a bad boundary, an empty global
+  /// boundary, or what RbfMover::setup throws.
+  void setup(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary);
+
+  /// Collective. Displacement (Dim × part.size()) of every local node for the displacements
+  /// `d` (Dim × boundary.size()) of this rank's boundary entries; only owned entries are
+  /// read. Throws on every rank for a wrong shape or a non-finite value on any rank, and what
+  /// RbfMover::move throws.
+  void move_into(const Points<Dim>& d, Points<Dim>& out);
+  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
+    Points<Dim> out;
+    move_into(d, out);
+    return out;
+  }
+
+  /// Collective. For v (Dim × part.size()), the gradient of Σ over ranks of ⟨v, move(d)⟩ on
+  /// owned nodes with respect to this rank's boundary entries (Dim × boundary.size()): owned
+  /// entries carry it, ghost and sliding entries are zero, so the ranks' gradients add up to
+  /// the serial one.
+  [[nodiscard]] Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>> v);
+
+ private:
+  void require_ready(const char* where) const {
+    if (!ready_) throw InputError(std::string("DistributedRbfMover::") + where + ": setup() was not called");
+  }
+
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  RbfMover<Dim> inner_;      ///< over the gathered centres followed by the local interior nodes
+  MoverStats stats_;
+  bool ready_ = false;
+  Index n_local_ = 0;
+  Index inner_columns_ = 0;
+  std::vector<char> owned_;            ///< per local node
+  std::vector<Index> owned_entries_;   ///< this rank's boundary entries it owns, in its order
+  std::vector<std::int64_t> sorted_ids_;  ///< global ids of the whole boundary, ascending
+  std::vector<Index> slot_of_gathered_;   ///< gathered entry (rank order) → sorted position
+  std::vector<Index> column_;          ///< local node → column of the inner mover
+  std::vector<Index> entry_slot_;      ///< this rank's boundary entry → sorted position (-1: ghost)
+  std::vector<int> counts_;            ///< owned entries per rank
+  Points<Dim> gathered_, inner_out_;
+};
+
+template <int Dim>
+void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary) {
+  const meshmotion::detail::Stopwatch watch;
+  ready_ = false;
+  comm_ = part.comm;
+  const Index n = part.size();
+  collective(comm_, [&] {
+    part.check("DistributedRbfMover::setup");
+    if (boundary.size() > 0) meshmotion::detail::check_boundary<Dim>("DistributedRbfMover::setup", boundary, n, false);
+    const auto& radii = inner_.options().support_radii;
+    if (!radii.empty() && static_cast<Index>(radii.size()) != boundary.size())
+      throw InputError("DistributedRbfMover::setup: " + std::to_string(radii.size()) + " support radii for " +
+                       std::to_string(boundary.size()) + " local boundary entries (expected one per entry, or none)");
+  });
+  n_local_ = n;
+  owned_.resize(static_cast<std::size_t>(n));
+  for (Index i = 0; i < n; ++i) owned_[static_cast<std::size_t>(i)] = part.owns(i) ? 1 : 0;
+
+  // This rank's owned entries, packed for the gather.
+  owned_entries_.clear();
+  std::vector<std::int64_t> ids;
+  std::vector<int> kinds;
+  std::vector<double> geometry;  // position, normal, direction, radius per entry
+  const bool per_entry_radius = !inner_.options().support_radii.empty();
+  int radius_flag = per_entry_radius ? 1 : 0, any_radius = 0;
+  MPI_Allreduce(&radius_flag, &any_radius, 1, MPI_INT, MPI_MAX, comm_);
+  constexpr int stride = 3 * Dim + 1;
+  for (Index k = 0; k < boundary.size(); ++k) {
+    const Index node = boundary.nodes[static_cast<std::size_t>(k)];
+    if (!part.owns(node)) continue;
+    owned_entries_.push_back(k);
+    ids.push_back(part.global_ids[static_cast<std::size_t>(node)]);
+    kinds.push_back(static_cast<int>(boundary.kinds[static_cast<std::size_t>(k)]));
+    for (int d = 0; d < Dim; ++d) geometry.push_back(part.points(d, node));
+    for (int d = 0; d < Dim; ++d) geometry.push_back(boundary.normals(d, k));
+    for (int d = 0; d < Dim; ++d) geometry.push_back(boundary.directions.cols() > k ? boundary.directions(d, k) : 0.0);
+    geometry.push_back(per_entry_radius ? inner_.options().support_radii[static_cast<std::size_t>(k)] : 0.0);
+  }
+  const std::vector<std::int64_t> all_ids = all_gather(comm_, ids, &counts_);
+  const std::vector<int> all_kinds = all_gather(comm_, kinds);
+  const std::vector<double> all_geometry = all_gather(comm_, geometry);
+  const auto m = static_cast<Index>(all_ids.size());
+
+  std::vector<Index> order(static_cast<std::size_t>(m));
+  std::iota(order.begin(), order.end(), Index{0});
+  std::sort(order.begin(), order.end(), [&](Index a, Index b) { return all_ids[static_cast<std::size_t>(a)] < all_ids[static_cast<std::size_t>(b)]; });
+  sorted_ids_.resize(static_cast<std::size_t>(m));
+  slot_of_gathered_.resize(static_cast<std::size_t>(m));
+  for (Index s = 0; s < m; ++s) {
+    sorted_ids_[static_cast<std::size_t>(s)] = all_ids[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])];
+    slot_of_gathered_[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])] = s;
+  }
+  // Every rank sees the same gathered arrays, so these checks agree everywhere.
+  if (m == 0) throw InputError("DistributedRbfMover::setup: no rank owns a boundary node (expected at least one)");
+  for (Index s = 1; s < m; ++s)
+    if (sorted_ids_[static_cast<std::size_t>(s)] == sorted_ids_[static_cast<std::size_t>(s - 1)])
+      throw InputError("DistributedRbfMover::setup: global node " + std::to_string(sorted_ids_[static_cast<std::size_t>(s)]) +
+                       " is an owned boundary node on two ranks (each node must have one owner)");
+
+  // Inner mover: the centres first (sorted), then this rank's nodes that are not centres.
+  column_.assign(static_cast<std::size_t>(n), -1);
+  entry_slot_.assign(static_cast<std::size_t>(boundary.size()), -1);
+  Index interior = 0;
+  for (Index i = 0; i < n; ++i) {
+    const std::int64_t g = part.global_ids[static_cast<std::size_t>(i)];
+    const auto it = std::lower_bound(sorted_ids_.begin(), sorted_ids_.end(), g);
+    if (it != sorted_ids_.end() && *it == g)
+      column_[static_cast<std::size_t>(i)] = static_cast<Index>(it - sorted_ids_.begin());
+    else
+      column_[static_cast<std::size_t>(i)] = m + interior++;
+  }
+  for (Index e = 0; e < static_cast<Index>(owned_entries_.size()); ++e)
+    entry_slot_[static_cast<std::size_t>(owned_entries_[static_cast<std::size_t>(e)])] =
+        column_[static_cast<std::size_t>(boundary.nodes[static_cast<std::size_t>(owned_entries_[static_cast<std::size_t>(e)])])];
+
+  inner_columns_ = m + interior;
+  Points<Dim> points(Dim, inner_columns_);
+  ResolvedBoundary<Dim> centres;
+  centres.nodes.resize(static_cast<std::size_t>(m));
+  centres.kinds.resize(static_cast<std::size_t>(m));
+  centres.displacements.setZero(Dim, m);
+  centres.normals.resize(Dim, m);
+  centres.directions.resize(Dim, m);
+  std::vector<double> radii(any_radius != 0 ? static_cast<std::size_t>(m) : 0);
+  for (Index j = 0; j < m; ++j) {
+    const Index s = slot_of_gathered_[static_cast<std::size_t>(j)];
+    const double* g = all_geometry.data() + j * stride;
+    centres.nodes[static_cast<std::size_t>(s)] = s;
+    centres.kinds[static_cast<std::size_t>(s)] = static_cast<BoundaryKind>(all_kinds[static_cast<std::size_t>(j)]);
+    for (int d = 0; d < Dim; ++d) {
+      points(d, s) = g[d];
+      centres.normals(d, s) = g[Dim + d];
+      centres.directions(d, s) = g[2 * Dim + d];
+    }
+    if (!radii.empty()) radii[static_cast<std::size_t>(s)] = g[3 * Dim];
+  }
+  for (Index i = 0; i < n; ++i)
+    if (column_[static_cast<std::size_t>(i)] >= m) points.col(column_[static_cast<std::size_t>(i)]) = part.points.col(i);
+
+  RbfOptions options = inner_.options();
+  options.support_radii = std::move(radii);
+  inner_ = RbfMover<Dim>(std::move(options));
+  collective(comm_, [&] { inner_.setup_reference(std::move(points), centres); });
+  gathered_.resize(Dim, m);
+  stats_ = inner_.stats();
+  stats_.evaluated_nodes = std::min(stats_.evaluated_nodes, n);
+  ready_ = true;
+  stats_.setup_seconds = watch.seconds();
+}
+
+template <int Dim>
+void DistributedRbfMover<Dim>::move_into(const Points<Dim>& d, Points<Dim>& out) {
+  const meshmotion::detail::Stopwatch watch;
+  collective(comm_, [&] {
+    require_ready("move");
+    const auto expected = static_cast<Index>(entry_slot_.size());
+    if (d.cols() != expected)
+      throw InputError("DistributedRbfMover::move: got " + std::to_string(d.cols()) + " displacements (expected " +
+                       std::to_string(expected) + ", one per local boundary entry)");
+    for (const Index k : owned_entries_)
+      if (!d.col(k).allFinite())
+        throw InputError("DistributedRbfMover::move: boundary entry " + std::to_string(k) + " has a non-finite displacement");
+  });
+  std::vector<double> mine;
+  mine.reserve(owned_entries_.size() * Dim);
+  for (const Index k : owned_entries_)
+    for (int a = 0; a < Dim; ++a) mine.push_back(d(a, k));
+  const std::vector<double> all = all_gather(comm_, mine);
+  for (std::size_t j = 0; j < slot_of_gathered_.size(); ++j)
+    for (int a = 0; a < Dim; ++a) gathered_(a, slot_of_gathered_[j]) = all[j * Dim + static_cast<std::size_t>(a)];
+  collective(comm_, [&] { inner_.move_into(gathered_, inner_out_); });
+  if (out.cols() != n_local_) out.resize(Dim, n_local_);
+  for (Index i = 0; i < n_local_; ++i) out.col(i) = inner_out_.col(column_[static_cast<std::size_t>(i)]);
+  const MoverStats& s = inner_.stats();
+  ++stats_.moves;
+  stats_.iterations = s.iterations;
+  stats_.residual = s.residual;
+  stats_.fell_back = s.fell_back;
+  stats_.move_seconds = watch.seconds();
+}
+
+template <int Dim>
+Points<Dim> DistributedRbfMover<Dim>::derivative_reverse(Eigen::Ref<const Points<Dim>> v) {
+  collective(comm_, [&] {
+    require_ready("derivative_reverse");
+    meshmotion::detail::check_node_field<Dim>("DistributedRbfMover::derivative_reverse", v, n_local_);
+  });
+  const Index m = global_boundary_size();
+  Points<Dim> seed = Points<Dim>::Zero(Dim, inner_columns_);
+  // Owned nodes only: a ghost's term belongs to its owner.
+  for (Index i = 0; i < n_local_; ++i)
+    if (owned_[static_cast<std::size_t>(i)] != 0) seed.col(column_[static_cast<std::size_t>(i)]) += v.col(i);
+  Points<Dim> local;
+  collective(comm_, [&] { local = inner_.derivative_reverse(seed); });
+  Points<Dim> total(Dim, m);
+  MPI_Allreduce(local.data(), total.data(), static_cast<int>(Dim * m), MPI_DOUBLE, MPI_SUM, comm_);
+  Points<Dim> grad = Points<Dim>::Zero(Dim, static_cast<Index>(entry_slot_.size()));
+  for (std::size_t k = 0; k < entry_slot_.size(); ++k)
+    if (entry_slot_[k] >= 0) grad.col(static_cast<Index>(k)) = total.col(entry_slot_[k]);
+  return grad;
+}
+
+}  // namespace meshmotion::parallel

@@ -1,0 +1,260 @@
+// The distributed RBF mover against the serial one on the whole mesh, which every rank also
+// holds here: equal to 1e-12 (relative) at any number of ranks, by METIS partitions and by
+// partitions made to leave a rank without moving nodes, without group nodes, or empty.
+#include "parallel_support.hpp"
+
+#include "meshmotion/core/generators.hpp"
+#include "meshmotion/io.hpp"
+#include "meshmotion/movers/rbf.hpp"
+#include "meshmotion/parallel.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+using namespace meshmotion;
+using namespace meshmotion::parallel;
+using test::global_max;
+using test::world;
+
+namespace {
+
+struct Outcome {
+  double error = 0.0;       // max |distributed - serial| / max |serial|, over all ranks
+  double gradient = 0.0;    // the same for the reverse derivative
+  // How far the serial reverse product itself moves when its seed changes in the last bits:
+  // the ranks' partial sums of Eᵀv enter the transposed solve in another order than the
+  // serial sum, and an ill-conditioned interpolation matrix (a wide support over a fine
+  // wall) amplifies that rounding alike. The distributed gradient must agree within it.
+  double gradient_rounding = 0.0;
+  Index global_entries = 0;
+};
+
+// Moves `whole` with `spec` serially and distributed (partitioned by `cell_ranks`, or METIS),
+// and compares the displacements and the reverse derivatives node by node.
+template <int Dim>
+Outcome compare_with_serial(const Mesh<Dim>& whole, const ResolvedBoundary<Dim>& b, RbfOptions options,
+                            std::span<const int> cell_ranks = {}, bool radius_per_entry = false) {
+  const auto radius_at = [&](const Vec<Dim>& x) { return options.support_radius * (0.8 + 0.4 * std::abs(x[0])); };
+  RbfOptions serial_options = options;
+  if (radius_per_entry)
+    for (const Index v : b.nodes) serial_options.support_radii.push_back(radius_at(whole.points.col(v)));
+  RbfMover<Dim> serial(serial_options);
+  serial.setup(whole, b);
+  const Points<Dim> expected = serial.move(b.displacements);
+  // A smooth seed for the reverse product: ⟨v, move(d)⟩ with v(x) = (sin x, cos y, ...).
+  Points<Dim> v_whole(Dim, whole.num_nodes());
+  for (Index i = 0; i < whole.num_nodes(); ++i)
+    for (int a = 0; a < Dim; ++a) v_whole(a, i) = std::sin(1.0 + a + 2.0 * whole.points(a, i));
+  const Points<Dim> expected_gradient = serial.derivative_reverse(v_whole);
+  Points<Dim> v_rounded = v_whole;
+  for (Index i = 0; i < v_rounded.cols(); ++i) v_rounded.col(i) *= 1.0 + 1e-15 * std::sin(3.0 * static_cast<double>(i));
+  const double gradient_scale = std::max(1e-300, expected_gradient.colwise().norm().maxCoeff());
+
+  const DistributedMesh<Dim> part = partition_mesh(world(), whole, cell_ranks);
+  const ResolvedBoundary<Dim> local_b = distribute_boundary(part, b);
+  RbfOptions local_options = options;
+  if (radius_per_entry)
+    for (const Index v : local_b.nodes) local_options.support_radii.push_back(radius_at(part.local.points.col(v)));
+  DistributedRbfMover<Dim> mover(local_options);
+  mover.setup(part.view(), local_b);
+  const Points<Dim> got = mover.move(local_b.displacements);
+
+  Outcome out;
+  out.gradient_rounding = (serial.derivative_reverse(v_rounded) - expected_gradient).colwise().norm().maxCoeff() / gradient_scale;
+  out.global_entries = mover.global_boundary_size();
+  double worst = 0.0;
+  for (Index i = 0; i < part.local.num_nodes(); ++i)
+    worst = std::max(worst, (got.col(i) - expected.col(part.global_ids[static_cast<std::size_t>(i)])).norm());
+  out.error = global_max(worst) / std::max(1e-300, expected.colwise().norm().maxCoeff());
+
+  Points<Dim> v_local(Dim, part.local.num_nodes());
+  for (Index i = 0; i < part.local.num_nodes(); ++i) v_local.col(i) = v_whole.col(part.global_ids[static_cast<std::size_t>(i)]);
+  const Points<Dim> gradient = mover.derivative_reverse(v_local);
+  worst = 0.0;
+  for (Index k = 0; k < local_b.size(); ++k) {
+    const Index local = local_b.nodes[static_cast<std::size_t>(k)];
+    if (!part.view().owns(local)) {
+      worst = std::max(worst, gradient.col(k).norm());  // ghost entries carry nothing
+      continue;
+    }
+    const Index whole_entry = b.column(part.global_ids[static_cast<std::size_t>(local)]);
+    worst = std::max(worst, (gradient.col(k) - expected_gradient.col(whole_entry)).norm());
+  }
+  out.gradient = global_max(worst) / gradient_scale;
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("distributed RBF equals serial on a 2D mesh partitioned by METIS", "[parallel][rbf]") {
+  RectangleOptions o;
+  o.nx = 24;
+  o.ny = 18;
+  o.cells = RectangleCells::tri_quad;
+  const Mesh<2> mesh = rectangle_mesh(o);
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Rotation2D{{0.5, 0.0}, radians(8.0)}).fixed("top").fixed("left");
+  for (const bool polynomial : {false, true}) {
+    RbfOptions options;
+    options.support_radius = 0.6;
+    options.polynomial = polynomial;
+    const Outcome r = compare_with_serial(mesh, spec.resolve(mesh), options);
+    INFO("polynomial " << polynomial);
+    CHECK(r.error <= 1e-12);
+    CHECK(r.gradient <= 1e-12);
+    CHECK(r.global_entries == static_cast<Index>(spec.resolve(mesh).size()));
+  }
+}
+
+TEST_CASE("distributed RBF keeps sliding nodes and per-node radii as serial does", "[parallel][rbf]") {
+  const Mesh<2> mesh = rectangle_mesh({.nx = 20, .ny = 16, .cells = RectangleCells::tri3});
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Translation<2>{{0.05, 0.02}}).fixed("top").sliding("left").sliding("right");
+  RbfOptions options;
+  options.support_radius = 0.5;
+  CHECK(compare_with_serial(mesh, spec.resolve(mesh), options).error <= 1e-12);
+  const Outcome radii = compare_with_serial(mesh, spec.resolve(mesh), options, {}, true);
+  CHECK(radii.error <= 1e-12);
+  CHECK(radii.gradient <= 1e-12);
+}
+
+TEST_CASE("distributed RBF equals serial on 3D meshes", "[parallel][rbf]") {
+  for (const BoxCells cells : {BoxCells::tet4, BoxCells::hex_prism}) {
+    const Mesh<3> mesh = box_mesh({.nx = 8, .ny = 6, .nz = 6, .cells = cells});
+    BoundarySpec<3> spec;
+    spec.moving("bottom", Rotation3D{{0.5, 0.5, 0.0}, {1.0, 0.0, 0.0}, radians(5.0)}).fixed("top").sliding("front");
+    RbfOptions options;
+    options.support_radius = 0.7;
+    options.polynomial = cells == BoxCells::tet4;
+    const Outcome r = compare_with_serial(mesh, spec.resolve(mesh), options);
+    INFO("move " << r.error << ", gradient " << r.gradient << ", rounding " << r.gradient_rounding);
+    CHECK(r.error <= 1e-12);
+    CHECK(r.gradient <= 1e-12);
+  }
+}
+
+TEST_CASE("distributed RBF equals serial on real meshes of ../shared/data", "[parallel][rbf][shared]") {
+  const std::filesystem::path dir = MESHMOTION_SHARED_DATA_DIR;
+  const auto naca = dir / "su2_naca0012_inviscid_tri.su2";
+  if (!std::filesystem::exists(naca)) {
+    WARN("skipped: " << naca << " is absent (../shared/data holds the public meshes)");
+    return;
+  }
+  {
+    const Mesh<2> mesh = std::get<Mesh<2>>(read_mesh(naca.string()));
+    BoundarySpec<2> spec;
+    spec.moving("airfoil", Rotation2D{{0.25, 0.0}, radians(3.0)}).fixed("farfield");
+    RbfOptions options;
+    options.support_radius = 3.0;
+    // One kind of evaluation operator on every rank and in serial: whether a part stores its
+    // operator dense depends on how much of the boundary its own nodes see, and the dense
+    // product sums in another order, which this wide support over a fine wall (huge,
+    // alternating coefficients) turns into 5e-12 instead of 1e-16.
+    options.max_evaluation_cache_bytes = 0;
+    const Outcome r = compare_with_serial(mesh, spec.resolve(mesh), options);
+    INFO("move " << r.error << ", gradient " << r.gradient << ", rounding " << r.gradient_rounding);
+    CHECK(r.error <= 1e-12);
+    CHECK(r.gradient <= std::max(1e-12, 100.0 * r.gradient_rounding));
+  }
+  const auto sphere = dir / "meshopt_sphere_symmetry_linear_tet.msh";
+  if (!std::filesystem::exists(sphere)) return;
+  // Its facets carry no physical groups: the sphere (radius 0.5) moves, the symmetry plane
+  // y = 0 slides, the rest of the box is held.
+  const Mesh<3> mesh = std::get<Mesh<3>>(read_mesh(sphere.string()));
+  GroupNodes groups{{"sphere", {}}, {"symmetry", {}}, {"box", {}}};
+  std::vector<char> seen(static_cast<std::size_t>(mesh.num_nodes()), 0);
+  for (const auto& block : mesh.facets)
+    for (const Index v : block.connectivity) {
+      if (seen[static_cast<std::size_t>(v)] != 0) continue;
+      seen[static_cast<std::size_t>(v)] = 1;
+      const Vec<3> x = mesh.points.col(v);
+      groups[x.norm() < 0.6 ? "sphere" : std::abs(x[1]) < 1e-9 ? "symmetry" : "box"].push_back(v);
+    }
+  BoundarySpec<3> spec;
+  spec.moving("sphere", Rotation3D{{0.0, 0.0, 0.0}, {0.0, 0.0, 1.0}, radians(4.0)}).sliding("symmetry", Vec<3>::UnitY()).fixed("box");
+  RbfOptions options;
+  options.support_radius = 5.0;
+  const Outcome r = compare_with_serial(mesh, spec.resolve(mesh.points, groups), options);
+  INFO("move " << r.error << ", gradient " << r.gradient << ", rounding " << r.gradient_rounding);
+  CHECK(r.error <= 1e-12);
+  CHECK(r.gradient <= std::max(1e-12, 100.0 * r.gradient_rounding));
+}
+
+TEST_CASE("distributed RBF: a rank without moving nodes, one without group nodes, an empty one", "[parallel][rbf]") {
+  // Rows of cells: rank 0 the two rows on the moving bottom, rank 1 the middle rows (it owns
+  // no node of any group: its boundary rows are owned by ranks 0 and 2), rank 2 the top rows
+  // (fixed nodes only); a fourth rank gets nothing.
+  const Index nx = 10, ny = 10;
+  const Mesh<2> mesh = rectangle_mesh({.nx = nx, .ny = ny});
+  const int p = size_of(world());
+  std::vector<int> ranks(static_cast<std::size_t>(nx * ny));
+  for (Index j = 0; j < ny; ++j)
+    for (Index i = 0; i < nx; ++i) {
+      const int band = j < 2 ? 0 : j < ny - 2 ? 1 : 2;
+      ranks[static_cast<std::size_t>(i + nx * j)] = std::min(band, p - 1);
+    }
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Translation<2>{{0.0, 0.08}}).fixed("top");
+  RbfOptions options;
+  options.support_radius = 0.9;
+  const Outcome r = compare_with_serial(mesh, spec.resolve(mesh), options, ranks);
+  CHECK(r.error <= 1e-12);
+  CHECK(r.gradient <= 1e-12);
+}
+
+TEST_CASE("distributed RBF: an error on one rank is raised on every rank", "[parallel][rbf]") {
+  const Mesh<2> mesh = rectangle_mesh({.nx = 8, .ny = 8});
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Translation<2>{{0.0, 0.05}}).fixed("top");
+  const ResolvedBoundary<2> whole = spec.resolve(mesh);
+  const DistributedMesh<2> part = partition_mesh(world(), mesh);
+  const ResolvedBoundary<2> b = distribute_boundary(part, whole);
+  const int last = size_of(world()) - 1;
+
+  RbfOptions wrong;
+  wrong.support_radius = 0.5;
+  if (rank_of(world()) == last) wrong.support_radii.assign(static_cast<std::size_t>(b.size()) + 1, 0.5);
+  DistributedRbfMover<2> refused(wrong);
+  CHECK_THROWS_WITH(refused.setup(part.view(), b), Catch::Contains("rank " + std::to_string(last)) &&
+                                                     Catch::Contains("support radii"));
+
+  DistributedRbfMover<2> mover({.support_radius = 0.5});
+  mover.setup(part.view(), b);
+  Points<2> d = b.displacements;
+  // The last rank's first owned entry gets a NaN: every rank hears of it.
+  for (Index k = 0; k < b.size() && rank_of(world()) == last; ++k)
+    if (part.view().owns(b.nodes[static_cast<std::size_t>(k)])) {
+      d(0, k) = std::nan("");
+      break;
+    }
+  int has_owned = 0;
+  for (Index k = 0; k < b.size(); ++k) has_owned |= part.view().owns(b.nodes[static_cast<std::size_t>(k)]) ? 1 : 0;
+  const bool poisoned = test::global_max(rank_of(world()) == last && has_owned != 0 ? 1.0 : 0.0) > 0.0;
+  if (poisoned)
+    CHECK_THROWS_AS(mover.move(d), InputError);
+  CHECK_THROWS_WITH(mover.move(Points<2>::Zero(2, b.size() + (rank_of(world()) == 0 ? 1 : 0))),
+                    Catch::Contains("rank 0") && Catch::Contains("one per local boundary entry"));
+  // After refusals the mover still works.
+  CHECK(test::global_max(mover.move(b.displacements).hasNaN() ? 1.0 : 0.0) == 0.0);
+}
+
+TEST_CASE("partition_mesh keeps every node once, and gather_owned restores the whole numbering", "[parallel][mesh]") {
+  const Mesh<3> mesh = box_mesh({.nx = 5, .ny = 4, .nz = 3, .cells = BoxCells::tet_pyramid_prism});
+  const DistributedMesh<3> part = partition_mesh(world(), mesh);
+  Index owned = part.num_owned, cells = part.local.num_cells();
+  MPI_Allreduce(MPI_IN_PLACE, &owned, 1, MPI_INT64_T, MPI_SUM, world());
+  MPI_Allreduce(MPI_IN_PLACE, &cells, 1, MPI_INT64_T, MPI_SUM, world());
+  CHECK(owned == mesh.num_nodes());
+  CHECK(cells == mesh.num_cells());
+  const Points<3> gathered = gather_owned(part.view(), part.local.points, part.num_global_nodes);
+  if (rank_of(world()) == 0) CHECK(gathered == mesh.points);
+  // Every local cell's nodes are local, and the ghosts are owned elsewhere.
+  double bad = 0.0;
+  for (Index i = part.num_owned; i < part.local.num_nodes(); ++i)
+    if (part.owner[static_cast<std::size_t>(i)] == rank_of(world())) bad = 1.0;
+  CHECK(global_max(bad) == 0.0);
+  CHECK_THROWS_WITH(partition_mesh(world(), mesh, std::vector<int>(3, 0)), Catch::Contains("cell ranks for"));
+}
