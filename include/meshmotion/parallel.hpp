@@ -7,3 +7,4 @@
 #include "meshmotion/parallel/distributed_mesh.hpp"
 #include "meshmotion/parallel/distributed_rbf.hpp"
 #include "meshmotion/parallel/partition.hpp"
+#include "meshmotion/parallel/distributed_elasticity.hpp"

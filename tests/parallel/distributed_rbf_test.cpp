@@ -37,7 +37,7 @@ struct Outcome {
 template <int Dim>
 Outcome compare_with_serial(const Mesh<Dim>& whole, const ResolvedBoundary<Dim>& b, RbfOptions options,
                             std::span<const int> cell_ranks = {}, bool radius_per_entry = false) {
-  const auto radius_at = [&](const Vec<Dim>& x) { return options.support_radius * (0.8 + 0.4 * std::abs(x[0])); };
+  const auto radius_at = [&](const meshmotion::Vec<Dim>& x) { return options.support_radius * (0.8 + 0.4 * std::abs(x[0])); };
   RbfOptions serial_options = options;
   if (radius_per_entry)
     for (const Index v : b.nodes) serial_options.support_radii.push_back(radius_at(whole.points.col(v)));
@@ -170,11 +170,11 @@ TEST_CASE("distributed RBF equals serial on real meshes of ../shared/data", "[pa
     for (const Index v : block.connectivity) {
       if (seen[static_cast<std::size_t>(v)] != 0) continue;
       seen[static_cast<std::size_t>(v)] = 1;
-      const Vec<3> x = mesh.points.col(v);
+      const meshmotion::Vec<3> x = mesh.points.col(v);
       groups[x.norm() < 0.6 ? "sphere" : std::abs(x[1]) < 1e-9 ? "symmetry" : "box"].push_back(v);
     }
   BoundarySpec<3> spec;
-  spec.moving("sphere", Rotation3D{{0.0, 0.0, 0.0}, {0.0, 0.0, 1.0}, radians(4.0)}).sliding("symmetry", Vec<3>::UnitY()).fixed("box");
+  spec.moving("sphere", Rotation3D{{0.0, 0.0, 0.0}, {0.0, 0.0, 1.0}, radians(4.0)}).sliding("symmetry", meshmotion::Vec<3>::UnitY()).fixed("box");
   RbfOptions options;
   options.support_radius = 5.0;
   const Outcome r = compare_with_serial(mesh, spec.resolve(mesh.points, groups), options);

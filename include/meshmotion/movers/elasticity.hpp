@@ -91,9 +91,17 @@ class ElasticityMover : public detail::LinearMechanicsMover<Dim> {
   /// setup() on the library's own mesh type.
   void setup_mesh(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary);
 
- private:
-  /// Mean over the cells of their measure Σ_q w_q |det J_q|.
-  [[nodiscard]] static double mean_cell_measure(const Mesh<Dim>& mesh) {
+  /// The stiffness matrix (n_nodes · Dim square, node-major dofs) of `mesh` before boundary
+  /// conditions, with Jacobian stiffening against `j0` (used when options.stiffening_exponent
+  /// ≠ 0), a factor per cell (cell order; empty: 1) and, when `unknown` is not empty, only the
+  /// cells touching a flagged node. What setup() assembles; the distributed mover assembles
+  /// each rank's cells with it. Throws InputError for a degenerate cell under stiffening.
+  [[nodiscard]] static SparseMatrix assemble_stiffness(const Mesh<Dim>& mesh, const ElasticityOptions& options, double j0,
+                                                       const std::vector<double>& cell_factor = {},
+                                                       const std::vector<bool>& unknown = {});
+
+  /// Σ over the cells of their measure Σ_q w_q |det J_q| (J0's default is its mean).
+  [[nodiscard]] static double total_cell_measure(const Mesh<Dim>& mesh) {
     double total = 0.0;
     detail::ElementCoords<Dim> x;
     detail::ElementGradients<Dim> g;
@@ -106,7 +114,13 @@ class ElasticityMover : public detail::LinearMechanicsMover<Dim> {
           total += table.weights[static_cast<std::size_t>(q)] * std::abs(detail::element_geometry<Dim>(table, q, x, g, jacobian));
       }
     }
-    const double mean = total / static_cast<double>(mesh.num_cells());
+    return total;
+  }
+
+ private:
+  /// Mean over the cells of their measure.
+  [[nodiscard]] static double mean_cell_measure(const Mesh<Dim>& mesh) {
+    const double mean = total_cell_measure(mesh) / static_cast<double>(mesh.num_cells());
     if (!(mean > 0.0)) throw InputError("ElasticityMover::setup: every cell has zero measure (expected a positive mean)");
     return mean;
   }
@@ -188,9 +202,56 @@ class ElasticityMover : public detail::LinearMechanicsMover<Dim> {
 };
 
 template <int Dim>
+SparseMatrix ElasticityMover<Dim>::assemble_stiffness(const Mesh<Dim>& mesh, const ElasticityOptions& options, double j0,
+                                                      const std::vector<double>& cell_factor,
+                                                      const std::vector<bool>& unknown) {
+  std::vector<Index> block_start{0};
+  for (const auto& block : mesh.cells) block_start.push_back(block_start.back() + block.size());
+
+  std::atomic<bool> degenerate{false};
+  const detail::Lame lame = detail::lame_parameters(options.youngs_modulus, options.poisson_ratio, "ElasticityMover::setup");
+  const double chi = options.stiffening_exponent;
+  SparseMatrix stiffness = detail::assemble(mesh, mesh.num_nodes() * Dim, Dim * Dim, [&](Index b, Index e, auto& out) {
+    const ElementBlock& block = mesh.cells[static_cast<std::size_t>(b)];
+    const detail::QuadratureTable& table = detail::quadrature_table(block.type);
+    const double measure = detail::reference_measure(block.type);
+    const double factor = cell_factor.empty() ? 1.0 : cell_factor[static_cast<std::size_t>(block_start[static_cast<std::size_t>(b)] + e)];
+    if (!unknown.empty()) {
+      bool touches_free = false;
+      for (const Index v : block.element(e)) touches_free = touches_free || unknown[static_cast<std::size_t>(v)];
+      if (!touches_free) return;
+    }
+    detail::ElementCoords<Dim> x;
+    detail::gather_coords(mesh.points, block, e, x);
+    const int n = table.num_nodes;
+    detail::ElementMatrix<Dim> k = detail::ElementMatrix<Dim>::Zero(n * Dim, n * Dim);
+    detail::ElementGradients<Dim> g;
+    Eigen::Matrix<double, Dim, Dim> jacobian;
+    for (int q = 0; q < table.size(); ++q) {
+      const double det = std::abs(detail::element_geometry<Dim>(table, q, x, g, jacobian));
+      double scale = det * table.weights[static_cast<std::size_t>(q)] * factor;
+      if (chi != 0.0) {
+        if (!(det > 0.0)) {
+          degenerate.store(true, std::memory_order_relaxed);
+          return;
+        }
+        scale *= std::pow(j0 / (det * measure), chi);
+      }
+      detail::add_elastic_stiffness<Dim>(g, lame.lambda, lame.mu, scale, k);
+    }
+    detail::scatter_element_matrix<Dim>(block.element(e), k, out);
+  });
+  if (degenerate)
+    throw InputError("ElasticityMover::setup: a cell has a zero Jacobian determinant (degenerate cell), so its "
+                     "stiffening factor (J0/J)^chi is infinite");
+  return stiffness;
+}
+
+template <int Dim>
 void ElasticityMover<Dim>::setup_mesh(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) {
   const detail::Stopwatch watch;
-  const detail::Lame lame = detail::lame_parameters(options_.youngs_modulus, options_.poisson_ratio, "ElasticityMover::setup");
+  // E and ν are refused before the mesh is copied.
+  static_cast<void>(detail::lame_parameters(options_.youngs_modulus, options_.poisson_ratio, "ElasticityMover::setup"));
   for (const double exponent : {options_.stiffening_exponent, options_.distance_exponent})
     if (!(exponent >= 0.0) || !std::isfinite(exponent))
       throw InputError("ElasticityMover::setup: stiffening exponents must be finite and >= 0 (got " +
@@ -202,46 +263,9 @@ void ElasticityMover<Dim>::setup_mesh(const Mesh<Dim>& mesh, const ResolvedBound
   ResolvedBoundary<Dim> limited;
   if (!unknown.empty()) limited = hold_far_sliding_nodes(boundary, unknown);
   const ResolvedBoundary<Dim>& used = unknown.empty() ? boundary : limited;
-  const double chi = options_.stiffening_exponent;
-  j0_ = chi == 0.0 ? 0.0 : options_.reference_jacobian > 0.0 ? options_.reference_jacobian : mean_cell_measure(copy);
+  j0_ = options_.stiffening_exponent == 0.0 ? 0.0 : options_.reference_jacobian > 0.0 ? options_.reference_jacobian : mean_cell_measure(copy);
   const std::vector<double> wall_factor = distance_factors(copy, boundary);
-  std::vector<Index> block_start{0};
-  for (const auto& block : copy.cells) block_start.push_back(block_start.back() + block.size());
-
-  std::atomic<bool> degenerate{false};
-  SparseMatrix stiffness = detail::assemble(copy, copy.num_nodes() * Dim, Dim * Dim, [&](Index b, Index e, auto& out) {
-    const ElementBlock& block = copy.cells[static_cast<std::size_t>(b)];
-    const detail::QuadratureTable& table = detail::quadrature_table(block.type);
-    const double measure = detail::reference_measure(block.type);
-    const double cell_factor = wall_factor.empty() ? 1.0 : wall_factor[static_cast<std::size_t>(block_start[static_cast<std::size_t>(b)] + e)];
-    if (!unknown.empty()) {
-      bool touches_free = false;
-      for (const Index v : block.element(e)) touches_free = touches_free || unknown[static_cast<std::size_t>(v)];
-      if (!touches_free) return;
-    }
-    detail::ElementCoords<Dim> x;
-    detail::gather_coords(copy.points, block, e, x);
-    const int n = table.num_nodes;
-    detail::ElementMatrix<Dim> k = detail::ElementMatrix<Dim>::Zero(n * Dim, n * Dim);
-    detail::ElementGradients<Dim> g;
-    Eigen::Matrix<double, Dim, Dim> jacobian;
-    for (int q = 0; q < table.size(); ++q) {
-      const double det = std::abs(detail::element_geometry<Dim>(table, q, x, g, jacobian));
-      double scale = det * table.weights[static_cast<std::size_t>(q)] * cell_factor;
-      if (chi != 0.0) {
-        if (!(det > 0.0)) {
-          degenerate.store(true, std::memory_order_relaxed);
-          return;
-        }
-        scale *= std::pow(j0_ / (det * measure), chi);
-      }
-      detail::add_elastic_stiffness<Dim>(g, lame.lambda, lame.mu, scale, k);
-    }
-    detail::scatter_element_matrix<Dim>(block.element(e), k, out);
-  });
-  if (degenerate)
-    throw InputError("ElasticityMover::setup: a cell has a zero Jacobian determinant (degenerate cell), so its "
-                     "stiffening factor (J0/J)^chi is infinite");
+  SparseMatrix stiffness = assemble_stiffness(copy, options_, j0_, wall_factor, unknown);
   SolverOptions solver = options_.solver;
   solver.diagonal_scaling = true;
   this->finish_setup(copy, used, std::move(stiffness), Dim, solver, watch, unknown.empty() ? nullptr : &unknown);

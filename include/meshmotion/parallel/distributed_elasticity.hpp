@@ -1,0 +1,524 @@
+#pragma once
+/// \file
+/// DistributedElasticityMover: linear and Jacobian-stiffened elasticity on a partitioned mesh,
+/// assembled into a PETSc MPIAIJ matrix and solved by PETSc (CG with GAMG or hypre's
+/// BoomerAMG, or MUMPS's Cholesky).
+///
+/// - Numbering: each rank's owned nodes take a contiguous range of PETSc rows (Dim dofs per
+///   node, node-major, block size Dim); a ghost's row is asked of its owner once in setup,
+///   together with its boundary condition (the owner's entry decides).
+/// - Assembly: each rank integrates its own cells with the serial element code
+///   (ElasticityMover::assemble_stiffness) and adds them by COO with global indices; PETSc
+///   sends the rows of ghost nodes to their owners. J0, the mean cell measure, is reduced over
+///   all ranks, so stiffening matches the serial mover.
+/// - Sliding nodes: their dofs are rotated into (tangents, normal) frames (Tᵀ K T); the normal
+///   component is then a zero Dirichlet dof, as the line's normals are for a node on two planes.
+/// - Dirichlet dofs: zeroed rows and columns with a unit diagonal (MatZeroRowsColumns); the
+///   unmodified matrix is kept to move their values to the right-hand side at each move.
+/// - Scaling: the system is solved symmetrically scaled by its diagonal, as the serial mover
+///   does, so the tolerance is a relative residual in displacement units.
+/// - Setup builds the preconditioner (or factorization) once; a move is one solve. A Krylov
+///   solve that does not converge falls back to MUMPS when fallback_to_direct is set, and
+///   raises SolverError on every rank otherwise.
+///
+/// Not supported here (InputError): distance stiffening (distance_exponent) and active_radius;
+/// the serial ElasticityMover has them.
+///
+/// PETSc must be initialized (PetscInitialize) before setup and finalized after the mover is
+/// destroyed.
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/mesh_like.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/detail/mover_support.hpp"
+#include "meshmotion/movers/elasticity.hpp"
+#include "meshmotion/parallel/communicator.hpp"
+#include "meshmotion/parallel/distributed_mesh.hpp"
+#include "meshmotion/solvers/detail/stopwatch.hpp"
+
+#include <petscksp.h>
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace meshmotion::parallel {
+
+/// PETSc solver of the distributed elasticity system.
+enum class PetscSolverKind {
+  cg_gamg,       ///< CG preconditioned by PETSc's algebraic multigrid (rigid-body near null space)
+  cg_hypre,      ///< CG preconditioned by hypre's BoomerAMG
+  direct_mumps,  ///< Cholesky by MUMPS (distributed direct)
+};
+
+struct DistributedElasticityOptions {
+  /// Material and Jacobian stiffening as in serial; `solver` there is not used (see below),
+  /// distance_exponent and active_radius must be 0.
+  ElasticityOptions elasticity = {};
+  PetscSolverKind solver = PetscSolverKind::cg_gamg;
+  /// Relative residual of the diagonally scaled system (displacement units) for CG.
+  double tolerance = 1e-10;
+  PetscInt max_iterations = 10000;
+  /// A CG solve that does not converge is solved again by MUMPS instead of raising.
+  bool fallback_to_direct = false;
+  /// Prefix of the PETSc options that refine the solver from the command line or
+  /// PETSC_OPTIONS (e.g. -meshmotion_ksp_monitor).
+  std::string petsc_prefix = "meshmotion_";
+};
+
+namespace detail {
+
+inline void petsc_check(PetscErrorCode code, const char* call) {
+  if (code != 0) throw SolverError(std::string("DistributedElasticityMover: PETSc's ") + call + " failed (error " + std::to_string(code) + ")");
+}
+
+}  // namespace detail
+
+template <int Dim>
+class DistributedElasticityMover {
+ public:
+  static constexpr int dim = Dim;
+
+  explicit DistributedElasticityMover(DistributedElasticityOptions options = {}) : options_(std::move(options)) {}
+  DistributedElasticityMover(const DistributedElasticityMover&) = delete;
+  DistributedElasticityMover& operator=(const DistributedElasticityMover&) = delete;
+  ~DistributedElasticityMover() { release(); }
+
+  [[nodiscard]] const DistributedElasticityOptions& options() const noexcept { return options_; }
+  [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
+
+  /// Collective. `part`: this rank's nodes; `local_mesh`: its cells over the local node
+  /// indices (any MeshLike, whose nodes are part's); `boundary`: entries of local nodes (owned
+  /// entries decide). Throws on every rank what any rank finds wrong.
+  template <MeshLike M>
+    requires(mesh_dim<M> == Dim)
+  void setup(const PartitionView<Dim>& part, const M& local_mesh, const ResolvedBoundary<Dim>& boundary) {
+    if constexpr (std::same_as<M, Mesh<Dim>>)
+      setup_mesh(part, local_mesh, boundary);
+    else
+      setup_mesh(part, to_mesh(local_mesh), boundary);
+  }
+  void setup(const DistributedMesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) {
+    setup_mesh(mesh.view(), mesh.local, boundary);
+  }
+
+  /// Collective. Displacement (Dim × part.size(), ghosts included) for the displacements `d`
+  /// (Dim × boundary.size()) of this rank's boundary entries; owned entries are read.
+  void move_into(const Points<Dim>& d, Points<Dim>& out);
+  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
+    Points<Dim> out;
+    move_into(d, out);
+    return out;
+  }
+
+ private:
+  using Frame = Eigen::Matrix<double, Dim, Dim>;
+  enum Condition : int { free_node = -1, prescribed = 0, fixed = 1, sliding = 2 };
+  struct NodeCondition {
+    int kind = free_node;
+    Frame frame = Frame::Identity();  ///< columns: free directions first, then constrained ones
+    int constrained = 0;              ///< trailing columns of `frame` held at zero (sliding)
+  };
+
+  void setup_mesh(const PartitionView<Dim>& part, const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary);
+  void build_solver(KSP& ksp, PetscSolverKind kind);
+  void release() {
+    if (ksp_ != nullptr) KSPDestroy(&ksp_);
+    if (direct_ != nullptr) KSPDestroy(&direct_);
+    if (a_ != nullptr) MatDestroy(&a_);
+    if (k_ != nullptr) MatDestroy(&k_);
+    for (::Vec* v : {&scale_, &b_, &x_, &values_, &ghosts_})
+      if (*v != nullptr) VecDestroy(v);
+    if (scatter_ != nullptr) VecScatterDestroy(&scatter_);
+  }
+
+  static NodeCondition condition_of(const ResolvedBoundary<Dim>& b, Index k) {
+    NodeCondition c;
+    c.kind = static_cast<int>(b.kinds[static_cast<std::size_t>(k)]);
+    if (c.kind != sliding) return c;
+    const auto basis = b.sliding_basis(k);  // the free directions
+    const auto free_count = static_cast<int>(basis.cols());
+    c.constrained = Dim - free_count;
+    // Complete the free directions into an orthonormal frame: the constrained ones follow.
+    const Eigen::HouseholderQR<Eigen::Matrix<double, Dim, Eigen::Dynamic>> qr{Eigen::Matrix<double, Dim, Eigen::Dynamic>(basis)};
+    Frame q = qr.householderQ();
+    q.leftCols(free_count) = basis;
+    c.frame = q;
+    return c;
+  }
+
+  DistributedElasticityOptions options_;
+  MoverStats stats_;
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  bool ready_ = false;
+  Index n_local_ = 0;
+  std::vector<Index> owned_nodes_;        ///< local indices of owned nodes, in PETSc row order
+  std::vector<Index> ghost_nodes_;        ///< local indices of ghosts, in scatter order
+  std::vector<NodeCondition> conditions_; ///< per local node
+  std::vector<Index> owned_entries_;      ///< boundary entries of owned nodes
+  std::vector<Index> entry_nodes_;        ///< their local nodes
+  std::vector<PetscInt> entry_rows_;      ///< their positions among the owned nodes
+  std::vector<PetscInt> dirichlet_;       ///< owned Dirichlet rows (global)
+  Index boundary_size_ = 0;
+  PetscInt first_row_ = 0;
+  Mat k_ = nullptr, a_ = nullptr;  ///< K in the rotated frames; the same with Dirichlet rows, scaled
+  KSP ksp_ = nullptr, direct_ = nullptr;
+  ::Vec scale_ = nullptr, b_ = nullptr, x_ = nullptr, values_ = nullptr, ghosts_ = nullptr;
+  VecScatter scatter_ = nullptr;
+};
+
+template <int Dim>
+void DistributedElasticityMover<Dim>::build_solver(KSP& ksp, PetscSolverKind kind) {
+  using meshmotion::parallel::detail::petsc_check;
+  petsc_check(KSPCreate(comm_, &ksp), "KSPCreate");
+  petsc_check(KSPSetOperators(ksp, a_, a_), "KSPSetOperators");
+  PC pc = nullptr;
+  petsc_check(KSPGetPC(ksp, &pc), "KSPGetPC");
+  if (kind == PetscSolverKind::direct_mumps) {
+    petsc_check(KSPSetType(ksp, KSPPREONLY), "KSPSetType");
+    petsc_check(PCSetType(pc, PCCHOLESKY), "PCSetType");
+    petsc_check(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS), "PCFactorSetMatSolverType");
+  } else {
+    petsc_check(KSPSetType(ksp, KSPCG), "KSPSetType");
+    if (kind == PetscSolverKind::cg_hypre) {
+      petsc_check(PCSetType(pc, PCHYPRE), "PCSetType");
+      petsc_check(PCHYPRESetType(pc, "boomeramg"), "PCHYPRESetType");
+    } else {
+      petsc_check(PCSetType(pc, PCGAMG), "PCSetType");
+    }
+    petsc_check(KSPSetTolerances(ksp, options_.tolerance, 0.0, PETSC_DEFAULT, options_.max_iterations), "KSPSetTolerances");
+    petsc_check(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
+  }
+  petsc_check(KSPSetOptionsPrefix(ksp, options_.petsc_prefix.c_str()), "KSPSetOptionsPrefix");
+  petsc_check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
+  petsc_check(KSPSetUp(ksp), "KSPSetUp");
+}
+
+template <int Dim>
+void DistributedElasticityMover<Dim>::setup_mesh(const PartitionView<Dim>& part, const Mesh<Dim>& mesh,
+                                                 const ResolvedBoundary<Dim>& boundary) {
+  using meshmotion::parallel::detail::petsc_check;
+  const meshmotion::detail::Stopwatch watch;
+  ready_ = false;
+  release();
+  comm_ = part.comm;
+  const int me = rank_of(comm_), p = size_of(comm_);
+  const Index n = part.size();
+  const ElasticityOptions& eo = options_.elasticity;
+  collective(comm_, [&] {
+    PetscBool initialized = PETSC_FALSE;
+    PetscInitialized(&initialized);
+    if (!initialized) throw InputError("DistributedElasticityMover::setup: PETSc is not initialized (call PetscInitialize first)");
+    part.check("DistributedElasticityMover::setup");
+    if (mesh.num_nodes() != n)
+      throw InputError("DistributedElasticityMover::setup: the local mesh has " + std::to_string(mesh.num_nodes()) +
+                       " nodes but the part " + std::to_string(n) + " (expected the same local nodes)");
+    if (eo.distance_exponent != 0.0 || eo.active_radius != 0.0)
+      throw InputError("DistributedElasticityMover::setup: distance_exponent and active_radius are not supported in "
+                       "parallel (expected 0; the serial ElasticityMover has them)");
+    if (!(eo.stiffening_exponent >= 0.0) || !std::isfinite(eo.stiffening_exponent))
+      throw InputError("DistributedElasticityMover::setup: stiffening_exponent must be finite and >= 0 (got " +
+                       std::to_string(eo.stiffening_exponent) + ")");
+    if (!(options_.tolerance > 0.0)) throw InputError("DistributedElasticityMover::setup: tolerance must be positive");
+    static_cast<void>(meshmotion::detail::lame_parameters(eo.youngs_modulus, eo.poisson_ratio, "DistributedElasticityMover::setup"));
+    for (const auto& block : mesh.cells)
+      for (const Index v : block.connectivity)
+        if (v < 0 || v >= n)
+          throw InputError("DistributedElasticityMover::setup: a " + std::string(name(block.type)) + " cell refers to local node " +
+                           std::to_string(v) + " (expected 0 to " + std::to_string(n - 1) + ")");
+    if (boundary.size() > 0) meshmotion::detail::check_boundary<Dim>("DistributedElasticityMover::setup", boundary, n, false);
+  });
+  n_local_ = n;
+  boundary_size_ = boundary.size();
+
+  // Rows: owned nodes in local order, contiguous per rank.
+  owned_nodes_.clear();
+  ghost_nodes_.clear();
+  for (Index i = 0; i < n; ++i) (part.owns(i) ? owned_nodes_ : ghost_nodes_).push_back(i);
+  const auto n_owned = static_cast<PetscInt>(owned_nodes_.size());
+  PetscInt first_node = 0;
+  MPI_Exscan(&n_owned, &first_node, 1, MPIU_INT, MPI_SUM, comm_);
+  if (me == 0) first_node = 0;
+  first_row_ = first_node * Dim;
+  std::vector<PetscInt> row_of(static_cast<std::size_t>(n), -1);  // first dof of each local node
+  std::vector<PetscInt> position(static_cast<std::size_t>(n), -1);
+  for (PetscInt j = 0; j < n_owned; ++j) {
+    row_of[static_cast<std::size_t>(owned_nodes_[static_cast<std::size_t>(j)])] = (first_node + j) * Dim;
+    position[static_cast<std::size_t>(owned_nodes_[static_cast<std::size_t>(j)])] = j;
+  }
+
+  // Conditions of owned nodes from the owned entries; ghosts ask their owners for both.
+  conditions_.assign(static_cast<std::size_t>(n), NodeCondition{});
+  owned_entries_.clear();
+  entry_nodes_.clear();
+  entry_rows_.clear();
+  for (Index k = 0; k < boundary.size(); ++k) {
+    const Index v = boundary.nodes[static_cast<std::size_t>(k)];
+    if (!part.owns(v)) continue;
+    conditions_[static_cast<std::size_t>(v)] = condition_of(boundary, k);
+    owned_entries_.push_back(k);
+    entry_nodes_.push_back(v);
+    entry_rows_.push_back(position[static_cast<std::size_t>(v)]);
+  }
+  std::unordered_map<std::int64_t, Index> owned_by_id;
+  owned_by_id.reserve(owned_nodes_.size());
+  for (const Index i : owned_nodes_) owned_by_id.emplace(part.global_ids[static_cast<std::size_t>(i)], i);
+  std::vector<std::vector<std::int64_t>> asks(static_cast<std::size_t>(p));
+  for (const Index i : ghost_nodes_) asks[static_cast<std::size_t>(part.owner[static_cast<std::size_t>(i)])].push_back(part.global_ids[static_cast<std::size_t>(i)]);
+  const auto asked = parallel::exchange(comm_, asks);
+  // Reply per asked node: its first row, kind, constrained count, frame.
+  constexpr int reply_size = 3 + Dim * Dim;
+  std::vector<std::vector<double>> replies(static_cast<std::size_t>(p));
+  std::int64_t unknown_id = -1;
+  for (int r = 0; r < p; ++r)
+    for (const std::int64_t id : asked[static_cast<std::size_t>(r)]) {
+      auto& out = replies[static_cast<std::size_t>(r)];
+      const auto it = owned_by_id.find(id);
+      if (it == owned_by_id.end()) {
+        unknown_id = id;
+        out.insert(out.end(), reply_size, 0.0);
+        continue;
+      }
+      const NodeCondition& c = conditions_[static_cast<std::size_t>(it->second)];
+      out.push_back(static_cast<double>(row_of[static_cast<std::size_t>(it->second)]));
+      out.push_back(c.kind);
+      out.push_back(c.constrained);
+      out.insert(out.end(), c.frame.data(), c.frame.data() + Dim * Dim);
+    }
+  collective(comm_, [&] {
+    if (unknown_id >= 0)
+      throw InputError("DistributedElasticityMover::setup: another rank holds global node " + std::to_string(unknown_id) +
+                       " as a ghost owned here, but this rank does not hold it");
+  });
+  const auto answers = parallel::exchange(comm_, replies);
+  std::vector<std::size_t> at(static_cast<std::size_t>(p), 0);
+  for (const Index i : ghost_nodes_) {
+    const auto r = static_cast<std::size_t>(part.owner[static_cast<std::size_t>(i)]);
+    const double* a = answers[r].data() + at[r];
+    at[r] += reply_size;
+    row_of[static_cast<std::size_t>(i)] = static_cast<PetscInt>(a[0]);
+    NodeCondition& c = conditions_[static_cast<std::size_t>(i)];
+    c.kind = static_cast<int>(a[1]);
+    c.constrained = static_cast<int>(a[2]);
+    c.frame = Eigen::Map<const Frame>(a + 3);
+  }
+
+  // J0 over the whole mesh, then this rank's cells.
+  double j0 = eo.reference_jacobian;
+  if (eo.stiffening_exponent != 0.0 && !(j0 > 0.0)) {
+    double sums[2] = {0.0, static_cast<double>(mesh.num_cells())};
+    collective(comm_, [&] { sums[0] = ElasticityMover<Dim>::total_cell_measure(mesh); });
+    MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, comm_);
+    j0 = sums[1] > 0.0 ? sums[0] / sums[1] : 0.0;
+    collective(comm_, [&] {
+      if (!(j0 > 0.0)) throw InputError("DistributedElasticityMover::setup: every cell has zero measure (expected a positive mean)");
+    });
+  }
+  SparseMatrix k;
+  collective(comm_, [&] { k = ElasticityMover<Dim>::assemble_stiffness(mesh, eo, j0); });
+  // Rotate the dofs of sliding nodes into their frames: K ← Tᵀ K T.
+  bool rotated = false;
+  for (const auto& c : conditions_) rotated = rotated || c.kind == sliding;
+  if (rotated) {
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(static_cast<std::size_t>(n) * Dim * Dim);
+    for (Index i = 0; i < n; ++i)
+      for (int a = 0; a < Dim; ++a)
+        for (int b = 0; b < Dim; ++b)
+          if (const double f = conditions_[static_cast<std::size_t>(i)].frame(a, b); f != 0.0) t.emplace_back(i * Dim + a, i * Dim + b, f);
+    SparseMatrix rotation(n * Dim, n * Dim);
+    rotation.setFromTriplets(t.begin(), t.end());
+    k = SparseMatrix(rotation.transpose() * k * rotation);
+  }
+
+  // COO assembly with global indices.
+  std::vector<PetscInt> ci, cj;
+  std::vector<PetscScalar> cv;
+  ci.reserve(static_cast<std::size_t>(k.nonZeros()));
+  cj.reserve(static_cast<std::size_t>(k.nonZeros()));
+  cv.reserve(static_cast<std::size_t>(k.nonZeros()));
+  for (Index c = 0; c < k.outerSize(); ++c)
+    for (SparseMatrix::InnerIterator it(k, c); it; ++it) {
+      ci.push_back(row_of[static_cast<std::size_t>(it.row() / Dim)] + static_cast<PetscInt>(it.row() % Dim));
+      cj.push_back(row_of[static_cast<std::size_t>(it.col() / Dim)] + static_cast<PetscInt>(it.col() % Dim));
+      cv.push_back(it.value());
+    }
+  const PetscInt local_rows = n_owned * Dim;
+  petsc_check(MatCreate(comm_, &k_), "MatCreate");
+  petsc_check(MatSetSizes(k_, local_rows, local_rows, PETSC_DETERMINE, PETSC_DETERMINE), "MatSetSizes");
+  petsc_check(MatSetType(k_, MATAIJ), "MatSetType");
+  petsc_check(MatSetBlockSize(k_, Dim), "MatSetBlockSize");
+  petsc_check(MatSetPreallocationCOO(k_, static_cast<PetscCount>(ci.size()), ci.data(), cj.data()), "MatSetPreallocationCOO");
+  petsc_check(MatSetValuesCOO(k_, cv.data(), ADD_VALUES), "MatSetValuesCOO");
+  ci = {}, cj = {}, cv = {};
+
+  // Dirichlet dofs: prescribed and fixed nodes, the constrained directions of sliding ones,
+  // and dofs without stiffness (a node in no cell).
+  petsc_check(MatCreateVecs(k_, &x_, &b_), "MatCreateVecs");
+  petsc_check(VecDuplicate(x_, &values_), "VecDuplicate");
+  petsc_check(VecDuplicate(x_, &scale_), "VecDuplicate");
+  petsc_check(MatGetDiagonal(k_, scale_), "MatGetDiagonal");
+  dirichlet_.clear();
+  {
+    const PetscScalar* diag = nullptr;
+    petsc_check(VecGetArrayRead(scale_, &diag), "VecGetArrayRead");
+    for (PetscInt j = 0; j < n_owned; ++j) {
+      const NodeCondition& c = conditions_[static_cast<std::size_t>(owned_nodes_[static_cast<std::size_t>(j)])];
+      for (int a = 0; a < Dim; ++a) {
+        const bool held = c.kind == prescribed || c.kind == fixed || (c.kind == sliding && a >= Dim - c.constrained) ||
+                          !(diag[j * Dim + a] != 0.0);
+        if (held) dirichlet_.push_back(first_row_ + j * Dim + a);
+      }
+    }
+    petsc_check(VecRestoreArrayRead(scale_, &diag), "VecRestoreArrayRead");
+  }
+  petsc_check(MatDuplicate(k_, MAT_COPY_VALUES, &a_), "MatDuplicate");
+  petsc_check(MatZeroRowsColumns(a_, static_cast<PetscInt>(dirichlet_.size()), dirichlet_.data(), 1.0, nullptr, nullptr),
+              "MatZeroRowsColumns");
+  // Symmetric diagonal scaling: s = diag^-1/2.
+  petsc_check(MatGetDiagonal(a_, scale_), "MatGetDiagonal");
+  double smallest = 0.0;
+  petsc_check(VecMin(scale_, nullptr, &smallest), "VecMin");
+  collective(comm_, [&] {
+    if (!(smallest > 0.0))
+      throw SolverError("DistributedElasticityMover::setup: the stiffness matrix has a non-positive diagonal entry "
+                        "(an inverted cell, or a material that is not positive definite)");
+  });
+  petsc_check(VecSqrtAbs(scale_), "VecSqrtAbs");
+  petsc_check(VecReciprocal(scale_), "VecReciprocal");
+  petsc_check(MatDiagonalScale(a_, scale_, scale_), "MatDiagonalScale");
+  petsc_check(MatSetOption(a_, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption");
+  petsc_check(MatSetOption(a_, MAT_SPD, PETSC_TRUE), "MatSetOption");
+  if (options_.solver == PetscSolverKind::cg_gamg) {
+    // Rigid-body modes of the owned nodes (in the unrotated frame: near enough for the AMG).
+    ::Vec coordinates = nullptr;
+    petsc_check(VecCreateMPI(comm_, local_rows, PETSC_DETERMINE, &coordinates), "VecCreateMPI");
+    petsc_check(VecSetBlockSize(coordinates, Dim), "VecSetBlockSize");
+    PetscScalar* xyz = nullptr;
+    petsc_check(VecGetArray(coordinates, &xyz), "VecGetArray");
+    for (PetscInt j = 0; j < n_owned; ++j)
+      for (int a = 0; a < Dim; ++a) xyz[j * Dim + a] = part.points(a, owned_nodes_[static_cast<std::size_t>(j)]);
+    petsc_check(VecRestoreArray(coordinates, &xyz), "VecRestoreArray");
+    MatNullSpace modes = nullptr;
+    petsc_check(MatNullSpaceCreateRigidBody(coordinates, &modes), "MatNullSpaceCreateRigidBody");
+    petsc_check(MatSetNearNullSpace(a_, modes), "MatSetNearNullSpace");
+    MatNullSpaceDestroy(&modes);
+    VecDestroy(&coordinates);
+  }
+  build_solver(ksp_, options_.solver);
+
+  // Ghost values come from their owners' rows.
+  std::vector<PetscInt> from;
+  from.reserve(ghost_nodes_.size() * Dim);
+  for (const Index i : ghost_nodes_)
+    for (int a = 0; a < Dim; ++a) from.push_back(row_of[static_cast<std::size_t>(i)] + a);
+  IS is_from = nullptr, is_to = nullptr;
+  petsc_check(ISCreateGeneral(PETSC_COMM_SELF, static_cast<PetscInt>(from.size()), from.data(), PETSC_COPY_VALUES, &is_from), "ISCreateGeneral");
+  petsc_check(ISCreateStride(PETSC_COMM_SELF, static_cast<PetscInt>(from.size()), 0, 1, &is_to), "ISCreateStride");
+  petsc_check(VecCreateSeq(PETSC_COMM_SELF, static_cast<PetscInt>(from.size()), &ghosts_), "VecCreateSeq");
+  petsc_check(VecScatterCreate(x_, is_from, ghosts_, is_to, &scatter_), "VecScatterCreate");
+  ISDestroy(&is_from);
+  ISDestroy(&is_to);
+
+  MatInfo info;
+  MatGetInfo(a_, MAT_LOCAL, &info);
+  stats_ = MoverStats{};
+  stats_.boundary_nodes = static_cast<Index>(owned_entries_.size());
+  MPI_Allreduce(MPI_IN_PLACE, &stats_.boundary_nodes, 1, MPI_INT64_T, MPI_SUM, comm_);
+  stats_.evaluated_nodes = n_owned;
+  stats_.nonzeros = static_cast<Index>(info.nz_used);
+  stats_.factorizations = 1;
+  ready_ = true;
+  stats_.setup_seconds = watch.seconds();
+}
+
+template <int Dim>
+void DistributedElasticityMover<Dim>::move_into(const Points<Dim>& d, Points<Dim>& out) {
+  using meshmotion::parallel::detail::petsc_check;
+  const meshmotion::detail::Stopwatch watch;
+  collective(comm_, [&] {
+    if (!ready_) throw InputError("DistributedElasticityMover::move: setup() was not called");
+    if (d.cols() != boundary_size_)
+      throw InputError("DistributedElasticityMover::move: got " + std::to_string(d.cols()) + " displacements (expected " +
+                       std::to_string(boundary_size_) + ", one per local boundary entry)");
+    for (const Index k : owned_entries_)
+      if (!d.col(k).allFinite())
+        throw InputError("DistributedElasticityMover::move: boundary entry " + std::to_string(k) + " has a non-finite displacement");
+  });
+  // values_: the prescribed displacements on their owned rows, zero elsewhere.
+  petsc_check(VecSet(values_, 0.0), "VecSet");
+  PetscScalar* v = nullptr;
+  petsc_check(VecGetArray(values_, &v), "VecGetArray");
+  for (std::size_t e = 0; e < owned_entries_.size(); ++e) {
+    const Index k = owned_entries_[e];
+    if (conditions_[static_cast<std::size_t>(entry_nodes_[e])].kind != prescribed) continue;
+    for (int a = 0; a < Dim; ++a) v[entry_rows_[e] * Dim + a] = d(a, k);
+  }
+  std::vector<double> held(dirichlet_.size());
+  for (std::size_t r = 0; r < held.size(); ++r) held[r] = v[dirichlet_[r] - first_row_];
+  petsc_check(VecRestoreArray(values_, &v), "VecRestoreArray");
+  // b = −K u_D on free rows, u_D on Dirichlet rows; then scaled like the matrix.
+  petsc_check(MatMult(k_, values_, b_), "MatMult");
+  petsc_check(VecScale(b_, -1.0), "VecScale");
+  PetscScalar* b = nullptr;
+  petsc_check(VecGetArray(b_, &b), "VecGetArray");
+  for (std::size_t r = 0; r < held.size(); ++r) b[dirichlet_[r] - first_row_] = held[r];
+  petsc_check(VecRestoreArray(b_, &b), "VecRestoreArray");
+  petsc_check(VecPointwiseMult(b_, b_, scale_), "VecPointwiseMult");
+  PetscReal rhs_norm = 0.0;
+  petsc_check(VecNorm(b_, NORM_2, &rhs_norm), "VecNorm");
+
+  petsc_check(KSPSolve(ksp_, b_, x_), "KSPSolve");
+  KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
+  petsc_check(KSPGetConvergedReason(ksp_, &reason), "KSPGetConvergedReason");
+  PetscInt iterations = 0;
+  petsc_check(KSPGetIterationNumber(ksp_, &iterations), "KSPGetIterationNumber");
+  stats_.fell_back = false;
+  // The reason is the same on every rank, so every rank raises or falls back alike.
+  if (reason < 0) {
+    if (!options_.fallback_to_direct) {
+      throw SolverError("DistributedElasticityMover::move: CG did not converge (PETSc reason " + std::to_string(static_cast<int>(reason)) +
+                        " after " + std::to_string(iterations) + " iterations; tolerance " + std::to_string(options_.tolerance) +
+                        "); set fallback_to_direct or another solver");
+    }
+    if (direct_ == nullptr) build_solver(direct_, PetscSolverKind::direct_mumps);
+    petsc_check(KSPSolve(direct_, b_, x_), "KSPSolve");
+    stats_.fell_back = true;
+  }
+  ::Vec residual = nullptr;
+  petsc_check(VecDuplicate(b_, &residual), "VecDuplicate");
+  petsc_check(MatMult(a_, x_, residual), "MatMult");
+  petsc_check(VecAYPX(residual, -1.0, b_), "VecAYPX");
+  PetscReal residual_norm = 0.0;
+  petsc_check(VecNorm(residual, NORM_2, &residual_norm), "VecNorm");
+  VecDestroy(&residual);
+  petsc_check(VecPointwiseMult(x_, x_, scale_), "VecPointwiseMult");
+  // Dirichlet values exactly, whatever the Krylov iterate left there.
+  PetscScalar* x = nullptr;
+  petsc_check(VecGetArray(x_, &x), "VecGetArray");
+  for (std::size_t r = 0; r < held.size(); ++r) x[dirichlet_[r] - first_row_] = held[r];
+  out.resize(Dim, n_local_);
+  for (std::size_t j = 0; j < owned_nodes_.size(); ++j) {
+    const Index i = owned_nodes_[j];
+    out.col(i) = conditions_[static_cast<std::size_t>(i)].frame * Eigen::Map<const Vec<Dim>>(x + j * Dim);
+  }
+  petsc_check(VecRestoreArray(x_, &x), "VecRestoreArray");
+  petsc_check(VecScatterBegin(scatter_, x_, ghosts_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
+  petsc_check(VecScatterEnd(scatter_, x_, ghosts_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
+  const PetscScalar* g = nullptr;
+  petsc_check(VecGetArrayRead(ghosts_, &g), "VecGetArrayRead");
+  for (std::size_t j = 0; j < ghost_nodes_.size(); ++j) {
+    const Index i = ghost_nodes_[j];
+    out.col(i) = conditions_[static_cast<std::size_t>(i)].frame * Eigen::Map<const Vec<Dim>>(g + j * Dim);
+  }
+  petsc_check(VecRestoreArrayRead(ghosts_, &g), "VecRestoreArrayRead");
+  ++stats_.moves;
+  stats_.iterations = iterations;
+  stats_.residual = rhs_norm > 0.0 ? residual_norm / rhs_norm : 0.0;
+  stats_.move_seconds = watch.seconds();
+}
+
+}  // namespace meshmotion::parallel

@@ -1,0 +1,102 @@
+// The distributed elasticity mover (PETSc) against the serial ElasticityMover (direct
+// Cholesky) on the whole mesh: equal within the solver's tolerance at any number of ranks.
+#include "parallel_support.hpp"
+
+#include "meshmotion/core/generators.hpp"
+#include "meshmotion/movers/elasticity.hpp"
+#include "meshmotion/parallel.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace meshmotion;
+using namespace meshmotion::parallel;
+using test::global_max;
+using test::world;
+
+namespace {
+
+template <int Dim>
+double relative_error(const Mesh<Dim>& whole, const BoundarySpec<Dim>& spec, const DistributedElasticityOptions& options,
+                      std::span<const int> cell_ranks = {}, MoverStats* stats = nullptr) {
+  const ResolvedBoundary<Dim> b = spec.resolve(whole);
+  ElasticityMover<Dim> serial(options.elasticity);
+  serial.setup(whole, b);
+  const Points<Dim> expected = serial.move(b.displacements);
+
+  const DistributedMesh<Dim> part = partition_mesh(world(), whole, cell_ranks);
+  const ResolvedBoundary<Dim> local_b = distribute_boundary(part, b);
+  DistributedElasticityMover<Dim> mover(options);
+  mover.setup(part, local_b);
+  const Points<Dim> got = mover.move(local_b.displacements);
+  if (stats != nullptr) *stats = mover.stats();
+  double worst = 0.0;
+  for (Index i = 0; i < part.local.num_nodes(); ++i)
+    worst = std::max(worst, (got.col(i) - expected.col(part.global_ids[static_cast<std::size_t>(i)])).norm());
+  return global_max(worst) / expected.colwise().norm().maxCoeff();
+}
+
+}  // namespace
+
+TEST_CASE("distributed elasticity equals serial within the solver tolerance (2D, sliding side)", "[parallel][elasticity]") {
+  const Mesh<2> mesh = rectangle_mesh({.nx = 24, .ny = 16, .cells = RectangleCells::tri_quad});
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Rotation2D{{0.5, 0.0}, radians(6.0)}).fixed("top").sliding("left").sliding("right");
+  DistributedElasticityOptions options;
+  options.elasticity.poisson_ratio = 0.4;
+  options.tolerance = 1e-12;
+  SECTION("CG + GAMG") { CHECK(relative_error(mesh, spec, options) <= 1e-9); }
+  SECTION("CG + BoomerAMG") {
+    options.solver = PetscSolverKind::cg_hypre;
+    CHECK(relative_error(mesh, spec, options) <= 1e-9);
+  }
+  SECTION("MUMPS") {
+    options.solver = PetscSolverKind::direct_mumps;
+    CHECK(relative_error(mesh, spec, options) <= 1e-11);
+  }
+}
+
+TEST_CASE("distributed stiffened elasticity equals serial in 3D", "[parallel][elasticity]") {
+  const Mesh<3> mesh = box_mesh({.nx = 8, .ny = 6, .nz = 5, .cells = BoxCells::tet_pyramid_prism});
+  BoundarySpec<3> spec;
+  spec.moving("bottom", Rotation3D{{0.5, 0.5, 0.0}, {1.0, 0.0, 0.0}, radians(4.0)}).fixed("top").sliding("front").sliding("left");
+  DistributedElasticityOptions options;
+  options.elasticity.stiffening_exponent = 2.0;
+  options.tolerance = 1e-12;
+  MoverStats stats;
+  CHECK(relative_error(mesh, spec, options, {}, &stats) <= 1e-9);
+  CHECK(stats.moves == 1);
+  CHECK(global_max(stats.residual) <= 1e-12);
+}
+
+TEST_CASE("distributed elasticity: an empty rank and a rank without boundary nodes", "[parallel][elasticity]") {
+  const Index nx = 10, ny = 10;
+  const Mesh<2> mesh = rectangle_mesh({.nx = nx, .ny = ny});
+  const int p = size_of(world());
+  std::vector<int> ranks(static_cast<std::size_t>(nx * ny));
+  for (Index j = 0; j < ny; ++j)
+    for (Index i = 0; i < nx; ++i) ranks[static_cast<std::size_t>(i + nx * j)] = std::min(j < 2 ? 0 : j < ny - 2 ? 1 : 2, p - 1);
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Translation<2>{{0.02, 0.05}}).fixed("top");
+  DistributedElasticityOptions options;
+  options.tolerance = 1e-12;
+  CHECK(relative_error(mesh, spec, options, ranks) <= 1e-9);
+}
+
+TEST_CASE("distributed elasticity: a solver failure raises on every rank, or falls back when asked", "[parallel][elasticity]") {
+  const Mesh<2> mesh = rectangle_mesh({.nx = 16, .ny = 16, .cells = RectangleCells::tri3});
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Translation<2>{{0.0, 0.05}}).fixed("top");
+  DistributedElasticityOptions options;
+  options.tolerance = 1e-14;
+  options.max_iterations = 1;
+  options.solver = PetscSolverKind::cg_hypre;
+  CHECK_THROWS_AS(relative_error(mesh, spec, options), SolverError);
+  options.fallback_to_direct = true;
+  MoverStats stats;
+  CHECK(relative_error(mesh, spec, options, {}, &stats) <= 1e-11);
+  CHECK(stats.fell_back);
+
+  DistributedElasticityOptions unsupported;
+  unsupported.elasticity.active_radius = 0.3;
+  CHECK_THROWS_WITH(relative_error(mesh, spec, unsupported), Catch::Contains("not supported in parallel"));
+}
