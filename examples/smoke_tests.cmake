@@ -65,19 +65,28 @@ file(MAKE_DIRECTORY "${smoke_dir}")
 set(smoke_checker "${CMAKE_CURRENT_LIST_FILE}")
 
 # smoke_test(NAME name KEYS a,b/c [VALUES a/b=text,...] [EXPECT_RC n] [SETUP fixture]
-#            [REQUIRES fixtures...] COMMAND program args...)
+#            [REQUIRES fixtures...] [RANKS n] COMMAND program args...)
+# RANKS runs the program under mpiexec with n ranks.
 function(smoke_test)
-  cmake_parse_arguments(PARSE_ARGV 0 arg "" "NAME;KEYS;VALUES;EXPECT_RC;SETUP" "REQUIRES;COMMAND")
+  cmake_parse_arguments(PARSE_ARGV 0 arg "" "NAME;KEYS;VALUES;EXPECT_RC;SETUP;RANKS" "REQUIRES;COMMAND")
   if(NOT DEFINED arg_EXPECT_RC)
     set(arg_EXPECT_RC 0)
   endif()
   list(POP_FRONT arg_COMMAND program)
+  set(launcher)
+  if(arg_RANKS)
+    meshmotion_mpiexec_flags(mpi_flags)
+    set(launcher ${MESHMOTION_MPIEXEC} ${mpi_flags} -n ${arg_RANKS})
+  endif()
   add_test(NAME examples.${arg_NAME}
            COMMAND "${CMAKE_COMMAND}" -DKEYS=${arg_KEYS} "-DVALUES=${arg_VALUES}" -DEXPECT_RC=${arg_EXPECT_RC}
                    -P "${smoke_checker}"
-                   -- $<TARGET_FILE:${program}> ${arg_COMMAND}
+                   -- ${launcher} $<TARGET_FILE:${program}> ${arg_COMMAND}
            WORKING_DIRECTORY "${smoke_dir}")
   set_tests_properties(examples.${arg_NAME} PROPERTIES LABELS examples)
+  if(arg_RANKS)
+    set_tests_properties(examples.${arg_NAME} PROPERTIES ENVIRONMENT "OMP_NUM_THREADS=1" RUN_SERIAL TRUE)
+  endif()
   if(arg_SETUP)
     set_tests_properties(examples.${arg_NAME} PROPERTIES FIXTURES_SETUP ${arg_SETUP})
   endif()
@@ -221,3 +230,29 @@ smoke_test(NAME move_mesh.json_file_name_with_quote.json
            KEYS output VALUES output=${smoke_dir}/moved\"quote.su2
            COMMAND move_mesh "${smoke_dir}/clockwise.su2" -o "${smoke_dir}/moved\"quote.su2" --group bottom
                    --translate 0.01,0 --fixed rest --json)
+
+# move_mesh_mpi: the same mesh as move_mesh's, byte for byte, from 3 ranks; elasticity through
+# PETSc; an unknown group refused by every rank with rank 0's message.
+if(TARGET move_mesh_mpi)
+  smoke_test(NAME move_mesh_mpi.help KEYS "" EXPECT_RC 0 RANKS 1 COMMAND move_mesh_mpi --version)
+  smoke_test(NAME move_mesh_mpi.serial_peer.json REQUIRES examples_demo_mesh SETUP examples_mpi_serial_peer
+             KEYS after/min
+             COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_serial_peer.msh" --group wall --rotate 5
+                     --fixed farfield --json)
+  smoke_test(NAME move_mesh_mpi.rbf.json REQUIRES examples_demo_mesh SETUP examples_mpi_moved RANKS 3
+             KEYS ranks,setup_seconds,move_seconds,after/min VALUES ranks=3,after/invalid=0
+             COMMAND move_mesh_mpi "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_mpi.msh" --group wall --rotate 5
+                     --fixed farfield --json)
+  add_test(NAME examples.move_mesh_mpi.equals_move_mesh
+           COMMAND "${CMAKE_COMMAND}" -E compare_files "${smoke_dir}/moved_mpi.msh" "${smoke_dir}/moved_serial_peer.msh")
+  set_tests_properties(examples.move_mesh_mpi.equals_move_mesh PROPERTIES LABELS examples
+                       FIXTURES_REQUIRED "examples_mpi_moved;examples_mpi_serial_peer")
+  smoke_test(NAME move_mesh_mpi.sle.json REQUIRES examples_demo_mesh RANKS 2
+             KEYS solver VALUES method=sle,after/invalid=0
+             COMMAND move_mesh_mpi "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_mpi_sle.vtu" --group wall --rotate 2
+                     --fixed farfield --method sle --petsc-solver cg_hypre --rank-files --json)
+  smoke_test(NAME move_mesh_mpi.unknown_group.json REQUIRES examples_demo_mesh RANKS 2 EXPECT_RC 1 KEYS error
+             VALUES kind=input
+             COMMAND move_mesh_mpi "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_mpi_bad.msh" --group nosuch --rotate 5
+                     --json)
+endif()

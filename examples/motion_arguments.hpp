@@ -1,0 +1,156 @@
+#pragma once
+// The boundary motion options move_mesh and move_mesh_mpi share: the moving group and its
+// rotation, translation or displacement file, the fixed and sliding groups, and the support
+// radius of the methods that take one (a heuristic from the boundary when not given).
+
+#include "meshmotion/core/option_text.hpp"
+#include "meshmotion/movers.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cstdint>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+namespace meshmotion::examples {
+
+struct MotionArguments {
+  std::string group, displacements_file;
+  std::vector<std::string> fixed, sliding;
+  std::optional<double> rotate;
+  std::optional<std::string> support_radius;
+  std::vector<double> center, axis, translate;
+};
+
+inline void add_motion_options(CLI::App& app, MotionArguments& a) {
+  app.add_option("--group", a.group, "Moving boundary group");
+  auto* rotate = app.add_option("--rotate", a.rotate, "Rotation angle in degrees");
+  app.add_option("--center", a.center, "Rotation centre X,Y[,Z]")->delimiter(',');
+  app.add_option("--axis", a.axis, "Rotation axis AX,AY,AZ (3D, default z)")->delimiter(',');
+  auto* translate = app.add_option("--translate", a.translate, "Translation DX,DY[,DZ]")->delimiter(',');
+  auto* file = app.add_option("--displacements", a.displacements_file,
+                              "Text file: lines 'node dx dy [dz]', node = the node's id in the mesh file, any order; "
+                              "every node of --group once");
+  rotate->excludes(translate)->excludes(file);
+  translate->excludes(file);
+  app.add_option("--fixed", a.fixed, "Fixed groups");
+  app.add_option("--sliding", a.sliding, "Groups sliding in their plane");
+  app.add_option("--support-radius", a.support_radius, "support radius of rbf (default: heuristic from the boundary)");
+}
+
+/// Throws InputError unless a group and one motion are given.
+inline void require_motion(const MotionArguments& a, const std::string& program) {
+  if (a.group.empty()) throw InputError(program + ": give --group GROUP (see --help)");
+  if (!a.rotate && a.translate.empty() && a.displacements_file.empty())
+    throw InputError(program + ": give one of --rotate, --translate, --displacements");
+}
+
+template <int Dim>
+Vec<Dim> vec(const std::vector<double>& v, const char* what) {
+  if (static_cast<int>(v.size()) != Dim)
+    throw InputError(std::string("--") + what + " needs " + std::to_string(Dim) + " comma-separated values (got " +
+                     std::to_string(v.size()) + ")");
+  Vec<Dim> out;
+  for (int d = 0; d < Dim; ++d) out[d] = v[static_cast<std::size_t>(d)];
+  return out;
+}
+
+// Lines "node dx dy [dz]": the node's id in the mesh file, then its displacement; '#' starts a
+// comment. The nodes may come in any order; resolve() checks them against the group.
+template <int Dim>
+std::pair<std::vector<std::int64_t>, Points<Dim>> read_displacements(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw IoError("cannot open " + file);
+  std::vector<std::int64_t> ids;
+  std::vector<double> values;
+  std::string line;
+  std::uint64_t line_number = 0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line_number == 1 && line.starts_with("\xEF\xBB\xBF")) line.erase(0, 3);
+    if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
+    std::istringstream s(line);
+    std::vector<std::string> fields;
+    for (std::string f; s >> f;) fields.push_back(f);
+    if (fields.empty()) continue;
+    if (static_cast<int>(fields.size()) != Dim + 1)
+      throw ParseError(file, line_number,
+                       "expected 'node " + std::string(Dim == 2 ? "dx dy" : "dx dy dz") + "' (the node's id in the mesh file, then " +
+                           std::to_string(Dim) + " numbers; got " + std::to_string(fields.size()) + " fields)");
+    std::int64_t id = 0;
+    try {
+      parse_option_value("node", fields[0], id);
+      for (int d = 0; d < Dim; ++d) {
+        double x = 0.0;
+        parse_option_value("displacement", fields[static_cast<std::size_t>(d + 1)], x);
+        values.push_back(x);
+      }
+    } catch (const InputError& e) {
+      throw ParseError(file, line_number, e.what());
+    }
+    ids.push_back(id);
+  }
+  return {ids, Eigen::Map<const Points<Dim>>(values.data(), Dim, static_cast<Index>(ids.size()))};
+}
+
+template <int Dim>
+Motion<Dim> motion(const MotionArguments& a) {
+  if (!a.translate.empty()) return Translation<Dim>{vec<Dim>(a.translate, "translate")};
+  const double angle = radians(*a.rotate);
+  const Vec<Dim> c = a.center.empty() ? Vec<Dim>::Zero() : vec<Dim>(a.center, "center");
+  if constexpr (Dim == 2) {
+    return Rotation2D{c, angle};
+  } else {
+    return Rotation3D{c, a.axis.empty() ? Vec<3>::UnitZ() : vec<3>(a.axis, "axis"), angle};
+  }
+}
+
+/// The boundary conditions the arguments give, on `mesh`.
+template <int Dim>
+BoundarySpec<Dim> boundary_spec(const MotionArguments& a, const Mesh<Dim>& mesh) {
+  BoundarySpec<Dim> spec;
+  if (!a.displacements_file.empty()) {
+    auto [ids, d] = read_displacements<Dim>(a.displacements_file);
+    spec.moving(a.group, mesh.node_indices(ids), std::move(d));
+  } else {
+    spec.moving(a.group, motion<Dim>(a));
+  }
+  for (const auto& g : a.fixed) spec.fixed(g);
+  for (const auto& g : a.sliding) spec.sliding(g);
+  return spec;
+}
+
+/// Sets the support radius of a method that takes one: --support-radius, else an option
+/// given, else the heuristic on the resolved boundary. Returns the radius (none for methods
+/// without one); refuses --support-radius for those.
+template <int Dim>
+std::optional<double> set_support_radius(MoverConfig<Dim>& config, const MotionArguments& a, const KeyValues& given,
+                                         const BoundarySpec<Dim>& spec, const Mesh<Dim>& mesh) {
+  std::optional<double> radius;
+  std::visit(
+      [&]<class O>(O& o) {
+        if constexpr (TakesSupportRadius<O>) {
+          if (a.support_radius) {
+            parse_option_value("support_radius", *a.support_radius, o.support_radius);
+          } else if (std::none_of(given.begin(), given.end(), [](const auto& kv) { return kv.first == "support_radius"; })) {
+            const ResolvedBoundary<Dim> b = spec.resolve(mesh);
+            Points<Dim> at(Dim, b.size());
+            for (Index k = 0; k < b.size(); ++k) at.col(k) = mesh.points.col(b.nodes[static_cast<std::size_t>(k)]);
+            o.support_radius = suggest_support_radius(at, b.displacements);
+          }
+          radius = o.support_radius;
+        } else if (a.support_radius) {
+          throw InputError("--support-radius: method '" + config.method + "' takes no support radius");
+        }
+      },
+      config.options);
+  return radius;
+}
+
+}  // namespace meshmotion::examples

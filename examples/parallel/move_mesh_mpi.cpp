@@ -1,0 +1,216 @@
+// move_mesh_mpi: move_mesh on MPI ranks. Rank 0 reads the mesh and resolves the boundary
+// conditions on the whole mesh; METIS partitions the cells; every rank moves its part
+// (distributed RBF, or linear/stiffened elasticity through PETSc); rank 0 gathers the moved
+// nodes and writes one mesh with the input's numbering (and, with --rank-files, each rank its
+// own part).
+//
+//   mpiexec -n 4 move_mesh_mpi wing.msh -o moved.msh --group wall --rotate 30 --center 0.25,0 --fixed farfield
+//   mpiexec -n 2 move_mesh_mpi wing.su2 -o moved.su2 --group wall --translate 0,0.1 --method sle --petsc-solver cg_hypre
+//
+// PETSc options refine the elasticity solver through PETSC_OPTIONS with the prefix
+// meshmotion_ (e.g. PETSC_OPTIONS="-meshmotion_ksp_monitor"). Exit codes as move_mesh: 0
+// moved and valid, 1 error (nothing written), 2 written with invalid cells or refused by
+// --strict. Every rank exits with the same code.
+
+#include "meshmotion/core/json.hpp"
+#include "meshmotion/io.hpp"
+#include "meshmotion/movers.hpp"
+#include "meshmotion/parallel.hpp"
+#include "meshmotion/quality.hpp"
+
+#include "../motion_arguments.hpp"
+#include "../mover_arguments.hpp"
+#include "../program.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <petscsys.h>
+
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+using namespace meshmotion;
+using namespace meshmotion::parallel;
+
+namespace {
+
+struct Arguments {
+  std::string input, output;
+  examples::MotionArguments motion;
+  std::string solver = "cg_gamg";
+  double tolerance = 1e-10;
+  bool json = false, strict = false, overwrite = false, keep_orientation = false, rank_files = false;
+  examples::MoverArguments mover;
+};
+
+PetscSolverKind solver_kind(const std::string& name) {
+  if (name == "cg_gamg") return PetscSolverKind::cg_gamg;
+  if (name == "cg_hypre") return PetscSolverKind::cg_hypre;
+  if (name == "mumps") return PetscSolverKind::direct_mumps;
+  throw InputError("move_mesh_mpi: --petsc-solver '" + name + "' is not one of cg_gamg, cg_hypre, mumps");
+}
+
+// rank<R>.<ext> beside OUTPUT: each rank's part with its local numbering.
+std::string rank_file(const std::string& output, int rank) {
+  std::filesystem::path p(output);
+  const std::string ext = p.extension().string();
+  return p.replace_extension("").string() + ".rank" + std::to_string(rank) + ext;
+}
+
+template <int Dim>
+int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
+  const MPI_Comm comm = MPI_COMM_WORLD;
+  const bool root = rank_of(comm) == 0;
+  const int ranks = size_of(comm);
+  // Rank 0 prepares the whole mesh and its boundary; the others wait for its verdict.
+  ResolvedBoundary<Dim> boundary;
+  QualityReport before;
+  MoverConfig<Dim> config;
+  double radius = 0.0;
+  collective(comm, [&] {
+    KeyValues given = examples::given_options(a.mover);
+    config = mover_config<Dim>(a.mover.method, given);
+    if (config.method != "rbf" && config.method != "le" && config.method != "sle")
+      throw InputError("move_mesh_mpi: --method '" + config.method + "' has no distributed mover (expected rbf, le or sle)");
+    if (!root) return;
+    examples::handle_orientation(*whole, a.input, a.keep_orientation);
+    name_unnamed_facet_groups(*whole);
+    const BoundarySpec<Dim> spec = examples::boundary_spec<Dim>(a.motion, *whole);
+    if (const auto r = examples::set_support_radius(config, a.motion, given, spec, *whole)) radius = *r;
+    boundary = spec.resolve(*whole);
+    before = quality_report(*whole, Metric::skew);
+  });
+  MPI_Bcast(&radius, 1, MPI_DOUBLE, 0, comm);
+  if (auto* rbf = std::get_if<RbfOptions>(&config.options)) rbf->support_radius = radius;
+
+  const Mesh<Dim> empty;
+  const DistributedMesh<Dim> part = partition_mesh(comm, root ? *whole : empty);
+  const ResolvedBoundary<Dim> local = distribute_boundary(part, boundary);
+  Points<Dim> displacement;
+  MoverStats stats;
+  if (auto* rbf = std::get_if<RbfOptions>(&config.options)) {
+    DistributedRbfMover<Dim> mover(*rbf);
+    mover.setup(part.view(), local);
+    displacement = mover.move(local.displacements);
+    stats = mover.stats();
+  } else {
+    DistributedElasticityOptions options;
+    options.elasticity = std::get<ElasticityOptions>(config.options);
+    options.solver = solver_kind(a.solver);
+    options.tolerance = a.tolerance;
+    DistributedElasticityMover<Dim> mover(options);
+    mover.setup(part, local);
+    displacement = mover.move(local.displacements);
+    stats = mover.stats();
+  }
+  double seconds[2] = {stats.setup_seconds, stats.move_seconds};
+  MPI_Allreduce(MPI_IN_PLACE, seconds, 2, MPI_DOUBLE, MPI_MAX, comm);
+  const Points<Dim> moved_local = part.local.points + displacement;
+  if (a.rank_files) {
+    Mesh<Dim> mine = part.local;
+    mine.points = moved_local;
+    collective(comm, [&] { write_mesh(rank_file(a.output, rank_of(comm)), mine); });
+  }
+  const Points<Dim> moved = gather_owned(part.view(), moved_local, part.num_global_nodes);
+
+  int code = examples::exit_ok;
+  collective(comm, [&] {
+    if (!root) return;
+    whole->points = moved;
+    const QualityReport after = quality_report(*whole, Metric::skew);
+    const bool invalid = after.num_invalid > 0;
+    if (invalid && a.strict)
+      throw InvalidMeshError("move_mesh_mpi: " + std::to_string(after.num_invalid) + " of " + std::to_string(after.num_elements) +
+                             " cells invalid after the motion (--strict: nothing written)");
+    write_mesh(a.output, *whole);
+    if (a.json) {
+      JsonWriter w(std::cout);
+      w.begin_object().key("input").value(a.input).key("output").value(a.output).key("method").value(config.method);
+      w.key("ranks").value(ranks);
+      if (std::holds_alternative<RbfOptions>(config.options)) w.key("support_radius").value(radius);
+      else w.key("solver").value(a.solver);
+      w.key("nodes").value(whole->num_nodes()).key("boundary_nodes").value(stats.boundary_nodes);
+      w.key("setup_seconds").value(seconds[0]).key("move_seconds").value(seconds[1]);
+      w.key("before").begin_object().key("min").value(before.min).key("mean").value(before.mean);
+      w.key("invalid").value(before.num_invalid).end_object();
+      w.key("after").begin_object().key("min").value(after.min).key("mean").value(after.mean);
+      w.key("invalid").value(after.num_invalid).end_object();
+      w.end_object();
+      std::cout << "\n";
+    } else {
+      std::cout << "moved " << whole->num_nodes() << " nodes with " << config.method << " on " << ranks << " rank(s)\n"
+                << "  setup " << seconds[0] << " s, move " << seconds[1] << " s (slowest rank)\n"
+                << "  skew before: min " << before.min << " mean " << before.mean << " invalid " << before.num_invalid << "\n"
+                << "  skew after:  min " << after.min << " mean " << after.mean << " invalid " << after.num_invalid << "\n";
+    }
+    if (invalid) {
+      std::cerr << "wrote " << a.output << " WITH " << after.num_invalid << " INVALID CELLS of " << after.num_elements << "\n";
+      code = examples::exit_invalid;
+    } else if (!a.json) {
+      std::cout << "wrote " << a.output << "\n";
+    }
+  });
+  MPI_Bcast(&code, 1, MPI_INT, 0, comm);
+  return code;
+}
+
+int main_body(int argc, char** argv) {
+  const MPI_Comm comm = MPI_COMM_WORLD;
+  const bool root = rank_of(comm) == 0;
+  CLI::App app{"Move a mesh on MPI ranks: read on rank 0, partitioned by METIS, moved by the distributed movers"};
+  examples::add_version_flag(app);
+  Arguments a;
+  app.add_option("input", a.input, "Input mesh (.msh, .su2)")->check(CLI::ExistingFile);
+  app.add_option("-o,--output", a.output, "Output mesh (.msh, .su2, .vtu), written by rank 0");
+  examples::add_motion_options(app, a.motion);
+  examples::add_mover_options(app, a.mover, "");
+  app.add_option("--petsc-solver", a.solver, "le/sle: PETSc solver cg_gamg | cg_hypre | mumps")->capture_default_str();
+  app.add_option("--petsc-tolerance", a.tolerance, "le/sle: relative residual of CG (displacement units)")->capture_default_str();
+  app.add_flag("--rank-files", a.rank_files, "also write each rank's part as OUTPUT's stem + .rankR + extension");
+  app.add_flag("--strict", a.strict, "write nothing when invalid cells remain (exit 2)");
+  app.add_flag("--overwrite", a.overwrite, "allow the output to be the input file");
+  app.add_flag("--keep-orientation", a.keep_orientation,
+               "refuse a mesh whose cells are all negatively oriented instead of reorienting it");
+  app.add_flag("--json", a.json, "Print one JSON object (rank 0)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // Every rank parses the same words; rank 0 alone prints help or the complaint.
+    if (root) return app.exit(e);
+    return e.get_exit_code();
+  }
+  // Rank 0 reports; every rank gets the same exception from the collective calls.
+  return examples::guarded(a.json && root, [&] {
+    try {
+      if (examples::list_options<2>(a.mover)) return examples::exit_ok;
+      int dim = 0;
+      std::unique_ptr<AnyMesh> mesh;
+      collective(comm, [&] {
+        if (a.input.empty() || a.output.empty()) throw InputError("move_mesh_mpi: give an input mesh and -o OUTPUT (see --help)");
+        examples::require_motion(a.motion, "move_mesh_mpi");
+        if (!root) return;
+        examples::check_output(a.input, a.output, 1, a.overwrite);
+        mesh = std::make_unique<AnyMesh>(read_mesh(a.input));
+        dim = std::holds_alternative<Mesh<2>>(*mesh) ? 2 : 3;
+      });
+      MPI_Bcast(&dim, 1, MPI_INT, 0, comm);
+      if (dim == 2) return run<2>(a, root ? std::make_unique<Mesh<2>>(std::move(std::get<Mesh<2>>(*mesh))) : nullptr);
+      return run<3>(a, root ? std::make_unique<Mesh<3>>(std::move(std::get<Mesh<3>>(*mesh))) : nullptr);
+    } catch (const Error&) {
+      if (!root) std::cerr.setstate(std::ios::failbit);  // one message, from rank 0
+      throw;
+    }
+  });
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // PETSc's options come from PETSC_OPTIONS: the command line is ours.
+  int petsc_argc = 1;
+  if (PetscInitialize(&petsc_argc, &argv, nullptr, nullptr) != 0) return examples::exit_error;
+  const int code = main_body(argc, argv);
+  PetscFinalize();
+  return code;
+}
