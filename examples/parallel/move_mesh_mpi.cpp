@@ -38,17 +38,18 @@ namespace {
 struct Arguments {
   std::string input, output;
   examples::MotionArguments motion;
-  std::string solver = "cg_gamg";
+  std::string solver = "automatic";
   double tolerance = 1e-10;
   bool json = false, strict = false, overwrite = false, keep_orientation = false, rank_files = false;
   examples::MoverArguments mover;
 };
 
 PetscSolverKind solver_kind(const std::string& name) {
+  if (name == "automatic") return PetscSolverKind::automatic;
   if (name == "cg_gamg") return PetscSolverKind::cg_gamg;
   if (name == "cg_hypre") return PetscSolverKind::cg_hypre;
   if (name == "mumps") return PetscSolverKind::direct_mumps;
-  throw InputError("move_mesh_mpi: --petsc-solver '" + name + "' is not one of cg_gamg, cg_hypre, mumps");
+  throw InputError("move_mesh_mpi: --petsc-solver '" + name + "' is not one of automatic, cg_gamg, cg_hypre, mumps");
 }
 
 // rank<R>.<ext> beside OUTPUT: each rank's part with its local numbering.
@@ -165,7 +166,7 @@ int main_body(int argc, char** argv) {
   app.add_option("-o,--output", a.output, "Output mesh (.msh, .su2, .vtu), written by rank 0");
   examples::add_motion_options(app, a.motion);
   examples::add_mover_options(app, a.mover, "");
-  app.add_option("--petsc-solver", a.solver, "le/sle: PETSc solver cg_gamg | cg_hypre | mumps")->capture_default_str();
+  app.add_option("--petsc-solver", a.solver, "le/sle: PETSc solver automatic (mumps in 2D, cg_gamg in 3D) | cg_gamg | cg_hypre | mumps")->capture_default_str();
   app.add_option("--petsc-tolerance", a.tolerance, "le/sle: relative residual of CG (displacement units)")->capture_default_str();
   app.add_flag("--rank-files", a.rank_files, "also write each rank's part as OUTPUT's stem + .rankR + extension");
   app.add_flag("--strict", a.strict, "write nothing when invalid cells remain (exit 2)");

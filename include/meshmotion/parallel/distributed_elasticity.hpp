@@ -49,6 +49,10 @@ namespace meshmotion::parallel {
 
 /// PETSc solver of the distributed elasticity system.
 enum class PetscSolverKind {
+  /// MUMPS in 2D, CG + GAMG in 3D: on boundary-layer meshes the stiffened 2D system defeats
+  /// the multigrids (thousands of iterations on the 30P30N) while MUMPS factorizes it in
+  /// seconds; 3D systems outgrow direct factorization first (docs/parallel.md).
+  automatic,
   cg_gamg,       ///< CG preconditioned by PETSc's algebraic multigrid (rigid-body near null space)
   cg_hypre,      ///< CG preconditioned by hypre's BoomerAMG
   direct_mumps,  ///< Cholesky by MUMPS (distributed direct)
@@ -58,7 +62,7 @@ struct DistributedElasticityOptions {
   /// Material and Jacobian stiffening as in serial; `solver` there is not used (see below),
   /// distance_exponent and active_radius must be 0.
   ElasticityOptions elasticity = {};
-  PetscSolverKind solver = PetscSolverKind::cg_gamg;
+  PetscSolverKind solver = PetscSolverKind::automatic;
   /// Relative residual of the diagonally scaled system (displacement units) for CG.
   double tolerance = 1e-10;
   PetscInt max_iterations = 10000;
@@ -181,6 +185,11 @@ void DistributedElasticityMover<Dim>::build_solver(KSP& ksp, PetscSolverKind kin
     petsc_check(KSPSetType(ksp, KSPPREONLY), "KSPSetType");
     petsc_check(PCSetType(pc, PCCHOLESKY), "PCSetType");
     petsc_check(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS), "PCFactorSetMatSolverType");
+    // METIS ordering: MUMPS's automatic choice fills twice as much on these meshes.
+    petsc_check(PCFactorSetUpMatSolverType(pc), "PCFactorSetUpMatSolverType");
+    Mat factor = nullptr;
+    petsc_check(PCFactorGetMatrix(pc, &factor), "PCFactorGetMatrix");
+    petsc_check(MatMumpsSetIcntl(factor, 7, 5), "MatMumpsSetIcntl");
   } else {
     petsc_check(KSPSetType(ksp, KSPCG), "KSPSetType");
     if (kind == PetscSolverKind::cg_hypre) {
@@ -392,7 +401,7 @@ void DistributedElasticityMover<Dim>::setup_mesh(const PartitionView<Dim>& part,
   petsc_check(MatDiagonalScale(a_, scale_, scale_), "MatDiagonalScale");
   petsc_check(MatSetOption(a_, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption");
   petsc_check(MatSetOption(a_, MAT_SPD, PETSC_TRUE), "MatSetOption");
-  if (options_.solver == PetscSolverKind::cg_gamg) {
+  if (options_.solver == PetscSolverKind::cg_gamg || (options_.solver == PetscSolverKind::automatic && Dim == 3)) {
     // Rigid-body modes of the owned nodes (in the unrotated frame: near enough for the AMG).
     ::Vec coordinates = nullptr;
     petsc_check(VecCreateMPI(comm_, local_rows, PETSC_DETERMINE, &coordinates), "VecCreateMPI");
@@ -408,7 +417,10 @@ void DistributedElasticityMover<Dim>::setup_mesh(const PartitionView<Dim>& part,
     MatNullSpaceDestroy(&modes);
     VecDestroy(&coordinates);
   }
-  build_solver(ksp_, options_.solver);
+  const PetscSolverKind kind = options_.solver != PetscSolverKind::automatic ? options_.solver
+                               : Dim == 2                                   ? PetscSolverKind::direct_mumps
+                                                                            : PetscSolverKind::cg_gamg;
+  build_solver(ksp_, kind);
 
   // Ghost values come from their owners' rows.
   std::vector<PetscInt> from;
