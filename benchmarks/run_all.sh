@@ -72,6 +72,8 @@ for name in "${order[@]}"; do
 done
 targets=("${benches[@]}")
 [[ $peers == 1 ]] && targets+=(motion_peer_bench python_overhead_peer meshmotion_python)
+# The parallel layer's benchmark exists when MPI, PETSc and METIS were found at configure time.
+mpi_targets=(mpi_bench)
 
 {
   echo "# $(date -u +%FT%TZ)  nproc=$(nproc)  $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //')"
@@ -83,6 +85,8 @@ if [[ $build == 1 ]]; then
     >> "$log" 2>&1 || { echo "run_all.sh: configure failed, see $log" >&2; exit 1; }
   cmake --build "$build_dir" --target "${targets[@]}" -j"$jobs" >> "$log" 2>&1 \
     || { echo "run_all.sh: build failed, see $log" >&2; exit 1; }
+  cmake --build "$build_dir" --target "${mpi_targets[@]}" -j"$jobs" >> "$log" 2>&1 \
+    || echo "run_all.sh: mpi_bench not built (parallel layer skipped at configure time?)" | tee -a "$log" >&2
 fi
 
 status=0
@@ -115,6 +119,16 @@ for name in "${benches[@]}"; do
   # shellcheck disable=SC2086  # args is a word list on purpose
   run "$name" "$build_dir/benchmarks/$name" $args
 done
+# The distributed movers at 1, 2 and 4 ranks (4 is oversubscribed on two cores and says so),
+# each against the serial mover in the same process.
+if [[ -x "$build_dir/benchmarks/mpi_bench" ]]; then
+  mpi_flags=()
+  mpiexec --version 2>&1 | grep -q "Open MPI" && mpi_flags=(--oversubscribe --allow-run-as-root)
+  for ranks in 1 2 4; do
+    run "mpi_bench_$ranks" mpiexec "${mpi_flags[@]}" -n "$ranks" "$build_dir/benchmarks/mpi_bench" \
+      "$([[ $full == 1 ]] && echo 126 || echo 64)"
+  done
+fi
 if [[ $peers == 1 ]]; then
   for name in "${peer_scripts[@]}"; do
     run "$name" "$here/$name.sh" "$build_dir" "$build_dir/$name"

@@ -8,7 +8,8 @@
 // stiffened elasticity mover (χ = 2.75; serial: direct Cholesky, distributed: CG + GAMG).
 // The serial mover runs first on rank 0 with every core's threads while the other ranks
 // sleep; then every rank runs the distributed mover with cores / ranks threads. Setup and move
-// are the slowest rank's; memory is each rank's resident size after setup (largest and rank 0's);
+// are the slowest rank's; memory is the heap each rank's mover keeps after setup (largest, and
+// rank 0's);
 // more ranks than cores is flagged "oversubscribed". A table and one JSON line per case.
 
 #include "meshmotion/core/generators.hpp"
@@ -17,13 +18,13 @@
 #include "meshmotion/parallel.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 
+#include <malloc.h>
 #include <petscsys.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <string>
 #include <thread>
 
@@ -32,19 +33,11 @@ using namespace meshmotion::parallel;
 
 namespace {
 
-// Resident set size now (VmRSS), in MB.
-double resident_mb() {
-  std::ifstream in("/proc/self/status");
-  std::string key;
-  double kb = 0.0;
-  while (in >> key) {
-    if (key == "VmRSS:") {
-      in >> kb;
-      break;
-    }
-    in.ignore(1 << 12, '\n');
-  }
-  return kb / 1024.0;
+// Heap in use now (glibc's count of live allocations), in MB: what a mover keeps after setup
+// is the growth across it, unaffected by pages an earlier case freed.
+double heap_mb() {
+  const struct mallinfo2 m = mallinfo2();
+  return static_cast<double>(m.uordblks + m.hblkhd) / (1024.0 * 1024.0);
 }
 
 // Waits for the other ranks without spinning a core (the serial run must have them all).
@@ -66,10 +59,10 @@ struct Figures {
 template <class Mover, class Setup>
 Figures measure(Mover& mover, Setup&& setup, const Points<Mover::dim>& d, int moves) {
   Figures f;
-  const double before = resident_mb();
+  const double before = heap_mb();
   setup();
   f.setup = mover.stats().setup_seconds;
-  f.memory = resident_mb() - before;
+  f.memory = heap_mb() - before;
   Points<Mover::dim> u;
   const meshmotion::detail::Stopwatch watch;
   for (int i = 0; i < moves; ++i) mover.move_into(d, u);
