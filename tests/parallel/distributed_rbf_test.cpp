@@ -36,7 +36,8 @@ struct Outcome {
 // and compares the displacements and the reverse derivatives node by node.
 template <int Dim>
 Outcome compare_with_serial(const Mesh<Dim>& whole, const ResolvedBoundary<Dim>& b, RbfOptions options,
-                            std::span<const int> cell_ranks = {}, bool radius_per_entry = false) {
+                            std::span<const int> cell_ranks = {}, bool radius_per_entry = false,
+                            BoundarySolveOptions solve = {}) {
   const auto radius_at = [&](const meshmotion::Vec<Dim>& x) { return options.support_radius * (0.8 + 0.4 * std::abs(x[0])); };
   RbfOptions serial_options = options;
   if (radius_per_entry)
@@ -58,8 +59,9 @@ Outcome compare_with_serial(const Mesh<Dim>& whole, const ResolvedBoundary<Dim>&
   RbfOptions local_options = options;
   if (radius_per_entry)
     for (const Index v : local_b.nodes) local_options.support_radii.push_back(radius_at(part.local.points.col(v)));
-  DistributedRbfMover<Dim> mover(local_options);
+  DistributedRbfMover<Dim> mover(local_options, solve);
   mover.setup(part.view(), local_b);
+  REQUIRE(mover.petsc_solve() == (solve.kind == BoundarySolve::petsc));
   const Points<Dim> got = mover.move(local_b.displacements);
 
   Outcome out;
@@ -107,6 +109,60 @@ TEST_CASE("distributed RBF equals serial on a 2D mesh partitioned by METIS", "[p
     CHECK(r.gradient <= 1e-12);
     CHECK(r.global_entries == static_cast<Index>(spec.resolve(mesh).size()));
   }
+}
+
+TEST_CASE("distributed RBF with the boundary system factorized across the ranks by MUMPS", "[parallel][rbf][petsc]") {
+  const BoundarySolveOptions petsc{BoundarySolve::petsc};
+  {
+    const Mesh<2> mesh = rectangle_mesh({.nx = 24, .ny = 18, .cells = RectangleCells::tri_quad});
+    BoundarySpec<2> spec;
+    spec.moving("bottom", Rotation2D{{0.5, 0.0}, radians(8.0)}).fixed("top").fixed("left");
+    for (const bool polynomial : {false, true}) {
+      RbfOptions options;
+      options.support_radius = 0.6;
+      options.polynomial = polynomial;
+      const Outcome r = compare_with_serial(mesh, spec.resolve(mesh), options, {}, false, petsc);
+      INFO("polynomial " << polynomial << ": move " << r.error << ", gradient " << r.gradient << ", rounding " << r.gradient_rounding);
+      CHECK(r.error <= 1e-12);
+      CHECK(r.gradient <= std::max(1e-12, 100.0 * r.gradient_rounding));
+    }
+  }
+  {
+    const Mesh<3> mesh = box_mesh({.nx = 8, .ny = 6, .nz = 6, .cells = BoxCells::tet4});
+    BoundarySpec<3> spec;
+    spec.moving("bottom", Rotation3D{{0.5, 0.5, 0.0}, {1.0, 0.0, 0.0}, radians(5.0)}).fixed("top").fixed("front");
+    RbfOptions options;
+    options.support_radius = 0.7;
+    options.polynomial = true;
+    const Outcome r = compare_with_serial(mesh, spec.resolve(mesh), options, {}, false, petsc);
+    INFO("move " << r.error << ", gradient " << r.gradient << ", rounding " << r.gradient_rounding);
+    CHECK(r.error <= 1e-12);
+    CHECK(r.gradient <= std::max(1e-12, 100.0 * r.gradient_rounding));
+  }
+  {
+    // The partition that leaves ranks without moving nodes, without group nodes, or empty.
+    const Index nx = 10, ny = 10;
+    const Mesh<2> mesh = rectangle_mesh({.nx = nx, .ny = ny});
+    const int p = size_of(world());
+    std::vector<int> ranks(static_cast<std::size_t>(nx * ny));
+    for (Index j = 0; j < ny; ++j)
+      for (Index i = 0; i < nx; ++i) ranks[static_cast<std::size_t>(i + nx * j)] = std::min(j < 2 ? 0 : j < ny - 2 ? 1 : 2, p - 1);
+    BoundarySpec<2> spec;
+    spec.moving("bottom", Translation<2>{{0.0, 0.08}}).fixed("top");
+    const Outcome r = compare_with_serial(mesh, spec.resolve(mesh), {.support_radius = 0.9}, ranks, false, petsc);
+    CHECK(r.error <= 1e-12);
+  }
+  // What the PETSc path cannot take is refused on every rank, naming the reason.
+  const Mesh<2> mesh = rectangle_mesh({.nx = 8, .ny = 8});
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Translation<2>{{0.0, 0.05}}).fixed("top").sliding("left");
+  const DistributedMesh<2> part = partition_mesh(world(), mesh);
+  const ResolvedBoundary<2> b = distribute_boundary(part, spec.resolve(mesh));
+  DistributedRbfMover<2> sliding({.support_radius = 0.5}, petsc);
+  CHECK_THROWS_WITH(sliding.setup(part.view(), b), Catch::Contains("sliding nodes"));
+  DistributedRbfMover<2> automatic({.support_radius = 0.5}, {BoundarySolve::automatic, 1});
+  automatic.setup(part.view(), b);
+  CHECK_FALSE(automatic.petsc_solve());
 }
 
 TEST_CASE("distributed RBF keeps sliding nodes and per-node radii as serial does", "[parallel][rbf]") {

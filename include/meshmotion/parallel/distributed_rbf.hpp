@@ -5,10 +5,14 @@
 /// - setup: every rank's owned boundary entries (global id, position, kind, sliding plane or
 ///   line, radius) are gathered on all ranks (allgatherv) and sorted by global id, so every
 ///   rank holds the same centres in the same order as a serial RbfMover given the boundary of
-///   the whole mesh by ascending node index; the interpolation system is factorized on every
-///   rank (replicated: no communication per move beyond the boundary displacements). Each
-///   rank then builds the evaluation operator of its own local nodes (owned and ghost) with
-///   its own k-d tree over the centres.
+///   the whole mesh by ascending node index. The interpolation system is then either
+///   factorized on every rank (replicated: no communication per move beyond the boundary
+///   displacements; any option), or once across the ranks by MUMPS through PETSc
+///   (PetscRbfSystem: the factor's memory and the solves split between the ranks; compact
+///   kernel, one radius, no sliding node, distinct centres). BoundarySolve::automatic takes
+///   PETSc from BoundarySolveOptions::petsc_min_centres centres on when the options allow it.
+///   Each rank then builds the evaluation operator of its own local nodes (owned and ghost)
+///   with its own k-d tree over the centres.
 /// - move: one allgatherv of the owned entries' displacements (Dim doubles per boundary node),
 ///   then one solve and the local evaluation. Ghost nodes get the values their owners compute.
 /// - derivative_reverse: the transposed evaluation on each rank's owned nodes, summed over the
@@ -28,24 +32,43 @@
 #include "meshmotion/movers/rbf.hpp"
 #include "meshmotion/parallel/communicator.hpp"
 #include "meshmotion/parallel/distributed_mesh.hpp"
+#include "meshmotion/parallel/petsc_rbf_system.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 
 #include <algorithm>
 #include <cstdint>
+#include <memory>
 #include <numeric>
 #include <string>
 #include <vector>
 
 namespace meshmotion::parallel {
 
+/// Where the distributed RBF mover solves its boundary system.
+enum class BoundarySolve {
+  automatic,   ///< PETSc from petsc_min_centres centres on when the options allow it, else replicated
+  replicated,  ///< factorized on every rank (any option: sliding, radius per node, global kernels)
+  petsc,       ///< factorized once across the ranks by MUMPS (compact kernel, one radius, no sliding, distinct centres)
+};
+
+struct BoundarySolveOptions {
+  BoundarySolve kind = BoundarySolve::automatic;
+  /// Fewest centres for which automatic takes PETSc (docs/parallel.md measures the crossover).
+  Index petsc_min_centres = 5000;
+};
+
 template <int Dim>
 class DistributedRbfMover {
  public:
   static constexpr int dim = Dim;
 
-  explicit DistributedRbfMover(RbfOptions options = {}) : inner_(std::move(options)) {}
+  explicit DistributedRbfMover(RbfOptions options = {}, BoundarySolveOptions solve = {})
+      : inner_(options), options_(std::move(options)), solve_(solve) {}
 
-  [[nodiscard]] const RbfOptions& options() const noexcept { return inner_.options(); }
+  /// True when the last setup solves the boundary system through PETSc.
+  [[nodiscard]] bool petsc_solve() const noexcept { return petsc_; }
+
+  [[nodiscard]] const RbfOptions& options() const noexcept { return options_; }
   /// This rank's figures; boundary_nodes counts the whole boundary's centres.
   [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
   /// Entries of the whole boundary (before merging coincident nodes).
@@ -58,6 +81,8 @@ class DistributedRbfMover {
   /// boundary, or what RbfMover::setup throws.
   void setup(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary);
 
+  /// Collective. Throws InputError on every rank for BoundarySolve::petsc with options it does
+  /// not take.
   /// Collective. Displacement (Dim × part.size()) of every local node for the displacements
   /// `d` (Dim × boundary.size()) of this rank's boundary entries; only owned entries are
   /// read. Throws on every rank for a wrong shape or a non-finite value on any rank, and what
@@ -80,8 +105,24 @@ class DistributedRbfMover {
     if (!ready_) throw InputError(std::string("DistributedRbfMover::") + where + ": setup() was not called");
   }
 
+  /// Why PETSc cannot solve this boundary system (empty: it can).
+  [[nodiscard]] std::string petsc_obstacle(const std::vector<int>& kinds, bool radius_per_entry, const Points<Dim>& centres) const;
+  void setup_petsc(const PartitionView<Dim>& part, Points<Dim> centres);
+  void move_petsc(Points<Dim>& out);
+  [[nodiscard]] Points<Dim> reverse_petsc(const Eigen::Ref<const Points<Dim>>& v);
+
   MPI_Comm comm_ = MPI_COMM_NULL;
-  RbfMover<Dim> inner_;      ///< over the gathered centres followed by the local interior nodes
+  RbfMover<Dim> inner_;      ///< replicated: over the gathered centres followed by the local interior nodes
+  RbfOptions options_;
+  BoundarySolveOptions solve_;
+  bool petsc_ = false;
+  std::unique_ptr<detail::PetscRbfSystem<Dim>> system_;  ///< PETSc: the boundary system
+  Points<Dim> local_points_;                 ///< PETSc: this rank's nodes
+  std::vector<Index> interior_;              ///< PETSc: local nodes that are not centres
+  std::vector<Index> evaluated_;             ///< PETSc: those with kernel weights (operator rows)
+  Eigen::SparseMatrix<double, Eigen::RowMajor, int> operator_;  ///< PETSc: evaluated_ × centres
+  Eigen::MatrixXd alpha_;
+  typename detail::PetscRbfSystem<Dim>::PolyCoefficients beta_;
   MoverStats stats_;
   bool ready_ = false;
   Index n_local_ = 0;
@@ -105,7 +146,7 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
   collective(comm_, [&] {
     part.check("DistributedRbfMover::setup");
     if (boundary.size() > 0) meshmotion::detail::check_boundary<Dim>("DistributedRbfMover::setup", boundary, n, false);
-    const auto& radii = inner_.options().support_radii;
+    const auto& radii = options_.support_radii;
     if (!radii.empty() && static_cast<Index>(radii.size()) != boundary.size())
       throw InputError("DistributedRbfMover::setup: " + std::to_string(radii.size()) + " support radii for " +
                        std::to_string(boundary.size()) + " local boundary entries (expected one per entry, or none)");
@@ -119,7 +160,7 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
   std::vector<std::int64_t> ids;
   std::vector<int> kinds;
   std::vector<double> geometry;  // position, normal, direction, radius per entry
-  const bool per_entry_radius = !inner_.options().support_radii.empty();
+  const bool per_entry_radius = !options_.support_radii.empty();
   int radius_flag = per_entry_radius ? 1 : 0, any_radius = 0;
   MPI_Allreduce(&radius_flag, &any_radius, 1, MPI_INT, MPI_MAX, comm_);
   constexpr int stride = 3 * Dim + 1;
@@ -132,7 +173,7 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
     for (int d = 0; d < Dim; ++d) geometry.push_back(part.points(d, node));
     for (int d = 0; d < Dim; ++d) geometry.push_back(boundary.normals(d, k));
     for (int d = 0; d < Dim; ++d) geometry.push_back(boundary.directions.cols() > k ? boundary.directions(d, k) : 0.0);
-    geometry.push_back(per_entry_radius ? inner_.options().support_radii[static_cast<std::size_t>(k)] : 0.0);
+    geometry.push_back(per_entry_radius ? options_.support_radii[static_cast<std::size_t>(k)] : 0.0);
   }
   const std::vector<std::int64_t> all_ids = all_gather(comm_, ids, &counts_);
   const std::vector<int> all_kinds = all_gather(comm_, kinds);
@@ -195,13 +236,25 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
   for (Index i = 0; i < n; ++i)
     if (column_[static_cast<std::size_t>(i)] >= m) points.col(column_[static_cast<std::size_t>(i)]) = part.points.col(i);
 
-  RbfOptions options = inner_.options();
-  options.support_radii = std::move(radii);
-  inner_ = RbfMover<Dim>(std::move(options));
-  collective(comm_, [&] { inner_.setup_reference(std::move(points), centres); });
   gathered_.resize(Dim, m);
-  stats_ = inner_.stats();
-  stats_.evaluated_nodes = std::min(stats_.evaluated_nodes, n);
+  // Every rank decides alike: the inputs are the gathered arrays.
+  const std::string obstacle = petsc_obstacle(all_kinds, any_radius != 0, points.leftCols(m));
+  if (solve_.kind == BoundarySolve::petsc && !obstacle.empty())
+    throw InputError("DistributedRbfMover::setup: the boundary system cannot go through PETSc: " + obstacle +
+                     " (use BoundarySolve::replicated)");
+  petsc_ = obstacle.empty() && (solve_.kind == BoundarySolve::petsc ||
+                                (solve_.kind == BoundarySolve::automatic && m >= solve_.petsc_min_centres));
+  if (petsc_) {
+    setup_petsc(part, Points<Dim>(points.leftCols(m)));
+  } else {
+    system_.reset();
+    RbfOptions options = options_;
+    options.support_radii = std::move(radii);
+    inner_ = RbfMover<Dim>(std::move(options));
+    collective(comm_, [&] { inner_.setup_reference(std::move(points), centres); });
+    stats_ = inner_.stats();
+    stats_.evaluated_nodes = std::min(stats_.evaluated_nodes, n);
+  }
   ready_ = true;
   stats_.setup_seconds = watch.seconds();
 }
@@ -226,14 +279,18 @@ void DistributedRbfMover<Dim>::move_into(const Points<Dim>& d, Points<Dim>& out)
   const std::vector<double> all = all_gather(comm_, mine);
   for (std::size_t j = 0; j < slot_of_gathered_.size(); ++j)
     for (int a = 0; a < Dim; ++a) gathered_(a, slot_of_gathered_[j]) = all[j * Dim + static_cast<std::size_t>(a)];
-  collective(comm_, [&] { inner_.move_into(gathered_, inner_out_); });
-  if (out.cols() != n_local_) out.resize(Dim, n_local_);
-  for (Index i = 0; i < n_local_; ++i) out.col(i) = inner_out_.col(column_[static_cast<std::size_t>(i)]);
-  const MoverStats& s = inner_.stats();
+  if (petsc_) {
+    move_petsc(out);
+  } else {
+    collective(comm_, [&] { inner_.move_into(gathered_, inner_out_); });
+    if (out.cols() != n_local_) out.resize(Dim, n_local_);
+    for (Index i = 0; i < n_local_; ++i) out.col(i) = inner_out_.col(column_[static_cast<std::size_t>(i)]);
+    const MoverStats& s = inner_.stats();
+    stats_.iterations = s.iterations;
+    stats_.residual = s.residual;
+    stats_.fell_back = s.fell_back;
+  }
   ++stats_.moves;
-  stats_.iterations = s.iterations;
-  stats_.residual = s.residual;
-  stats_.fell_back = s.fell_back;
   stats_.move_seconds = watch.seconds();
 }
 
@@ -243,6 +300,7 @@ Points<Dim> DistributedRbfMover<Dim>::derivative_reverse(Eigen::Ref<const Points
     require_ready("derivative_reverse");
     meshmotion::detail::check_node_field<Dim>("DistributedRbfMover::derivative_reverse", v, n_local_);
   });
+  if (petsc_) return reverse_petsc(v);
   const Index m = global_boundary_size();
   Points<Dim> seed = Points<Dim>::Zero(Dim, inner_columns_);
   // Owned nodes only: a ghost's term belongs to its owner.
@@ -255,6 +313,89 @@ Points<Dim> DistributedRbfMover<Dim>::derivative_reverse(Eigen::Ref<const Points
   Points<Dim> grad = Points<Dim>::Zero(Dim, static_cast<Index>(entry_slot_.size()));
   for (std::size_t k = 0; k < entry_slot_.size(); ++k)
     if (entry_slot_[k] >= 0) grad.col(static_cast<Index>(k)) = total.col(entry_slot_[k]);
+  return grad;
+}
+
+template <int Dim>
+std::string DistributedRbfMover<Dim>::petsc_obstacle(const std::vector<int>& kinds, bool radius_per_entry,
+                                                     const Points<Dim>& centres) const {
+  if (!is_compact(options_.kernel)) return "the kernel is global (dense system)";
+  if (radius_per_entry) return "the support radius differs between nodes (nonsymmetric system)";
+  if (std::find(kinds.begin(), kinds.end(), static_cast<int>(BoundaryKind::sliding)) != kinds.end())
+    return "the boundary has sliding nodes";
+  const double diagonal = centres.cols() > 0 ? (centres.rowwise().maxCoeff() - centres.rowwise().minCoeff()).norm() : 0.0;
+  const auto rep = meshmotion::detail::coincident_representatives(centres, options_.coincidence_tolerance * diagonal);
+  for (std::size_t i = 0; i < rep.size(); ++i)
+    if (rep[i] != static_cast<Index>(i)) return "boundary nodes coincide (global ids " + std::to_string(sorted_ids_[static_cast<std::size_t>(rep[i])]) +
+                                                " and " + std::to_string(sorted_ids_[i]) + ")";
+  return {};
+}
+
+template <int Dim>
+void DistributedRbfMover<Dim>::setup_petsc(const PartitionView<Dim>& part, Points<Dim> centres) {
+  const Index m = centres.cols();
+  local_points_ = part.points;
+  if (!(options_.support_radius > 0.0) || !std::isfinite(options_.support_radius))
+    throw InputError("DistributedRbfMover::setup: support radius must be positive (got " + std::to_string(options_.support_radius) + ")");
+  const meshmotion::detail::RbfKernelSettings kernel{options_.kernel, options_.support_radius, options_.polynomial};
+  system_ = std::make_unique<detail::PetscRbfSystem<Dim>>();
+  system_->setup(comm_, centres, kernel);
+  interior_.clear();
+  for (Index i = 0; i < n_local_; ++i)
+    if (column_[static_cast<std::size_t>(i)] >= m) interior_.push_back(i);
+  std::vector<Index> kept;
+  operator_ = meshmotion::detail::compact_kernel_rows(local_points_, interior_, system_->within(), m, kernel, &kept);
+  evaluated_.clear();
+  for (const Index r : kept) evaluated_.push_back(interior_[static_cast<std::size_t>(r)]);
+  stats_ = MoverStats{};
+  stats_.boundary_nodes = m;
+  stats_.evaluated_nodes = options_.polynomial ? static_cast<Index>(interior_.size()) : static_cast<Index>(evaluated_.size());
+  stats_.nonzeros = system_->nonzeros() + operator_.nonZeros();
+  stats_.factorizations = 1;
+}
+
+template <int Dim>
+void DistributedRbfMover<Dim>::move_petsc(Points<Dim>& out) {
+  collective(comm_, [&] { system_->solve(gathered_.transpose(), alpha_, beta_); });
+  if (out.cols() != n_local_) out.resize(Dim, n_local_);
+  out.setZero();
+  const Eigen::MatrixXd values = operator_ * alpha_;
+  for (std::size_t r = 0; r < evaluated_.size(); ++r) out.col(evaluated_[r]) = values.row(static_cast<Index>(r)).transpose();
+  if (options_.polynomial)
+    for (const Index i : interior_) out.col(i) += beta_.transpose() * system_->polynomial(local_points_.col(i));
+  const Index m = global_boundary_size();
+  for (Index i = 0; i < n_local_; ++i)
+    if (const Index c = column_[static_cast<std::size_t>(i)]; c < m) out.col(i) = gathered_.col(c);
+}
+
+template <int Dim>
+Points<Dim> DistributedRbfMover<Dim>::reverse_petsc(const Eigen::Ref<const Points<Dim>>& v) {
+  const Index m = global_boundary_size();
+  constexpr int poly = (Dim + 1) * Dim;
+  // One buffer summed over the ranks: ᾱ (m × Dim), the boundary nodes' own terms (Dim × m), β̄.
+  Eigen::VectorXd sums = Eigen::VectorXd::Zero(2 * m * Dim + poly);
+  Eigen::Map<Eigen::MatrixXd> alpha_bar(sums.data(), m, Dim);
+  Eigen::Map<Points<Dim>> direct(sums.data() + m * Dim, Dim, m);
+  Eigen::Map<typename detail::PetscRbfSystem<Dim>::PolyCoefficients> beta_bar(sums.data() + 2 * m * Dim);
+  // Owned nodes only: a ghost's term belongs to its owner.
+  Eigen::MatrixXd seed(static_cast<Index>(evaluated_.size()), Dim);
+  for (std::size_t r = 0; r < evaluated_.size(); ++r)
+    seed.row(static_cast<Index>(r)) = owned_[static_cast<std::size_t>(evaluated_[r])] != 0 ? Eigen::RowVectorXd(v.col(evaluated_[r]).transpose())
+                                                                                      : Eigen::RowVectorXd::Zero(Dim);
+  alpha_bar = operator_.transpose() * seed;
+  if (options_.polynomial)
+    for (const Index i : interior_)
+      if (owned_[static_cast<std::size_t>(i)] != 0) beta_bar += system_->polynomial(local_points_.col(i)) * v.col(i).transpose();
+  for (Index i = 0; i < n_local_; ++i)
+    if (const Index c = column_[static_cast<std::size_t>(i)]; c < m && owned_[static_cast<std::size_t>(i)] != 0) direct.col(c) += v.col(i);
+  MPI_Allreduce(MPI_IN_PLACE, sums.data(), static_cast<int>(sums.size()), MPI_DOUBLE, MPI_SUM, comm_);
+  Eigen::MatrixXd values_bar;
+  collective(comm_, [&] {
+    system_->solve_transpose(alpha_bar, typename detail::PetscRbfSystem<Dim>::PolyCoefficients(beta_bar), values_bar);
+  });
+  Points<Dim> grad = Points<Dim>::Zero(Dim, static_cast<Index>(entry_slot_.size()));
+  for (std::size_t k = 0; k < entry_slot_.size(); ++k)
+    if (const Index s = entry_slot_[k]; s >= 0) grad.col(static_cast<Index>(k)) = direct.col(s) + values_bar.row(s).transpose();
   return grad;
 }
 

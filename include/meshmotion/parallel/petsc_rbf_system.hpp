@@ -1,0 +1,183 @@
+#pragma once
+/// \file
+/// PetscRbfSystem: the RBF interpolation system of a compact kernel, A α + P β = d, Pᵀ α = 0,
+/// factorized once by MUMPS across the ranks instead of on every rank.
+///
+/// The centres are known to every rank (the distributed RBF mover gathers them); rank r
+/// assembles the rows of A of its block of centres [m r / P, m (r + 1) / P) with k-d tree radius
+/// queries, and MUMPS's Cholesky (METIS ordering) holds the factor distributed. A solve takes
+/// right-hand sides every rank holds and gives every rank the whole solution (α is needed by
+/// every rank's evaluation). The polynomial is eliminated through the Schur complement
+/// S = Pᵀ A⁻¹ P, as the serial RbfSystem does, with A⁻¹ P kept on every rank.
+///
+/// For a single radius only (A symmetric positive definite) and distinct centres: the
+/// distributed mover chooses it under those conditions.
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/movers/detail/rbf_system.hpp"
+#include "meshmotion/movers/rbf_kernels.hpp"
+#include "meshmotion/parallel/communicator.hpp"
+#include "meshmotion/spatial/kd_tree.hpp"
+
+#include <petscksp.h>
+
+#include <Eigen/LU>
+
+#include <string>
+#include <vector>
+
+namespace meshmotion::parallel::detail {
+
+inline void petsc_ok(PetscErrorCode code, const char* call) {
+  if (code != 0) throw SolverError(std::string("PETSc's ") + call + " failed (error " + std::to_string(code) + ")");
+}
+
+template <int Dim>
+class PetscRbfSystem {
+ public:
+  using PolyCoefficients = Eigen::Matrix<double, Dim + 1, Dim>;
+
+  PetscRbfSystem() = default;
+  PetscRbfSystem(const PetscRbfSystem&) = delete;
+  PetscRbfSystem& operator=(const PetscRbfSystem&) = delete;
+  ~PetscRbfSystem() { release(); }
+
+  /// Collective. `centres` (Dim × m, the same on every rank, distinct), a compact kernel with
+  /// one radius. Throws SolverError when MUMPS fails (on every rank).
+  void setup(MPI_Comm comm, const Points<Dim>& centres, const meshmotion::detail::RbfKernelSettings& kernel) {
+    release();
+    comm_ = comm;
+    centres_ = centres;
+    kernel_ = kernel;
+    const Index m = centres_.cols();
+    const int r = rank_of(comm), p = size_of(comm);
+    lo_ = m * r / p;
+    hi_ = m * (r + 1) / p;
+    tree_.build(centres_);
+    std::vector<Index> rows;
+    for (Index i = lo_; i < hi_; ++i) rows.push_back(i);
+    // Sorted columns per row: the storage-order round trip sorts them.
+    const Eigen::SparseMatrix<double, Eigen::RowMajor, int> block(Eigen::SparseMatrix<double, Eigen::ColMajor, int>(
+        meshmotion::detail::compact_kernel_rows(centres_, rows, within(), m, kernel_)));
+    nonzeros_ = block.nonZeros();
+    const auto local = static_cast<PetscInt>(hi_ - lo_);
+    std::vector<PetscInt> outer(block.outerIndexPtr(), block.outerIndexPtr() + local + 1);
+    std::vector<PetscInt> inner(block.innerIndexPtr(), block.innerIndexPtr() + block.nonZeros());
+    std::vector<PetscScalar> values(block.valuePtr(), block.valuePtr() + block.nonZeros());
+    collective(comm_, [&] {
+      petsc_ok(MatCreateMPIAIJWithArrays(comm_, local, local, static_cast<PetscInt>(m), static_cast<PetscInt>(m), outer.data(),
+                                         inner.data(), values.data(), &a_),
+               "MatCreateMPIAIJWithArrays");
+      petsc_ok(MatSetOption(a_, MAT_SPD, PETSC_TRUE), "MatSetOption");
+      petsc_ok(KSPCreate(comm_, &ksp_), "KSPCreate");
+      petsc_ok(KSPSetOperators(ksp_, a_, a_), "KSPSetOperators");
+      petsc_ok(KSPSetType(ksp_, KSPPREONLY), "KSPSetType");
+      PC pc = nullptr;
+      petsc_ok(KSPGetPC(ksp_, &pc), "KSPGetPC");
+      petsc_ok(PCSetType(pc, PCCHOLESKY), "PCSetType");
+      petsc_ok(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS), "PCFactorSetMatSolverType");
+      petsc_ok(PCFactorSetUpMatSolverType(pc), "PCFactorSetUpMatSolverType");
+      Mat factor = nullptr;
+      petsc_ok(PCFactorGetMatrix(pc, &factor), "PCFactorGetMatrix");
+      petsc_ok(MatMumpsSetIcntl(factor, 7, 5), "MatMumpsSetIcntl");
+      petsc_ok(KSPSetOptionsPrefix(ksp_, "meshmotion_rbf_"), "KSPSetOptionsPrefix");
+      petsc_ok(KSPSetFromOptions(ksp_), "KSPSetFromOptions");
+      petsc_ok(KSPSetUp(ksp_), "KSPSetUp");
+      petsc_ok(MatCreateVecs(a_, &x_, &b_), "MatCreateVecs");
+      petsc_ok(VecScatterCreateToAll(x_, &to_all_, &whole_), "VecScatterCreateToAll");
+    });
+    PC pc = nullptr;
+    KSPGetPC(ksp_, &pc);
+    PCFailedReason failed = PC_NOERROR;
+    PCGetFailedReason(pc, &failed);
+    if (failed != PC_NOERROR)
+      throw SolverError("DistributedRbfMover::setup: MUMPS could not factorize the boundary system (PETSc reason " +
+                        std::to_string(static_cast<int>(failed)) + ")");
+    if (kernel_.polynomial && m > 0) {
+      p_.resize(m, Dim + 1);
+      for (Index i = 0; i < m; ++i) p_.row(i) = polynomial(centres_.col(i)).transpose();
+      solve_a(p_, g_);
+      const Eigen::Matrix<double, Dim + 1, Dim + 1> s = p_.transpose() * g_;
+      schur_.compute(s);
+      if (!(std::abs(schur_.determinant()) > 1e-14 * std::max(1.0, s.norm())))
+        throw InputError("DistributedRbfMover::setup: linear polynomial augmentation needs boundary nodes that span the space "
+                         "(got them all on a line or plane)");
+    }
+  }
+
+  [[nodiscard]] Index size() const noexcept { return centres_.cols(); }
+  [[nodiscard]] Index nonzeros() const noexcept { return nonzeros_; }
+  [[nodiscard]] auto within() const {
+    return [this](const Vec<Dim>& x, std::vector<Neighbor>& out) { tree_.radius_search(x, kernel_.radius, out); };
+  }
+  /// The polynomial basis [1, (x − shift)/scale], the serial RbfSystem's.
+  [[nodiscard]] Vec<Dim + 1> polynomial(const Vec<Dim>& x) const {
+    Vec<Dim + 1> q;
+    q[0] = 1.0;
+    q.template tail<Dim>() = (x - shift()) / scale();
+    return q;
+  }
+
+  /// Collective. Coefficients (m × Dim, on every rank) interpolating `values` (m × Dim, the
+  /// same on every rank).
+  void solve(const Eigen::MatrixXd& values, Eigen::MatrixXd& alpha, PolyCoefficients& beta) {
+    solve_a(values, alpha);
+    beta.setZero();
+    if (!kernel_.polynomial || size() == 0) return;
+    beta = schur_.solve(p_.transpose() * alpha);
+    alpha.noalias() -= g_ * beta;
+  }
+  /// Collective. The transpose of solve() (A is symmetric): A⁻¹ (ᾱ + P S⁻ᵀ (β̄ − Gᵀ ᾱ)).
+  void solve_transpose(const Eigen::MatrixXd& alpha_bar, const PolyCoefficients& beta_bar, Eigen::MatrixXd& values_bar) {
+    Eigen::MatrixXd rhs = alpha_bar;
+    if (kernel_.polynomial && size() > 0) rhs.noalias() += p_ * schur_.transpose().solve(beta_bar - g_.transpose() * alpha_bar);
+    solve_a(rhs, values_bar);
+  }
+
+ private:
+  [[nodiscard]] Vec<Dim> shift() const { return centres_.rowwise().mean(); }
+  [[nodiscard]] double scale() const {
+    return std::max((centres_.colwise() - shift()).colwise().norm().maxCoeff(), 1e-300);
+  }
+
+  // Each column of b (m rows, on every rank): this rank's rows in, the whole solution out.
+  void solve_a(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) {
+    x.resize(b.rows(), b.cols());
+    for (Index c = 0; c < b.cols(); ++c) {
+      PetscScalar* local = nullptr;
+      petsc_ok(VecGetArray(b_, &local), "VecGetArray");
+      for (Index i = lo_; i < hi_; ++i) local[i - lo_] = b(i, c);
+      petsc_ok(VecRestoreArray(b_, &local), "VecRestoreArray");
+      petsc_ok(KSPSolve(ksp_, b_, x_), "KSPSolve");
+      petsc_ok(VecScatterBegin(to_all_, x_, whole_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
+      petsc_ok(VecScatterEnd(to_all_, x_, whole_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
+      const PetscScalar* all = nullptr;
+      petsc_ok(VecGetArrayRead(whole_, &all), "VecGetArrayRead");
+      for (Index i = 0; i < b.rows(); ++i) x(i, c) = all[i];
+      petsc_ok(VecRestoreArrayRead(whole_, &all), "VecRestoreArrayRead");
+    }
+  }
+
+  void release() {
+    if (ksp_ != nullptr) KSPDestroy(&ksp_);
+    if (a_ != nullptr) MatDestroy(&a_);
+    for (::Vec* v : {&x_, &b_, &whole_})
+      if (*v != nullptr) VecDestroy(v);
+    if (to_all_ != nullptr) VecScatterDestroy(&to_all_);
+  }
+
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  Points<Dim> centres_;
+  meshmotion::detail::RbfKernelSettings kernel_;
+  KdTree<Dim> tree_;
+  Index lo_ = 0, hi_ = 0, nonzeros_ = 0;
+  Mat a_ = nullptr;
+  KSP ksp_ = nullptr;
+  ::Vec x_ = nullptr, b_ = nullptr, whole_ = nullptr;
+  VecScatter to_all_ = nullptr;
+  Eigen::MatrixXd p_, g_;
+  Eigen::PartialPivLU<Eigen::Matrix<double, Dim + 1, Dim + 1>> schur_;
+};
+
+}  // namespace meshmotion::parallel::detail
