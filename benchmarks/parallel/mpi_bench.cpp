@@ -1,7 +1,9 @@
 // mpi_bench: the distributed movers against the serial ones in the same run.
 //
-//   mpiexec -n R mpi_bench [box_cells_per_axis=126] [path/to/su2_30p30n_rans_L1_coarse.su2]
+//   mpiexec -n R mpi_bench [box_cells_per_axis=126] [automatic|replicated|petsc] [path/to/su2_30p30n_rans_L1_coarse.su2]
 //
+// The second argument is where the distributed RBF solves its boundary system (BoundarySolve;
+// automatic: PETSc from 50000 centres on).
 // Cases: the 3D hex box of rbf_bench (bottom face moving as a bump, support radius 6 grid
 // spacings; 126 cells per axis = 2.05M nodes) with the RBF mover, and the 30P30N RANS mesh
 // (../shared/data, skipped when absent) with the RBF mover (wall rotated 2°) and the
@@ -72,6 +74,8 @@ Figures measure(Mover& mover, Setup&& setup, const Points<Mover::dim>& d, int mo
 
 enum class Method { rbf, sle };
 
+BoundarySolveOptions boundary_solve;
+
 template <int Dim>
 void run_case(const std::string& name, const Mesh<Dim>& whole, const ResolvedBoundary<Dim>& boundary, Method method,
               double radius) {
@@ -102,9 +106,11 @@ void run_case(const std::string& name, const Mesh<Dim>& whole, const ResolvedBou
   const DistributedMesh<Dim> part = partition_mesh(comm, whole);
   const ResolvedBoundary<Dim> local = distribute_boundary(part, boundary);
   Figures mine;
+  bool petsc = method == Method::sle;
   if (method == Method::rbf) {
-    DistributedRbfMover<Dim> mover(rbf);
+    DistributedRbfMover<Dim> mover(rbf, boundary_solve);
     mine = measure(mover, [&] { mover.setup(part.view(), local); }, local.displacements, moves);
+    petsc = mover.petsc_solve();
   } else {
     DistributedElasticityOptions options;
     options.elasticity = elasticity;
@@ -117,14 +123,15 @@ void run_case(const std::string& name, const Mesh<Dim>& whole, const ResolvedBou
   if (rank != 0) return;
   const bool oversubscribed = ranks > cores;
   const double setup_ratio = worst[0] / serial.setup, move_ratio = worst[1] / serial.move;
-  std::printf("%-16s %6s %5d %10ld %10.3f %10.3f %10.4f %10.4f %8.2f %8.2f %10.0f %10.0f %s\n", name.c_str(),
-              method == Method::rbf ? "rbf" : "sle", ranks, static_cast<long>(whole.num_nodes()), serial.setup, worst[0],
+  const char* label = method == Method::sle ? "sle" : petsc ? "rbf/petsc" : "rbf/repl";
+  std::printf("%-16s %10s %5d %10ld %10.3f %10.3f %10.4f %10.4f %8.2f %8.2f %10.0f %10.0f %s\n", name.c_str(),
+              label, ranks, static_cast<long>(whole.num_nodes()), serial.setup, worst[0],
               serial.move, worst[1], setup_ratio, move_ratio, serial.memory, worst[2], oversubscribed ? "oversubscribed" : "");
-  std::printf("{\"case\":\"%s\",\"method\":\"%s\",\"ranks\":%d,\"cores\":%d,\"oversubscribed\":%s,\"nodes\":%ld,"
+  std::printf("{\"case\":\"%s\",\"method\":\"%s\",\"boundary_solve\":\"%s\",\"ranks\":%d,\"cores\":%d,\"oversubscribed\":%s,\"nodes\":%ld,"
               "\"boundary_nodes\":%ld,\"serial_setup_seconds\":%.6f,\"setup_seconds\":%.6f,\"serial_move_seconds\":%.6f,"
               "\"move_seconds\":%.6f,\"setup_ratio\":%.3f,\"move_ratio\":%.3f,\"serial_setup_memory_mb\":%.1f,"
               "\"setup_memory_mb_per_rank_max\":%.1f,\"rank0_setup_memory_mb\":%.1f}\n",
-              name.c_str(), method == Method::rbf ? "rbf" : "sle", ranks, cores, oversubscribed ? "true" : "false",
+              name.c_str(), method == Method::rbf ? "rbf" : "sle", petsc ? "petsc" : "replicated", ranks, cores, oversubscribed ? "true" : "false",
               static_cast<long>(whole.num_nodes()), static_cast<long>(boundary.size()), serial.setup, worst[0], serial.move,
               worst[1], setup_ratio, move_ratio, serial.memory, worst[2], mine.memory);
   std::fflush(stdout);
@@ -184,10 +191,17 @@ int main(int argc, char** argv) {
   int petsc_argc = 1;
   if (PetscInitialize(&petsc_argc, &argv, nullptr, nullptr) != 0) return 1;
   const int n = argc > 1 ? std::atoi(argv[1]) : 126;
+  const std::string solve = argc > 2 ? argv[2] : "automatic";
+  if (solve != "automatic" && solve != "replicated" && solve != "petsc") {
+    std::fprintf(stderr, "mpi_bench: the boundary solve '%s' is not one of automatic, replicated, petsc\n", solve.c_str());
+    PetscFinalize();
+    return 2;
+  }
+  boundary_solve.kind = solve == "petsc" ? BoundarySolve::petsc : solve == "replicated" ? BoundarySolve::replicated : BoundarySolve::automatic;
   const std::filesystem::path airfoil_file =
-      argc > 2 ? std::filesystem::path(argv[2]) : std::filesystem::path(MESHMOTION_SHARED_DATA_DIR) / "su2_30p30n_rans_L1_coarse.su2";
+      argc > 3 ? std::filesystem::path(argv[3]) : std::filesystem::path(MESHMOTION_SHARED_DATA_DIR) / "su2_30p30n_rans_L1_coarse.su2";
   if (rank_of(MPI_COMM_WORLD) == 0)
-    std::printf("%-16s %6s %5s %10s %10s %10s %10s %10s %8s %8s %10s %10s\n", "case", "method", "ranks", "nodes",
+    std::printf("%-16s %10s %5s %10s %10s %10s %10s %10s %8s %8s %10s %10s\n", "case", "method", "ranks", "nodes",
                 "ser_setup", "setup_s", "ser_move", "move_s", "setup_x", "move_x", "ser_MB", "MB/rank");
   int code = 0;
   try {

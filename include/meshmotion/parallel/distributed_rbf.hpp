@@ -53,8 +53,9 @@ enum class BoundarySolve {
 
 struct BoundarySolveOptions {
   BoundarySolve kind = BoundarySolve::automatic;
-  /// Fewest centres for which automatic takes PETSc (docs/parallel.md measures the crossover).
-  Index petsc_min_centres = 5000;
+  /// Fewest centres for which automatic takes PETSc: below, the replicated solve moves faster on
+  /// the machines measured (docs/parallel.md); above, its factor on every rank costs too much memory.
+  Index petsc_min_centres = 50000;
 };
 
 template <int Dim>

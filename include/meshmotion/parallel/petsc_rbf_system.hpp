@@ -24,6 +24,7 @@
 
 #include <Eigen/LU>
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -84,8 +85,6 @@ class PetscRbfSystem {
       petsc_ok(KSPSetOptionsPrefix(ksp_, "meshmotion_rbf_"), "KSPSetOptionsPrefix");
       petsc_ok(KSPSetFromOptions(ksp_), "KSPSetFromOptions");
       petsc_ok(KSPSetUp(ksp_), "KSPSetUp");
-      petsc_ok(MatCreateVecs(a_, &x_, &b_), "MatCreateVecs");
-      petsc_ok(VecScatterCreateToAll(x_, &to_all_, &whole_), "VecScatterCreateToAll");
     });
     PC pc = nullptr;
     KSPGetPC(ksp_, &pc);
@@ -141,30 +140,34 @@ class PetscRbfSystem {
     return std::max((centres_.colwise() - shift()).colwise().norm().maxCoeff(), 1e-300);
   }
 
-  // Each column of b (m rows, on every rank): this rank's rows in, the whole solution out.
+  // b: m rows on every rank. This rank's rows go in as one dense block, all columns solved in
+  // one MUMPS call (one pass of communication for the Dim right-hand sides, not one each);
+  // every rank gets the whole solution.
   void solve_a(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) {
-    x.resize(b.rows(), b.cols());
-    for (Index c = 0; c < b.cols(); ++c) {
-      PetscScalar* local = nullptr;
-      petsc_ok(VecGetArray(b_, &local), "VecGetArray");
-      for (Index i = lo_; i < hi_; ++i) local[i - lo_] = b(i, c);
-      petsc_ok(VecRestoreArray(b_, &local), "VecRestoreArray");
-      petsc_ok(KSPSolve(ksp_, b_, x_), "KSPSolve");
-      petsc_ok(VecScatterBegin(to_all_, x_, whole_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
-      petsc_ok(VecScatterEnd(to_all_, x_, whole_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
-      const PetscScalar* all = nullptr;
-      petsc_ok(VecGetArrayRead(whole_, &all), "VecGetArrayRead");
-      for (Index i = 0; i < b.rows(); ++i) x(i, c) = all[i];
-      petsc_ok(VecRestoreArrayRead(whole_, &all), "VecRestoreArrayRead");
-    }
+    const auto local = static_cast<PetscInt>(hi_ - lo_);
+    const auto columns = static_cast<PetscInt>(b.cols());
+    Mat rhs = nullptr, solution = nullptr;
+    petsc_ok(MatCreateDense(comm_, local, PETSC_DECIDE, static_cast<PetscInt>(b.rows()), columns, nullptr, &rhs), "MatCreateDense");
+    petsc_ok(MatDuplicate(rhs, MAT_DO_NOT_COPY_VALUES, &solution), "MatDuplicate");
+    PetscScalar* block = nullptr;
+    petsc_ok(MatDenseGetArrayWrite(rhs, &block), "MatDenseGetArrayWrite");
+    Eigen::Map<Eigen::MatrixXd>(block, local, columns) = b.middleRows(lo_, local);
+    petsc_ok(MatDenseRestoreArrayWrite(rhs, &block), "MatDenseRestoreArrayWrite");
+    petsc_ok(KSPMatSolve(ksp_, rhs, solution), "KSPMatSolve");
+    const PetscScalar* solved = nullptr;
+    petsc_ok(MatDenseGetArrayRead(solution, &solved), "MatDenseGetArrayRead");
+    // Row-major pieces, so that each rank's rows land contiguously in x's transpose.
+    Eigen::MatrixXd mine = Eigen::Map<const Eigen::MatrixXd>(solved, local, columns).transpose();
+    petsc_ok(MatDenseRestoreArrayRead(solution, &solved), "MatDenseRestoreArrayRead");
+    MatDestroy(&rhs);
+    MatDestroy(&solution);
+    const std::vector<double> all = all_gather(comm_, std::span<const double>(mine.data(), static_cast<std::size_t>(mine.size())));
+    x = Eigen::Map<const Eigen::MatrixXd>(all.data(), columns, b.rows()).transpose();
   }
 
   void release() {
     if (ksp_ != nullptr) KSPDestroy(&ksp_);
     if (a_ != nullptr) MatDestroy(&a_);
-    for (::Vec* v : {&x_, &b_, &whole_})
-      if (*v != nullptr) VecDestroy(v);
-    if (to_all_ != nullptr) VecScatterDestroy(&to_all_);
   }
 
   MPI_Comm comm_ = MPI_COMM_NULL;
@@ -174,8 +177,6 @@ class PetscRbfSystem {
   Index lo_ = 0, hi_ = 0, nonzeros_ = 0;
   Mat a_ = nullptr;
   KSP ksp_ = nullptr;
-  ::Vec x_ = nullptr, b_ = nullptr, whole_ = nullptr;
-  VecScatter to_all_ = nullptr;
   Eigen::MatrixXd p_, g_;
   Eigen::PartialPivLU<Eigen::Matrix<double, Dim + 1, Dim + 1>> schur_;
 };
