@@ -50,6 +50,7 @@ declare -A quick_args=(
   [elasticity_bench]="--quick"
   [curving_bench]="--quick"
   [bump3d_bench]="0 1"
+  [cholmod_bench]="64 1"
 )
 declare -A full_args=(
   [io_bench]="100"
@@ -60,8 +61,9 @@ declare -A full_args=(
   [elasticity_bench]=""
   [curving_bench]=""
   [bump3d_bench]="0 1 2"
+  [cholmod_bench]="126 3"
 )
-order=(io_bench quality_bench rbf_bench interpolation_bench elasticity_bench delaunay_bench curving_bench bump3d_bench)
+order=(io_bench quality_bench rbf_bench interpolation_bench elasticity_bench delaunay_bench curving_bench bump3d_bench cholmod_bench)
 # Peer scripts: they take the build folder and a work folder, install their peer with apt-get
 # when it is absent, and report it missing when that fails.
 peer_scripts=(openfoam_peer dense_rbf_peer)

@@ -104,3 +104,45 @@ TEST_CASE("dense solvers agree and detect failures", "[solvers]") {
   lu.compute(Eigen::MatrixXd::Zero(3, 3));
   CHECK_THROWS_AS(lu.solve(Eigen::VectorXd::Ones(3)), SolverError);
 }
+
+TEST_CASE("CHOLMOD's supernodal Cholesky: asked for, chosen for large matrices, refused without it", "[solvers]") {
+  const SparseMatrix a = poisson(30);
+  const Eigen::MatrixXd x_true = Eigen::MatrixXd::Random(a.rows(), 3);
+  const Eigen::MatrixXd b = a * x_true;
+  if (!have_cholmod()) {
+    LinearSolver solver(SolverOptions{SolverKind::cholmod_supernodal});
+    CHECK_THROWS_WITH(solver.compute(a), Catch::Contains("no CHOLMOD"));
+    // The simplicial kinds stay simplicial whatever the size.
+    LinearSolver large(SolverOptions{.supernodal_min_rows = 10});
+    large.compute(a);
+    CHECK_FALSE(large.report().supernodal);
+    WARN("skipped the CHOLMOD cases: this build has no CHOLMOD (libsuitesparse-dev)");
+    return;
+  }
+  LinearSolver asked(SolverOptions{SolverKind::cholmod_supernodal});
+  asked.compute(a);
+  CHECK(asked.report().supernodal);
+  CHECK((asked.solve(b) - x_true).norm() / x_true.norm() < 1e-12);
+
+  // The default simplicial_ldlt hands a matrix past supernodal_min_rows to CHOLMOD, and equals
+  // the simplicial answer to rounding.
+  LinearSolver small(SolverOptions{.supernodal_min_rows = a.rows() + 1});
+  small.compute(a);
+  CHECK_FALSE(small.report().supernodal);
+  LinearSolver large(SolverOptions{.supernodal_min_rows = a.rows()});
+  large.compute(a);
+  CHECK(large.report().supernodal);
+  CHECK((large.solve(b) - small.solve(b)).norm() / x_true.norm() < 1e-13);
+
+  // A matrix CHOLMOD finds indefinite (LDLᵀ takes it) goes back to the simplicial LDLᵀ;
+  // asked for explicitly, CHOLMOD's failure is an error naming it.
+  SparseMatrix indefinite = poisson(30, 0.0);
+  for (Index k = 0; k < 10; ++k) indefinite.coeffRef(k, k) = -4.0;
+  LinearSolver back(SolverOptions{.supernodal_min_rows = 1});
+  back.compute(indefinite);
+  CHECK_FALSE(back.report().supernodal);
+  const Eigen::VectorXd y = back.solve(Eigen::VectorXd::Ones(indefinite.rows()));
+  CHECK((indefinite * y - Eigen::VectorXd::Ones(indefinite.rows())).norm() < 1e-8);
+  LinearSolver refused(SolverOptions{SolverKind::cholmod_supernodal});
+  CHECK_THROWS_WITH(refused.compute(indefinite), Catch::Contains("cholmod_supernodal"));
+}

@@ -15,6 +15,9 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
+#ifdef MESHMOTION_HAVE_CHOLMOD
+#include <Eigen/CholmodSupport>
+#endif
 
 #include <algorithm>
 #include <cmath>
@@ -84,12 +87,26 @@ class IterativeBackend final : public SparseBackend {
   EigenSolver solver_;
 };
 
-// A template, so that only a LinearSolver that is compiled instantiates the six Eigen solvers.
+/// True when a matrix of `rows` rows goes to CHOLMOD under options `o` (see
+/// SolverOptions::supernodal_min_rows).
+[[nodiscard]] inline bool use_supernodal(const SolverOptions& o, Index rows) {
+  if (o.kind == SolverKind::cholmod_supernodal) return true;
+  return have_cholmod() && (o.kind == SolverKind::simplicial_ldlt || o.kind == SolverKind::simplicial_llt) &&
+         o.supernodal_min_rows > 0 && rows >= o.supernodal_min_rows;
+}
+
+// A template, so that only a LinearSolver that is compiled instantiates the Eigen solvers.
 template <int = 0>
 std::unique_ptr<SparseBackend> make_backend(const SolverOptions& o) {
   constexpr int Lower = Eigen::Lower;
   constexpr int LowerUpper = Eigen::Lower | Eigen::Upper;
   switch (o.kind) {
+    case SolverKind::cholmod_supernodal:
+#ifdef MESHMOTION_HAVE_CHOLMOD
+      return std::make_unique<DirectBackend<Eigen::CholmodSupernodalLLT<SparseMatrix, Lower>>>();
+#else
+      throw InputError("cholmod_supernodal: this build has no CHOLMOD (install libsuitesparse-dev and configure again)");
+#endif
     case SolverKind::simplicial_ldlt:
       return std::make_unique<DirectBackend<Eigen::SimplicialLDLT<SparseMatrix, Lower>>>();
     case SolverKind::simplicial_llt:
@@ -149,17 +166,29 @@ class BasicLinearSolver {
     matrix_.makeCompressed();
     if (options_.diagonal_scaling) scale_matrix();
     if (!same_pattern) {
-      backend_ = detail::make_backend(options_);
+      supernodal_ = detail::use_supernodal(options_, matrix_.rows());
+      backend_ = detail::make_backend(supernodal_ ? with_kind(SolverKind::cholmod_supernodal) : options_);
       fallback_.reset();
       backend_->analyze(matrix_);
       ++report_.analyses;
     }
-    const bool ok = backend_->factorize(matrix_);
+    bool ok = backend_->factorize(matrix_);
     ++report_.factorizations;
+    // Chosen for its size, CHOLMOD may meet a matrix that is not positive definite (a
+    // quasi-definite one LDLᵀ takes): the simplicial factorization asked for answers.
+    if (!ok && supernodal_ && options_.kind != SolverKind::cholmod_supernodal) {
+      supernodal_ = false;
+      backend_ = detail::make_backend(options_);
+      backend_->analyze(matrix_);
+      ++report_.analyses;
+      ok = backend_->factorize(matrix_);
+      ++report_.factorizations;
+    }
+    report_.supernodal = supernodal_;
     if (fallback_) fallback_factorize();
     report_.seconds += watch.seconds();
     if (!ok)
-      throw SolverError(std::string(name(options_.kind)) + ": factorization of a " + std::to_string(a.rows()) +
+      throw SolverError(std::string(name(supernodal_ ? SolverKind::cholmod_supernodal : options_.kind)) + ": factorization of a " + std::to_string(a.rows()) +
                         " × " + std::to_string(a.rows()) +
                         " matrix failed (matrix singular or not positive definite)");
   }
@@ -221,6 +250,12 @@ class BasicLinearSolver {
   }
 
  private:
+  [[nodiscard]] SolverOptions with_kind(SolverKind kind) const {
+    SolverOptions o = options_;
+    o.kind = kind;
+    return o;
+  }
+
   [[nodiscard]] bool same_pattern_as(const SparseMatrix& a) const {
     if (a.rows() != matrix_.rows() || a.nonZeros() != matrix_.nonZeros() || !a.isCompressed()) return false;
     for (Index j = 0; j <= a.cols(); ++j)
@@ -288,6 +323,7 @@ class BasicLinearSolver {
   SparseMatrix matrix_;
   std::unique_ptr<detail::SparseBackend> backend_;
   std::unique_ptr<detail::SparseBackend> fallback_;
+  bool supernodal_ = false;  ///< backend_ is CHOLMOD's
   Eigen::VectorXd scale_;  ///< diag(A)^-1/2 under diagonal_scaling
   Eigen::VectorXd rhs_;
   Eigen::VectorXd column_;

@@ -18,6 +18,9 @@ enum class SolverKind {
   cg_jacobi,               ///< Eigen::ConjugateGradient with a diagonal preconditioner: SPD, iterative
   cg_incomplete_cholesky,  ///< Eigen::ConjugateGradient with IncompleteCholesky: SPD, iterative
   bicgstab,                ///< Eigen::BiCGSTAB with a diagonal preconditioner: any square, iterative
+  /// CHOLMOD's supernodal Cholesky through Eigen's CholmodSupport: SPD, direct; only in builds
+  /// with SuiteSparse (MESHMOTION_HAVE_CHOLMOD, set by CMake when libsuitesparse-dev is found).
+  cholmod_supernodal,
 };
 
 /// Name of a solver kind as used in messages and on command lines ("simplicial_ldlt", ...).
@@ -29,14 +32,25 @@ enum class SolverKind {
     case SolverKind::cg_jacobi: return "cg_jacobi";
     case SolverKind::cg_incomplete_cholesky: return "cg_incomplete_cholesky";
     case SolverKind::bicgstab: return "bicgstab";
+    case SolverKind::cholmod_supernodal: return "cholmod_supernodal";
   }
   return "unknown";
 }
 
 /// Every solver kind, for the option parser (core/option_text.hpp).
-[[nodiscard]] constexpr std::array<SolverKind, 6> option_choices(SolverKind) {
+[[nodiscard]] constexpr std::array<SolverKind, 7> option_choices(SolverKind) {
   return {SolverKind::simplicial_ldlt, SolverKind::simplicial_llt, SolverKind::sparse_lu,
-          SolverKind::cg_jacobi,       SolverKind::cg_incomplete_cholesky, SolverKind::bicgstab};
+          SolverKind::cg_jacobi,       SolverKind::cg_incomplete_cholesky, SolverKind::bicgstab,
+          SolverKind::cholmod_supernodal};
+}
+
+/// True when this build has CHOLMOD (SolverKind::cholmod_supernodal and the automatic choice).
+[[nodiscard]] constexpr bool have_cholmod() {
+#ifdef MESHMOTION_HAVE_CHOLMOD
+  return true;
+#else
+  return false;
+#endif
 }
 
 /// True for the Krylov solvers (tolerance and max_iterations apply to them only).
@@ -64,6 +78,11 @@ struct SolverOptions {
   /// then also meet the tolerance in D^-1-scaled (displacement) units, ||D^-1 r|| ≤ tol
   /// ||D^-1 b||, restarting warm with a tighter target when their own test stops short.
   bool diagonal_scaling = false;
+  /// The simplicial Cholesky kinds hand matrices of at least this many rows to CHOLMOD's
+  /// supernodal factorization in builds that have it (its dense kernels win on the large
+  /// systems; the simplicial factorization answers if CHOLMOD finds the matrix not positive
+  /// definite). 0 never does.
+  Index supernodal_min_rows = 20000;
 };
 
 /// What a solver did, accumulated since it was created (seconds, factorizations) or for the
@@ -75,6 +94,7 @@ struct SolverReport {
   Index analyses = 0;        ///< symbolic analyses (sparsity pattern) performed
   Index factorizations = 0;  ///< numeric factorizations (or preconditioner builds) performed
   bool fell_back = false;    ///< an iterative solve failed and the direct fallback answered
+  bool supernodal = false;   ///< the last factorization was CHOLMOD's supernodal one
 };
 
 }  // namespace meshmotion
