@@ -82,7 +82,7 @@ struct SolverOptions {
   /// supernodal factorization in builds that have it (its dense kernels win on the large
   /// systems; the simplicial factorization answers if CHOLMOD finds the matrix not positive
   /// definite). 0 never does.
-  Index supernodal_min_rows = 20000;
+  Index supernodal_min_rows = 10000;
 };
 
 /// What a solver did, accumulated since it was created (seconds, factorizations) or for the
