@@ -75,6 +75,10 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
     if (config.method != "rbf" && config.method != "le" && config.method != "sle")
       throw InputError("move_mesh_mpi: --method '" + config.method + "' has no distributed mover (expected rbf, le or sle)");
     if (!root) return;
+    // As move_mesh: an output that cannot hold the mesh's order is refused before any work.
+    int order = 1;
+    for (const auto& b : whole->cells) order = std::max(order, meshmotion::order(b.type));
+    check_mesh_output(a.output, order);
     examples::handle_orientation(*whole, a.input, a.keep_orientation);
     name_unnamed_facet_groups(*whole);
     const BoundarySpec<Dim> spec = examples::boundary_spec<Dim>(a.motion, *whole);
