@@ -10,6 +10,7 @@
 //
 // A table and one JSON line per case. Without CHOLMOD in the build it says so and exits 0.
 
+#include "box_bump.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/io.hpp"
 #include "meshmotion/movers.hpp"
@@ -70,18 +71,8 @@ int main(int argc, char** argv) {
   std::printf("%-24s %10s %10s %12s %12s %8s %12s\n", "case", "nodes", "centres", "simplicial_s", "supernodal_s", "ratio",
               "difference");
   {
-    BoxOptions b;
-    b.nx = b.ny = b.nz = n;
-    const Mesh<3> mesh = box_mesh(b);
-    const std::vector<Index> bottom = mesh.group_nodes("bottom");
-    Points<3> d = Points<3>::Zero(3, static_cast<Index>(bottom.size()));
-    for (std::size_t k = 0; k < bottom.size(); ++k) {
-      const double x = mesh.points(0, bottom[k]), y = mesh.points(1, bottom[k]);
-      d(2, static_cast<Index>(k)) = 0.05 * std::sin(M_PI * x) * std::sin(M_PI * y);
-    }
-    BoundarySpec<3> spec;
-    spec.moving("bottom", d);
-    compare("box rbf setup", mesh, spec.resolve(mesh), rounds, [&](const SolverOptions& solver) {
+    const Mesh<3> mesh = bench::box(n);
+    compare("box rbf setup", mesh, bench::bottom_bump(mesh), rounds, [&](const SolverOptions& solver) {
       RbfOptions o;
       o.support_radius = 6.0 / n;
       o.solver = solver;

@@ -8,6 +8,7 @@
 // Prints a table and one JSON line per case. Usage: rbf_bench [max_box_cells_per_axis=126]
 // (sizes 20, 40, 80, 126, 160 cells per axis up to the maximum; 126 gives 2.05M nodes).
 
+#include "box_bump.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/movers.hpp"
 #include "meshmotion/quality.hpp"
@@ -100,18 +101,8 @@ void scaling(int max_cells) {
               "setup_us/node", "direct_s", "speedup", "nonzeros", "peak_MB");
   for (const int n : {20, 40, 80, 126, 160}) {
     if (n > max_cells) break;
-    BoxOptions b;
-    b.nx = b.ny = b.nz = n;
-    const Mesh<3> mesh = box_mesh(b);
-    const std::vector<Index> bottom = mesh.group_nodes("bottom");
-    Points<3> d = Points<3>::Zero(3, static_cast<Index>(bottom.size()));
-    for (std::size_t k = 0; k < bottom.size(); ++k) {
-      const double x = mesh.points(0, bottom[k]), y = mesh.points(1, bottom[k]);
-      d(2, static_cast<Index>(k)) = 0.05 * std::sin(M_PI * x) * std::sin(M_PI * y);
-    }
-    BoundarySpec<3> spec;
-    spec.moving("bottom", d);
-    const ResolvedBoundary<3> boundary = spec.resolve(mesh);
+    const Mesh<3> mesh = bench::box(n);
+    const ResolvedBoundary<3> boundary = bench::bottom_bump(mesh);
     RbfOptions options;
     options.support_radius = 6.0 / n;
     RbfMover<3> mover(options);

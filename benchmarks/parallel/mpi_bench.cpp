@@ -14,6 +14,7 @@
 // rank 0's);
 // more ranks than cores is flagged "oversubscribed". A table and one JSON line per case.
 
+#include "../box_bump.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/io.hpp"
 #include "meshmotion/movers.hpp"
@@ -144,18 +145,8 @@ void box(int n) {
   // Every rank builds the box (the serial peer needs it on rank 0 only, partition_mesh reads
   // it there): generating it is not part of either figure.
   if (root) {
-    BoxOptions b;
-    b.nx = b.ny = b.nz = n;
-    mesh = box_mesh(b);
-    const std::vector<Index> bottom = mesh.group_nodes("bottom");
-    Points<3> d = Points<3>::Zero(3, static_cast<Index>(bottom.size()));
-    for (std::size_t k = 0; k < bottom.size(); ++k) {
-      const double x = mesh.points(0, bottom[k]), y = mesh.points(1, bottom[k]);
-      d(2, static_cast<Index>(k)) = 0.05 * std::sin(M_PI * x) * std::sin(M_PI * y);
-    }
-    BoundarySpec<3> spec;
-    spec.moving("bottom", d);
-    boundary = spec.resolve(mesh);
+    mesh = bench::box(n);
+    boundary = bench::bottom_bump(mesh);
   }
   run_case("box" + std::to_string(n), mesh, boundary, Method::rbf, 6.0 / n);
 }

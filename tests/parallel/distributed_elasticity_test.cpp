@@ -69,12 +69,8 @@ TEST_CASE("distributed stiffened elasticity equals serial in 3D", "[parallel][el
 }
 
 TEST_CASE("distributed elasticity: an empty rank and a rank without boundary nodes", "[parallel][elasticity]") {
-  const Index nx = 10, ny = 10;
-  const Mesh<2> mesh = rectangle_mesh({.nx = nx, .ny = ny});
-  const int p = size_of(world());
-  std::vector<int> ranks(static_cast<std::size_t>(nx * ny));
-  for (Index j = 0; j < ny; ++j)
-    for (Index i = 0; i < nx; ++i) ranks[static_cast<std::size_t>(i + nx * j)] = std::min(j < 2 ? 0 : j < ny - 2 ? 1 : 2, p - 1);
+  const Mesh<2> mesh = rectangle_mesh({.nx = 10, .ny = 10});
+  const std::vector<int> ranks = test::row_bands(10, 10);
   BoundarySpec<2> spec;
   spec.moving("bottom", Translation<2>{{0.02, 0.05}}).fixed("top");
   DistributedElasticityOptions options;

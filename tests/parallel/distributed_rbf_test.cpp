@@ -141,12 +141,8 @@ TEST_CASE("distributed RBF with the boundary system factorized across the ranks 
   }
   {
     // The partition that leaves ranks without moving nodes, without group nodes, or empty.
-    const Index nx = 10, ny = 10;
-    const Mesh<2> mesh = rectangle_mesh({.nx = nx, .ny = ny});
-    const int p = size_of(world());
-    std::vector<int> ranks(static_cast<std::size_t>(nx * ny));
-    for (Index j = 0; j < ny; ++j)
-      for (Index i = 0; i < nx; ++i) ranks[static_cast<std::size_t>(i + nx * j)] = std::min(j < 2 ? 0 : j < ny - 2 ? 1 : 2, p - 1);
+    const Mesh<2> mesh = rectangle_mesh({.nx = 10, .ny = 10});
+    const std::vector<int> ranks = test::row_bands(10, 10);
     BoundarySpec<2> spec;
     spec.moving("bottom", Translation<2>{{0.0, 0.08}}).fixed("top");
     const Outcome r = compare_with_serial(mesh, spec.resolve(mesh), {.support_radius = 0.9}, ranks, false, petsc);
@@ -240,18 +236,10 @@ TEST_CASE("distributed RBF equals serial on real meshes of ../shared/data", "[pa
 }
 
 TEST_CASE("distributed RBF: a rank without moving nodes, one without group nodes, an empty one", "[parallel][rbf]") {
-  // Rows of cells: rank 0 the two rows on the moving bottom, rank 1 the middle rows (it owns
-  // no node of any group: its boundary rows are owned by ranks 0 and 2), rank 2 the top rows
-  // (fixed nodes only); a fourth rank gets nothing.
-  const Index nx = 10, ny = 10;
-  const Mesh<2> mesh = rectangle_mesh({.nx = nx, .ny = ny});
-  const int p = size_of(world());
-  std::vector<int> ranks(static_cast<std::size_t>(nx * ny));
-  for (Index j = 0; j < ny; ++j)
-    for (Index i = 0; i < nx; ++i) {
-      const int band = j < 2 ? 0 : j < ny - 2 ? 1 : 2;
-      ranks[static_cast<std::size_t>(i + nx * j)] = std::min(band, p - 1);
-    }
+  // test::row_bands: rank 0 on the moving bottom, rank 1 without group nodes, rank 2 with fixed
+  // nodes only, rank 3 empty.
+  const Mesh<2> mesh = rectangle_mesh({.nx = 10, .ny = 10});
+  const std::vector<int> ranks = test::row_bands(10, 10);
   BoundarySpec<2> spec;
   spec.moving("bottom", Translation<2>{{0.0, 0.08}}).fixed("top");
   RbfOptions options;
