@@ -239,12 +239,14 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
 
   gathered_.resize(Dim, m);
   // Every rank decides alike: the inputs are the gathered arrays.
-  const std::string obstacle = petsc_obstacle(all_kinds, any_radius != 0, points.leftCols(m));
+  // The obstacles (a k-d tree over the centres among them) are looked for only when PETSc is wanted.
+  const bool wanted = solve_.kind == BoundarySolve::petsc ||
+                      (solve_.kind == BoundarySolve::automatic && m >= solve_.petsc_min_centres);
+  const std::string obstacle = wanted ? petsc_obstacle(all_kinds, any_radius != 0, points.leftCols(m)) : std::string();
   if (solve_.kind == BoundarySolve::petsc && !obstacle.empty())
     throw InputError("DistributedRbfMover::setup: the boundary system cannot go through PETSc: " + obstacle +
                      " (use BoundarySolve::replicated)");
-  petsc_ = obstacle.empty() && (solve_.kind == BoundarySolve::petsc ||
-                                (solve_.kind == BoundarySolve::automatic && m >= solve_.petsc_min_centres));
+  petsc_ = wanted && obstacle.empty();
   if (petsc_) {
     setup_petsc(part, Points<Dim>(points.leftCols(m)));
   } else {

@@ -56,6 +56,10 @@ class PetscRbfSystem {
     lo_ = m * r / p;
     hi_ = m * (r + 1) / p;
     tree_.build(centres_);
+    // The serial RbfSystem's scaling of the polynomial basis, computed once: every node's
+    // evaluation asks for its polynomial.
+    shift_ = m > 0 ? Vec<Dim>(centres_.rowwise().mean()) : Vec<Dim>::Zero();
+    scale_ = m > 0 ? std::max((centres_.colwise() - shift_).colwise().norm().maxCoeff(), 1e-300) : 1.0;
     std::vector<Index> rows;
     for (Index i = lo_; i < hi_; ++i) rows.push_back(i);
     // Sorted columns per row: the storage-order round trip sorts them.
@@ -114,7 +118,7 @@ class PetscRbfSystem {
   [[nodiscard]] Vec<Dim + 1> polynomial(const Vec<Dim>& x) const {
     Vec<Dim + 1> q;
     q[0] = 1.0;
-    q.template tail<Dim>() = (x - shift()) / scale();
+    q.template tail<Dim>() = (x - shift_) / scale_;
     return q;
   }
 
@@ -135,10 +139,6 @@ class PetscRbfSystem {
   }
 
  private:
-  [[nodiscard]] Vec<Dim> shift() const { return centres_.rowwise().mean(); }
-  [[nodiscard]] double scale() const {
-    return std::max((centres_.colwise() - shift()).colwise().norm().maxCoeff(), 1e-300);
-  }
 
   // b: m rows on every rank. This rank's rows go in as one dense block, all columns solved in
   // one MUMPS call (one pass of communication for the Dim right-hand sides, not one each);
@@ -175,6 +175,8 @@ class PetscRbfSystem {
   meshmotion::detail::RbfKernelSettings kernel_;
   KdTree<Dim> tree_;
   Index lo_ = 0, hi_ = 0, nonzeros_ = 0;
+  Vec<Dim> shift_ = Vec<Dim>::Zero();
+  double scale_ = 1.0;
   Mat a_ = nullptr;
   KSP ksp_ = nullptr;
   Eigen::MatrixXd p_, g_;
