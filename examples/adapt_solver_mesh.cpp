@@ -58,6 +58,7 @@ struct meshmotion::MeshTraits<solver::FlowMesh> {
 static_assert(meshmotion::MeshLike<solver::FlowMesh>);
 
 int main(int argc, char** argv) {
+  meshmotion::tune_process_memory(argc, argv);  // may restart the program once (core/process_memory.hpp)
   CLI::App app{"Adapt a flow solver's own mesh arrays to meshmotion through MeshTraits"};
   meshmotion::examples::add_version_flag(app);
   int nx = 40, ny = 10;

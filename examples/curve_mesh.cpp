@@ -222,6 +222,7 @@ void print_summary(const CurveResult<Dim>& result, const Arguments& args, const 
 }  // namespace
 
 int main(int argc, char** argv) {
+  meshmotion::tune_process_memory(argc, argv);  // may restart the program once (core/process_memory.hpp)
   CLI::App app{"Curve a linear mesh into a certified P2 mesh (spline or CAD boundary, RBF or blending interior)"};
   Arguments args;
   app.add_option("input", args.input, "linear mesh (.msh, .su2); none: the built-in demo");

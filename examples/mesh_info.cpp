@@ -14,6 +14,7 @@
 #include <variant>
 
 int main(int argc, char** argv) {
+  meshmotion::tune_process_memory(argc, argv);  // may restart the program once (core/process_memory.hpp)
   using namespace meshmotion;
   CLI::App app{"Print the contents of a mesh file (.msh or .su2)"};
   examples::add_version_flag(app);

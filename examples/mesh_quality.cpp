@@ -88,6 +88,7 @@ int run(Mesh<Dim>& mesh, const Settings& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  meshmotion::tune_process_memory(argc, argv);  // may restart the program once (core/process_memory.hpp)
   CLI::App app{"Mesh quality report: Knupp size/shape/skew metrics and the certified scaled Jacobian of P1/P2 cells"};
   examples::add_version_flag(app);
   Settings s;

@@ -99,6 +99,7 @@ int run(const Arguments& a, Mesh<Dim> mesh) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  meshmotion::tune_process_memory(argc, argv);  // may restart the program once (core/process_memory.hpp)
   CLI::App app{"Move a mesh whose boundary group rotates, translates or moves by given displacements"};
   examples::add_version_flag(app);
   Arguments a;

@@ -8,6 +8,7 @@
 #include "meshmotion/core/json.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/orientation.hpp"
+#include "meshmotion/core/process_memory.hpp"
 #include "meshmotion/io/mesh_io.hpp"
 #include "meshmotion/version.hpp"
 

@@ -1,14 +1,18 @@
-// The JSON writer, the thread-count setting and the version (issue 17).
+// The JSON writer, the thread-count setting, the process memory settings and the version.
 
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/core/json.hpp"
+#include "meshmotion/core/process_memory.hpp"
 #include "meshmotion/core/threads.hpp"
 #include "meshmotion/quality/quality_report.hpp"
 #include "meshmotion/version.hpp"
 
 #include <catch2/catch.hpp>
 
+#include <cstdlib>
+#include <optional>
 #include <sstream>
+#include <string>
 
 using namespace meshmotion;
 
@@ -41,3 +45,30 @@ TEST_CASE("version: the macros agree with the string", "[core]") {
   CHECK(expected == MESHMOTION_VERSION_STRING);
   CHECK(std::string(version_string) == expected);
 }
+
+#if defined(__linux__) && defined(__GLIBC__) && (__GLIBC__ > 2 || __GLIBC_MINOR__ >= 35)
+// The cases below decide without restarting: a restart would re-run this test program.
+TEST_CASE("process memory: a choice already made in GLIBC_TUNABLES or MESHMOTION_HUGE_PAGES is kept", "[core]") {
+  const auto saved = [](const char* name) -> std::optional<std::string> {
+    const char* v = std::getenv(name);
+    return v ? std::optional<std::string>(v) : std::nullopt;
+  };
+  const auto tunables = saved("GLIBC_TUNABLES"), choice = saved("MESHMOTION_HUGE_PAGES");
+  char name[] = "meshmotion_tests";
+  char* argv[] = {name, nullptr};
+  setenv("GLIBC_TUNABLES", "glibc.malloc.check=0:glibc.malloc.hugetlb=0", 1);
+  CHECK(tune_process_memory(1, argv) == HugePages::declined);
+  setenv("GLIBC_TUNABLES", "glibc.malloc.hugetlb=1", 1);
+  CHECK(tune_process_memory(1, argv) == HugePages::enabled);
+  unsetenv("GLIBC_TUNABLES");
+  setenv("MESHMOTION_HUGE_PAGES", "0", 1);
+  CHECK(tune_process_memory(1, argv) == HugePages::declined);
+  CHECK(std::getenv("GLIBC_TUNABLES") == nullptr);  // nothing set for child processes either
+  const auto restore = [](const char* n, const std::optional<std::string>& v) {
+    if (v) setenv(n, v->c_str(), 1);
+    else unsetenv(n);
+  };
+  restore("GLIBC_TUNABLES", tunables);
+  restore("MESHMOTION_HUGE_PAGES", choice);
+}
+#endif
