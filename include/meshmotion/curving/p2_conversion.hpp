@@ -5,7 +5,8 @@
 /// using that edge; a node at the centre of every quadrilateral face for the complete types
 /// (quad9, hex27, prism18, pyramid14) and at the centre of every hex27. The linear nodes
 /// keep their numbering; the new ones are appended after them (edges, then quadrilateral
-/// faces, then hexahedron centres), so a flow solver's node indices stay valid.
+/// faces, then hexahedron centres), so a flow solver's node indices stay valid. In 2D the
+/// quadrilateral face nodes follow cell order.
 
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
@@ -68,17 +69,20 @@ template <int Dim>
     }
   const Index n_linear = linear.num_nodes();
   const EdgeTopology edge_topo = unique_edges(blocks, n_linear);
+  // In 2D the only faces are the cells themselves, one node each: no numbering needed.
   bool any_face_nodes = false;
   for (const auto* b : blocks) any_face_nodes |= has_face_nodes(quadratic_type(b->type, options.complete));
-  const FacetTopology face_topo = any_face_nodes ? unique_faces(blocks, n_linear) : FacetTopology{};
+  const FacetTopology face_topo = Dim == 3 && any_face_nodes ? unique_faces(blocks, n_linear) : FacetTopology{};
 
   QuadraticConversion<Dim> out;
   out.num_linear_nodes = n_linear;
   auto& sources = out.sources;
-  std::size_t num_hexahedra = 0;
-  for (const auto& b : linear.cells)
-    if (quadratic_type(b.type, options.complete) == ElementType::hex27) num_hexahedra += static_cast<std::size_t>(b.size());
-  sources.reserve(edge_topo.edges.size() + static_cast<std::size_t>(face_topo.size()) + num_hexahedra);
+  std::size_t num_cell_nodes = 0;  // hexahedron centres, 2D face nodes
+  for (const auto& b : linear.cells) {
+    const ElementType qt = quadratic_type(b.type, options.complete);
+    if (qt == ElementType::hex27 || (Dim == 2 && has_face_nodes(qt))) num_cell_nodes += static_cast<std::size_t>(b.size());
+  }
+  sources.reserve(edge_topo.edges.size() + static_cast<std::size_t>(face_topo.size()) + num_cell_nodes);
   for (const auto& e : edge_topo.edges) sources.push_back({HighOrderNodeSource::Kind::edge, {e[0], e[1], -1, -1}, -1, {-1, -1}});
   std::vector<Index> face_node(static_cast<std::size_t>(face_topo.size()), -1);
   for (Index f = 0; f < face_topo.size(); ++f)
@@ -105,7 +109,10 @@ template <int Dim>
         const auto el = b.element(e);
         q.connectivity.insert(q.connectivity.end(), el.begin(), el.end());
         for (Index id : edge_topo.element_edges.of(block_index, e)) q.connectivity.push_back(n_linear + id);
-        if (has_face_nodes(qt)) {
+        if (Dim == 2 && has_face_nodes(qt)) {
+          q.connectivity.push_back(n_linear + static_cast<Index>(sources.size()));
+          sources.push_back({HighOrderNodeSource::Kind::face, {el[0], el[1], el[2], el[3]}, -1, {-1, -1}});
+        } else if (has_face_nodes(qt)) {
           const auto faces = face_topo.element_facets.of(block_index, e);
           for (std::size_t f = 0; f < faces.size(); ++f)
             if (face_node[static_cast<std::size_t>(faces[f])] >= 0) q.connectivity.push_back(face_node[static_cast<std::size_t>(faces[f])]);

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <limits>
 #include <span>
 #include <string>
@@ -31,15 +32,12 @@ struct KeyNumbering {
   std::vector<Index> count;        ///< per unique id, how many items carry it
 };
 
-/// Numbers the items that `visit` enumerates: visit(f) must call f(item, key) once for every
-/// item 0 .. num_items-1 (in any order), with `key` sorted ascending (padded with
-/// key_padding), key[0] in [0, num_nodes). It is called twice. Unique ids follow the
-/// lexicographic order of the keys.
-template <std::size_t N, class Visit>
-[[nodiscard]] KeyNumbering number_keys(Index num_items, Index num_nodes, Visit&& visit) {
+/// number_keys() with bucket entries of integer type I (large enough for every node and item).
+template <std::size_t N, class I, class Visit>
+[[nodiscard]] KeyNumbering number_keys_as(Index num_items, Index num_nodes, Visit&& visit) {
   struct Entry {
-    std::array<Index, N - 1> rest;
-    Index item;
+    std::array<I, N - 1> rest;
+    I item;
   };
   std::vector<Index> offsets(static_cast<std::size_t>(num_nodes) + 1, 0);
   visit([&](Index, const std::array<Index, N>& key) { ++offsets[static_cast<std::size_t>(key[0]) + 1]; });
@@ -49,12 +47,17 @@ template <std::size_t N, class Visit>
     std::vector<Index> fill(offsets.begin(), offsets.end() - 1);
     visit([&](Index item, const std::array<Index, N>& key) {
       Entry& e = entries[static_cast<std::size_t>(fill[static_cast<std::size_t>(key[0])]++)];
-      std::copy(key.begin() + 1, key.end(), e.rest.begin());
-      e.item = item;
+      for (std::size_t i = 0; i + 1 < N; ++i) e.rest[i] = static_cast<I>(key[i + 1]);
+      e.item = static_cast<I>(item);
     });
   }
   KeyNumbering out;
   out.id_of_item.resize(static_cast<std::size_t>(num_items));
+  // At most one id per item; the reservation is address space only until ids are written,
+  // and it spares the copies of growing three arrays entity by entity.
+  out.first_item.reserve(static_cast<std::size_t>(num_items));
+  out.second_item.reserve(static_cast<std::size_t>(num_items));
+  out.count.reserve(static_cast<std::size_t>(num_items));
   for (Index v = 0; v < num_nodes; ++v) {
     const auto begin = entries.begin() + offsets[static_cast<std::size_t>(v)];
     const auto end = entries.begin() + offsets[static_cast<std::size_t>(v) + 1];
@@ -82,6 +85,19 @@ template <std::size_t N, class Visit>
     }
   }
   return out;
+}
+
+/// Numbers the items that `visit` enumerates: visit(f) must call f(item, key) once for every
+/// item 0 .. num_items-1 (in any order), with `key` sorted ascending (padded with
+/// key_padding), key[0] in [0, num_nodes). It is called twice. Unique ids follow the
+/// lexicographic order of the keys.
+template <std::size_t N, class Visit>
+[[nodiscard]] KeyNumbering number_keys(Index num_items, Index num_nodes, Visit&& visit) {
+  // The bucket entries are scattered over memory once: half their size is half the traffic.
+  // Padding (key_padding) must stay the largest key value, so 32 bits only below its range.
+  constexpr Index small = std::numeric_limits<std::uint32_t>::max();
+  if (num_items < small && num_nodes < small) return number_keys_as<N, std::uint32_t>(num_items, num_nodes, visit);
+  return number_keys_as<N, Index>(num_items, num_nodes, visit);
 }
 
 /// Blocks of elements seen through one interface, whether they are ElementBlocks or the
