@@ -171,6 +171,7 @@ class GmshParser {
     const auto capped = static_cast<std::size_t>(std::min<std::uint64_t>(count, data_.size()));
     raw_.coords.reserve(3 * capped);
     raw_.node_ids.reserve(capped);
+    node_entity_.reserve(capped);
   }
   void finish_nodes() {
     std::int64_t max_id = -1;
@@ -228,8 +229,8 @@ class GmshParser {
       (void)bin.read_size(size_bytes_, "min node tag");
       (void)bin.read_size(size_bytes_, "max node tag");
       begin_nodes(num_nodes);
-      std::vector<std::uint64_t> tags;
-      std::vector<double> values;
+      // Tags and coordinates go straight into the node arrays: no staging copy of the section.
+      std::vector<double> values;  // parametric blocks only
       for (std::uint64_t b = 0; b < num_blocks; ++b) {
         const int dim = bin.read<std::int32_t>("entity dimension");
         const int tag = bin.read<std::int32_t>("entity tag");
@@ -238,22 +239,31 @@ class GmshParser {
         if (dim < 0 || dim > 3) bin.fail("entity dimension " + std::to_string(dim) + " (expected 0 to 3)");
         if (parametric != 0 && parametric != 1) bin.fail("parametric flag " + std::to_string(parametric) + " (expected 0 or 1)");
         bin.require(n, size_bytes_, "node tags");
-        tags.resize(n);
-        if (size_bytes_ == 8) bin.read_array(tags.data(), n, "node tags");
-        else for (auto& t : tags) t = bin.read<std::uint32_t>("node tag");
+        const std::size_t first = raw_.node_ids.size();
+        raw_.node_ids.resize(first + n);
+        for (std::uint64_t i = 0; i < n; ++i) {
+          const std::uint64_t t = bin.read_size(size_bytes_, "node tag");
+          if (t > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) bin.fail("node tag out of range");
+          raw_.node_ids[first + i] = static_cast<std::int64_t>(t);
+        }
         const int per_node = 3 + (parametric ? dim : 0);
         bin.require(n, static_cast<std::size_t>(per_node) * sizeof(double), "node coordinates");
-        values.resize(n * static_cast<std::size_t>(per_node));
-        bin.read_array(values.data(), values.size(), "node coordinates");
+        const std::size_t first_coord = raw_.coords.size();
+        raw_.coords.resize(first_coord + 3 * n);
+        double* coords = raw_.coords.data() + first_coord;
+        if (per_node == 3) {
+          bin.read_array(coords, 3 * n, "node coordinates");
+        } else {
+          values.resize(n * static_cast<std::size_t>(per_node));
+          bin.read_array(values.data(), values.size(), "node coordinates");
+          for (std::uint64_t i = 0; i < n; ++i)
+            std::copy_n(values.data() + i * static_cast<std::size_t>(per_node), 3, coords + 3 * i);
+        }
         for (std::uint64_t i = 0; i < n; ++i) {
-          if (tags[i] > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) bin.fail("node tag out of range");
-          raw_.node_ids.push_back(static_cast<std::int64_t>(tags[i]));
-          const double* v = values.data() + i * static_cast<std::size_t>(per_node);
-          for (int d = 0; d < 3; ++d) {
-            if (!std::isfinite(v[d])) bin.fail("node " + std::to_string(tags[i]) + " has a non-finite coordinate");
-            raw_.coords.push_back(v[d]);
-          }
-          add_node_entity(dim, tag, parametric != 0, v + 3);
+          for (int d = 0; d < 3; ++d)
+            if (!std::isfinite(coords[3 * i + static_cast<std::size_t>(d)]))
+              bin.fail("node " + std::to_string(raw_.node_ids[first + i]) + " has a non-finite coordinate");
+          add_node_entity(dim, tag, parametric != 0, per_node == 3 ? nullptr : values.data() + i * static_cast<std::size_t>(per_node) + 3);
         }
       }
       if (raw_.node_ids.size() != num_nodes)
@@ -398,7 +408,6 @@ class GmshParser {
       const std::uint64_t num_elements = bin.read_size(size_bytes_, "number of elements");
       (void)bin.read_size(size_bytes_, "min element tag");
       (void)bin.read_size(size_bytes_, "max element tag");
-      std::vector<std::uint64_t> buffer;
       std::uint64_t total = 0;
       for (std::uint64_t b = 0; b < num_blocks; ++b) {
         const int dim = bin.read<std::int32_t>("entity dimension");
@@ -408,19 +417,23 @@ class GmshParser {
         const ElementType type = checked_type(gmsh_type, bin);
         ElementBlock& block = block_for(gmsh_type);
         const int physical = physical_tag_of(dim, entity);
-        const std::uint64_t per = 1 + static_cast<std::uint64_t>(num_nodes(type));
-        bin.require(n, per * size_bytes_, "element data");
-        buffer.resize(n * per);
-        if (size_bytes_ == 8) bin.read_array(buffer.data(), buffer.size(), "element data");
-        else for (auto& v : buffer) v = bin.read<std::uint32_t>("element data");
-        block.reserve(block.size() + static_cast<Index>(n));
+        const auto per = static_cast<std::size_t>(num_nodes(type));
+        bin.require(n, (1 + per) * size_bytes_, "element data");
+        // Records are decoded in place into the block's arrays, sized once.
+        const auto first = static_cast<std::size_t>(block.size());
+        block.ids.resize(first + n);
+        block.tags.resize(first + n, physical);
+        block.connectivity.resize((first + n) * per);
+        Index* nodes = block.connectivity.data() + first * per;
+        constexpr auto largest = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
         for (std::uint64_t e = 0; e < n; ++e) {
-          const std::uint64_t* rec = buffer.data() + e * per;
-          const auto id = static_cast<std::int64_t>(rec[0]);
-          block.ids.push_back(id);
-          block.tags.push_back(physical);
-          for (std::uint64_t k = 1; k < per; ++k)
-            block.connectivity.push_back(node_index(static_cast<std::int64_t>(rec[k] > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()) ? -1 : static_cast<std::int64_t>(rec[k])), id, bin));
+          const std::uint64_t raw_id = bin.read_size(size_bytes_, "element tag");
+          const auto id = static_cast<std::int64_t>(std::min(raw_id, largest));
+          block.ids[first + e] = id;
+          for (std::size_t k = 0; k < per; ++k) {
+            const std::uint64_t node = bin.read_size(size_bytes_, "element node");
+            *nodes++ = node_index(node > largest ? -1 : static_cast<std::int64_t>(node), id, bin);
+          }
         }
         total += n;
       }

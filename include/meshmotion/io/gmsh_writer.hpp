@@ -235,6 +235,12 @@ template <int Dim>
 [[nodiscard]] std::string format_gmsh(const Mesh<Dim>& mesh, const GmshWriteOptions& options = {}) {
   validate(mesh);
   detail::GmshFormatter f(options.binary);
+  // One allocation for the whole file: appending into a growing string copied it log n times.
+  // Binary values are 8 bytes at most; ASCII ones are bounded by the shortest round-trip form.
+  std::size_t values = static_cast<std::size_t>(mesh.num_nodes()) * 5;
+  for (const auto* list : {&mesh.cells, &mesh.facets, &mesh.lower})
+    for (const auto& b : *list) values += b.connectivity.size() + 5 * static_cast<std::size_t>(b.size());
+  f.out.reserve(4096 + values * (options.binary ? 8 : 12) + (options.binary ? 0 : static_cast<std::size_t>(mesh.num_nodes()) * 3 * 14));
   f.text(options.version == MshVersion::v2_2 ? "$MeshFormat\n2.2 " : "$MeshFormat\n4.1 ");
   f.text(options.binary ? "1 8\n" : "0 8\n");
   if (options.binary) {

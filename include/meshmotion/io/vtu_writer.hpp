@@ -66,17 +66,24 @@ struct VtkCell {
 
 inline void append_base64(std::string& out, const unsigned char* bytes, std::size_t n) {
   static constexpr char alphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  // Sized once and written through a pointer: character appends kept the encoder at ~100 MB/s.
+  const std::size_t start = out.size();
+  out.resize(start + (n + 2) / 3 * 4);
+  char* o = out.data() + start;
   std::size_t i = 0;
-  for (; i + 3 <= n; i += 3) {
+  for (; i + 3 <= n; i += 3, o += 4) {
     const unsigned v = (unsigned{bytes[i]} << 16) | (unsigned{bytes[i + 1]} << 8) | bytes[i + 2];
-    for (const int shift : {18, 12, 6, 0}) out.push_back(alphabet[(v >> shift) & 63u]);
+    o[0] = alphabet[(v >> 18) & 63u];
+    o[1] = alphabet[(v >> 12) & 63u];
+    o[2] = alphabet[(v >> 6) & 63u];
+    o[3] = alphabet[v & 63u];
   }
   if (i == n) return;
   const unsigned v = (unsigned{bytes[i]} << 16) | (i + 1 < n ? unsigned{bytes[i + 1]} << 8 : 0u);
-  out.push_back(alphabet[(v >> 18) & 63u]);
-  out.push_back(alphabet[(v >> 12) & 63u]);
-  out.push_back(i + 1 < n ? alphabet[(v >> 6) & 63u] : '=');
-  out.push_back('=');
+  o[0] = alphabet[(v >> 18) & 63u];
+  o[1] = alphabet[(v >> 12) & 63u];
+  o[2] = i + 1 < n ? alphabet[(v >> 6) & 63u] : '=';
+  o[3] = '=';
 }
 
 /// One <DataArray> element; `attributes` holds its type, name and component count. In binary,
