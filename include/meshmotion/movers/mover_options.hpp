@@ -60,6 +60,9 @@ void visit_options(RbfOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "max_dense_centres", o.max_dense_centres, "largest centre count of a global kernel");
   f(prefix + "coincidence_tolerance", o.coincidence_tolerance, "boundary nodes closer than this × the diagonal are one");
   f(prefix + "max_evaluation_cache_bytes", o.max_evaluation_cache_bytes, "largest dense evaluation matrix kept");
+  f(prefix + "partition_of_unity", o.partition_of_unity, "local systems on overlapping patches (boundaries of ~100k+ nodes)");
+  f(prefix + "patch_centres", o.patch_centres, "partition of unity: most centres per patch before the overlap");
+  f(prefix + "patch_overlap", o.patch_overlap, "partition of unity: overlap, x each patch's radius (at least the support radius)");
 }
 
 template <class F>

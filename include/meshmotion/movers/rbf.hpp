@@ -27,6 +27,9 @@
 ///   boundary-layer thickness: s(x) = Σ_j α_j φ(|x − c_j| / ρ_j), still interpolating.
 /// - derivative_forward / derivative_reverse give J w and Jᵀ v for J = ∂(node displacements)
 ///   / ∂(boundary displacements), reusing the factorizations (shape optimization).
+/// - Boundaries too large for one factorization (RbfOptions::partition_of_unity): local
+///   systems on overlapping patches of centres, blended by a partition of unity
+///   (detail/rbf_partition_of_unity.hpp); still interpolating, linear, with derivatives.
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh_like.hpp"
@@ -35,6 +38,7 @@
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/detail/coincident_nodes.hpp"
 #include "meshmotion/movers/detail/mover_support.hpp"
+#include "meshmotion/movers/detail/rbf_partition_of_unity.hpp"
 #include "meshmotion/movers/detail/rbf_system.hpp"
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
@@ -45,6 +49,7 @@
 #include <concepts>
 #include <cmath>
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -78,6 +83,17 @@ struct RbfOptions {
   /// 0 never caches. Compact kernels keep a sparse operator unless their support reaches most
   /// centres from most nodes and the dense matrix fits here.
   std::size_t max_evaluation_cache_bytes = std::size_t{256} << 20;
+  /// Interpolate with local systems on overlapping patches of the boundary, blended by a
+  /// partition of unity, instead of one system over every centre: for boundaries too large to
+  /// factorize at once (from ~100k nodes). Needs a compact kernel, one support_radius and no
+  /// polynomial. Interpolating and linear like the global system, not equal to it: the
+  /// difference is what data beyond a patch contributes inside it (docs/interpolation.md).
+  bool partition_of_unity = false;
+  /// Partition of unity: most centres per patch before the overlap is added.
+  Index patch_centres = 4000;
+  /// Partition of unity: each patch's ball reaches this fraction of its radius, and at least
+  /// the support radius, beyond its own centres.
+  double patch_overlap = 0.25;
 };
 
 /// The RBF mover in Dim dimensions; models MeshMover.
@@ -94,6 +110,8 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   /// True when the last setup stored a dense evaluation matrix: a global kernel, or a compact
   /// one whose support covers most centres (see RbfOptions::max_evaluation_cache_bytes).
   [[nodiscard]] bool evaluation_cached() const noexcept { return dense_operator_.size() > 0; }
+  /// Patches of the partition of unity after setup (0: one global system).
+  [[nodiscard]] Index patches() const noexcept { return patched_all_ ? patched_all_->num_patches() : 0; }
 
   /// Reference-configuration work (see the file comment). `mesh`: any MeshLike of dimension
   /// Dim; `boundary`: nodes and kinds (its displacements are not used here).
@@ -137,6 +155,16 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   using Poly = typename detail::RbfSystem<Dim>::PolyCoefficients;
 
   [[nodiscard]] const Points<Dim>& all_centres() const { return all_.centres(); }
+
+  /// f(the system over every centre), global or patched; likewise over the constrained ones.
+  template <class F>
+  decltype(auto) with_all(F&& f) {
+    return patched_all_ ? f(*patched_all_) : f(all_);
+  }
+  template <class F>
+  decltype(auto) with_constrained(F&& f) {
+    return patched_constrained_ ? f(*patched_constrained_) : f(constrained_);
+  }
 
   void require_ready(const char* where) const {
     if (!ready_) throw InputError(std::string("RbfMover::") + where + ": setup() was not called");
@@ -197,7 +225,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   void timed_apply(const Points<Dim>& d, Out& out) {
     detail::timed_move<Dim>("RbfMover::move", ready_, d, boundary_nodes_, stats_, [&] {
       apply(d, out);
-      const SolverReport& r = all_.report();
+      const SolverReport& r = with_all([](auto& system) -> const SolverReport& { return system.report(); });
       stats_.iterations = r.iterations;
       stats_.residual = r.residual;
       stats_.fell_back = r.fell_back;
@@ -208,7 +236,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   /// or an Eigen::Ref of the right shape.
   template <class Out>
   void apply(const Points<Dim>& d, Out& out) {
-    const Index k = all_.size();
+    const Index k = n_centres_;
     const auto m = static_cast<Index>(boundary_nodes_.size());
     values_.resize(k, Dim);
     for (Index c = 0; c < n_constrained_; ++c) values_.row(c) = d.col(source_[static_cast<std::size_t>(c)]).transpose();
@@ -223,7 +251,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
                          " coincide but get different displacements");
     }
     if (k > n_constrained_) {
-      constrained_.solve(values_.topRows(n_constrained_), alpha_, beta_);
+      with_constrained([&](auto& system) { system.solve(values_.topRows(n_constrained_), alpha_, beta_); });
       Eigen::MatrixXd s = sliding_operator_ * alpha_;
       if (options_.polynomial)
         for (Index r = 0; r < s.rows(); ++r)
@@ -231,7 +259,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
       project_rows(s);
       values_.bottomRows(k - n_constrained_) = s;
     }
-    all_.solve(values_, alpha_, beta_);
+    with_all([&](auto& system) { system.solve(values_, alpha_, beta_); });
 
     const Index n = points_.cols();
     if constexpr (std::same_as<Out, Points<Dim>>) {
@@ -280,7 +308,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   /// The seed's rows are gathered into a buffer kept across calls (a reverse product per
   /// optimization iteration should not pay fresh pages for a volume-sized array).
   void interior_transpose(const Eigen::Ref<const Points<Dim>>& v, Eigen::MatrixXd& alpha_bar, Poly& beta_bar) {
-    const Index k = all_.size();
+    const Index k = n_centres_;
     const auto gather = [&](const std::vector<Index>& nodes) {
       seed_rows_.resize(static_cast<Index>(nodes.size()), Dim);
       for (std::size_t r = 0; r < nodes.size(); ++r) seed_rows_.row(static_cast<Index>(r)) = v.col(nodes[r]).transpose();
@@ -305,6 +333,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   MoverStats stats_;
   bool ready_ = false;
   Points<Dim> points_;                      ///< reference coordinates, Dim × n
+  Index n_centres_ = 0;                     ///< boundary centres (merged coincident nodes)
   std::vector<Index> boundary_nodes_;       ///< as given to setup
   std::vector<BoundaryKind> kinds_;
   std::vector<Index> centre_of_;            ///< boundary entry → centre
@@ -314,6 +343,8 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   std::vector<Projector> projectors_;       ///< onto the plane or line of each sliding centre
   detail::RbfSystem<Dim> all_;              ///< over every centre
   detail::RbfSystem<Dim> constrained_;      ///< over constrained centres (sliding boundaries only)
+  /// Partition of unity: replace all_ and constrained_ (the coefficients are then the patches')
+  std::unique_ptr<detail::PartitionOfUnityRbf<Dim>> patched_all_, patched_constrained_;
   std::vector<Index> sliding_rows_;         ///< sliding centres
   Operator sliding_operator_;               ///< sliding centres × constrained centres
   std::vector<Index> interior_;             ///< non-boundary nodes
@@ -341,6 +372,20 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
         throw InputError("RbfMover::setup: support radius of boundary entry " + std::to_string(b) + " (node " +
                          std::to_string(boundary.nodes[b]) + ") must be positive (got " +
                          std::to_string(options_.support_radii[b]) + ")");
+  }
+  if (options_.partition_of_unity) {
+    const auto refuse = [](const std::string& why) {
+      throw InputError("RbfMover::setup: partition_of_unity " + why);
+    };
+    if (!is_compact(options_.kernel))
+      refuse("needs a compact kernel such as wendland2 (got " + std::string(name(options_.kernel)) + ")");
+    if (!options_.support_radii.empty()) refuse("needs one support_radius (got support_radii)");
+    if (options_.polynomial)
+      refuse("does not take a polynomial (nodes beyond every patch would lose its affine part)");
+    if (options_.patch_centres < 1)
+      refuse("needs patch_centres >= 1 (got " + std::to_string(options_.patch_centres) + ")");
+    if (!(options_.patch_overlap >= 0.0) || !std::isfinite(options_.patch_overlap))
+      refuse("needs a finite patch_overlap >= 0 (got " + std::to_string(options_.patch_overlap) + ")");
   }
   points_ = std::move(points);
   const Index n = points_.cols();
@@ -400,17 +445,36 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
       kernel.radii[static_cast<std::size_t>(c)] = options_.support_radii[static_cast<std::size_t>(source_[static_cast<std::size_t>(c)])];
     kernel.radius = k > 0 ? *std::max_element(kernel.radii.begin(), kernel.radii.end()) : options_.support_radius;
   }
-  all_.setup(centres, kernel, options_.solver, options_.dense_solver, options_.max_dense_centres);
+  n_centres_ = k;
+  patched_all_.reset();
+  patched_constrained_.reset();
+  const auto patched = [&](const Points<Dim>& at, const detail::RbfKernelSettings& settings) {
+    auto system = std::make_unique<detail::PartitionOfUnityRbf<Dim>>();
+    system->setup(at, settings, options_.patch_centres, options_.patch_overlap, options_.solver);
+    return system;
+  };
+  if (options_.partition_of_unity) {
+    all_ = detail::RbfSystem<Dim>{};
+    patched_all_ = patched(centres, kernel);
+  } else {
+    all_.setup(centres, kernel, options_.solver, options_.dense_solver, options_.max_dense_centres);
+  }
   stats_ = MoverStats{};
   stats_.boundary_nodes = k;
-  stats_.nonzeros = all_.nonzeros();
+  stats_.nonzeros = with_all([](auto& system) { return system.nonzeros(); });
   if (k > n_constrained_) {
-    constrained_.setup(Points<Dim>(centres.leftCols(n_constrained_)), kernel.leading(n_constrained_), options_.solver,
-                       options_.dense_solver, options_.max_dense_centres);
+    const Points<Dim> constrained_centres = centres.leftCols(n_constrained_);
     sliding_rows_.resize(static_cast<std::size_t>(k - n_constrained_));
     for (Index c = n_constrained_; c < k; ++c) sliding_rows_[static_cast<std::size_t>(c - n_constrained_)] = c;
-    sliding_operator_ = build_operator(centres, sliding_rows_, constrained_);
-    stats_.nonzeros += constrained_.nonzeros() + sliding_operator_.nonZeros();
+    if (options_.partition_of_unity) {
+      patched_constrained_ = patched(constrained_centres, kernel.leading(n_constrained_));
+      sliding_operator_ = patched_constrained_->evaluation_rows(centres, sliding_rows_);
+    } else {
+      constrained_.setup(constrained_centres, kernel.leading(n_constrained_), options_.solver, options_.dense_solver,
+                         options_.max_dense_centres);
+      sliding_operator_ = build_operator(centres, sliding_rows_, constrained_);
+    }
+    stats_.nonzeros += with_constrained([](auto& system) { return system.nonzeros(); }) + sliding_operator_.nonZeros();
   }
 
   // Nodes evaluated: every non-boundary node inside some support (all of them for global
@@ -426,8 +490,14 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   // A compact support that reaches most centres from most nodes (a radius far larger than the
   // moving body, as rotations want) makes the sparse operator a full one stored with indices:
   // building it dense is several times cheaper and so is every move.
-  const bool dense = fits && (!is_compact(options_.kernel) || covered_fraction() > 0.5);
-  if (is_compact(options_.kernel) && !dense) {
+  const bool dense = !patched_all_ && fits && (!is_compact(options_.kernel) || covered_fraction() > 0.5);
+  if (patched_all_) {
+    std::vector<Index> kept;
+    operator_ = patched_all_->evaluation_rows(points_, interior_, &kept);
+    evaluated_.reserve(kept.size());
+    for (const Index r : kept) evaluated_.push_back(interior_[static_cast<std::size_t>(r)]);
+    stats_.nonzeros += operator_.nonZeros();
+  } else if (is_compact(options_.kernel) && !dense) {
     // Only rows with weights are kept, so skipped nodes cost nothing per move.
     std::vector<Index> kept;
     operator_ = detail::compact_kernel_rows(points_, interior_, all_.within(), k, kernel, &kept);
@@ -446,7 +516,8 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
     }
   }
   stats_.evaluated_nodes = options_.polynomial ? static_cast<Index>(interior_.size()) : static_cast<Index>(evaluated_.size());
-  stats_.factorizations = all_.report().factorizations + (k > n_constrained_ ? constrained_.report().factorizations : 0);
+  stats_.factorizations = with_all([](auto& system) { return system.report().factorizations; }) +
+                          (k > n_constrained_ ? with_constrained([](auto& system) { return system.report().factorizations; }) : 0);
   ready_ = true;
   stats_.setup_seconds = watch.seconds();
 }
@@ -475,7 +546,7 @@ Points<Dim> RbfMover<Dim>::derivative_reverse(Eigen::Ref<const Points<Dim>> v) {
   require_ready("derivative_reverse");
   detail::check_node_field<Dim>("RbfMover::derivative_reverse", v, points_.cols());
   const Index m = static_cast<Index>(boundary_nodes_.size());
-  const Index k = all_.size();
+  const Index k = n_centres_;
   Points<Dim> grad = Points<Dim>::Zero(Dim, m);
   // Boundary nodes output their target directly.
   Eigen::MatrixXd values_bar = Eigen::MatrixXd::Zero(k, Dim);
@@ -490,7 +561,7 @@ Points<Dim> RbfMover<Dim>::derivative_reverse(Eigen::Ref<const Points<Dim>> v) {
   typename detail::RbfSystem<Dim>::PolyCoefficients beta_bar;
   interior_transpose(v, alpha_bar, beta_bar);
   Eigen::MatrixXd through_all;
-  all_.solve_transpose(alpha_bar, beta_bar, through_all);
+  with_all([&](auto& system) { system.solve_transpose(alpha_bar, beta_bar, through_all); });
   values_bar += through_all;
   if (k > n_constrained_) {
     Eigen::MatrixXd s_bar = values_bar.bottomRows(k - n_constrained_);
@@ -498,7 +569,7 @@ Points<Dim> RbfMover<Dim>::derivative_reverse(Eigen::Ref<const Points<Dim>> v) {
     const Eigen::MatrixXd a_bar = sliding_operator_.transpose() * s_bar;
     typename detail::RbfSystem<Dim>::PolyCoefficients b_bar = polynomial_transpose(constrained_, sliding_rows_, all_centres(), s_bar);
     Eigen::MatrixXd through_constrained;
-    constrained_.solve_transpose(a_bar, b_bar, through_constrained);
+    with_constrained([&](auto& system) { system.solve_transpose(a_bar, b_bar, through_constrained); });
     values_bar.topRows(n_constrained_) += through_constrained;
   }
   for (Index c = 0; c < n_constrained_; ++c) grad.col(source_[static_cast<std::size_t>(c)]) += values_bar.row(c).transpose();

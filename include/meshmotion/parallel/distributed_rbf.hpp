@@ -323,6 +323,7 @@ template <int Dim>
 std::string DistributedRbfMover<Dim>::petsc_obstacle(const std::vector<int>& kinds, bool radius_per_entry,
                                                      const Points<Dim>& centres) const {
   if (!is_compact(options_.kernel)) return "the kernel is global (dense system)";
+  if (options_.partition_of_unity) return "the options ask for a partition of unity (local systems, replicated)";
   if (radius_per_entry) return "the support radius differs between nodes (nonsymmetric system)";
   if (std::find(kinds.begin(), kinds.end(), static_cast<int>(BoundaryKind::sliding)) != kinds.end())
     return "the boundary has sliding nodes";

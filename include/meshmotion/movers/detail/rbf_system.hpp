@@ -58,6 +58,28 @@ struct RbfKernelSettings {
   }
 };
 
+/// A row-major matrix (columns `cols`) with rows of count[r] entries, its inner indices and
+/// values left to fill; with `kept`, rows of no entry are left out and the positions of the
+/// others written to *kept.
+[[nodiscard]] inline Eigen::SparseMatrix<double, Eigen::RowMajor, int> rows_of_counts(const std::vector<int>& count,
+                                                                                     Index cols, std::vector<Index>* kept) {
+  std::vector<int> outer;
+  outer.reserve(count.size() + 1);
+  outer.push_back(0);
+  if (kept != nullptr) kept->clear();
+  for (std::size_t r = 0; r < count.size(); ++r) {
+    if (kept != nullptr) {
+      if (count[r] == 0) continue;
+      kept->push_back(static_cast<Index>(r));
+    }
+    outer.push_back(outer.back() + count[r]);
+  }
+  Eigen::SparseMatrix<double, Eigen::RowMajor, int> m(static_cast<Index>(outer.size()) - 1, cols);
+  m.resizeNonZeros(outer.back());
+  std::copy(outer.begin(), outer.end(), m.outerIndexPtr());
+  return m;
+}
+
 /// Rows of φ(|x_i - c_j| / ρ_j) for the points x_i (columns of `points` listed in `rows`)
 /// against the centres that `within(x, out)` lists for x (pairs of centre index and squared
 /// distance, each centre within its own radius), compact kernels only: a row-major sparse
@@ -89,23 +111,8 @@ template <int Dim, class Within>
       }
     }
   }
-  // Row offsets (skipping empty rows when asked) and where each range's pairs start.
-  std::vector<int> outer;
-  outer.reserve(static_cast<std::size_t>(n) + 1);
-  outer.push_back(0);
-  if (kept != nullptr) kept->clear();
-  for (Index r = 0; r < n; ++r) {
-    const int c = count[static_cast<std::size_t>(r)];
-    if (kept != nullptr) {
-      if (c == 0) continue;
-      kept->push_back(r);
-    }
-    outer.push_back(outer.back() + c);
-  }
-  const auto n_out = static_cast<Index>(outer.size()) - 1;
-  Eigen::SparseMatrix<double, Eigen::RowMajor, int> m(n_out, n_centres);
-  m.resizeNonZeros(outer.back());
-  std::copy(outer.begin(), outer.end(), m.outerIndexPtr());
+  Eigen::SparseMatrix<double, Eigen::RowMajor, int> m = rows_of_counts(count, n_centres, kept);
+  // Where each range's pairs start.
   std::vector<Index> start(found.size() + 1, 0);
   for (std::size_t c = 0; c < found.size(); ++c) start[c + 1] = start[c] + static_cast<Index>(found[c].size());
 #pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(dynamic, 1)

@@ -1,0 +1,276 @@
+#pragma once
+/// \file
+/// Partition-of-unity RBF interpolation: for boundaries too large for one factorization.
+///
+/// The centres are split by recursive bisection (median along the longest side) into clusters
+/// of at most `patch_centres`. Cluster j, with bounding-box centre p_j and radius ρ_j (its
+/// farthest centre), becomes the patch of radius R_j = ρ_j + max(overlap ρ_j, r) (r: the
+/// kernel's support radius); the patch's local system is the compact RBF system of every
+/// centre within R_j of p_j (RbfSystem), factorized on its own. The interpolant blends the
+/// local ones with Shepard weights of Wendland C2 bumps:
+///
+///   s(x) = Σ_j w_j(x) s_j(x),   w_j = ψ(|x − p_j| / R_j) / Σ_i ψ(|x − p_i| / R_i).
+///
+/// Properties kept from the global interpolant:
+/// - interpolation: a centre inside patch i's ball is in patch i's local set, so every local
+///   interpolant with a nonzero weight there reproduces its value, and so does the blend;
+/// - support: a point within r of a centre of cluster j lies within R_j of p_j (R_j ≥ ρ_j + r),
+///   so it has a weight; a point farther than r from every centre gets zero, as globally;
+/// - linearity in the values, so the derivatives are the transposed local solves.
+/// The blend differs from the global interpolant by how much data beyond each patch matters
+/// inside it; benchmarks/pu_rbf_bench reports that difference.
+///
+/// The coefficients are the local systems' α stacked patch after patch; evaluation rows carry
+/// the weights, so a move is the local solves and one sparse product, as for the global system.
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/threads.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/movers/detail/rbf_system.hpp"
+#include "meshmotion/movers/rbf_kernels.hpp"
+#include "meshmotion/solvers/solver_options.hpp"
+#include "meshmotion/spatial/kd_tree.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <numeric>
+#include <string>
+#include <vector>
+
+namespace meshmotion::detail {
+
+template <int Dim>
+class PartitionOfUnityRbf {
+ public:
+  using PolyCoefficients = typename RbfSystem<Dim>::PolyCoefficients;
+
+  /// Builds and factorizes the patches over `centres` (Dim × k). `kernel` must be compact,
+  /// with one radius and no polynomial (the caller checks and says why).
+  void setup(const Points<Dim>& centres, const RbfKernelSettings& kernel, Index patch_centres, double overlap,
+             const SolverOptions& solver) {
+    kernel_ = kernel;
+    k_ = centres.cols();
+    const double r = kernel.radius;
+    std::vector<Index> order(static_cast<std::size_t>(k_));
+    std::iota(order.begin(), order.end(), Index{0});
+    std::vector<std::pair<Index, Index>> clusters;  // ranges of `order`
+    split(centres, order, 0, k_, std::max<Index>(patch_centres, 1), clusters);
+
+    const auto n_patches = static_cast<Index>(clusters.size());
+    patch_centre_.resize(Dim, n_patches);
+    patch_radius_.assign(static_cast<std::size_t>(n_patches), 0.0);
+    for (Index j = 0; j < n_patches; ++j) {
+      const auto [begin, end] = clusters[static_cast<std::size_t>(j)];
+      Vec<Dim> lo = centres.col(order[static_cast<std::size_t>(begin)]), hi = lo;
+      for (Index i = begin; i < end; ++i) {
+        lo = lo.cwiseMin(centres.col(order[static_cast<std::size_t>(i)]));
+        hi = hi.cwiseMax(centres.col(order[static_cast<std::size_t>(i)]));
+      }
+      const Vec<Dim> mid = 0.5 * (lo + hi);
+      double rho = 0.0;
+      for (Index i = begin; i < end; ++i) rho = std::max(rho, (centres.col(order[static_cast<std::size_t>(i)]) - mid).norm());
+      patch_centre_.col(j) = mid;
+      patch_radius_[static_cast<std::size_t>(j)] = rho + std::max(overlap * rho, r);
+    }
+    largest_radius_ = patch_radius_.empty() ? 0.0 : *std::max_element(patch_radius_.begin(), patch_radius_.end());
+
+    // Local sets, sorted so that a patch's system does not depend on the tree's order.
+    const KdTree<Dim> all(centres);
+    local_.assign(static_cast<std::size_t>(n_patches), {});
+    offsets_.assign(static_cast<std::size_t>(n_patches) + 1, 0);
+    std::vector<Neighbor> found;
+    for (Index j = 0; j < n_patches; ++j) {
+      all.radius_search(Vec<Dim>(patch_centre_.col(j)), patch_radius_[static_cast<std::size_t>(j)], found);
+      auto& ids = local_[static_cast<std::size_t>(j)];
+      ids.reserve(found.size());
+      for (const auto& hit : found) ids.push_back(static_cast<Index>(hit.first));
+      std::sort(ids.begin(), ids.end());
+      offsets_[static_cast<std::size_t>(j) + 1] = offsets_[static_cast<std::size_t>(j)] + static_cast<Index>(ids.size());
+    }
+
+    // Patches are factorized side by side; each factorization runs on one thread.
+    systems_.clear();
+    systems_.resize(static_cast<std::size_t>(n_patches));
+    const RbfKernelSettings local_kernel{kernel.kernel, r, false};
+    for_each_patch([&](Index j) {
+      const auto& ids = local_[static_cast<std::size_t>(j)];
+      Points<Dim> at(Dim, static_cast<Index>(ids.size()));
+      for (std::size_t i = 0; i < ids.size(); ++i) at.col(static_cast<Index>(i)) = centres.col(ids[i]);
+      systems_[static_cast<std::size_t>(j)].setup(at, local_kernel, solver, DenseSolverKind::partial_piv_lu, 0);
+    });
+    patch_tree_ = KdTree<Dim>{};
+    patch_tree_.build(patch_centre_);
+    report_ = SolverReport{};
+    nonzeros_ = 0;
+    for (const auto& s : systems_) {
+      report_.factorizations += s.report().factorizations;
+      report_.analyses += s.report().analyses;
+      report_.seconds += s.report().seconds;
+      report_.supernodal = report_.supernodal || s.report().supernodal;
+      nonzeros_ += s.nonzeros();
+    }
+  }
+
+  [[nodiscard]] Index size() const noexcept { return k_; }
+  [[nodiscard]] Index num_patches() const noexcept { return static_cast<Index>(systems_.size()); }
+  /// Rows of the stacked coefficients (the local sets' sizes summed).
+  [[nodiscard]] Index num_coefficients() const noexcept { return offsets_.empty() ? 0 : offsets_.back(); }
+  [[nodiscard]] Index largest_patch() const {
+    Index largest = 0;
+    for (const auto& ids : local_) largest = std::max(largest, static_cast<Index>(ids.size()));
+    return largest;
+  }
+  [[nodiscard]] Index nonzeros() const noexcept { return nonzeros_; }
+  [[nodiscard]] const SolverReport& report() const noexcept { return report_; }
+
+  /// The stacked local coefficients (num_coefficients() × Dim) interpolating `values`
+  /// (k × Dim) at the centres; β is zero (no polynomial).
+  void solve(const Eigen::MatrixXd& values, Eigen::MatrixXd& alpha, PolyCoefficients& beta) {
+    alpha.resize(num_coefficients(), values.cols());
+    beta.setZero();
+    SolverReport last;
+    for_each_patch([&](Index j) {
+      const auto& ids = local_[static_cast<std::size_t>(j)];
+      Eigen::MatrixXd local(static_cast<Index>(ids.size()), values.cols()), a;
+      for (std::size_t i = 0; i < ids.size(); ++i) local.row(static_cast<Index>(i)) = values.row(ids[i]);
+      PolyCoefficients b;
+      systems_[static_cast<std::size_t>(j)].solve(local, a, b);
+      alpha.middleRows(offsets_[static_cast<std::size_t>(j)], a.rows()) = a;
+    });
+    for (const auto& s : systems_) {
+      last.iterations = std::max(last.iterations, s.report().iterations);
+      last.residual = std::max(last.residual, s.report().residual);
+      last.fell_back = last.fell_back || s.report().fell_back;
+    }
+    report_.iterations = last.iterations;
+    report_.residual = last.residual;
+    report_.fell_back = last.fell_back;
+  }
+
+  /// Transpose of solve(): the gradient (k × Dim) with respect to the values of ⟨ᾱ, α⟩.
+  void solve_transpose(const Eigen::MatrixXd& alpha_bar, const PolyCoefficients&, Eigen::MatrixXd& values_bar) {
+    std::vector<Eigen::MatrixXd> local_bar(systems_.size());
+    for_each_patch([&](Index j) {
+      const auto& ids = local_[static_cast<std::size_t>(j)];
+      const Eigen::MatrixXd a = alpha_bar.middleRows(offsets_[static_cast<std::size_t>(j)], static_cast<Index>(ids.size()));
+      systems_[static_cast<std::size_t>(j)].solve_transpose(a, PolyCoefficients::Zero(), local_bar[static_cast<std::size_t>(j)]);
+    });
+    values_bar.setZero(k_, alpha_bar.cols());
+    for (std::size_t j = 0; j < local_.size(); ++j)
+      for (std::size_t i = 0; i < local_[j].size(); ++i) values_bar.row(local_[j][i]) += local_bar[j].row(static_cast<Index>(i));
+  }
+
+  /// Evaluation rows: for the points x (columns of `points` listed in `rows`), the weights
+  /// w_j(x) φ(|x − c| / r) against the stacked coefficients (rows.size() × num_coefficients(),
+  /// row-major). With `kept`, only rows with a weight are stored and their positions in `rows`
+  /// written to *kept, as compact_kernel_rows() does.
+  [[nodiscard]] Eigen::SparseMatrix<double, Eigen::RowMajor, int> evaluation_rows(const Points<Dim>& points,
+                                                                                 const std::vector<Index>& rows,
+                                                                                 std::vector<Index>* kept = nullptr) const {
+    const auto n = static_cast<Index>(rows.size());
+    std::vector<int> count(static_cast<std::size_t>(n), 0);
+    const Index chunks = std::clamp<Index>(n / 256, 1, 64);
+    struct Entry {
+      int column;
+      double value;
+    };
+    std::vector<std::vector<Entry>> found(static_cast<std::size_t>(chunks));
+#pragma omp parallel num_threads(::meshmotion::num_threads())
+    {
+      std::vector<Neighbor> patches, hits;
+      std::vector<std::pair<Index, double>> weights;
+#pragma omp for schedule(dynamic, 1)
+      for (Index c = 0; c < chunks; ++c) {
+        auto& entries = found[static_cast<std::size_t>(c)];
+        for (Index r = n * c / chunks; r < n * (c + 1) / chunks; ++r) {
+          const Vec<Dim> x = points.col(rows[static_cast<std::size_t>(r)]);
+          patch_tree_.radius_search(x, largest_radius_, patches);
+          weights.clear();
+          double total = 0.0;
+          for (const auto& [j, d2] : patches) {
+            const double w = rbf_value(RbfKernel::wendland2, std::sqrt(d2), patch_radius_[j]);
+            if (w <= 0.0) continue;
+            weights.emplace_back(static_cast<Index>(j), w);
+            total += w;
+          }
+          // Patch order, not the tree's: the sum below is then the same on any thread count.
+          std::sort(weights.begin(), weights.end());
+          const std::size_t before = entries.size();
+          for (const auto& [j, w] : weights) {
+            systems_[static_cast<std::size_t>(j)].centres_within(x, hits);
+            const double share = w / total;
+            for (const auto& [i, h2] : hits)
+              entries.push_back({static_cast<int>(offsets_[static_cast<std::size_t>(j)] + static_cast<Index>(i)),
+                                 share * rbf_value(kernel_.kernel, std::sqrt(h2), kernel_.radius)});
+          }
+          count[static_cast<std::size_t>(r)] = static_cast<int>(entries.size() - before);
+        }
+      }
+    }
+    Eigen::SparseMatrix<double, Eigen::RowMajor, int> m = rows_of_counts(count, num_coefficients(), kept);
+    std::size_t at = 0;
+    for (const auto& entries : found)
+      for (const Entry& e : entries) {
+        m.innerIndexPtr()[at] = e.column;
+        m.valuePtr()[at] = e.value;
+        ++at;
+      }
+    return m;
+  }
+
+ private:
+  /// Splits order[begin, end) at the median of the longest side until ranges hold at most `most`.
+  static void split(const Points<Dim>& centres, std::vector<Index>& order, Index begin, Index end, Index most,
+                    std::vector<std::pair<Index, Index>>& out) {
+    if (end - begin <= most) {
+      if (end > begin) out.emplace_back(begin, end);
+      return;
+    }
+    Vec<Dim> lo = centres.col(order[static_cast<std::size_t>(begin)]), hi = lo;
+    for (Index i = begin; i < end; ++i) {
+      lo = lo.cwiseMin(centres.col(order[static_cast<std::size_t>(i)]));
+      hi = hi.cwiseMax(centres.col(order[static_cast<std::size_t>(i)]));
+    }
+    int axis = 0;
+    (hi - lo).maxCoeff(&axis);
+    const Index mid = begin + (end - begin) / 2;
+    std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end, [&](Index a, Index b) {
+      const double ca = centres(axis, a), cb = centres(axis, b);
+      return ca < cb || (ca == cb && a < b);
+    });
+    split(centres, order, begin, mid, most, out);
+    split(centres, order, mid, end, most, out);
+  }
+
+  /// f(j) for every patch, in parallel; the first error (by patch) is rethrown after all ran.
+  template <class F>
+  void for_each_patch(F&& f) {
+    const auto n = static_cast<Index>(systems_.size());
+    std::vector<std::exception_ptr> errors(static_cast<std::size_t>(n));
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(dynamic, 1)
+    for (Index j = 0; j < n; ++j) {
+      try {
+        f(j);
+      } catch (...) {
+        errors[static_cast<std::size_t>(j)] = std::current_exception();
+      }
+    }
+    for (const auto& e : errors)
+      if (e) std::rethrow_exception(e);
+  }
+
+  RbfKernelSettings kernel_;
+  Index k_ = 0;
+  Points<Dim> patch_centre_;
+  std::vector<double> patch_radius_;
+  double largest_radius_ = 0.0;
+  KdTree<Dim> patch_tree_;
+  std::vector<std::vector<Index>> local_;  ///< per patch, its centres (ascending)
+  std::vector<Index> offsets_;             ///< start of each patch's coefficients
+  std::vector<RbfSystem<Dim>> systems_;
+  SolverReport report_;
+  Index nonzeros_ = 0;
+};
+
+}  // namespace meshmotion::detail
