@@ -25,6 +25,7 @@
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/threads.hpp"
+#include "meshmotion/core/topology.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/detail/rbf_system.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
@@ -76,18 +77,29 @@ class PartitionOfUnityRbf {
     largest_radius_ = patch_radius_.empty() ? 0.0 : *std::max_element(patch_radius_.begin(), patch_radius_.end());
 
     // Local sets, sorted so that a patch's system does not depend on the tree's order.
-    const KdTree<Dim> all(centres);
+    centres_ = centres;
+    tree_ = KdTree<Dim>{};
+    tree_.build(centres_);
     local_.assign(static_cast<std::size_t>(n_patches), {});
     offsets_.assign(static_cast<std::size_t>(n_patches) + 1, 0);
     std::vector<Neighbor> found;
     for (Index j = 0; j < n_patches; ++j) {
-      all.radius_search(Vec<Dim>(patch_centre_.col(j)), patch_radius_[static_cast<std::size_t>(j)], found);
+      tree_.radius_search(Vec<Dim>(patch_centre_.col(j)), patch_radius_[static_cast<std::size_t>(j)], found);
       auto& ids = local_[static_cast<std::size_t>(j)];
       ids.reserve(found.size());
       for (const auto& hit : found) ids.push_back(static_cast<Index>(hit.first));
       std::sort(ids.begin(), ids.end());
       offsets_[static_cast<std::size_t>(j) + 1] = offsets_[static_cast<std::size_t>(j)] + static_cast<Index>(ids.size());
     }
+    // Centre → the coefficients it has (one per patch holding it): an evaluation then asks the
+    // tree once per point, not once per patch covering it.
+    // Each entry packs the patch (high 32 bits) and the centre's place in it (low 32 bits).
+    membership_ = csr_from_pairs(k_, [&](auto&& f) {
+      for (Index j = 0; j < n_patches; ++j) {
+        const auto& ids = local_[static_cast<std::size_t>(j)];
+        for (std::size_t i = 0; i < ids.size(); ++i) f(ids[i], (j << 32) | static_cast<Index>(i));
+      }
+    });
 
     // Patches are factorized side by side; each factorization runs on one thread.
     systems_.clear();
@@ -179,31 +191,34 @@ class PartitionOfUnityRbf {
 #pragma omp parallel num_threads(::meshmotion::num_threads())
     {
       std::vector<Neighbor> patches, hits;
-      std::vector<std::pair<Index, double>> weights;
+      std::vector<double> share(systems_.size(), 0.0);  // per patch, its weight at x (0: not covering)
 #pragma omp for schedule(dynamic, 1)
       for (Index c = 0; c < chunks; ++c) {
         auto& entries = found[static_cast<std::size_t>(c)];
         for (Index r = n * c / chunks; r < n * (c + 1) / chunks; ++r) {
           const Vec<Dim> x = points.col(rows[static_cast<std::size_t>(r)]);
           patch_tree_.radius_search(x, largest_radius_, patches);
-          weights.clear();
+          // Patch order, not the tree's: the weights' sum is then the same on any thread count.
+          std::sort(patches.begin(), patches.end());
           double total = 0.0;
           for (const auto& [j, d2] : patches) {
-            const double w = rbf_value(RbfKernel::wendland2, std::sqrt(d2), patch_radius_[j]);
-            if (w <= 0.0) continue;
-            weights.emplace_back(static_cast<Index>(j), w);
-            total += w;
+            share[j] = rbf_value(RbfKernel::wendland2, std::sqrt(d2), patch_radius_[j]);
+            total += share[j];
           }
-          // Patch order, not the tree's: the sum below is then the same on any thread count.
-          std::sort(weights.begin(), weights.end());
           const std::size_t before = entries.size();
-          for (const auto& [j, w] : weights) {
-            systems_[static_cast<std::size_t>(j)].centres_within(x, hits);
-            const double share = w / total;
-            for (const auto& [i, h2] : hits)
-              entries.push_back({static_cast<int>(offsets_[static_cast<std::size_t>(j)] + static_cast<Index>(i)),
-                                 share * rbf_value(kernel_.kernel, std::sqrt(h2), kernel_.radius)});
+          if (total > 0.0) {
+            tree_.radius_search(x, kernel_.radius, hits);
+            for (const auto& [centre, h2] : hits) {
+              const double phi = rbf_value(kernel_.kernel, std::sqrt(h2), kernel_.radius) / total;
+              for (const Index packed : membership_.row(static_cast<Index>(centre))) {
+                const Index j = packed >> 32;
+                const double w = share[static_cast<std::size_t>(j)];
+                if (w > 0.0)
+                  entries.push_back({static_cast<int>(offsets_[static_cast<std::size_t>(j)] + (packed & 0xffffffff)), w * phi});
+              }
+            }
           }
+          for (const auto& [j, d2] : patches) share[j] = 0.0;
           count[static_cast<std::size_t>(r)] = static_cast<int>(entries.size() - before);
         }
       }
@@ -266,6 +281,9 @@ class PartitionOfUnityRbf {
   std::vector<double> patch_radius_;
   double largest_radius_ = 0.0;
   KdTree<Dim> patch_tree_;
+  Points<Dim> centres_;                    ///< every centre (the tree reads them in place)
+  KdTree<Dim> tree_;
+  Adjacency membership_;                   ///< centre → (patch, place in it), packed
   std::vector<std::vector<Index>> local_;  ///< per patch, its centres (ascending)
   std::vector<Index> offsets_;             ///< start of each patch's coefficients
   std::vector<RbfSystem<Dim>> systems_;
