@@ -16,15 +16,20 @@ inline meshmotion::Mesh<3> box(int n) {
   return meshmotion::box_mesh(b);
 }
 
-inline meshmotion::ResolvedBoundary<3> bottom_bump(const meshmotion::Mesh<3>& mesh) {
+/// The bump's displacement of each node of the group "bottom", in group_nodes("bottom") order.
+inline meshmotion::Points<3> bump_displacements(const meshmotion::Mesh<3>& mesh) {
   const std::vector<meshmotion::Index> bottom = mesh.group_nodes("bottom");
   meshmotion::Points<3> d = meshmotion::Points<3>::Zero(3, static_cast<meshmotion::Index>(bottom.size()));
   for (std::size_t k = 0; k < bottom.size(); ++k) {
     const double x = mesh.points(0, bottom[k]), y = mesh.points(1, bottom[k]);
     d(2, static_cast<meshmotion::Index>(k)) = 0.05 * std::sin(M_PI * x) * std::sin(M_PI * y);
   }
+  return d;
+}
+
+inline meshmotion::ResolvedBoundary<3> bottom_bump(const meshmotion::Mesh<3>& mesh) {
   meshmotion::BoundarySpec<3> spec;
-  spec.moving("bottom", d);
+  spec.moving("bottom", bump_displacements(mesh));
   return spec.resolve(mesh);
 }
 

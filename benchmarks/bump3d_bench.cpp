@@ -10,12 +10,12 @@
 // RBF at the thesis radius, RBF at the pipeline's default radius. Prints a table and one
 // JSON line per case. Usage: bump3d_bench [level ...] (levels 0, 1, 2; default all three)
 
+#include "bench_memory.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/curving/curve_mesh.hpp"
 #include "meshmotion/curving/function_graph.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -38,12 +38,6 @@ constexpr std::array<Thesis, 3> thesis{{{32841, 2304, 0.06, 0.714, 0.68},
                                         {243729, 8704, 0.06, 0.852, 12.6},
                                         {1875489, 33792, 0.04, 0.926, 338.0}}};
 constexpr std::array<const char*, 3> level_names{"coarse", "medium", "fine"};
-
-double peak_memory_mb() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;
-}
 
 // The thesis's boundary-point count: nodes on the bottom, top, inflow and outflow faces (its
 // RBF centres; the side planes were not among them).
@@ -101,7 +95,7 @@ void run_level(int level, bool all_centres) {
                 name, c.label, static_cast<long long>(points), static_cast<long long>(centres),
                 static_cast<long long>(boundary_points), r.support_radius, q.min, q.mean,
                 static_cast<long long>(q.num_invalid), generate_seconds, r.seconds.quadratic, r.seconds.snap,
-                r.seconds.layer + r.seconds.regularize, r.seconds.certify, seconds, seconds / baseline, peak_memory_mb(),
+                r.seconds.layer + r.seconds.regularize, r.seconds.certify, seconds, seconds / baseline, bench::peak_memory_mb(),
                 t.points, t.boundary_points, t.radius, t.min_quality, t.seconds);
     std::printf("{\"bench\":\"bump3d\",\"level\":\"%s\",\"case\":\"%s\",\"points\":%lld,\"rbf_centres\":%lld,"
                 "\"boundary_points\":%lld,\"support_radius\":%.6g,\"min\":%.6f,\"mean\":%.6f,\"invalid\":%lld,"
@@ -112,7 +106,7 @@ void run_level(int level, bool all_centres) {
                 name, c.label, static_cast<long long>(points), static_cast<long long>(centres),
                 static_cast<long long>(boundary_points), r.support_radius, q.min, q.mean,
                 static_cast<long long>(q.num_invalid), generate_seconds, r.seconds.quadratic, r.seconds.snap,
-                r.seconds.layer, r.seconds.regularize, r.seconds.certify, seconds, seconds / baseline, peak_memory_mb(),
+                r.seconds.layer, r.seconds.regularize, r.seconds.certify, seconds, seconds / baseline, bench::peak_memory_mb(),
                 t.points, t.boundary_points, t.radius, t.min_quality, t.seconds);
     std::fflush(stdout);
   }
@@ -121,6 +115,7 @@ void run_level(int level, bool all_centres) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  bench::tune_memory(argc, argv);
   std::vector<int> levels;
   bool fine_all_centres = false;
   for (int a = 1; a < argc; ++a) {

@@ -10,6 +10,7 @@
 //
 // A table and one JSON line per case. Without CHOLMOD in the build it says so and exits 0.
 
+#include "bench_memory.hpp"
 #include "box_bump.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/io.hpp"
@@ -62,6 +63,7 @@ void compare(const std::string& name, const Mesh<Dim>& mesh, const ResolvedBound
 }  // namespace
 
 int main(int argc, char** argv) {
+  bench::tune_memory(argc, argv);
   if (!have_cholmod()) {
     std::printf("cholmod_bench: this build has no CHOLMOD (libsuitesparse-dev): nothing to compare\n");
     return 0;

@@ -21,6 +21,7 @@
 //                with more layers), which take minutes of CPU each
 
 
+#include "bench_memory.hpp"
 #include "gmsh_peer.hpp"
 
 #include "meshmotion/core/generators.hpp"
@@ -484,6 +485,7 @@ void gmsh_comparison(bool quick) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  bench::tune_memory(argc, argv);
   bool with_gmsh = true, with_thesis = true, quick = false;
   fs::path file = fs::path(MESHMOTION_SHARED_DATA_DIR) / "su2_30p30n_rans_L1_coarse.su2";
   for (int i = 1; i < argc; ++i) {

@@ -6,6 +6,7 @@
 // each hinted with the previous answer after a Hilbert sort (the DGM access pattern).
 // Usage: delaunay_bench [n ...]   (default 100000 1000000; 3D grids have n/10 points)
 
+#include "bench_memory.hpp"
 #include "meshmotion/delaunay.hpp"
 #include "meshmotion/delaunay/detail/spatial_sort.hpp"
 
@@ -136,6 +137,7 @@ void run(const std::string& kind, const Points<Dim>& points) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  bench::tune_memory(argc, argv);
   std::vector<Index> sizes;
   for (int a = 1; a < argc; ++a) sizes.push_back(std::atoll(argv[a]));
   if (sizes.empty()) sizes = {100000, 1000000};

@@ -23,6 +23,7 @@
 //   elasticity_bench [--quick]   (--quick: the default SLE rows of part 1 and part 2 without
 //                                 neo-Hookean)
 
+#include "bench_memory.hpp"
 #include "meshmotion/core/json.hpp"
 #include "meshmotion/core/topology.hpp"
 #include "meshmotion/curving/curve_mesh.hpp"
@@ -153,6 +154,7 @@ Row flap(const Mesh<2>& mesh, const BoundarySpec<2>& spec, const GroupNodes& gro
 }  // namespace
 
 int main(int argc, char** argv) {
+  bench::tune_memory(argc, argv);
   const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
   const std::filesystem::path file = std::filesystem::path(MESHMOTION_SHARED_DATA_DIR) / "su2_30p30n_rans_L1_coarse.su2";
   if (!std::filesystem::exists(file)) {

@@ -22,7 +22,9 @@
 #include <string>
 #include <vector>
 
-namespace meshmotion::bench {
+namespace bench {
+
+using namespace meshmotion;
 
 /// Gmsh's "(Wall Xs, CPU Ys)" timers, summed over the lines that carry one.
 struct GmshTimer {
@@ -246,4 +248,4 @@ struct NacaGeo {
   return s.str();
 }
 
-}  // namespace meshmotion::bench
+}  // namespace bench

@@ -7,6 +7,7 @@
 // DGRBF2 valid at 120°; RBF valid to ~110°.
 // Prints a table and one JSON line per case. Usage: interpolation_bench [n_around=128] [n_radial=64]
 
+#include "bench_memory.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/movers.hpp"
 #include "meshmotion/movers/dgm.hpp"
@@ -71,6 +72,7 @@ bool valid(const Outcome& o) { return !o.refused && o.invalid == 0; }
 }  // namespace
 
 int main(int argc, char** argv) {
+  bench::tune_memory(argc, argv);
   OMeshOptions options;
   options.semi_axis_x = 0.5;
   options.semi_axis_y = 0.25;

@@ -1,8 +1,9 @@
 // io_bench: writes and reads a >= 1M-node tetrahedral mesh (a structured box split into six
-// tets per cube) as msh 4.1 binary, 4.1 ASCII and 2.2 ASCII; prints MB/s and nodes/s, and
+// tets per cube) as msh 4.1 binary, 4.1 ASCII, 2.2 ASCII and SU2; prints MB/s and nodes/s, and
 // compares binary reading against Gmsh's own reader (`gmsh FILE -0`) when gmsh is installed.
 // Usage: io_bench [cells_per_side = 100]
 
+#include "bench_memory.hpp"
 #include "meshmotion/io.hpp"
 
 #include <chrono>
@@ -48,6 +49,7 @@ double seconds_since(Clock::time_point t) { return std::chrono::duration<double>
 }  // namespace
 
 int main(int argc, char** argv) {
+  bench::tune_memory(argc, argv);
   const int n = argc > 1 ? std::atoi(argv[1]) : 100;
   const auto mesh = box_mesh(n);
   const auto dir = std::filesystem::temp_directory_path() / "meshmotion_io_bench";
@@ -57,15 +59,17 @@ int main(int argc, char** argv) {
               "read MB/s", "read nodes/s");
   struct Case {
     const char* name;
+    const char* extension;
     WriteOptions options;
   };
-  const Case cases[] = {{"msh4.1-binary", {MshVersion::v4_1, true, false}},
-                        {"msh4.1-ascii", {MshVersion::v4_1, false, false}},
-                        {"msh2.2-ascii", {MshVersion::v2_2, false, false}}};
+  const Case cases[] = {{"msh4.1-binary", ".msh", {MshVersion::v4_1, true, false}},
+                        {"msh4.1-ascii", ".msh", {MshVersion::v4_1, false, false}},
+                        {"msh2.2-ascii", ".msh", {MshVersion::v2_2, false, false}},
+                        {"su2-ascii", ".su2", {}}};
   double binary_read_seconds = 0;
   std::vector<std::string> json;
   for (const auto& c : cases) {
-    const auto file = dir / (std::string(c.name) + ".msh");
+    const auto file = dir / (std::string(c.name) + c.extension);
     auto t = Clock::now();
     write_mesh(file, mesh, c.options);
     const double write_s = seconds_since(t);

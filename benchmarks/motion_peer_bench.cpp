@@ -18,6 +18,7 @@
 // ellipse O-mesh of rbf_bench, n_radial = n_around / 2, farfield fixed) or box:<n> (rbf_bench's
 // 3D box, the bottom face rising as a bump, the top fixed, the sides free).
 
+#include "bench_memory.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/io/detail/atomic_file.hpp"
 #include "meshmotion/io/mesh_io.hpp"
@@ -595,6 +596,7 @@ int run(const std::string& command, const Case<Dim>& c, const fs::path& dir, int
 }  // namespace
 
 int main(int argc, char** argv) {
+  bench::tune_memory(argc, argv);
   if (argc < 4) return usage();
   try {
     const std::string command = argv[1];

@@ -28,16 +28,19 @@ COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e
            "#bcbd22"]
 
 
-def read_rows(path):
+def read_rows(path, baseline=False):
+    """The JSON rows of a results file; run_all.sh --baseline's older-build rows only if asked."""
     rows = []
     with open(path, encoding="utf-8") as f:
         for line in f:
             line = line.strip()
             if line.startswith("{"):
                 try:
-                    rows.append(json.loads(line))
+                    row = json.loads(line)
                 except json.JSONDecodeError:
-                    pass  # a table line that happens to start with a brace
+                    continue  # a table line that happens to start with a brace
+                if baseline or row.get("build") != "baseline":
+                    rows.append(row)
     return rows
 
 

@@ -9,6 +9,7 @@
 // line: seconds of setup and per move / per reverse product (median and mean), and checksums
 // of the last results so the Python side can check it did the same work.
 
+#include "bench_memory.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/io/mesh_io.hpp"
 #include "meshmotion/movers/any_mover.hpp"
@@ -79,6 +80,7 @@ int run(const std::string& file, double radius, int moves) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  bench::tune_memory(argc, argv);
   try {
     const std::string what = argc > 1 ? argv[1] : "";
     if (what == "write" && argc == 4) {

@@ -6,6 +6,7 @@
 //
 //   quality_bench [--quick]     (--quick: ~100k elements)
 
+#include "bench_memory.hpp"
 #include "meshmotion/core/json.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/quality/scaled_jacobian.hpp"
@@ -158,6 +159,7 @@ void run_cases(const char* mesh_name, const Mesh<Dim>& mesh) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  bench::tune_memory(argc, argv);
   const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
   // Mid-edge nodes moved by up to 15% (tri6) and 5% (tet10) of half the spacing: curved, valid.
   const Mesh<2> tri = tri6_mesh(quick ? 224 : 708, 0.15);  // 2 m^2 ≥ 1M

@@ -8,13 +8,12 @@
 // Prints a table and one JSON line per case. Usage: rbf_bench [max_box_cells_per_axis=126]
 // (sizes 20, 40, 80, 126, 160 cells per axis up to the maximum; 126 gives 2.05M nodes).
 
+#include "bench_memory.hpp"
 #include "box_bump.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/movers.hpp"
 #include "meshmotion/quality.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
-
-#include <sys/resource.h>
 
 #include <cmath>
 #include <cstdio>
@@ -24,12 +23,6 @@
 using namespace meshmotion;
 
 namespace {
-
-double peak_memory_mb() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;
-}
 
 /// Seconds of the direct O(N_volume × N_boundary) evaluation Σ_c φ(|x_i − x_c|) d_c over every
 /// node and every boundary node (no k-d tree): the baseline the mover's speed is a ratio to.
@@ -118,11 +111,11 @@ void scaling(int max_cells) {
     std::printf("%-10ld %10ld %10.3f %10.4f %12.3f %10.3f %12.1f %12ld %10.0f\n", static_cast<long>(mesh.num_nodes()),
                 static_cast<long>(boundary.size()), mover.stats().setup_seconds, move_seconds,
                 1e6 * mover.stats().setup_seconds / static_cast<double>(mesh.num_nodes()), direct, speedup,
-                static_cast<long>(mover.stats().nonzeros), peak_memory_mb());
+                static_cast<long>(mover.stats().nonzeros), bench::peak_memory_mb());
     std::printf("{\"case\":\"scaling\",\"nodes\":%ld,\"boundary_nodes\":%ld,\"setup_seconds\":%.6f,\"move_seconds\":%.6f,"
                 "\"direct_seconds\":%.6f,\"speedup_move_vs_direct\":%.2f,\"nonzeros\":%ld,\"peak_memory_mb\":%.1f}\n",
                 static_cast<long>(mesh.num_nodes()), static_cast<long>(boundary.size()), mover.stats().setup_seconds,
-                move_seconds, direct, speedup, static_cast<long>(mover.stats().nonzeros), peak_memory_mb());
+                move_seconds, direct, speedup, static_cast<long>(mover.stats().nonzeros), bench::peak_memory_mb());
     std::fflush(stdout);
   }
 }
@@ -130,6 +123,7 @@ void scaling(int max_cells) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  bench::tune_memory(argc, argv);
   const int max_cells = argc > 1 ? std::atoi(argv[1]) : 126;
   rotating_object();
   scaling(max_cells);

@@ -5,10 +5,24 @@
 # machine; --full runs the sizes the issues ask for (>= 1M elements/nodes: much longer).
 #
 #   benchmarks/run_all.sh [--full] [--build-dir DIR] [--out FILE] [--jobs N] [--no-build] [--no-peers]
+#                         [--baseline GIT_REF] [--only NAME,NAME...]
 #
 # The output file holds, per benchmark, a {"benchmark_run": ...} line (program, arguments, load
 # average before it, exit code, wall seconds) followed by that program's own JSON lines. The
-# readable tables go to the terminal and to FILE.log.
+# readable tables go to the terminal and to FILE.log. At the end, targets.py prints the speed
+# targets of the issues with this build's figures.
+#
+# --baseline GIT_REF builds the library of that commit (git archive into BUILD/baseline-src)
+# with this tree's benchmarks, and runs each benchmark against it right after this build's run,
+# so both see the same machine state; its JSON lines carry "build":"baseline" and the targets
+# table shows its figures and the ratios. A benchmark that does not compile against the older
+# library is reported and skipped.
+#
+# --only runs the named benchmarks alone (e.g. --only conversion_bench,io_bench,curve_mesh_program).
+#
+# Programs and benchmarks run with glibc's huge-page heap (GLIBC_TUNABLES, see
+# include/meshmotion/core/process_memory.hpp) for both builds; MESHMOTION_HUGE_PAGES=0 runs
+# without.
 set -uo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -19,6 +33,8 @@ build=1
 peers=1
 jobs=1
 out=""
+baseline=""
+only=""
 
 while [[ $# -gt 0 ]]; do
   case "$1" in
@@ -28,7 +44,9 @@ while [[ $# -gt 0 ]]; do
     --build-dir) build_dir="$2"; shift ;;
     --out) out="$2"; shift ;;
     --jobs) jobs="$2"; shift ;;
-    -h|--help) sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --baseline) baseline="$2"; shift ;;
+    --only) only=",$2,"; shift ;;
+    -h|--help) sed -n '2,28p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "run_all.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
   shift
@@ -43,6 +61,8 @@ log="$out.log"
 # name and arguments per benchmark: quick sizes, then full sizes.
 declare -A quick_args=(
   [io_bench]="60"
+  [conversion_bench]="--quick"
+  [pu_rbf_bench]="--quick"
   [quality_bench]="--quick"
   [delaunay_bench]="100000"
   [rbf_bench]="64"
@@ -54,6 +74,8 @@ declare -A quick_args=(
 )
 declare -A full_args=(
   [io_bench]="100"
+  [conversion_bench]=""
+  [pu_rbf_bench]=""
   [quality_bench]=""
   [delaunay_bench]="100000 1000000"
   [rbf_bench]="126"
@@ -63,17 +85,17 @@ declare -A full_args=(
   [bump3d_bench]="0 1 2"
   [cholmod_bench]="126 3"
 )
-order=(io_bench quality_bench rbf_bench interpolation_bench elasticity_bench delaunay_bench curving_bench bump3d_bench cholmod_bench)
+order=(io_bench conversion_bench pu_rbf_bench quality_bench rbf_bench interpolation_bench elasticity_bench delaunay_bench curving_bench bump3d_bench cholmod_bench)
 # Peer scripts: they take the build folder and a work folder, install their peer with apt-get
 # when it is absent, and report it missing when that fails.
 peer_scripts=(openfoam_peer dense_rbf_peer)
 
 benches=()
 for name in "${order[@]}"; do
-  [[ -f "$here/$name.cpp" ]] && benches+=("$name")
+  [[ -f "$here/$name.cpp" ]] && [[ -z "$only" || "$only" == *",$name,"* ]] && benches+=("$name")
 done
-targets=("${benches[@]}")
-[[ $peers == 1 ]] && targets+=(motion_peer_bench python_overhead_peer meshmotion_python)
+targets=("${benches[@]}" curve_mesh)
+[[ $peers == 1 && -z "$only" ]] && targets+=(motion_peer_bench python_overhead_peer meshmotion_python)
 # The parallel layer's benchmark exists when MPI, PETSc and METIS were found at configure time.
 mpi_targets=(mpi_bench)
 
@@ -81,6 +103,30 @@ mpi_targets=(mpi_bench)
   echo "# $(date -u +%FT%TZ)  nproc=$(nproc)  $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //')"
   echo "# $(c++ --version | head -1)  mode=$([[ $full == 1 ]] && echo full || echo quick)"
 } | tee -a "$log"
+
+# Both builds get the huge-page heap the programs ask for, so their ratio is the code's.
+if [[ "${MESHMOTION_HUGE_PAGES:-1}" != 0 ]] && grep -q '\[madvise\]' /sys/kernel/mm/transparent_hugepage/enabled 2>/dev/null; then
+  export GLIBC_TUNABLES="${GLIBC_TUNABLES:+$GLIBC_TUNABLES:}glibc.malloc.hugetlb=1"
+fi
+echo "# GLIBC_TUNABLES=${GLIBC_TUNABLES:-}" | tee -a "$log"
+
+baseline_dir="$build_dir/baseline"
+if [[ -n "$baseline" && $build == 1 ]]; then
+  # The older library with this tree's benchmarks, so both builds run the same benchmark code.
+  base_src="$build_dir/baseline-src"
+  rm -rf "$base_src" && mkdir -p "$base_src"
+  git -C "$source_dir" archive "$baseline" | tar -x -C "$base_src" \
+    || { echo "run_all.sh: cannot export $baseline from git" >&2; exit 1; }
+  rm -rf "$base_src/benchmarks" && cp -r "$here" "$base_src/benchmarks"
+  echo "# baseline: $baseline = $(git -C "$source_dir" rev-parse --short "$baseline")" | tee -a "$log"
+  cmake -S "$base_src" -B "$baseline_dir" -DCMAKE_BUILD_TYPE=Release -DMESHMOTION_BUILD_BENCHMARKS=ON \
+    -DMESHMOTION_SHARED_DATA_DIR="$source_dir/../shared/data" >> "$log" 2>&1 \
+    || { echo "run_all.sh: baseline configure failed, see $log" >&2; exit 1; }
+  for target in "${targets[@]}"; do
+    cmake --build "$baseline_dir" --target "$target" -j"$jobs" >> "$log" 2>&1 \
+      || echo "run_all.sh: $target does not build against $baseline: no baseline figures for it" | tee -a "$log" >&2
+  done
+fi
 
 if [[ $build == 1 ]]; then
   cmake -S "$source_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DMESHMOTION_BUILD_BENCHMARKS=ON \
@@ -107,8 +153,30 @@ run() {
   tee -a "$log" < "$build_dir/$name.out" | grep -v '^{'
   printf '{"benchmark_run":"%s","arguments":"%s","load_average":"%s","exit_code":%d,"wall_seconds":%d.%03d}\n' \
     "$name" "$args" "$load" "$rc" $((milliseconds / 1000)) $((milliseconds % 1000)) >> "$out"
-  grep '^{' "$build_dir/$name.out" >> "$out"
+  if [[ "$name" == baseline:* ]]; then
+    grep '^{' "$build_dir/$name.out" | sed 's/^{/{"build":"baseline",/' >> "$out"
+  else
+    grep '^{' "$build_dir/$name.out" >> "$out"
+  fi
   [[ $rc == 0 ]] || { echo "run_all.sh: $name exited with $rc" | tee -a "$log" >&2; status=1; }
+}
+
+# curve_mesh on the 30P30N mesh, the whole program with its .msh and .vtu outputs: the median
+# wall time of 5 runs, as one JSON line.
+program_case() {
+  local program="$1" data="$source_dir/../shared/data/su2_30p30n_rans_L1_coarse.su2" work times=()
+  if [[ ! -f "$data" ]]; then echo "program_case: $data not found, skipped"; return 0; fi
+  work="$(mktemp -d)"
+  for _ in 1 2 3 4 5; do
+    local start=$(date +%s%N)
+    "$program" "$data" -o "$work/curved.msh" > /dev/null || { rm -rf "$work"; return 1; }
+    times+=($(( ($(date +%s%N) - start) / 1000 )))
+  done
+  rm -rf "$work"
+  local median
+  median=$(printf '%s\n' "${times[@]}" | sort -n | sed -n 3p)
+  printf 'curve_mesh 30P30N (.msh + .vtu): median of 5 runs %d.%06d s\n' $((median / 1000000)) $((median % 1000000))
+  printf '{"bench":"program","case":"curve_mesh-30p30n","median_s":%d.%06d}\n' $((median / 1000000)) $((median % 1000000))
 }
 
 for name in "${benches[@]}"; do
@@ -120,10 +188,19 @@ for name in "${benches[@]}"; do
   fi
   # shellcheck disable=SC2086  # args is a word list on purpose
   run "$name" "$build_dir/benchmarks/$name" $args
+  if [[ -n "$baseline" && -x "$baseline_dir/benchmarks/$name" ]]; then
+    # shellcheck disable=SC2086
+    run "baseline:$name" "$baseline_dir/benchmarks/$name" $args
+  fi
 done
+if [[ -x "$build_dir/examples/curve_mesh" && ( -z "$only" || "$only" == *",curve_mesh_program,"* ) ]]; then
+  run curve_mesh_program program_case "$build_dir/examples/curve_mesh"
+  [[ -n "$baseline" && -x "$baseline_dir/examples/curve_mesh" ]] \
+    && run "baseline:curve_mesh_program" program_case "$baseline_dir/examples/curve_mesh"
+fi
 # The distributed movers at 1, 2 and 4 ranks (4 is oversubscribed on two cores and says so),
 # each against the serial mover in the same process.
-if [[ -x "$build_dir/benchmarks/mpi_bench" ]]; then
+if [[ -x "$build_dir/benchmarks/mpi_bench" && ( -z "$only" || "$only" == *",mpi_bench,"* ) ]]; then
   mpi_flags=()
   mpiexec --version 2>&1 | grep -q "Open MPI" && mpi_flags=(--oversubscribe --allow-run-as-root)
   for ranks in 1 2 4; do
@@ -131,7 +208,7 @@ if [[ -x "$build_dir/benchmarks/mpi_bench" ]]; then
       "$([[ $full == 1 ]] && echo 126 || echo 64)"
   done
 fi
-if [[ $peers == 1 ]]; then
+if [[ $peers == 1 && -z "$only" ]]; then
   for name in "${peer_scripts[@]}"; do
     run "$name" "$here/$name.sh" "$build_dir" "$build_dir/$name"
   done
@@ -145,6 +222,7 @@ if [[ $peers == 1 ]]; then
 fi
 
 python3 "$here/plot_results.py" "$out" --out-dir "$build_dir/plots" | tee -a "$log"
+python3 "$here/targets.py" "$out" | tee -a "$log"
 echo "JSON lines: $out" | tee -a "$log"
 echo "tables:     $log"
 exit $status

@@ -1,0 +1,74 @@
+#!/usr/bin/env python3
+"""Prints the speed targets of the issues against a run_all.sh results file: this build's
+figure, the baseline build's (rows tagged "build": "baseline" by run_all.sh --baseline) and
+their ratio, and whether the target is met. A target whose benchmark case did not run (a quick
+run skips the full sizes; ../shared/data may be absent) is listed as "not run".
+
+  targets.py RESULTS.jsonl [--json]
+
+--json also prints one {"target": ...} line per target.
+"""
+import argparse
+import json
+import sys
+
+from plot_results import read_rows
+
+# (name, rows' fields to match, field, "<=" or ">=", limit, unit)
+TARGETS = [
+    ("P1->P2 30P30N quads (median)", {"bench": "conversion", "case": "30p30n-quads"}, "median_s", "<=", 0.015, "s"),
+    ("P1->P2 30P30N quads (first call)", {"bench": "conversion", "case": "30p30n-quads"}, "first_s", "<=", 0.015, "s"),
+    ("msh 4.1 binary write", {"bench": "io", "case": "msh4.1-binary"}, "write_mb_s", ">=", 500, "MB/s"),
+    ("msh 4.1 binary read", {"bench": "io", "case": "msh4.1-binary"}, "read_mb_s", ">=", 500, "MB/s"),
+    ("msh 4.1 ASCII read", {"bench": "io", "case": "msh4.1-ascii"}, "read_mb_s", ">=", 150, "MB/s"),
+    ("msh 2.2 ASCII read", {"bench": "io", "case": "msh2.2-ascii"}, "read_mb_s", ">=", 150, "MB/s"),
+    ("SU2 ASCII read", {"bench": "io", "case": "su2-ascii"}, "read_mb_s", ">=", 150, "MB/s"),
+    ("curve_mesh 30P30N, whole program", {"bench": "program", "case": "curve_mesh-30p30n"}, "median_s", "<=", 0.2, "s"),
+    ("3D RBF setup, box 2M nodes (CHOLMOD)", {"case": "box rbf setup", "nodes": 2048383}, "supernodal_setup_seconds",
+     "<=", 3.0, "s"),
+    ("bump fine level, whole pipeline", {"bench": "bump3d", "level": "fine", "case": "rbf default r"}, "seconds", "<=",
+     4.0, "s"),
+]
+
+
+def figure(rows, match, field, build):
+    """The last matching row's field for one build ("current" rows carry no build field)."""
+    value = None
+    for row in rows:
+        if row.get("build", "current") != build or field not in row:
+            continue
+        if all(row.get(k) == v for k, v in match.items()):
+            value = row[field]
+    return value
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("results")
+    parser.add_argument("--json", action="store_true")
+    args = parser.parse_args()
+    rows = read_rows(args.results, baseline=True)
+    print(f"{'target':40} {'limit':>12} {'this build':>12} {'baseline':>12} {'ratio':>7}  met")
+    lines = []
+    for name, match, field, sense, limit, unit in TARGETS:
+        now = figure(rows, match, field, "current")
+        before = figure(rows, match, field, "baseline")
+        if now is None:
+            print(f"{name:40} {sense + ' ' + format(limit, 'g') + ' ' + unit:>12} {'not run':>12}")
+            lines.append({"target": name, "limit": limit, "unit": unit, "run": False})
+            continue
+        met = now <= limit if sense == "<=" else now >= limit
+        ratio = now / before if before else None
+        print(f"{name:40} {sense + ' ' + format(limit, 'g') + ' ' + unit:>12} {now:12.4g} "
+              f"{(format(before, '12.4g') if before is not None else 'n/a'):>12} "
+              f"{(format(ratio, '7.3f') if ratio is not None else 'n/a'):>7}  {'yes' if met else 'NO'}")
+        lines.append({"target": name, "limit": limit, "unit": unit, "run": True, "value": now, "baseline": before,
+                      "ratio": ratio, "met": met})
+    if args.json:
+        for line in lines:
+            print(json.dumps(line))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
