@@ -216,37 +216,38 @@ template <std::size_t N, class Source>
   out.element_entities = std::move(numbering.id_of_item);
   out.count = std::move(numbering.count);
 
-  // Decodes an item into (element in block order, local index, its vertices).
-  const auto decode = [&](Index item, Index& element, int& k) {
-    const auto it = std::upper_bound(out.block_offsets.begin(), out.block_offsets.end(), item);
-    const auto b = static_cast<Index>(it - out.block_offsets.begin()) - 1;
-    const int n_local = num_local_entities(source.type(b), which);
-    const Index rel = item - out.block_offsets[static_cast<std::size_t>(b)];
-    element = out.element_offsets[static_cast<std::size_t>(b)] + rel / n_local;
-    k = static_cast<int>(rel % n_local);
-    return b;
-  };
+  // Per entity: its vertices as its first element lists them, its first two elements. The
+  // items are walked in element order, so the connectivity is read in sequence; visiting the
+  // entities in id order instead read it at random, which dominated at millions of cells.
   const std::size_t n_unique = numbering.first_item.size();
   out.vertices.resize(n_unique);
   out.num_vertices.resize(n_unique);
   out.elements.resize(n_unique);
   out.local.resize(n_unique);
-  for (std::size_t u = 0; u < n_unique; ++u) {
-    Index element = -1;
-    int k = 0;
-    const Index b = decode(numbering.first_item[u], element, k);
-    const LocalFacet ent = local_entity(source.type(b), which, k);
-    const Index e = element - out.element_offsets[static_cast<std::size_t>(b)];
-    std::array<Index, 4> verts{-1, -1, -1, -1};
-    for (int v = 0; v < ent.num_vertices; ++v)
-      verts[static_cast<std::size_t>(v)] = source.node(b, e, ent.vertices[static_cast<std::size_t>(v)]);
-    out.vertices[u] = verts;
-    out.num_vertices[u] = ent.num_vertices;
-    out.elements[u] = {element, -1};
-    out.local[u] = {k, -1};
-    if (numbering.second_item[u] >= 0) {
-      decode(numbering.second_item[u], out.elements[u][1], out.local[u][1]);
-    }
+  std::array<LocalFacet, 12> local{};
+  for (Index b = 0; b < num_blocks; ++b) {
+    const ElementType t = source.type(b);
+    const int n_local = num_local_entities(t, which);
+    for (int k = 0; k < n_local; ++k) local[static_cast<std::size_t>(k)] = local_entity(t, which, k);
+    Index item = out.block_offsets[static_cast<std::size_t>(b)];
+    const Index first_element = out.element_offsets[static_cast<std::size_t>(b)];
+    for (Index e = 0; e < source.size(b); ++e)
+      for (int k = 0; k < n_local; ++k, ++item) {
+        const auto u = static_cast<std::size_t>(out.element_entities[static_cast<std::size_t>(item)]);
+        if (numbering.first_item[u] == item) {
+          const LocalFacet& ent = local[static_cast<std::size_t>(k)];
+          std::array<Index, 4> verts{-1, -1, -1, -1};
+          for (int v = 0; v < ent.num_vertices; ++v)
+            verts[static_cast<std::size_t>(v)] = source.node(b, e, ent.vertices[static_cast<std::size_t>(v)]);
+          out.vertices[u] = verts;
+          out.num_vertices[u] = ent.num_vertices;
+          out.elements[u] = {first_element + e, -1};
+          out.local[u] = {k, -1};
+        } else if (numbering.second_item[u] == item) {
+          out.elements[u][1] = first_element + e;
+          out.local[u][1] = k;
+        }
+      }
   }
   return out;
 }
