@@ -1,7 +1,8 @@
 // io_bench: writes and reads a >= 1M-node tetrahedral mesh (a structured box split into six
-// tets per cube) as msh 4.1 binary, 4.1 ASCII, 2.2 ASCII and SU2 (medians of 3 rounds); prints
-// MB/s and nodes/s, and
-// compares binary reading against Gmsh's own reader (`gmsh FILE -0`) when gmsh is installed.
+// tets per cube) as msh 4.1 binary, 4.1 ASCII, 2.2 ASCII, SU2 and CGNS (when built with it;
+// medians of 3 rounds); prints MB/s and nodes/s, each format's times as ratios to the msh 4.1
+// binary row of the same run, and compares binary reading against Gmsh's own reader
+// (`gmsh FILE -0`) when gmsh is installed.
 // Usage: io_bench [cells_per_side = 100]
 
 #include "bench_memory.hpp"
@@ -57,18 +58,20 @@ int main(int argc, char** argv) {
   const auto dir = std::filesystem::temp_directory_path() / "meshmotion_io_bench";
   std::filesystem::create_directories(dir);
   std::printf("mesh: %lld nodes, %lld tets\n", static_cast<long long>(mesh.num_nodes()), static_cast<long long>(mesh.num_cells()));
-  std::printf("%-14s %9s %10s %10s %12s %10s %10s %12s\n", "case", "MB", "write s", "write MB/s", "write nodes/s", "read s",
-              "read MB/s", "read nodes/s");
+  std::printf("%-14s %9s %10s %10s %12s %10s %10s %12s %11s %11s\n", "case", "MB", "write s", "write MB/s", "write nodes/s",
+              "read s", "read MB/s", "read nodes/s", "write/msh-b", "read/msh-b");
   struct Case {
     const char* name;
     const char* extension;
     WriteOptions options;
   };
-  const Case cases[] = {{"msh4.1-binary", ".msh", {MshVersion::v4_1, true, false}},
-                        {"msh4.1-ascii", ".msh", {MshVersion::v4_1, false, false}},
-                        {"msh2.2-ascii", ".msh", {MshVersion::v2_2, false, false}},
-                        {"su2-ascii", ".su2", {}}};
-  double binary_read_seconds = 0;
+  std::vector<Case> cases{{"msh4.1-binary", ".msh", {MshVersion::v4_1, true, false}},
+                          {"msh4.1-ascii", ".msh", {MshVersion::v4_1, false, false}},
+                          {"msh2.2-ascii", ".msh", {MshVersion::v2_2, false, false}},
+                          {"su2-ascii", ".su2", {}}};
+  if (have_cgns) cases.push_back({"cgns-hdf5", ".cgns", {}});
+  else std::printf("cgns: meshmotion was built without the CGNS library (libcgns-dev): no CGNS row\n");
+  double binary_read_seconds = 0, binary_write_seconds = 0;
   std::vector<std::string> json;
   for (const auto& c : cases) {
     const auto file = dir / (std::string(c.name) + c.extension);
@@ -90,16 +93,20 @@ int main(int argc, char** argv) {
     std::sort(reads.begin(), reads.end());
     const double write_s = writes[1], read_s = reads[1];
     const double mb = static_cast<double>(std::filesystem::file_size(file)) / 1e6;
-    if (c.options.binary) binary_read_seconds = read_s;
+    if (c.options.binary) {
+      binary_read_seconds = read_s;
+      binary_write_seconds = write_s;
+    }
     const double nodes = static_cast<double>(mesh.num_nodes());
-    std::printf("%-14s %9.1f %10.3f %10.1f %12.3g %10.3f %10.1f %12.3g\n", c.name, mb, write_s, mb / write_s, nodes / write_s,
-                read_s, mb / read_s, nodes / read_s);
+    std::printf("%-14s %9.1f %10.3f %10.1f %12.3g %10.3f %10.1f %12.3g %11.2f %11.2f\n", c.name, mb, write_s, mb / write_s,
+                nodes / write_s, read_s, mb / read_s, nodes / read_s, write_s / binary_write_seconds, read_s / binary_read_seconds);
     char line[512];
     std::snprintf(line, sizeof line,
                   "{\"bench\":\"io\",\"case\":\"%s\",\"nodes\":%lld,\"cells\":%lld,\"mb\":%.3f,\"write_s\":%.4f,\"write_mb_s\":%.1f,"
-                  "\"read_s\":%.4f,\"read_mb_s\":%.1f,\"read_nodes_s\":%.4g}",
+                  "\"read_s\":%.4f,\"read_mb_s\":%.1f,\"read_nodes_s\":%.4g,\"write_ratio_msh_binary\":%.3f,"
+                  "\"read_ratio_msh_binary\":%.3f}",
                   c.name, static_cast<long long>(mesh.num_nodes()), static_cast<long long>(mesh.num_cells()), mb, write_s,
-                  mb / write_s, read_s, mb / read_s, nodes / read_s);
+                  mb / write_s, read_s, mb / read_s, nodes / read_s, write_s / binary_write_seconds, read_s / binary_read_seconds);
     json.emplace_back(line);
   }
   // Baseline: Gmsh reading the same binary file (process start included).

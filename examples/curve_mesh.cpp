@@ -4,7 +4,7 @@
 //   curve_mesh in.su2 -o out.msh --group wall --geometry naca:0012 --svg out.svg
 //   curve_mesh in.msh -o out.msh --group 7 --geometry sphere:0,0,0,0.5 --sliding 20 --json
 //
-// Writes OUTPUT (.msh/.su2), OUTPUT's .vtu beside it (per-cell certified scaled Jacobian),
+// Writes OUTPUT (.msh/.cgns/.su2), OUTPUT's .vtu beside it (per-cell certified scaled Jacobian),
 // and in 2D an SVG picture coloured by quality when --svg is given (always in the demo), with
 // a red ring on every invalid cell (too thin to see at a zoom that shows the body).
 // The input file is never modified. Exit codes: 0 curved and valid, 1 error (nothing
@@ -225,8 +225,8 @@ int main(int argc, char** argv) {
   meshmotion::tune_process_memory(argc, argv);  // may restart the program once (core/process_memory.hpp)
   CLI::App app{"Curve a linear mesh into a certified P2 mesh (spline or CAD boundary, RBF or blending interior)"};
   Arguments args;
-  app.add_option("input", args.input, "linear mesh (.msh, .su2); none: the built-in demo");
-  app.add_option("-o,--output", args.output, "curved mesh to write (.msh, .su2); a .vtu is written beside it");
+  app.add_option("input", args.input, "linear mesh (.msh, .su2, .cgns); none: the built-in demo");
+  app.add_option("-o,--output", args.output, "curved mesh to write (.msh, .cgns; .su2 for linear); a .vtu is written beside it");
   examples::add_version_flag(app);
   app.add_flag("--demo", args.demo, "curve the built-in boundary-layer mesh around a cylinder");
   examples::add_mover_options(app, args.mover, "interior regularization: blend, none, or ");

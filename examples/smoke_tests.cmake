@@ -231,6 +231,27 @@ smoke_test(NAME move_mesh.json_file_name_with_quote.json
            COMMAND move_mesh "${smoke_dir}/clockwise.su2" -o "${smoke_dir}/moved\"quote.su2" --group bottom
                    --translate 0.01,0 --fixed rest --json)
 
+# CGNS in and out (when built with the CGNS library): a linear CGNS mesh written by move_mesh,
+# read by mesh_info and curved by curve_mesh into a curved CGNS mesh; the demo's P2 mesh moved
+# into CGNS keeps every cell valid.
+if(MESHMOTION_HAVE_CGNS)
+  smoke_test(NAME move_mesh.cgns_output.json SETUP examples_square_cgns KEYS output VALUES after/invalid=0
+             COMMAND move_mesh "${smoke_dir}/clockwise.su2" -o "${smoke_dir}/square.cgns" --group bottom
+                     --translate 0.01,0 --fixed rest --json)
+  smoke_test(NAME mesh_info.cgns.json REQUIRES examples_square_cgns KEYS mesh/groups VALUES mesh/nodes=4,mesh/cells/tri3=2
+             COMMAND mesh_info "${smoke_dir}/square.cgns" --json)
+  smoke_test(NAME curve_mesh.cgns.json REQUIRES examples_square_cgns KEYS output,min_scaled_jacobian VALUES invalid=0
+             COMMAND curve_mesh "${smoke_dir}/square.cgns" -o "${smoke_dir}/square_curved.cgns" --group bottom
+                     --geometry straight --json)
+  smoke_test(NAME move_mesh.demo_to_cgns.json REQUIRES examples_demo_mesh SETUP examples_moved_cgns
+             KEYS output VALUES after/invalid=0
+             COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_demo.cgns" --group wall --rotate 5
+                     --fixed farfield --json)
+  smoke_test(NAME mesh_quality.cgns.json REQUIRES examples_moved_cgns VALUES metrics/scaled_jacobian/invalid=0
+             KEYS nodes
+             COMMAND mesh_quality "${smoke_dir}/moved_demo.cgns" --metric jacobian --json)
+endif()
+
 # move_mesh_mpi: the same mesh as move_mesh's, byte for byte, from 3 ranks; elasticity through
 # PETSc; an unknown group refused by every rank with rank 0's message.
 if(TARGET move_mesh_mpi)

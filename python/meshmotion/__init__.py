@@ -12,6 +12,7 @@ from ._core import (  # noqa: F401  (re-exported)
     IoError,
     SolverError,
     __version__,
+    have_cgns,
     mover_methods,
     mover_options,
     num_threads,
@@ -50,7 +51,7 @@ def from_arrays(points, cells, groups=None):
 
 
 def write_mesh(file, mesh):
-    """Writes a mesh by extension (.msh, .su2, .vtu), through a temporary file."""
+    """Writes a mesh by extension (.msh, .su2, .cgns, .vtu), through a temporary file."""
     _core.write_mesh(str(file), mesh)
 
 

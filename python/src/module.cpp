@@ -480,6 +480,7 @@ void bind_dimension(py::module_& m) {
 PYBIND11_MODULE(_core, m) {
   m.doc() = "meshmotion's compiled core (use the meshmotion package)";
   m.attr("__version__") = MESHMOTION_VERSION_STRING;
+  m.attr("have_cgns") = have_cgns;  // read_mesh/write_mesh take .cgns
 
   // The C++ hierarchy as Python exceptions with the same messages.
   static py::exception<Error> error(m, "Error", PyExc_RuntimeError);

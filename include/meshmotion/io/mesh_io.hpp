@@ -1,13 +1,15 @@
 #pragma once
 /// \file
 /// Reading and writing meshes by file extension: .msh (Gmsh 2.2/4.1, ASCII or binary, detected
-/// on reading), .su2 (SU2), and .vtu (VTK, write only).
+/// on reading), .su2 (SU2), .cgns (CGNS, when built with the CGNS library: io/cgns.hpp) and
+/// .vtu (VTK, write only).
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/core/orientation.hpp"
 #include "meshmotion/io/any_mesh.hpp"
+#include "meshmotion/io/cgns.hpp"
 #include "meshmotion/io/gmsh_reader.hpp"
 #include "meshmotion/io/gmsh_writer.hpp"
 #include "meshmotion/io/su2_reader.hpp"
@@ -70,7 +72,7 @@ void apply_orientation(Mesh<Dim>& mesh, const std::filesystem::path& file, ReadO
 
 }  // namespace detail
 
-/// Reads a mesh, choosing the format by extension (.msh or .su2). The result is 3D if the file
+/// Reads a mesh, choosing the format by extension (.msh, .su2 or .cgns). The result is 3D if the file
 /// holds 3D elements (SU2: NDIME 3), else 2D. The mesh is validated, and its orientation
 /// handled as `options` says.
 /// Throws InputError for an unknown extension, IoError for an unreadable file, ParseError (file
@@ -81,7 +83,8 @@ void apply_orientation(Mesh<Dim>& mesh, const std::filesystem::path& file, ReadO
   AnyMesh mesh = [&]() -> AnyMesh {
     if (ext == ".msh") return read_gmsh(file);
     if (ext == ".su2") return read_su2(file);
-    throw InputError("read_mesh: " + file.string() + ": unknown mesh format '" + ext + "' (expected .msh or .su2)");
+    if (ext == ".cgns") return read_cgns(file);
+    throw InputError("read_mesh: " + file.string() + ": unknown mesh format '" + ext + "' (expected .msh, .su2 or .cgns)");
   }();
   std::visit([&](auto& m) { detail::apply_orientation(m, file, options.orientation); }, mesh);
   return mesh;
@@ -104,7 +107,7 @@ struct WriteOptions {
   bool vtu_facets = false;                    ///< .vtu only: also write the facets
 };
 
-/// Writes a mesh, choosing the format by extension (.msh, .su2 or .vtu), through a temporary
+/// Writes a mesh, choosing the format by extension (.msh, .su2, .cgns or .vtu), through a temporary
 /// file in the same folder and a rename. Throws InputError for an unknown extension or an
 /// invalid mesh (nothing is written), IoError when the file cannot be written.
 template <int Dim>
@@ -113,7 +116,8 @@ void write_mesh(const std::filesystem::path& file, const Mesh<Dim>& mesh, const 
   if (ext == ".msh") return write_gmsh(file, mesh, GmshWriteOptions{options.msh_version, options.binary});
   if (ext == ".su2") return write_su2(file, mesh);
   if (ext == ".vtu") return write_vtu(file, mesh, VtuFields{}, VtuOptions{options.vtu_facets});
-  throw InputError("write_mesh: " + file.string() + ": unknown mesh format '" + ext + "' (expected .msh, .su2 or .vtu)");
+  if (ext == ".cgns") return write_cgns(file, mesh);
+  throw InputError("write_mesh: " + file.string() + ": unknown mesh format '" + ext + "' (expected .msh, .su2, .cgns or .vtu)");
 }
 
 /// Checks, before any work, that write_mesh() can write a mesh of element order `order` (1:
@@ -121,10 +125,12 @@ void write_mesh(const std::filesystem::path& file, const Mesh<Dim>& mesh, const 
 /// existing folder. Throws InputError saying which formats would do, or naming the folder.
 inline void check_mesh_output(const std::filesystem::path& file, int order = 1) {
   const std::string ext = detail::lower_extension(file);
-  if (ext != ".msh" && ext != ".su2" && ext != ".vtu")
-    throw InputError("output " + file.string() + ": unknown mesh format '" + ext + "' (expected .msh, .su2 or .vtu)");
+  if (ext != ".msh" && ext != ".su2" && ext != ".vtu" && ext != ".cgns")
+    throw InputError("output " + file.string() + ": unknown mesh format '" + ext + "' (expected .msh, .su2, .cgns or .vtu)");
+  if (ext == ".cgns" && !have_cgns)
+    throw InputError("output " + file.string() + ": writing CGNS needs the CGNS library (meshmotion was built without it)");
   if (ext == ".su2" && order > 1)
-    throw InputError("output " + file.string() + ": .su2 holds linear elements only (expected .msh or .vtu for order " +
+    throw InputError("output " + file.string() + ": .su2 holds linear elements only (expected .msh, .cgns or .vtu for order " +
                      std::to_string(order) + ")");
   const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
   std::error_code ec;

@@ -25,6 +25,33 @@ namespace meshmotion::detail {
   return tmp;
 }
 
+/// Moves the complete temporary file `tmp` onto `file`; removes `tmp` and throws IoError when
+/// the rename fails.
+inline void rename_into_place(const std::filesystem::path& tmp, const std::filesystem::path& file) {
+  std::error_code ec;
+  std::filesystem::rename(tmp, file, ec);
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw IoError(file.string() + ": cannot rename the temporary file into place (" + ec.message() + ")");
+  }
+}
+
+/// Has `write(tmp)` write a whole file at a temporary path beside `file`, then renames it onto
+/// `file`; when `write` throws, the temporary is removed and `file` is left as it was.
+template <class Write>
+void write_through_temporary(const std::filesystem::path& file, Write&& write) {
+  const std::filesystem::path tmp = temporary_path_for(file);
+  try {
+    write(tmp);
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw;
+  }
+  rename_into_place(tmp, file);
+}
+
 /// Writes `contents` to `file` through a temporary file in the same folder and a rename.
 /// Throws IoError (leaving neither `file` changed nor the temporary behind) on failure.
 inline void write_file_atomically(const std::filesystem::path& file, std::string_view contents) {
@@ -40,13 +67,7 @@ inline void write_file_atomically(const std::filesystem::path& file, std::string
       throw IoError(file.string() + ": write failed (disk full?)");
     }
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) {
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
-    throw IoError(file.string() + ": cannot rename the temporary file into place (" + ec.message() + ")");
-  }
+  rename_into_place(tmp, file);
 }
 
 }  // namespace meshmotion::detail

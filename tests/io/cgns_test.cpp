@@ -1,0 +1,452 @@
+// Tests of CGNS reading and writing (io/cgns.hpp): round trips of every element type and of
+// the real meshes, cgnscheck on what we write, files as other writers make them (MIXED
+// sections, vertex BCs, element-range BCs in families, several zones) built with the CGNS
+// library itself, and the error for each kind of bad file.
+
+#include "meshmotion/core/generators.hpp"
+#include "meshmotion/core/orientation.hpp"
+#include "meshmotion/curving/p2_conversion.hpp"
+#include "meshmotion/io.hpp"
+
+#include "io_support.hpp"
+#include "messages.hpp"
+#include "test_data.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+using namespace meshmotion;
+namespace fs = std::filesystem;
+
+#ifdef MESHMOTION_HAVE_CGNS
+
+namespace {
+
+// cgnscheck (Debian cgns-convert) on a file: its output, or empty when the tool is absent.
+std::string cgnscheck(const fs::path& file) {
+  if (std::system("command -v cgnscheck > /dev/null 2>&1") != 0) return {};
+  const fs::path log = fs::path(file).replace_extension(".cgnscheck.txt");
+  const std::string command = "cgnscheck " + file.string() + " > " + log.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  std::ifstream in(log);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (status != 0) text += "\n(cgnscheck exit status " + std::to_string(status) + ")";
+  return text;
+}
+
+// No error and no warning; `detached_facets` lets cgnscheck say that facets are not on the
+// cells' boundary: true of the synthetic one-element-per-type mesh, and what cgnscheck 3.4.0
+// also says of facets in MIXED sections (even of a file the CGNS library wrote itself).
+void require_cgnscheck_clean(const fs::path& file, bool detached_facets = false) {
+  std::string report = cgnscheck(file);
+  if (report.empty()) {
+    WARN("cgnscheck not installed (cgns-convert): the file's validity was not checked");
+    return;
+  }
+  INFO(report);
+  CHECK(report.find("ERROR") == std::string::npos);
+  CHECK(report.find("checking complete") != std::string::npos);
+  if (detached_facets)
+    for (std::size_t at = report.find("WARNING:"); at != std::string::npos; at = report.find("WARNING:", at + 1)) {
+      const std::size_t end = report.find('\n', at);
+      const std::string line = report.substr(at, end - at);
+      if (line.find("are not boundary elements") != std::string::npos || line.find("are not faces of the volume elements") != std::string::npos)
+        report.erase(at, end - at);
+    }
+  CHECK(report.find("WARNING:") == std::string::npos);
+}
+
+// Same nodes and cells and, group by group (by name), the same nodes.
+template <int Dim>
+void require_same_geometry(const Mesh<Dim>& a, const Mesh<Dim>& b) {
+  REQUIRE(a.points == b.points);
+  for (const auto& lists : {std::pair{&a.cells, &b.cells}, std::pair{&a.facets, &b.facets}, std::pair{&a.lower, &b.lower}}) {
+    REQUIRE(lists.first->size() == lists.second->size());
+    for (std::size_t k = 0; k < lists.first->size(); ++k) {
+      CHECK((*lists.first)[k].type == (*lists.second)[k].type);
+      CHECK((*lists.first)[k].connectivity == (*lists.second)[k].connectivity);
+    }
+  }
+  for (const auto& g : a.groups) {
+    INFO("group " << g.name);
+    const PhysicalGroup* other = b.find_group(g.name);
+    REQUIRE(other != nullptr);
+    CHECK(a.group_nodes(g.tag, g.dim) == b.group_nodes(other->tag, other->dim));
+  }
+}
+
+// A CGNS file written with the library's own calls, as another program would.
+class CgnsBuilder {
+ public:
+  explicit CgnsBuilder(const fs::path& file, int cell_dim = 2, int phys_dim = 2) {
+    REQUIRE(cg_open(file.c_str(), CG_MODE_WRITE, &fn_) == CG_OK);
+    REQUIRE(cg_base_write(fn_, "Base", cell_dim, phys_dim, &base_) == CG_OK);
+    phys_dim_ = phys_dim;
+  }
+  ~CgnsBuilder() { cg_close(fn_); }
+  CgnsBuilder(const CgnsBuilder&) = delete;
+  CgnsBuilder& operator=(const CgnsBuilder&) = delete;
+
+  int zone(const char* name, const std::vector<std::array<double, 3>>& xyz, cgsize_t num_cells) {
+    cgsize_t size[3] = {static_cast<cgsize_t>(xyz.size()), num_cells, 0};
+    int z = 0;
+    REQUIRE(cg_zone_write(fn_, base_, name, size, CGNS_ENUMV(Unstructured), &z) == CG_OK);
+    static constexpr const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
+    for (int d = 0; d < phys_dim_; ++d) {
+      std::vector<double> c;
+      for (const auto& p : xyz) c.push_back(p[static_cast<std::size_t>(d)]);
+      int C = 0;
+      REQUIRE(cg_coord_write(fn_, base_, z, CGNS_ENUMV(RealDouble), names[d], c.data(), &C) == CG_OK);
+    }
+    return z;
+  }
+  void section(int z, const char* name, CGNS_ENUMT(ElementType_t) type, cgsize_t start, cgsize_t end,
+               const std::vector<cgsize_t>& nodes) {
+    int S = 0;
+    REQUIRE(cg_section_write(fn_, base_, z, name, type, start, end, 0, nodes.data(), &S) == CG_OK);
+  }
+  void mixed(int z, const char* name, cgsize_t start, cgsize_t end, const std::vector<cgsize_t>& data,
+             const std::vector<cgsize_t>& offsets) {
+    int S = 0;
+    REQUIRE(cg_poly_section_write(fn_, base_, z, name, CGNS_ENUMV(MIXED), start, end, 0, data.data(), offsets.data(), &S) == CG_OK);
+  }
+  int boco(int z, const char* name, CGNS_ENUMT(PointSetType_t) set, const std::vector<cgsize_t>& points,
+           CGNS_ENUMT(GridLocation_t) location = CGNS_ENUMV(Vertex)) {
+    int bc = 0;
+    REQUIRE(cg_boco_write(fn_, base_, z, name, CGNS_ENUMV(BCWall), set, static_cast<cgsize_t>(points.size()), points.data(), &bc) ==
+            CG_OK);
+    if (location != CGNS_ENUMV(Vertex)) REQUIRE(cg_boco_gridlocation_write(fn_, base_, z, bc, location) == CG_OK);
+    return bc;
+  }
+  void family(int z, int bc, const char* name) {
+    int F = 0;
+    REQUIRE(cg_family_write(fn_, base_, name, &F) == CG_OK);
+    REQUIRE(cg_goto(fn_, base_, "Zone_t", z, "ZoneBC_t", 1, "BC_t", bc, "end") == CG_OK);
+    REQUIRE(cg_famname_write(name) == CG_OK);
+  }
+  [[nodiscard]] int id() const { return fn_; }
+  [[nodiscard]] int base() const { return base_; }
+
+ private:
+  int fn_ = -1, base_ = 0, phys_dim_ = 2;
+};
+
+// An nx × ny grid of nodes on [x0, x0 + nx - 1] × [0, ny - 1] and its quads (1-based).
+std::vector<std::array<double, 3>> grid_nodes(int nx, int ny, double x0 = 0.0) {
+  std::vector<std::array<double, 3>> xyz;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) xyz.push_back({x0 + i, static_cast<double>(j), 0.0});
+  return xyz;
+}
+std::vector<cgsize_t> grid_quads(int nx, int ny) {
+  std::vector<cgsize_t> q;
+  for (int j = 0; j + 1 < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {
+      const cgsize_t a = j * nx + i + 1;
+      q.insert(q.end(), {a, a + 1, a + 1 + nx, a + nx});
+    }
+  return q;
+}
+
+template <class F>
+void require_input_error(F&& f, const std::vector<std::string>& parts) {
+  const std::string message = test::message_of<InputError>(f);
+  INFO(message);
+  for (const auto& p : parts) CHECK(message.find(p) != std::string::npos);
+}
+
+}  // namespace
+
+TEST_CASE("CGNS: every element type, linear and quadratic, round-trips and passes cgnscheck", "[io][cgns]") {
+  for (const int element_order : {1, 2}) {
+    INFO("order " << element_order);
+    const auto check = [&](const auto& mesh, const std::string& stem) {
+      using M = std::decay_t<decltype(mesh)>;
+      const fs::path file = test::scratch_path(stem + ".cgns");
+      write_mesh(file, mesh);
+      require_cgnscheck_clean(file, true);
+      const M a = std::get<M>(read_mesh(file));
+      require_same_geometry(mesh, a);
+      CHECK(a.node_ids.empty());  // CGNS numbers nodes 1..n
+      // Element numbers follow the input's ids, renumbered 1..n in that order.
+      std::vector<std::pair<std::int64_t, std::int64_t>> numbers;  // (input id, CGNS number)
+      for (const auto& lists : {std::pair{&mesh.cells, &a.cells}, std::pair{&mesh.facets, &a.facets}, std::pair{&mesh.lower, &a.lower}})
+        for (std::size_t k = 0; k < lists.first->size(); ++k) {
+          REQUIRE((*lists.second)[k].ids.size() == static_cast<std::size_t>((*lists.second)[k].size()));
+          for (Index e = 0; e < (*lists.first)[k].size(); ++e)
+            numbers.emplace_back((*lists.first)[k].ids[static_cast<std::size_t>(e)], (*lists.second)[k].ids[static_cast<std::size_t>(e)]);
+        }
+      std::sort(numbers.begin(), numbers.end());
+      for (std::size_t k = 0; k < numbers.size(); ++k) CHECK(numbers[k].second == static_cast<std::int64_t>(k) + 1);
+      // What was read writes back to the same file content and reads back identical.
+      const fs::path again = test::scratch_path(stem + "_again.cgns");
+      write_mesh(again, a);
+      test::require_same_mesh(a, std::get<M>(read_mesh(again)));
+    };
+    check(test::all_types_mesh<3>(element_order), "all_types3_p" + std::to_string(element_order));
+    check(test::all_types_mesh<2>(element_order), "all_types2_p" + std::to_string(element_order));
+  }
+}
+
+TEST_CASE("CGNS: mixed P1 and P2 boxes keep orientation, numbering and groups", "[io][cgns]") {
+  for (const auto cells : {BoxCells::tet_pyramid_prism, BoxCells::hex_prism, BoxCells::pyramid5}) {
+    const Mesh<3> linear = box_mesh({.nx = 4, .ny = 3, .nz = 2, .cells = cells});
+    for (const Mesh<3>& mesh : {linear, to_quadratic(linear)}) {
+      REQUIRE(orientation_report(mesh).num_negative == 0);
+      const fs::path file = test::scratch_path("box.cgns");
+      write_mesh(file, mesh);
+      const Mesh<3> back = read_mesh_as<3>(file, ReadOptions{ReadOrientation::require_positive});
+      require_same_geometry(mesh, back);
+      for (const auto& g : mesh.groups)
+        if (g.dim == 2) CHECK(test::group_size(back, g.name) == test::group_size(mesh, g.name));
+    }
+  }
+  // Facets of one group that alternate in type (tri/quad faces of a mixed box listed by id)
+  // make one MIXED section, read back element by element.
+  Mesh<3> box = box_mesh({.nx = 4, .ny = 2, .nz = 2, .cells = BoxCells::hex_prism});
+  std::int64_t id = 1;
+  for (auto& b : box.cells) {
+    b.ids.resize(static_cast<std::size_t>(b.size()));
+    for (auto& i : b.ids) i = id++;
+  }
+  for (auto& b : box.facets) {
+    b.ids.resize(static_cast<std::size_t>(b.size()));
+    for (std::size_t k = 0; k < b.ids.size(); ++k) b.ids[k] = id + 2 * static_cast<std::int64_t>(k) + (b.type == ElementType::quad4 ? 1 : 0);
+  }
+  const fs::path file = test::scratch_path("alternating.cgns");
+  write_mesh(file, box);
+  require_cgnscheck_clean(file, true);
+  const Mesh<3> back = read_mesh_as<3>(file);
+  CHECK(back.num_facets() == box.num_facets());
+  for (const auto& g : box.groups)
+    if (g.dim == 2) CHECK(back.group_nodes(back.group(g.name).tag) == box.group_nodes(g.tag));
+}
+
+TEST_CASE("CGNS: every real mesh round-trips with its groups", "[io][cgns]") {
+  const auto data_dir = test::shared_data("SOURCES.md");
+  if (!data_dir) {
+    WARN("skipped: ../shared/data is absent");
+    return;
+  }
+  for (const auto& entry : fs::directory_iterator(data_dir->parent_path())) {
+    const fs::path& file = entry.path();
+    if (file.extension() != ".su2" && file.extension() != ".msh") continue;
+    INFO(file);
+    std::visit(
+        [&](const auto& mesh) {
+          using M = std::decay_t<decltype(mesh)>;
+          const fs::path out = test::scratch_path("real.cgns");
+          write_mesh(out, mesh);
+          require_cgnscheck_clean(out);
+          const M back = std::get<M>(read_mesh(out));
+          CHECK(back.points == mesh.points);
+          REQUIRE(back.cells.size() == mesh.cells.size());
+          for (std::size_t k = 0; k < mesh.cells.size(); ++k) CHECK(back.cells[k].connectivity == mesh.cells[k].connectivity);
+          CHECK(back.num_facets() == mesh.num_facets());
+          for (const auto& g : mesh.groups)
+            if (g.dim == M::dim - 1) CHECK(back.group_nodes(back.group(g.name).tag) == mesh.group_nodes(g.tag));
+          const fs::path again = test::scratch_path("real_again.cgns");
+          write_mesh(again, back);
+          test::require_same_mesh(back, std::get<M>(read_mesh(again)));
+        },
+        read_mesh(file));
+  }
+}
+
+TEST_CASE("CGNS written by other programs: MIXED sections, vertex BCs, families, element ranges", "[io][cgns]") {
+  SECTION("2D: one MIXED section of cells, BCs as vertex lists, no facet section") {
+    // 3 × 2 nodes: a quad on the left, two triangles on the right.
+    const fs::path file = test::scratch_path("vertex_bcs.cgns");
+    {
+      CgnsBuilder f(file);
+      const int z = f.zone("dom", grid_nodes(3, 2), 3);
+      f.mixed(z, "Fluid", 1, 3,
+              {CGNS_ENUMV(QUAD_4), 1, 2, 5, 4, CGNS_ENUMV(TRI_3), 2, 3, 6, CGNS_ENUMV(TRI_3), 2, 6, 5}, {0, 5, 9, 13});
+      f.boco(z, "bottom", CGNS_ENUMV(PointList), {1, 2, 3});
+      f.boco(z, "right", CGNS_ENUMV(PointRange), {3, 3});  // one node: no edge lies in it
+      f.boco(z, "top", CGNS_ENUMV(PointRange), {4, 6});
+    }
+    const Mesh<2> mesh = read_mesh_as<2>(file);
+    CHECK(mesh.num_nodes() == 6);
+    CHECK(mesh.num_cells() == 3);
+    CHECK(test::group_size(mesh, "Fluid") == 3);
+    CHECK(test::group_size(mesh, "bottom") == 2);
+    CHECK(test::group_size(mesh, "top") == 2);
+    CHECK(mesh.group_nodes("bottom") == std::vector<Index>{0, 1, 2});
+    CHECK(mesh.group_nodes("top") == std::vector<Index>{3, 4, 5});
+    CHECK(mesh.find_group("right") != nullptr);
+    CHECK(orientation_report(mesh).num_negative == 0);
+  }
+  SECTION("3D: cells and faces in one MIXED section, BCs as element ranges and lists, in families") {
+    // Two hexahedra along x; the x = 0 face and the x = 2 face as quads.
+    std::vector<std::array<double, 3>> xyz;
+    for (int k = 0; k < 2; ++k)
+      for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 3; ++i) xyz.push_back({double(i), double(j), double(k)});
+    const auto n = [](int i, int j, int k) { return static_cast<cgsize_t>(k * 6 + j * 3 + i + 1); };
+    const fs::path file = test::scratch_path("element_bcs.cgns");
+    {
+      CgnsBuilder f(file, 3, 3);
+      const int z = f.zone("block", xyz, 2);
+      std::vector<cgsize_t> data, offsets{0};
+      for (int i = 0; i < 2; ++i) {
+        data.insert(data.end(), {CGNS_ENUMV(HEXA_8), n(i, 0, 0), n(i + 1, 0, 0), n(i + 1, 1, 0), n(i, 1, 0), n(i, 0, 1),
+                                 n(i + 1, 0, 1), n(i + 1, 1, 1), n(i, 1, 1)});
+        offsets.push_back(static_cast<cgsize_t>(data.size()));
+      }
+      data.insert(data.end(), {CGNS_ENUMV(QUAD_4), n(0, 0, 0), n(0, 0, 1), n(0, 1, 1), n(0, 1, 0)});
+      offsets.push_back(static_cast<cgsize_t>(data.size()));
+      data.insert(data.end(), {CGNS_ENUMV(QUAD_4), n(2, 0, 0), n(2, 1, 0), n(2, 1, 1), n(2, 0, 1)});
+      offsets.push_back(static_cast<cgsize_t>(data.size()));
+      f.mixed(z, "All", 1, 4, data, offsets);
+      const int inlet = f.boco(z, "inlet_bc", CGNS_ENUMV(ElementRange), {3, 3});
+      f.family(z, inlet, "INLET");
+      f.boco(z, "outlet", CGNS_ENUMV(PointList), {4}, CGNS_ENUMV(FaceCenter));
+    }
+    const Mesh<3> mesh = read_mesh_as<3>(file);
+    CHECK(mesh.num_cells() == 2);
+    CHECK(test::group_size(mesh, "INLET") == 1);  // the family names the group
+    CHECK(mesh.find_group("inlet_bc") == nullptr);
+    CHECK(test::group_size(mesh, "outlet") == 1);
+    CHECK(mesh.group_nodes("outlet") == std::vector<Index>{2, 5, 8, 11});
+    CHECK(orientation_report(mesh).num_negative == 0);
+    // Element numbers are the file's.
+    CHECK(mesh.find_block(ElementType::quad4)->ids == std::vector<std::int64_t>{3, 4});
+  }
+  SECTION("several zones: one mesh, interface nodes shared, the zones as cell groups") {
+    const fs::path file = test::scratch_path("two_zones.cgns");
+    {
+      CgnsBuilder f(file);
+      for (const int k : {0, 1}) {
+        const int z = f.zone(k == 0 ? "left" : "right", grid_nodes(3, 3, 2.0 * k), 4);
+        f.section(z, "cells", CGNS_ENUMV(QUAD_4), 1, 4, grid_quads(3, 3));
+        f.section(z, "bottom_edges", CGNS_ENUMV(BAR_2), 5, 6, {1, 2, 2, 3});
+        f.boco(z, "bottom", CGNS_ENUMV(PointRange), {5, 6}, CGNS_ENUMV(EdgeCenter));
+      }
+    }
+    const Mesh<2> mesh = read_mesh_as<2>(file);
+    CHECK(mesh.num_nodes() == 15);  // 5 × 3: the x = 2 column is shared
+    CHECK(mesh.num_cells() == 8);
+    CHECK(test::group_size(mesh, "left") == 4);
+    CHECK(test::group_size(mesh, "right") == 4);
+    CHECK(test::group_size(mesh, "bottom") == 4);
+    CHECK(mesh.group_nodes("bottom").size() == 5);
+    CHECK(orientation_report(mesh).num_negative == 0);
+    std::vector<std::int64_t> ids = mesh.cells.front().ids;
+    CHECK(ids == std::vector<std::int64_t>{1, 2, 3, 4, 7, 8, 9, 10});  // the right zone's continue after the left's
+  }
+}
+
+TEST_CASE("CGNS: each kind of bad file gets a clear error naming the node path", "[io][cgns]") {
+  const fs::path dir = test::scratch_path("cgns_bad");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  CHECK_THROWS_AS(read_mesh(dir / "absent.cgns"), IoError);
+  {
+    std::ofstream(dir / "text.cgns") << "not a CGNS file\n";
+    CHECK(test::message_of<IoError>([&] { (void)read_mesh(dir / "text.cgns"); }).find("text.cgns: cannot open as a CGNS file") !=
+          std::string::npos);
+  }
+  {
+    const fs::path file = dir / "structured.cgns";
+    {
+      CgnsBuilder f(file);
+      cgsize_t size[6] = {3, 3, 2, 2, 0, 0};
+      int z = 0;
+      REQUIRE(cg_zone_write(f.id(), f.base(), "blk", size, CGNS_ENUMV(Structured), &z) == CG_OK);
+    }
+    require_input_error([&] { (void)read_mesh(file); }, {"structured.cgns", "/Base", "no unstructured zone", "blk"});
+  }
+  const auto one_quad = [&](const std::string& stem, auto&& add) {
+    const fs::path file = dir / (stem + ".cgns");
+    {
+      CgnsBuilder f(file);
+      const int z = f.zone("dom", grid_nodes(2, 2), 1);
+      add(f, z);
+    }
+    return file;
+  };
+  require_input_error([&] { (void)read_mesh(one_quad("node_range", [](CgnsBuilder& f, int z) {
+                          f.section(z, "q", CGNS_ENUMV(QUAD_4), 1, 1, {1, 2, 99, 3});
+                        })); },
+                      {"/Base/dom/q", "element 1 has node 99", "4 nodes"});
+  require_input_error([&] { (void)read_mesh(one_quad("tri10", [](CgnsBuilder& f, int z) {
+                          f.section(z, "p3", CGNS_ENUMV(TRI_10), 1, 1, {1, 2, 3, 1, 2, 3, 1, 2, 3, 4});
+                        })); },
+                      {"/Base/dom/p3", "TRI_10", "up to order 2"});
+  require_input_error([&] { (void)read_mesh(one_quad("two_bcs", [](CgnsBuilder& f, int z) {
+                          f.section(z, "q", CGNS_ENUMV(QUAD_4), 1, 1, {1, 2, 4, 3});
+                          f.section(z, "e", CGNS_ENUMV(BAR_2), 2, 2, {1, 2});
+                          f.boco(z, "a", CGNS_ENUMV(PointList), {2}, CGNS_ENUMV(EdgeCenter));
+                          f.boco(z, "b", CGNS_ENUMV(PointList), {2}, CGNS_ENUMV(EdgeCenter));
+                        })); },
+                      {"/Base/dom/ZoneBC/b", "element 2 is also in BC 'a'"});
+  require_input_error([&] { (void)read_mesh(one_quad("bc_element", [](CgnsBuilder& f, int z) {
+                          f.section(z, "q", CGNS_ENUMV(QUAD_4), 1, 1, {1, 2, 4, 3});
+                          f.boco(z, "a", CGNS_ENUMV(PointList), {7}, CGNS_ENUMV(EdgeCenter));
+                        })); },
+                      {"/Base/dom/ZoneBC/a", "element 7 is in no section"});
+  require_input_error([&] { (void)read_mesh(one_quad("ngon", [](CgnsBuilder& f, int z) {
+                          int S = 0;
+                          const std::vector<cgsize_t> data{1, 2, 4, 3}, offsets{0, 4};
+                          REQUIRE(cg_poly_section_write(f.id(), f.base(), z, "faces", CGNS_ENUMV(NGON_n), 1, 1, 0, data.data(),
+                                                        offsets.data(), &S) == CG_OK);
+                        })); },
+                      {"/Base/dom/faces", "NGON_n", "polyhedral"});
+  {
+    const fs::path file = dir / "two_bases.cgns";
+    {
+      CgnsBuilder f(file);
+      int b = 0;
+      REQUIRE(cg_base_write(f.id(), "Other", 2, 2, &b) == CG_OK);
+    }
+    require_input_error([&] { (void)read_mesh(file); }, {"2 bases", "Base, Other"});
+  }
+  {
+    const fs::path file = dir / "no_y.cgns";
+    {
+      CgnsBuilder f(file, 2, 2);
+      cgsize_t size[3] = {3, 1, 0};
+      int z = 0, C = 0;
+      REQUIRE(cg_zone_write(f.id(), f.base(), "dom", size, CGNS_ENUMV(Unstructured), &z) == CG_OK);
+      const double x[3] = {0, 1, 0};
+      REQUIRE(cg_coord_write(f.id(), f.base(), z, CGNS_ENUMV(RealDouble), "CoordinateR", x, &C) == CG_OK);
+    }
+    require_input_error([&] { (void)read_mesh(file); }, {"/Base/dom/GridCoordinates", "no CoordinateX", "CoordinateR"});
+  }
+
+  // A group name CGNS cannot hold: nothing written, an existing file untouched.
+  Mesh<2> mesh = rectangle_mesh({.nx = 2, .ny = 2});
+  const fs::path out = dir / "named.cgns";
+  write_mesh(out, mesh);
+  const auto size_before = fs::file_size(out);
+  mesh.groups.front().name = std::string(40, 'w');
+  require_input_error([&] { write_mesh(out, mesh); }, {std::string(40, 'w'), "32 characters"});
+  CHECK(fs::file_size(out) == size_before);
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++files;
+  mesh.groups.front().name = "a/b";
+  CHECK_THROWS_AS(write_mesh(dir / "slash.cgns", mesh), InputError);
+  std::size_t files_after = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++files_after;
+  CHECK(files_after == files);  // no temporary left behind
+}
+
+#else
+
+TEST_CASE("CGNS: without the CGNS library, .cgns files are refused with the reason", "[io][cgns]") {
+  const fs::path file = test::scratch_path("absent_library.cgns");
+  const Mesh<2> mesh = rectangle_mesh({.nx = 2, .ny = 2});
+  CHECK(test::message_of<InputError>([&] { write_mesh(file, mesh); }).find("libcgns-dev") != std::string::npos);
+  CHECK(!fs::exists(file));
+  CHECK_THROWS_AS(check_mesh_output(file), InputError);
+}
+
+#endif
