@@ -16,11 +16,11 @@
 int main(int argc, char** argv) {
   meshmotion::tune_process_memory(argc, argv);  // may restart the program once (core/process_memory.hpp)
   using namespace meshmotion;
-  CLI::App app{"Print the contents of a mesh file (.msh, .su2 or .cgns)"};
+  CLI::App app{"Print the contents of a mesh file (.msh, .su2 or .cgns) or OpenFOAM case"};
   examples::add_version_flag(app);
   std::string file;
   bool json = false;
-  app.add_option("file", file, "mesh file (.msh Gmsh 2.2/4.1, .su2, .cgns)")->required();
+  app.add_option("file", file, "mesh file (.msh Gmsh 2.2/4.1, .su2, .cgns) or OpenFOAM case folder")->required();
   app.add_flag("--json", json, "print one JSON object instead of text");
   CLI11_PARSE(app, argc, argv);
   return examples::guarded(json, [&] {

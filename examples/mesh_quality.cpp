@@ -1,6 +1,7 @@
 // mesh_quality: quality report of a mesh file (Knupp metrics and the certified scaled
 // Jacobian), per metric and per element type; optionally a .vtu with the per-cell values and,
-// for 2D meshes, an SVG picture coloured by the first metric.
+// for 2D meshes, an SVG picture coloured by the first metric. For an OpenFOAM case folder, also
+// checkMesh's measures (non-orthogonality, skewness, aspect ratio, volumes) on its polyhedra.
 //
 //   mesh_quality wing.msh --metric shape --metric jacobian --svg q.svg --zoom 0.9,1.1,-0.05,0.05
 
@@ -13,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -67,6 +69,9 @@ int run(Mesh<Dim>& mesh, const Settings& s) {
       std::cerr << "mesh_quality: --svg is for 2D meshes; " << s.file << " is 3D, no picture written\n";
     }
   }
+  // An OpenFOAM case: checkMesh's measures on its cells as they are (polyhedra included).
+  std::optional<FoamQuality> foam;
+  if (std::filesystem::is_directory(s.file)) foam = foam_quality(read_polymesh(s.file));
   if (s.json) {
     JsonWriter w(std::cout);
     w.begin_object().key("file").value(s.file).key("dim").value(Dim);
@@ -76,11 +81,34 @@ int run(Mesh<Dim>& mesh, const Settings& s) {
       w.key(metric_name(r.metric));
       write_json(w, r);
     }
-    w.end_object().end_object();
+    w.end_object();
+    if (foam) {
+      w.key("checkmesh").begin_object();
+      w.key("solution_directions").value(foam->solution_directions);
+      w.key("max_non_orthogonality").value(foam->max_non_orthogonality).key("average_non_orthogonality").value(foam->average_non_orthogonality);
+      w.key("severely_non_orthogonal_faces").value(foam->num_severely_non_orthogonal);
+      w.key("non_orthogonality_errors").value(foam->num_non_orthogonality_errors);
+      w.key("max_skewness").value(foam->max_skewness).key("highly_skewed_faces").value(foam->num_highly_skewed);
+      w.key("max_aspect_ratio").value(foam->max_aspect_ratio).key("high_aspect_ratio_cells").value(foam->num_high_aspect_ratio);
+      w.key("min_volume").value(foam->min_volume).key("max_volume").value(foam->max_volume).key("total_volume").value(foam->total_volume);
+      w.key("nonpositive_volume_cells").value(foam->num_nonpositive_volumes);
+      w.end_object();
+    }
+    w.end_object();
     std::cout << '\n';
   } else {
     std::cout << s.file << ": " << Dim << "D, " << mesh.num_nodes() << " nodes, " << mesh.num_cells() << " cells\n";
     for (const auto& r : reports) print_report(std::cout, r);
+    if (foam) {
+      std::cout << "checkMesh measures (" << foam->solution_directions << " solution directions):\n"
+                << "  non-orthogonality max " << foam->max_non_orthogonality << " deg, average " << foam->average_non_orthogonality
+                << " deg, " << foam->num_severely_non_orthogonal << " faces above 70, " << foam->num_non_orthogonality_errors
+                << " at 90 or more\n"
+                << "  skewness max " << foam->max_skewness << ", " << foam->num_highly_skewed << " faces above 4\n"
+                << "  aspect ratio max " << foam->max_aspect_ratio << ", " << foam->num_high_aspect_ratio << " cells above 1000\n"
+                << "  volume min " << foam->min_volume << ", max " << foam->max_volume << ", total " << foam->total_volume << ", "
+                << foam->num_nonpositive_volumes << " cells of zero or negative volume\n";
+    }
   }
   return 0;
 }
@@ -92,7 +120,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Mesh quality report: Knupp size/shape/skew metrics and the certified scaled Jacobian of P1/P2 cells"};
   examples::add_version_flag(app);
   Settings s;
-  app.add_option("file", s.file, "mesh file (.msh, .su2, .cgns)")->required()->check(CLI::ExistingFile);
+  app.add_option("file", s.file, "mesh file (.msh, .su2, .cgns) or OpenFOAM case folder")->required()->check(CLI::ExistingPath);
   app.add_option("--metric", s.metrics, "shape, skew, size, size-shape, size-skew or jacobian (repeatable; default shape, skew, size, jacobian)");
   app.add_flag("--json", s.json, "print one JSON object instead of the table");
   app.add_option("--vtu", s.vtu, "write the mesh with one cell array per metric");

@@ -91,6 +91,10 @@ struct Mesh {
   std::vector<PhysicalGroup> groups;               ///< names of the tags
   std::vector<std::int64_t> node_ids;              ///< node ids from the file; empty means 1..n
   std::vector<NodeParametrization> node_params;    ///< empty, or one per node
+  /// The last num_auxiliary_nodes nodes are construction nodes, not the file's: the cell and
+  /// face centres of a polyhedral mesh cut into tetrahedra (io/openfoam.hpp). They move with
+  /// the mesh; formats that store polyhedra write the nodes before them only.
+  Index num_auxiliary_nodes = 0;
 
   [[nodiscard]] Index num_nodes() const noexcept { return points.cols(); }
   [[nodiscard]] Index num_cells() const noexcept { return count(cells); }
@@ -247,6 +251,9 @@ void validate(const Mesh<Dim>& mesh) {
   if (!mesh.node_ids.empty() && static_cast<Index>(mesh.node_ids.size()) != n)
     throw InputError("validate: " + std::to_string(mesh.node_ids.size()) + " node ids for " +
                      std::to_string(n) + " nodes");
+  if (mesh.num_auxiliary_nodes < 0 || mesh.num_auxiliary_nodes > n)
+    throw InputError("validate: " + std::to_string(mesh.num_auxiliary_nodes) + " auxiliary nodes for " + std::to_string(n) +
+                     " nodes");
   if (!mesh.node_params.empty() && static_cast<Index>(mesh.node_params.size()) != n)
     throw InputError("validate: " + std::to_string(mesh.node_params.size()) +
                      " node parametrizations for " + std::to_string(n) + " nodes");

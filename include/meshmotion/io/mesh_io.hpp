@@ -2,7 +2,8 @@
 /// \file
 /// Reading and writing meshes by file extension: .msh (Gmsh 2.2/4.1, ASCII or binary, detected
 /// on reading), .su2 (SU2), .cgns (CGNS, when built with the CGNS library: io/cgns.hpp) and
-/// .vtu (VTK, write only).
+/// .vtu (VTK, write only); a folder is an OpenFOAM case (io/openfoam.hpp): read as its
+/// polyMesh, written by replacing its points.
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
@@ -12,6 +13,7 @@
 #include "meshmotion/io/cgns.hpp"
 #include "meshmotion/io/gmsh_reader.hpp"
 #include "meshmotion/io/gmsh_writer.hpp"
+#include "meshmotion/io/openfoam.hpp"
 #include "meshmotion/io/su2_reader.hpp"
 #include "meshmotion/io/su2_writer.hpp"
 #include "meshmotion/io/vtu_writer.hpp"
@@ -72,7 +74,8 @@ void apply_orientation(Mesh<Dim>& mesh, const std::filesystem::path& file, ReadO
 
 }  // namespace detail
 
-/// Reads a mesh, choosing the format by extension (.msh, .su2 or .cgns). The result is 3D if the file
+/// Reads a mesh, choosing the format by extension (.msh, .su2 or .cgns) or, for a folder, as an
+/// OpenFOAM case. The result is 3D if the file
 /// holds 3D elements (SU2: NDIME 3), else 2D. The mesh is validated, and its orientation
 /// handled as `options` says.
 /// Throws InputError for an unknown extension, IoError for an unreadable file, ParseError (file
@@ -81,10 +84,13 @@ void apply_orientation(Mesh<Dim>& mesh, const std::filesystem::path& file, ReadO
 [[nodiscard]] inline AnyMesh read_mesh(const std::filesystem::path& file, const ReadOptions& options = {}) {
   const std::string ext = detail::lower_extension(file);
   AnyMesh mesh = [&]() -> AnyMesh {
+    std::error_code ec;
+    if (std::filesystem::is_directory(file, ec)) return read_openfoam(file);
     if (ext == ".msh") return read_gmsh(file);
     if (ext == ".su2") return read_su2(file);
     if (ext == ".cgns") return read_cgns(file);
-    throw InputError("read_mesh: " + file.string() + ": unknown mesh format '" + ext + "' (expected .msh, .su2 or .cgns)");
+    throw InputError("read_mesh: " + file.string() + ": unknown mesh format '" + ext +
+                     "' (expected .msh, .su2, .cgns or an OpenFOAM case folder)");
   }();
   std::visit([&](auto& m) { detail::apply_orientation(m, file, options.orientation); }, mesh);
   return mesh;
@@ -107,11 +113,16 @@ struct WriteOptions {
   bool vtu_facets = false;                    ///< .vtu only: also write the facets
 };
 
-/// Writes a mesh, choosing the format by extension (.msh, .su2, .cgns or .vtu), through a temporary
-/// file in the same folder and a rename. Throws InputError for an unknown extension or an
+/// Writes a mesh, choosing the format by extension (.msh, .su2, .cgns or .vtu) or, for an
+/// OpenFOAM case, polyMesh or time folder, replacing the case's points
+/// (write_polymesh_points()), through a temporary file in the same folder and a rename. Throws InputError for an unknown extension or an
 /// invalid mesh (nothing is written), IoError when the file cannot be written.
 template <int Dim>
 void write_mesh(const std::filesystem::path& file, const Mesh<Dim>& mesh, const WriteOptions& options = {}) {
+  if (is_openfoam_target(file)) {
+    if constexpr (Dim == 3) return write_polymesh_points(file, mesh);
+    else throw InputError("write_mesh: " + file.string() + ": an OpenFOAM case holds a 3D mesh (got a 2D one)");
+  }
   const std::string ext = detail::lower_extension(file);
   if (ext == ".msh") return write_gmsh(file, mesh, GmshWriteOptions{options.msh_version, options.binary});
   if (ext == ".su2") return write_su2(file, mesh);
@@ -124,6 +135,11 @@ void write_mesh(const std::filesystem::path& file, const Mesh<Dim>& mesh, const 
 /// linear, 2: quadratic) to `file`: a known extension whose format holds that order, and an
 /// existing folder. Throws InputError saying which formats would do, or naming the folder.
 inline void check_mesh_output(const std::filesystem::path& file, int order = 1) {
+  if (is_openfoam_target(file)) {
+    if (order > 1) throw InputError("output " + file.string() + ": an OpenFOAM case holds linear cells only (expected .msh, .cgns or .vtu for order " +
+                                    std::to_string(order) + ")");
+    return;
+  }
   const std::string ext = detail::lower_extension(file);
   if (ext != ".msh" && ext != ".su2" && ext != ".vtu" && ext != ".cgns")
     throw InputError("output " + file.string() + ": unknown mesh format '" + ext + "' (expected .msh, .su2, .cgns or .vtu)");

@@ -34,6 +34,7 @@ struct GroupSummary {
 struct MeshSummary {
   int dim = 0;
   Index num_nodes = 0;
+  Index num_auxiliary_nodes = 0;  ///< of num_nodes: centres of polyhedra cut into tetrahedra
   std::vector<std::pair<std::string, Index>> cells, facets, lower;  ///< type name, count
   std::vector<GroupSummary> groups;
   std::array<double, 3> bbox_min{}, bbox_max{};   ///< z is 0 in 2D
@@ -48,6 +49,7 @@ template <int Dim>
   MeshSummary s;
   s.dim = Dim;
   s.num_nodes = mesh.num_nodes();
+  s.num_auxiliary_nodes = mesh.num_auxiliary_nodes;
   const auto counts = [](const std::vector<ElementBlock>& list) {
     std::vector<std::pair<std::string, Index>> out;
     for (const auto& b : list) out.emplace_back(std::string(name(b.type)), b.size());
@@ -106,7 +108,11 @@ namespace detail {
 
 /// The summary as readable lines.
 [[nodiscard]] inline std::string to_text(const MeshSummary& s) {
-  std::string out = std::to_string(s.dim) + "D mesh, " + std::to_string(s.num_nodes) + " nodes\n";
+  std::string out = std::to_string(s.dim) + "D mesh, " + std::to_string(s.num_nodes) + " nodes" +
+                    (s.num_auxiliary_nodes > 0 ? " (" + std::to_string(s.num_auxiliary_nodes) +
+                                                     " of them cell and face centres of polyhedra cut into tetrahedra)"
+                                               : std::string()) +
+                    "\n";
   const auto list = [&](const char* title, const std::vector<std::pair<std::string, Index>>& counts) {
     out += title;
     if (counts.empty()) out += " none";
@@ -146,6 +152,7 @@ inline void write_json(JsonWriter& w, const MeshSummary& s) {
     w.end_array();
   };
   w.begin_object().key("dim").value(s.dim).key("nodes").value(s.num_nodes);
+  if (s.num_auxiliary_nodes > 0) w.key("auxiliary_nodes").value(s.num_auxiliary_nodes);
   counts("cells", s.cells);
   counts("facets", s.facets);
   counts("lower", s.lower);

@@ -1,0 +1,367 @@
+// Tests of OpenFOAM polyMesh reading and in-place point writing (io/openfoam.hpp): the shared
+// airFoil2D case with its documented counts, a case with a polyhedral cell (a hanging node)
+// cut into tetrahedra, ASCII, binary and compressed files alike, moved points written into the
+// case or a time folder and read back, and the error for each kind of bad file.
+
+#include "meshmotion/core/orientation.hpp"
+#include "meshmotion/io.hpp"
+#include "meshmotion/io/openfoam_quality.hpp"
+#include "meshmotion/movers.hpp"
+#include "meshmotion/quality.hpp"
+
+#include "io_support.hpp"
+#include "messages.hpp"
+#include "test_data.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+using namespace meshmotion;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+enum class Format { ascii, binary, compressed };
+
+void write_case(const fs::path& case_dir, const PolyMesh& mesh, Format format = Format::ascii) {
+  fs::remove_all(case_dir);
+  write_polymesh(case_dir, mesh, PolyMeshWriteOptions{format == Format::binary, format == Format::compressed});
+  // What OpenFOAM's checkMesh reads beside the mesh.
+  fs::create_directories(case_dir / "system");
+  const auto dictionary = [&](const std::string& object, const std::string& body) {
+    std::ofstream(case_dir / "system" / object) << "FoamFile\n{\n    version 2.0;\n    format ascii;\n    class dictionary;\n    object "
+                                                << object << ";\n}\n" << body;
+  };
+  dictionary("controlDict", "application simpleFoam;\nstartFrom startTime;\nstartTime 0;\nstopAt endTime;\nendTime 1;\n"
+                            "deltaT 1;\nwriteControl timeStep;\nwriteInterval 1;\n");
+  dictionary("fvSchemes", "ddtSchemes { default steadyState; }\ngradSchemes { default Gauss linear; }\ndivSchemes { default none; }\n"
+                          "laplacianSchemes { default Gauss linear corrected; }\ninterpolationSchemes { default linear; }\n"
+                          "snGradSchemes { default corrected; }\n");
+  dictionary("fvSolution", "solvers {}\n");
+}
+
+std::vector<Format> formats() {
+#ifdef MESHMOTION_HAVE_ZLIB
+  return {Format::ascii, Format::binary, Format::compressed};
+#else
+  return {Format::ascii, Format::binary};
+#endif
+}
+
+// Three cells: a polyhedron x in [0,1], y in [0,2] (its +x side split in two faces, its z = 0
+// and z = 1 sides pentagons through the hanging node (1,1)), and two hexahedra beside it.
+PolyMesh hanging_node_case() {
+  PolyMesh c;
+  const double xy[8][2] = {{0, 0}, {1, 0}, {2, 0}, {1, 1}, {2, 1}, {0, 2}, {1, 2}, {2, 2}};
+  c.points.resize(3, 16);
+  for (int z = 0; z < 2; ++z)
+    for (int k = 0; k < 8; ++k) c.points.col(8 * z + k) << xy[k][0], xy[k][1], double(z);
+  const std::vector<std::vector<Index>> faces{
+      {1, 3, 11, 9},     {3, 6, 14, 11},   {3, 11, 12, 4},                   // internal
+      {0, 8, 13, 5},                                                         // wall
+      {2, 4, 12, 10},    {4, 7, 15, 12},                                     // outlet
+      {0, 1, 9, 8},      {1, 2, 10, 9},    {5, 13, 14, 6}, {6, 14, 15, 7},   // y sides
+      {0, 5, 6, 3, 1},   {1, 3, 4, 2},     {3, 6, 7, 4},                     // z = 0
+      {8, 9, 11, 14, 13}, {9, 10, 12, 11}, {11, 12, 15, 14}};                // z = 1
+  for (const auto& f : faces) {
+    c.face_nodes.insert(c.face_nodes.end(), f.begin(), f.end());
+    c.face_offsets.push_back(static_cast<Index>(c.face_nodes.size()));
+  }
+  c.owner = {0, 0, 1, 0, 1, 2, 0, 1, 0, 2, 0, 1, 2, 0, 1, 2};
+  c.neighbour = {1, 2, 2};
+  c.patches = {{"wall", "wall", 3, 1}, {"outlet", "patch", 4, 2}, {"sides", "patch", 6, 4}, {"frontAndBack", "empty", 10, 6}};
+  c.num_cells = 3;
+  return c;
+}
+
+// checkMesh's output on a case, or empty when OpenFOAM is not installed (Debian's openfoam
+// keeps its etc folder in /usr/share/openfoam).
+std::string check_mesh(const fs::path& case_dir) {
+  if (std::system("command -v checkMesh > /dev/null 2>&1") != 0) return {};
+  const fs::path log = case_dir / "checkMesh.log";
+  std::string env;
+  if (fs::exists("/usr/share/openfoam/etc/controlDict")) env = "WM_PROJECT_DIR=/usr/share/openfoam FOAM_ETC=/usr/share/openfoam/etc ";
+  const std::string command = env + "checkMesh -case " + case_dir.string() + " > " + log.string() + " 2>&1";
+  (void)std::system(command.c_str());
+  return read_text(log);
+}
+
+// The number after `label` in checkMesh's report.
+double reported(const std::string& report, const std::string& label) {
+  const std::size_t at = report.find(label);
+  if (at == std::string::npos) FAIL("checkMesh does not report '" << label << "'");
+  return std::stod(report.substr(at + label.size()));
+}
+
+// Our measures against checkMesh's report (6 significant digits there).
+void require_checkmesh_values(const FoamQuality& q, const std::string& report) {
+  INFO(report);
+  CHECK(q.max_aspect_ratio == Approx(reported(report, "Max aspect ratio = ")).epsilon(1e-5));
+  if (report.find("Minimum negative volume: ") != std::string::npos) {
+    CHECK(q.min_volume == Approx(reported(report, "Minimum negative volume: ")).epsilon(1e-5));
+    CHECK(q.num_nonpositive_volumes == static_cast<Index>(reported(report, "Number of negative volume cells: ")));
+  } else {
+    CHECK(q.num_nonpositive_volumes == 0);
+    CHECK(q.min_volume == Approx(reported(report, "Min volume = ")).epsilon(1e-5));
+    CHECK(q.max_volume == Approx(reported(report, "Max volume = ")).epsilon(1e-5));
+    CHECK(q.total_volume == Approx(reported(report, "Total volume = ")).epsilon(1e-5));
+  }
+  CHECK(q.max_non_orthogonality == Approx(reported(report, "non-orthogonality Max: ")).epsilon(1e-5));
+  CHECK(q.average_non_orthogonality == Approx(reported(report, "average: ")).epsilon(1e-5));
+  CHECK(q.max_skewness == Approx(reported(report, "Max skewness = ")).epsilon(1e-5));
+  const bool severe = report.find("severely non-orthogonal") != std::string::npos;
+  CHECK(severe == (q.num_severely_non_orthogonal > 0));
+  if (severe) CHECK(q.num_severely_non_orthogonal == static_cast<Index>(reported(report, "Number of severely non-orthogonal (> 70 degrees) faces: ")));
+  // " ***Max skewness = S, N highly skew faces detected ..."
+  const std::size_t skew_count = report.find(" highly skew faces");
+  CHECK((skew_count != std::string::npos) == (q.num_highly_skewed > 0));
+  if (skew_count != std::string::npos) {
+    const std::size_t from = report.rfind(", ", skew_count) + 2;
+    CHECK(q.num_highly_skewed == std::stol(report.substr(from, skew_count - from)));
+  }
+  const bool errors = report.find("non-orthogonality errors") != std::string::npos;
+  CHECK(errors == (q.num_non_orthogonality_errors > 0));
+  if (errors) CHECK(q.num_non_orthogonality_errors == static_cast<Index>(reported(report, "Number of non-orthogonality errors: ")));
+}
+
+double total_volume(const Mesh<3>& mesh) {
+  double v = 0;
+  for (const auto& b : mesh.cells)
+    for (Index e = 0; e < b.size(); ++e) v += signed_measure(mesh, b.type, b.element(e));
+  return v;
+}
+
+}  // namespace
+
+TEST_CASE("OpenFOAM: the airFoil2D case reads with checkMesh's counts, all hexahedra", "[io][openfoam]") {
+  MESHMOTION_REQUIRE_DATA(file, "openfoam_airFoil2D_polyMesh");
+  const PolyMesh poly = read_polymesh(file);
+  CHECK(poly.points.cols() == 21812);
+  CHECK(poly.num_faces() == 43066);
+  CHECK(poly.num_internal_faces() == 21254);
+  CHECK(poly.num_cells == 10720);
+  REQUIRE(poly.patches.size() == 4);
+  CHECK(poly.patches[2].name == "walls");
+  CHECK(poly.patches[2].type == "wall");
+  CHECK(poly.patches[3].size == 21440);
+  const Mesh<3> mesh = std::get<Mesh<3>>(read_mesh(file));
+  CHECK(mesh.num_auxiliary_nodes == 0);
+  CHECK(mesh.num_nodes() == 21812);
+  REQUIRE(mesh.cells.size() == 1);
+  CHECK(mesh.cells.front().type == ElementType::hex8);
+  CHECK(mesh.cells.front().size() == 10720);
+  CHECK(orientation_report(mesh).num_negative == 0);
+  CHECK(test::group_size(mesh, "walls") == 78);
+  CHECK(test::group_size(mesh, "frontAndBack") == 21440);
+  CHECK(mesh.points == poly.points);
+}
+
+TEST_CASE("OpenFOAM: a polyhedral cell is cut into tetrahedra around auxiliary centres", "[io][openfoam]") {
+  const PolyMesh c = hanging_node_case();
+  for (const auto format : formats()) {
+    INFO("format " << static_cast<int>(format));
+    const fs::path dir = test::scratch_path("foam_hanging");
+    write_case(dir, c, format);
+    const PolyMesh poly = read_polymesh(dir);
+    CHECK(poly.num_cells == 3);
+    CHECK(poly.face(10).size() == 5);
+    const Mesh<3> mesh = read_openfoam(dir);
+    // 16 points, then a centre per face of 4 or 5 vertices (16) and per cell (3).
+    CHECK(mesh.num_auxiliary_nodes == 19);
+    CHECK(mesh.num_nodes() == 35);
+    REQUIRE(mesh.cells.size() == 1);
+    CHECK(mesh.cells.front().size() == 30 + 24 + 24);
+    CHECK(orientation_report(mesh).num_negative == 0);
+    CHECK(total_volume(mesh) == Approx(4.0).epsilon(1e-12));
+    CHECK(quality_report(mesh, Metric::scaled_jacobian).num_invalid == 0);
+    // The wall quad becomes 4 triangles around its centre, a patch's facets.
+    CHECK(test::group_size(mesh, "wall") == 4);
+    CHECK(test::group_size(mesh, "sides") == 4 * 4);
+    CHECK(test::group_size(mesh, "frontAndBack") == 2 * 5 + 4 * 4);
+    CHECK(mesh.points.leftCols(16) == c.points);
+  }
+  // OpenFOAM's own checkMesh reads the case we wrote: 3 cells, one of them a polyhedron.
+  const fs::path dir = test::scratch_path("foam_checkmesh");
+  write_case(dir, c);
+  const std::string report = check_mesh(dir);
+  if (report.empty()) {
+    WARN("checkMesh not installed (Debian openfoam): the written case was not checked by OpenFOAM");
+    return;
+  }
+  INFO(report);
+  CHECK_THAT(report, Catch::Contains("cells:            3") && Catch::Contains("polyhedra:     1") && Catch::Contains("Mesh OK."));
+}
+
+TEST_CASE("OpenFOAM: moved points go into the case or a time folder, in the case's format", "[io][openfoam]") {
+  const PolyMesh c = hanging_node_case();
+  for (const auto format : formats()) {
+    INFO("format " << static_cast<int>(format));
+    const fs::path dir = test::scratch_path("foam_moved");
+    write_case(dir, c, format);
+    const fs::path poly_dir = dir / "constant" / "polyMesh";
+    const std::string suffix = format == Format::compressed ? ".gz" : "";
+    const std::string faces_before = read_text(poly_dir / ("faces" + suffix));
+    const std::string points_before = read_text(poly_dir / ("points" + suffix));
+    Mesh<3> mesh = read_openfoam(dir);
+    for (Index i = 0; i < mesh.num_nodes(); ++i) mesh.points.col(i) += Vec<3>(0.1, 1.0 / 3.0, 0.0) * (1.0 + mesh.points(0, i));
+
+    // A time folder: created, the constant mesh left alone.
+    CHECK(is_openfoam_target(dir / "0.5"));
+    write_mesh(dir / "0.5", mesh);
+    CHECK(read_text(poly_dir / ("points" + suffix)) == points_before);
+    const Points<3> at_time = detail::read_foam_points(dir / "0.5" / "polyMesh" / "points");
+    CHECK(at_time == mesh.points.leftCols(16));  // every digit kept
+    CHECK(detail::read_foam_file(dir / "0.5" / "polyMesh" / "points").find("\"0.5/polyMesh\"") != std::string::npos);
+
+    // In place: only the points change.
+    write_mesh(dir, mesh);
+    CHECK(read_text(poly_dir / ("faces" + suffix)) == faces_before);
+    const Mesh<3> back = read_openfoam(dir);
+    CHECK(back.points.leftCols(16) == mesh.points.leftCols(16));
+    CHECK(back.cells.front().connectivity == mesh.cells.front().connectivity);
+    std::size_t files = 0;
+    for ([[maybe_unused]] const auto& e : fs::directory_iterator(poly_dir)) ++files;
+    CHECK(files == 5);  // no temporary left, no second points file
+    if (format == Format::ascii) {
+      const std::string report = check_mesh(dir);
+      INFO(report);
+      if (!report.empty()) CHECK_THAT(report, Catch::Contains("Mesh OK."));
+    }
+  }
+}
+
+TEST_CASE("OpenFOAM: each kind of bad case gets a clear error and nothing is written", "[io][openfoam]") {
+  const fs::path dir = test::scratch_path("foam_bad");
+  const auto message = [&](PolyMesh c) {
+    write_case(dir, c);
+    return test::message_of<InputError>([&] { (void)read_openfoam(dir); });
+  };
+  {
+    // An owner list one short (the writer wants one per face: cut the file instead).
+    write_case(dir, hanging_node_case());
+    const fs::path owner = dir / "constant" / "polyMesh" / "owner";
+    std::string text = read_text(owner);
+    text.replace(text.find("\n16\n"), 4, "\n15\n");
+    text.erase(text.rfind("2\n)"), 2);
+    std::ofstream(owner, std::ios::binary) << text;
+    CHECK_THAT(test::message_of<InputError>([&] { (void)read_openfoam(dir); }), Catch::Contains("owner") && Catch::Contains("15 entries for 16 faces"));
+  }
+  {
+    PolyMesh c = hanging_node_case();
+    c.face_nodes[static_cast<std::size_t>(c.face_offsets[5]) + 2] = 99;
+    CHECK_THAT(message(c), Catch::Contains("faces") && Catch::Contains("face 5 has vertex 99"));
+  }
+  {
+    write_case(dir, hanging_node_case());
+    const fs::path boundary = dir / "constant" / "polyMesh" / "boundary";
+    std::string text = read_text(boundary);
+    text.replace(text.rfind("nFaces          6;"), 18, "nFaces          5;");
+    std::ofstream(boundary, std::ios::binary) << text;
+    CHECK_THAT(test::message_of<InputError>([&] { (void)read_openfoam(dir); }),
+               Catch::Contains("boundary") && Catch::Contains("the patches end at face 15"));
+  }
+  {
+    PolyMesh c = hanging_node_case();
+    c.neighbour[1] = 0;
+    CHECK_THAT(message(c), Catch::Contains("internal face 1 has neighbour 0 (owner 0)"));
+  }
+  {
+    // A truncated list: the file and line of the end.
+    write_case(dir, hanging_node_case());
+    const fs::path faces = dir / "constant" / "polyMesh" / "faces";
+    std::string text = read_text(faces);
+    std::ofstream(faces, std::ios::binary) << text.substr(0, text.size() / 2);
+    const std::string m = test::message_of<ParseError>([&] { (void)read_openfoam(dir); });
+    CHECK_THAT(m, Catch::Contains("faces:") && Catch::Contains("unexpected end of file"));
+  }
+  {
+    // A binary list shorter than its count says.
+    write_case(dir, hanging_node_case(), Format::binary);
+    const fs::path owner = dir / "constant" / "polyMesh" / "owner";
+    std::string text = read_text(owner);
+    std::ofstream(owner, std::ios::binary) << text.substr(0, text.rfind(')') - 30);
+    CHECK_THAT(test::message_of<ParseError>([&] { (void)read_openfoam(dir); }), Catch::Contains("owner: byte") && Catch::Contains("binary owner ends"));
+  }
+  CHECK_THAT(test::message_of<IoError>([&] { (void)read_mesh(test::scratch_path("")); }), Catch::Contains("not an OpenFOAM case"));
+
+  // Another mesh's points are refused, and the case keeps its own.
+  write_case(dir, hanging_node_case());
+  const fs::path points = dir / "constant" / "polyMesh" / "points";
+  const std::string before = read_text(points);
+  Mesh<3> other = read_openfoam(dir);
+  other.points.conservativeResize(3, other.num_nodes() + 1);
+  other.points.col(other.num_nodes() - 1).setZero();
+  CHECK_THAT(test::message_of<InputError>([&] { write_mesh(dir, other); }), Catch::Contains("the mesh has 17 points, the case 16"));
+  CHECK(read_text(points) == before);
+  CHECK_THROWS_AS(check_mesh_output(dir, 2), InputError);
+  CHECK_NOTHROW(check_mesh_output(dir, 1));
+  CHECK_NOTHROW(check_mesh_output(dir / "0.25", 1));
+}
+
+TEST_CASE("OpenFOAM: checkMesh's measures agree with checkMesh on the shared case, a moved one and a polyhedral one",
+          "[io][openfoam][quality]") {
+  // The polyhedral case: volumes are exact (planar faces).
+  const PolyMesh hanging = hanging_node_case();
+  const FoamQuality h = foam_quality(hanging);
+  CHECK(h.solution_directions == 2);  // its z sides are an empty patch
+  CHECK(h.min_volume == Approx(1.0).epsilon(1e-14));
+  CHECK(h.max_volume == Approx(2.0).epsilon(1e-14));
+  CHECK(h.total_volume == Approx(4.0).epsilon(1e-14));
+  CHECK(h.num_nonpositive_volumes == 0);
+  const fs::path dir = test::scratch_path("foam_quality");
+  write_case(dir, hanging);
+  if (const std::string report = check_mesh(dir); !report.empty()) require_checkmesh_values(h, report);
+  else WARN("checkMesh not installed (Debian openfoam): compared with exact values only");
+  // The same cells in 3D (no empty patch): all three directions count.
+  PolyMesh solid = hanging;
+  solid.patches.back().type = "wall";
+  const FoamQuality h3 = foam_quality(solid);
+  CHECK(h3.solution_directions == 3);
+  write_case(dir, solid);
+  if (const std::string report = check_mesh(dir); !report.empty()) require_checkmesh_values(h3, report);
+
+  const auto shared = test::shared_data("openfoam_airFoil2D_polyMesh");
+  if (!shared) {
+    WARN("skipped: openfoam_airFoil2D_polyMesh not found (../shared/data is absent here)");
+    return;
+  }
+  PolyMesh poly = read_polymesh(*shared);
+  const FoamQuality q = foam_quality(poly);
+  // checkMesh (OpenFOAM 1912) on this case printed these.
+  CHECK(q.solution_directions == 2);
+  CHECK(q.max_aspect_ratio == Approx(98.7681).epsilon(1e-5));
+  CHECK(q.min_volume == Approx(0.00085511).epsilon(1e-5));
+  CHECK(q.max_volume == Approx(35.4259).epsilon(1e-5));
+  CHECK(q.total_volume == Approx(10564.5).epsilon(1e-5));
+  CHECK(q.max_non_orthogonality == Approx(41.6237).epsilon(1e-5));
+  CHECK(q.average_non_orthogonality == Approx(7.52805).epsilon(1e-5));
+  CHECK(q.max_skewness == Approx(0.983306).epsilon(1e-5));
+  write_case(dir, poly);
+  if (const std::string report = check_mesh(dir); !report.empty()) require_checkmesh_values(q, report);
+
+  // Moved: a swirl around the airfoil that fades with distance, strong enough to fold cells.
+  for (Index i = 0; i < poly.points.cols(); ++i) {
+    const double x = poly.points(0, i), y = poly.points(1, i);  // the airfoil spans x in [-17.5, 17.5]
+    const double turn = 8.0 * std::exp(-(x * x + y * y) / 100.0);
+    const double c = std::cos(turn), sn = std::sin(turn);
+    poly.points(0, i) = c * x - sn * y;
+    poly.points(1, i) = sn * x + c * y;
+  }
+  const FoamQuality moved = foam_quality(poly);
+  CHECK(moved.num_severely_non_orthogonal > 0);
+  CHECK(moved.num_non_orthogonality_errors > 0);
+  CHECK(moved.num_nonpositive_volumes > 0);
+  CHECK(moved.num_highly_skewed > 0);
+  write_case(dir, poly);
+  if (const std::string report = check_mesh(dir); !report.empty()) require_checkmesh_values(moved, report);
+}
