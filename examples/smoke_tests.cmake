@@ -252,6 +252,29 @@ if(MESHMOTION_HAVE_CGNS)
              COMMAND mesh_quality "${smoke_dir}/moved_demo.cgns" --metric jacobian --json)
 endif()
 
+# OpenFOAM cases: a 3D mesh written as a new case (a folder), read back by mesh_info and
+# mesh_quality (with checkMesh's measures), moved into a time folder of the case, and the case
+# itself refused as output without --overwrite.
+file(WRITE "${smoke_dir}/two_hexes.su2" "NDIME= 3\nNELEM= 2\n12 0 1 4 3 6 7 10 9 0\n12 1 2 5 4 7 8 11 10 1\nNPOIN= 12\n"
+     "0 0 0 0\n1 0 0 1\n2 0 0 2\n0 1 0 3\n1 1 0 4\n2 1 0 5\n0 0 1 6\n1 0 1 7\n2 0 1 8\n0 1 1 9\n1 1 1 10\n2 1 1 11\n"
+     "NMARK= 2\nMARKER_TAG= bottom\nMARKER_ELEMS= 2\n9 0 3 4 1\n9 1 4 5 2\nMARKER_TAG= top\nMARKER_ELEMS= 2\n9 6 7 10 9\n9 7 8 11 10\n")
+file(REMOVE_RECURSE "${smoke_dir}/foam_case")
+smoke_test(NAME move_mesh.new_openfoam_case.json SETUP examples_foam_case KEYS output VALUES after/invalid=0
+           COMMAND move_mesh "${smoke_dir}/two_hexes.su2" -o "${smoke_dir}/foam_case" --group top --translate 0,0,0.1
+                   --fixed bottom --json)
+smoke_test(NAME mesh_info.openfoam.json REQUIRES examples_foam_case KEYS mesh/groups VALUES mesh/nodes=12,mesh/cells/hex8=2
+           COMMAND mesh_info "${smoke_dir}/foam_case" --json)
+smoke_test(NAME mesh_quality.openfoam.json REQUIRES examples_foam_case
+           KEYS checkmesh/max_non_orthogonality,checkmesh/max_skewness,checkmesh/max_aspect_ratio
+           VALUES checkmesh/solution_directions=3,checkmesh/highly_skewed_faces=0,checkmesh/nonpositive_volume_cells=0
+           COMMAND mesh_quality "${smoke_dir}/foam_case" --json)
+smoke_test(NAME move_mesh.openfoam_time_folder.json REQUIRES examples_foam_case KEYS output VALUES after/invalid=0
+           COMMAND move_mesh "${smoke_dir}/foam_case" -o "${smoke_dir}/foam_case/0.5" --group top --translate 0.05,0,0
+                   --fixed bottom --json)
+smoke_test(NAME move_mesh.openfoam_in_place_needs_overwrite.json REQUIRES examples_foam_case EXPECT_RC 1 KEYS error
+           COMMAND move_mesh "${smoke_dir}/foam_case" -o "${smoke_dir}/foam_case" --group top --translate 0.05,0,0
+                   --fixed bottom --json)
+
 # move_mesh_mpi: the same mesh as move_mesh's, byte for byte, from 3 ranks; elasticity through
 # PETSc; an unknown group refused by every rank with rank 0's message.
 if(TARGET move_mesh_mpi)

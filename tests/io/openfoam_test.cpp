@@ -3,6 +3,7 @@
 // cut into tetrahedra, ASCII, binary and compressed files alike, moved points written into the
 // case or a time folder and read back, and the error for each kind of bad file.
 
+#include "meshmotion/core/generators.hpp"
 #include "meshmotion/core/orientation.hpp"
 #include "meshmotion/io.hpp"
 #include "meshmotion/io/openfoam_quality.hpp"
@@ -15,6 +16,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -364,4 +366,51 @@ TEST_CASE("OpenFOAM: checkMesh's measures agree with checkMesh on the shared cas
   CHECK(moved.num_highly_skewed > 0);
   write_case(dir, poly);
   if (const std::string report = check_mesh(dir); !report.empty()) require_checkmesh_values(moved, report);
+}
+
+TEST_CASE("OpenFOAM: a mixed mesh written as a new case reads back cell by cell and passes checkMesh", "[io][openfoam]") {
+  for (const auto cells : {BoxCells::tet_pyramid_prism, BoxCells::hex_prism, BoxCells::pyramid5, BoxCells::tet4}) {
+    INFO("box cells " << static_cast<int>(cells));
+    const Mesh<3> box = box_mesh({.nx = 4, .ny = 3, .nz = 2, .cells = cells});
+    const fs::path dir = test::scratch_path("foam_new_case");
+    fs::remove_all(dir);
+    CHECK(is_new_openfoam_case(dir));
+    write_mesh(dir, box);
+    CHECK(is_openfoam_target(dir));
+    const Mesh<3> back = read_openfoam(dir);
+    CHECK(back.num_auxiliary_nodes == 0);
+    CHECK(back.points == box.points);
+    CHECK(orientation_report(back).num_negative == 0);
+    // Cell by cell (OpenFOAM's cell c is the mesh's c-th cell): the same type and vertices.
+    const auto by_cell = [](const Mesh<3>& m, bool use_ids) {
+      std::vector<std::pair<ElementType, std::vector<Index>>> out(static_cast<std::size_t>(m.num_cells()));
+      Index position = 0;
+      for (const auto& b : m.cells)
+        for (Index e = 0; e < b.size(); ++e, ++position) {
+          const auto nodes = b.element(e);
+          std::vector<Index> sorted(nodes.begin(), nodes.end());
+          std::sort(sorted.begin(), sorted.end());
+          out[static_cast<std::size_t>(use_ids ? b.ids[static_cast<std::size_t>(e)] - 1 : position)] = {b.type, sorted};
+        }
+      return out;
+    };
+    CHECK(by_cell(back, true) == by_cell(box, false));
+    for (const auto& g : box.groups)
+      if (g.dim == 2) CHECK(back.group_nodes(back.group(g.name).tag) == box.group_nodes(g.tag));
+    if (const std::string report = check_mesh(dir); !report.empty()) {
+      write_case(dir, read_polymesh(dir));  // the same case with the dictionaries checkMesh wants
+      const std::string full = check_mesh(dir);
+      INFO(full);
+      CHECK_THAT(full, Catch::Contains("Mesh OK."));
+      require_checkmesh_values(foam_quality(read_polymesh(dir)), full);
+    }
+  }
+  // A new case only where there is nothing to lose.
+  const fs::path file = test::scratch_path("foam_not_empty");
+  fs::remove_all(file);
+  fs::create_directories(file);
+  std::ofstream(file / "keep.txt") << "x";
+  CHECK_FALSE(is_new_openfoam_case(file));
+  CHECK_THROWS_AS(write_mesh(file, box_mesh({})), InputError);
+  CHECK(fs::exists(file / "keep.txt"));
 }

@@ -115,13 +115,19 @@ struct WriteOptions {
 
 /// Writes a mesh, choosing the format by extension (.msh, .su2, .cgns or .vtu) or, for an
 /// OpenFOAM case, polyMesh or time folder, replacing the case's points
-/// (write_polymesh_points()), through a temporary file in the same folder and a rename. Throws InputError for an unknown extension or an
+/// (write_polymesh_points()), or, for a path without extension that does not exist or is an
+/// empty folder, writing a new OpenFOAM case (to_polymesh(), write_polymesh()); through
+/// temporary files in the same folder and renames. Throws InputError for an unknown extension or an
 /// invalid mesh (nothing is written), IoError when the file cannot be written.
 template <int Dim>
 void write_mesh(const std::filesystem::path& file, const Mesh<Dim>& mesh, const WriteOptions& options = {}) {
-  if (is_openfoam_target(file)) {
-    if constexpr (Dim == 3) return write_polymesh_points(file, mesh);
-    else throw InputError("write_mesh: " + file.string() + ": an OpenFOAM case holds a 3D mesh (got a 2D one)");
+  if (is_openfoam_target(file) || is_new_openfoam_case(file)) {
+    if constexpr (Dim == 3) {
+      if (is_openfoam_target(file)) return write_polymesh_points(file, mesh);
+      return write_polymesh(file, to_polymesh(mesh));
+    } else {
+      throw InputError("write_mesh: " + file.string() + ": an OpenFOAM case holds a 3D mesh (got a 2D one)");
+    }
   }
   const std::string ext = detail::lower_extension(file);
   if (ext == ".msh") return write_gmsh(file, mesh, GmshWriteOptions{options.msh_version, options.binary});
@@ -135,7 +141,7 @@ void write_mesh(const std::filesystem::path& file, const Mesh<Dim>& mesh, const 
 /// linear, 2: quadratic) to `file`: a known extension whose format holds that order, and an
 /// existing folder. Throws InputError saying which formats would do, or naming the folder.
 inline void check_mesh_output(const std::filesystem::path& file, int order = 1) {
-  if (is_openfoam_target(file)) {
+  if (is_openfoam_target(file) || is_new_openfoam_case(file)) {
     if (order > 1) throw InputError("output " + file.string() + ": an OpenFOAM case holds linear cells only (expected .msh, .cgns or .vtu for order " +
                                     std::to_string(order) + ")");
     return;

@@ -28,6 +28,7 @@
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/topology.hpp"
 #include "meshmotion/io/detail/atomic_file.hpp"
 #include "meshmotion/io/detail/number_format.hpp"
 #include "meshmotion/io/detail/read_file.hpp"
@@ -46,6 +47,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <unordered_map>
 #include <vector>
 
 #ifdef MESHMOTION_HAVE_ZLIB
@@ -771,6 +773,100 @@ struct SmallCell {
   return mesh;
 }
 
+/// The polyMesh of a linear 3D mesh: its nodes as points, its cells as cells (same order), each
+/// face once, oriented out of its owner (the lower-numbered cell), internal faces in upper
+/// triangular order, then one patch per facet group holding the boundary faces its facets
+/// cover (named after the group, type `patch`), and `defaultFaces` for boundary faces no
+/// facet covers. Throws InputError for quadratic elements or a face shared by three cells.
+[[nodiscard]] inline PolyMesh to_polymesh(const Mesh<3>& mesh) {
+  validate(mesh);
+  for (const auto* list : {&mesh.cells, &mesh.facets})
+    for (const auto& b : *list)
+      if (order(b.type) > 1) throw InputError("to_polymesh: OpenFOAM meshes are linear (the mesh has " + std::string(name(b.type)) + ")");
+  const FacetTopology topo = unique_facets(mesh);
+  PolyMesh poly;
+  poly.points = mesh.points;
+  poly.num_cells = mesh.num_cells();
+  // Boundary faces by facet group: the tag of the facet element on each face.
+  const auto key_of = [](std::span<const Index> v) {
+    std::array<Index, 4> k{-1, -1, -1, -1};
+    const std::size_t n = std::min<std::size_t>(v.size(), 4);
+    for (std::size_t i = 0; i < n; ++i) {  // insertion sort of at most 4 vertices
+      std::size_t j = i;
+      for (; j > 0 && k[j - 1] > v[i]; --j) k[j] = k[j - 1];
+      k[j] = v[i];
+    }
+    return k;
+  };
+  struct KeyHash {
+    std::size_t operator()(const std::array<Index, 4>& k) const noexcept {
+      std::size_t h = 0;
+      for (const Index v : k) h = h * 0x9E3779B97F4A7C15ull + static_cast<std::size_t>(v);
+      return h;
+    }
+  };
+  std::unordered_map<std::array<Index, 4>, int, KeyHash> tag_of_face;
+  for (const auto& b : mesh.facets)
+    for (Index e = 0; e < b.size(); ++e) tag_of_face.emplace(key_of(b.element(e).first(static_cast<std::size_t>(num_vertices(b.type)))), b.tags[static_cast<std::size_t>(e)]);
+  std::vector<int> tags;  // patch order: the named facet groups, then other tags, then 0
+  for (const auto& g : mesh.groups)
+    if (g.dim == 2 && std::find(tags.begin(), tags.end(), g.tag) == tags.end()) tags.push_back(g.tag);
+
+  struct Face {
+    Index owner, neighbour;  // neighbour -1 on the boundary
+    int patch;
+    Index facet;
+    bool flip;
+  };
+  std::vector<Face> faces;
+  faces.reserve(topo.vertices.size());
+  for (Index f = 0; f < topo.size(); ++f) {
+    const auto& e = topo.elements[static_cast<std::size_t>(f)];
+    if (topo.count[static_cast<std::size_t>(f)] == 2) {
+      faces.push_back({std::min(e[0], e[1]), std::max(e[0], e[1]), -1, f, e[0] > e[1]});
+      continue;
+    }
+    const auto v = std::span<const Index>(topo.vertices[static_cast<std::size_t>(f)].data(), static_cast<std::size_t>(topo.num_vertices[static_cast<std::size_t>(f)]));
+    const auto it = tag_of_face.find(key_of(v));
+    const int tag = it == tag_of_face.end() ? 0 : it->second;
+    auto at = std::find(tags.begin(), tags.end(), tag);
+    if (at == tags.end()) at = tags.insert(tags.end(), tag);
+    faces.push_back({e[0], -1, static_cast<int>(at - tags.begin()), f, false});
+  }
+  // Tag 0 (no group) last, as defaultFaces.
+  if (const auto zero = std::find(tags.begin(), tags.end(), 0); zero != tags.end()) {
+    const int old = static_cast<int>(zero - tags.begin());
+    tags.erase(zero);
+    tags.push_back(0);
+    for (Face& f : faces)
+      if (f.patch >= 0) f.patch = f.patch == old ? static_cast<int>(tags.size()) - 1 : f.patch > old ? f.patch - 1 : f.patch;
+  }
+  std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) {
+    if ((a.patch < 0) != (b.patch < 0)) return a.patch < 0;
+    if (a.patch != b.patch) return a.patch < b.patch;
+    return a.owner != b.owner ? a.owner < b.owner : a.neighbour < b.neighbour;
+  });
+  poly.face_nodes.reserve(4 * faces.size());
+  for (const Face& f : faces) {
+    const auto& v = topo.vertices[static_cast<std::size_t>(f.facet)];
+    const int n = topo.num_vertices[static_cast<std::size_t>(f.facet)];
+    for (int k = 0; k < n; ++k) poly.face_nodes.push_back(v[static_cast<std::size_t>(f.flip ? n - 1 - k : k)]);
+    poly.face_offsets.push_back(static_cast<Index>(poly.face_nodes.size()));
+    poly.owner.push_back(f.owner);
+    if (f.patch < 0) poly.neighbour.push_back(f.neighbour);
+  }
+  Index start = poly.num_internal_faces();
+  for (std::size_t p = 0; p < tags.size(); ++p) {
+    const Index size = static_cast<Index>(std::count_if(faces.begin(), faces.end(), [&](const Face& f) { return f.patch == static_cast<int>(p); }));
+    std::string patch_name = tags[p] == 0 ? "defaultFaces" : "tag_" + std::to_string(tags[p]);
+    for (const auto& g : mesh.groups)
+      if (g.dim == 2 && g.tag == tags[p]) patch_name = g.name;
+    poly.patches.push_back({patch_name, "patch", start, size});
+    start += size;
+  }
+  return poly;
+}
+
 /// Reads an OpenFOAM case or polyMesh folder as a Mesh<3> (read_polymesh, then to_mesh).
 [[nodiscard]] inline Mesh<3> read_openfoam(const std::filesystem::path& path) {
   Mesh<3> mesh = to_mesh(read_polymesh(path));
@@ -803,9 +899,19 @@ struct FoamPointsTarget {
 
 }  // namespace detail
 
-/// Whether write_mesh() treats `path` as an OpenFOAM output (a case, polyMesh or time folder).
+/// Whether write_mesh() treats `path` as an OpenFOAM output whose points it replaces (a case,
+/// polyMesh or time folder).
 [[nodiscard]] inline bool is_openfoam_target(const std::filesystem::path& path) {
   return !detail::foam_points_target(path).points.empty();
+}
+
+/// Whether write_mesh() writes a whole new OpenFOAM case at `path`: a path without extension
+/// that does not exist or is an empty folder.
+[[nodiscard]] inline bool is_new_openfoam_case(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (path.empty() || !path.extension().empty() || is_openfoam_target(path)) return false;
+  if (!std::filesystem::exists(path, ec)) return true;
+  return std::filesystem::is_directory(path, ec) && std::filesystem::is_empty(path, ec);
 }
 
 /// Replaces the points of the OpenFOAM case at `target` by the mesh's nodes (those before the
@@ -869,6 +975,9 @@ inline void write_polymesh(const std::filesystem::path& case_dir, const PolyMesh
     next += p.size;
   }
   if (next != nf) throw InputError("write_polymesh: the patches end at face " + std::to_string(next) + " of " + std::to_string(nf));
+  for (const auto& p : mesh.patches)
+    if (p.name.empty() || p.name.find_first_of(" \t\n\"';{}()/\\") != std::string::npos)
+      throw InputError("write_polymesh: patch name '" + p.name + "' is not an OpenFOAM word (no blanks, quotes, ;, braces, parentheses or slashes)");
 #ifndef MESHMOTION_HAVE_ZLIB
   if (options.compressed) throw InputError("write_polymesh: compressed files need zlib (meshmotion was built without it)");
 #endif
