@@ -114,11 +114,7 @@ int run(Mesh<Dim> linear, const Arguments& args) {
   if (!args.demo) examples::handle_orientation(linear, args.input, args.keep_orientation);
   const CurveOptions<Dim> options = curve_options<Dim>(args);
   const CurveResult<Dim> result = curve_mesh(linear, options);
-  const auto values = [&] {
-    std::vector<double> v;
-    for (const auto& c : evaluate_cells(result.curved, Metric::scaled_jacobian)) v.push_back(c.value);
-    return v;
-  }();
+  const std::vector<double>& values = result.cell_quality;
   write_mesh(args.output, result.curved);
   const std::filesystem::path vtu = with_extension(args.output, ".vtu");
   VtuFields fields;

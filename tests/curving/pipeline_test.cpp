@@ -271,6 +271,10 @@ TEST_CASE("pipeline: boundary-layer mesh (aspect ratio >= 1000) needs the regula
     INFO(method << ": min " << curved.quality.min << ", radius " << curved.support_radius);
     CHECK(curved.invalid() == 0);
     CHECK(curved.quality.min > 0.3);
+    // The per-cell values behind the report, in cell order (what the program writes to its .vtu).
+    REQUIRE(curved.cell_quality.size() == static_cast<std::size_t>(curved.curved.num_cells()));
+    CHECK(*std::min_element(curved.cell_quality.begin(), curved.cell_quality.end()) == curved.quality.min);
+    CHECK(curved.cell_quality[static_cast<std::size_t>(curved.quality.worst.front().id)] == curved.quality.min);
     CHECK(curved.moved_nodes > 0);
     REQUIRE(curved.layers.size() == 2);  // the farfield is spline-curved too, and has no layer
     CHECK(curved.layers[0].group == "wall");

@@ -155,6 +155,7 @@ struct CurveResult {
   Index solver_iterations = 0;      ///< summed over steps
   std::vector<MoverStats> steps;    ///< per step
   QualityReport quality;            ///< certified scaled Jacobian
+  std::vector<double> cell_quality;  ///< the certified scaled Jacobian of each cell, in cell order
   [[nodiscard]] Index invalid() const noexcept { return quality.num_invalid; }
 };
 
@@ -434,7 +435,12 @@ void regularize_and_certify(Mover& mover, const ResolvedBoundary<Dim>& boundary,
 
   detail::report_progress(options.progress, "certifying " + std::to_string(mesh.num_cells()) + " cells (scaled Jacobian)");
   const detail::Stopwatch certify_clock;
-  result.quality = quality_report(mesh, Metric::scaled_jacobian, options.report);
+  {
+    const std::vector<CellQuality> cells = evaluate_cells(mesh, Metric::scaled_jacobian, options.report.quality);
+    result.quality = make_report(mesh, Metric::scaled_jacobian, cells, options.report);
+    result.cell_quality.reserve(cells.size());
+    for (const CellQuality& c : cells) result.cell_quality.push_back(c.value);
+  }
   result.seconds.certify = certify_clock.seconds();
   if (options.strict && result.quality.num_invalid > 0) {
     const WorstElement& w = result.quality.worst.front();
