@@ -153,28 +153,15 @@ class FoamCursor {
 
   void expect(std::string_view expected) {
     const std::string_view t = token(expected);
-    if (t != expected) fail("expected '" + std::string(expected) + "' (got '" + shorten(t) + "')");
+    if (t != expected) fail("expected '" + std::string(expected) + "' (got '" + shorten_token(t) + "')");
   }
 
   template <class T>
   [[nodiscard]] T integer(std::string_view what, T lo, T hi) {
-    const std::string_view t = token(what);
-    std::int64_t v = 0;
-    const auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-    if (ec != std::errc() || ptr != t.data() + t.size()) fail("expected " + std::string(what) + " as an integer (got '" + shorten(t) + "')");
-    if (v < static_cast<std::int64_t>(lo) || v > static_cast<std::int64_t>(hi))
-      fail(std::string(what) + " out of range (got " + std::to_string(v) + ", expected " + std::to_string(lo) + " to " +
-           std::to_string(hi) + ")");
-    return static_cast<T>(v);
+    return integer_token(token(what), what, lo, hi, [this](const std::string& m) { fail(m); });
   }
   [[nodiscard]] double real(std::string_view what) {
-    const std::string_view t = token(what);
-    double v = 0;
-    const char* first = t.data() + (t.size() > 1 && t[0] == '+' ? 1 : 0);
-    const auto [ptr, ec] = std::from_chars(first, t.data() + t.size(), v);
-    if (ec != std::errc() || ptr != t.data() + t.size()) fail("expected " + std::string(what) + " as a number (got '" + shorten(t) + "')");
-    if (!std::isfinite(v)) fail(std::string(what) + " is not finite");
-    return v;
+    return real_token(token(what), what, [this](const std::string& m) { fail(m); });
   }
 
   /// `count` raw bytes right after the current position (a binary list body).
@@ -190,7 +177,6 @@ class FoamCursor {
   void use_byte_offsets() noexcept { binary_ = true; }
   [[nodiscard]] std::size_t offset() const noexcept { return pos_; }
 
-  [[nodiscard]] static std::string shorten(std::string_view t) { return TextCursor::shorten(t); }
 
  private:
   std::string_view text_;
@@ -424,14 +410,6 @@ inline void write_foam_file(const std::filesystem::path& file, const std::string
   }
   in.expect(")");
   return points;
-}
-
-/// The number of points a points file holds (its header and count only).
-[[nodiscard]] inline Index foam_point_count(const std::filesystem::path& file) {
-  const std::string text = read_foam_file(file);
-  FoamCursor in(text, file);
-  (void)read_foam_header(in);
-  return in.integer<Index>("point count", 0, Index{1} << 40);
 }
 
 /// Reads the faces: faceList "N ( k(a b ...) ... )" or faceCompactList (offsets, then labels).
@@ -927,14 +905,14 @@ inline void write_polymesh_points(const std::filesystem::path& target, const Mes
     for (const auto& b : *list)
       if (order(b.type) > 1) throw InputError(target.string() + ": OpenFOAM meshes are linear (the mesh has " + std::string(name(b.type)) + ")");
   const Index n = mesh.num_nodes() - mesh.num_auxiliary_nodes;
-  const Index expected = detail::foam_point_count(where.reference);
-  if (n != expected)
-    throw InputError(target.string() + ": the mesh has " + std::to_string(n) + " points, the case " + std::to_string(expected) +
-                     " (" + where.reference.string() + "): not this case's mesh");
   const bool compressed = detail::foam_file_is_compressed(where.reference);
   const std::string reference_text = detail::read_foam_file(where.reference);
   detail::FoamCursor in(reference_text, where.reference);
   const detail::FoamHeader h = detail::read_foam_header(in);
+  const auto expected = in.integer<Index>("point count", 0, Index{1} << 40);
+  if (n != expected)
+    throw InputError(target.string() + ": the mesh has " + std::to_string(n) + " points, the case " + std::to_string(expected) +
+                     " (" + where.reference.string() + "): not this case's mesh");
   std::string header(reference_text.substr(0, h.data_offset));
   if (where.points != where.reference) {
     // A time folder: the header's location names it.

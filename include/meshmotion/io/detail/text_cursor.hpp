@@ -17,6 +17,41 @@
 
 namespace meshmotion::detail {
 
+/// A token cut to a readable length for messages (non-printable bytes as '?').
+[[nodiscard]] inline std::string shorten_token(std::string_view token) {
+  std::string s(token.substr(0, 40));
+  for (char& c : s)
+    if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
+  return token.size() > 40 ? s + "..." : s;
+}
+
+/// A token as an integer of type T in [lo, hi]; otherwise calls fail(message), which throws.
+/// Shared by the readers' cursors, so every format words these errors alike.
+template <class T, class Fail>
+  requires std::is_signed_v<T>
+[[nodiscard]] T integer_token(std::string_view token, std::string_view what, T lo, T hi, Fail&& fail) {
+  std::int64_t value = 0;
+  const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+  if (ec != std::errc() || ptr != token.data() + token.size())
+    fail("expected " + std::string(what) + " as an integer (got '" + shorten_token(token) + "')");
+  if (value < static_cast<std::int64_t>(lo) || value > static_cast<std::int64_t>(hi))
+    fail(std::string(what) + " out of range (got " + std::to_string(value) + ", expected " + std::to_string(lo) + " to " +
+         std::to_string(hi) + ")");
+  return static_cast<T>(value);
+}
+
+/// A token as a finite double; otherwise calls fail(message), which throws.
+template <class Fail>
+[[nodiscard]] double real_token(std::string_view token, std::string_view what, Fail&& fail) {
+  double value = 0;
+  const char* first = token.data() + (token.size() > 1 && token[0] == '+' ? 1 : 0);
+  const auto [ptr, ec] = std::from_chars(first, token.data() + token.size(), value);
+  if (ec != std::errc() || ptr != token.data() + token.size())
+    fail("expected " + std::string(what) + " as a number (got '" + shorten_token(token) + "')");
+  if (!std::isfinite(value)) fail(std::string(what) + " is not finite (got '" + shorten_token(token) + "')");
+  return value;
+}
+
 class TextCursor {
  public:
   /// `text` must outlive the cursor; `file` is the name used in error messages.
@@ -102,27 +137,12 @@ class TextCursor {
     requires std::is_signed_v<T>
   [[nodiscard]] T integer(std::string_view what, T lo = std::numeric_limits<T>::min(),
                           T hi = std::numeric_limits<T>::max()) {
-    const std::string_view token = word(what);
-    std::int64_t value = 0;
-    const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-    if (ec != std::errc() || ptr != token.data() + token.size())
-      fail("expected " + std::string(what) + " as an integer (got '" + shorten(token) + "')");
-    if (value < static_cast<std::int64_t>(lo) || value > static_cast<std::int64_t>(hi))
-      fail(std::string(what) + " out of range (got " + std::to_string(value) + ", expected " + std::to_string(lo) +
-           " to " + std::to_string(hi) + ")");
-    return static_cast<T>(value);
+    return integer_token(word(what), what, lo, hi, [this](const std::string& m) { fail(m); });
   }
 
   /// Next token as a finite double.
   [[nodiscard]] double real(std::string_view what) {
-    const std::string_view token = word(what);
-    double value = 0;
-    const char* first = token.data() + (token.size() > 1 && token[0] == '+' ? 1 : 0);
-    const auto [ptr, ec] = std::from_chars(first, token.data() + token.size(), value);
-    if (ec != std::errc() || ptr != token.data() + token.size())
-      fail("expected " + std::string(what) + " as a number (got '" + shorten(token) + "')");
-    if (!std::isfinite(value)) fail(std::string(what) + " is not finite (got '" + shorten(token) + "')");
-    return value;
+    return real_token(word(what), what, [this](const std::string& m) { fail(m); });
   }
 
   /// Requires the next token to be exactly `expected`.
@@ -145,12 +165,7 @@ class TextCursor {
   }
 
   /// A token cut to a readable length for messages.
-  [[nodiscard]] static std::string shorten(std::string_view token) {
-    std::string s(token.substr(0, 40));
-    for (char& c : s)
-      if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
-    return token.size() > 40 ? s + "..." : s;
-  }
+  [[nodiscard]] static std::string shorten(std::string_view token) { return shorten_token(token); }
 
  private:
   static bool is_space(char c) noexcept {
