@@ -1,8 +1,9 @@
 #pragma once
 /// \file
 /// CGNS (.cgns) reading and writing through the CGNS library (Debian libcgns-dev): an optional
-/// component. CMake defines MESHMOTION_HAVE_CGNS and links the library when it finds it;
-/// without it read_cgns() and write_cgns() throw InputError saying so, and have_cgns is false.
+/// component. CMake defines MESHMOTION_HAVE_CGNS when it finds the library, which is then loaded
+/// on first use (io/detail/cgns_library.hpp); without it read_cgns() and write_cgns() throw
+/// InputError saying so, and have_cgns is false.
 ///
 /// Reading (one base; unstructured zones):
 /// - Element sections of every type of the catalogue (linear and quadratic, MIXED sections
@@ -37,6 +38,7 @@
 #include "meshmotion/core/topology.hpp"
 #include "meshmotion/io/any_mesh.hpp"
 #include "meshmotion/io/detail/atomic_file.hpp"
+#include "meshmotion/io/detail/cgns_library.hpp"
 #include "meshmotion/io/detail/raw_mesh.hpp"
 
 #include <algorithm>
@@ -51,10 +53,6 @@
 #include <unordered_map>
 #include <utility>
 #include <vector>
-
-#ifdef MESHMOTION_HAVE_CGNS
-#include <cgnslib.h>
-#endif
 
 namespace meshmotion {
 
@@ -134,7 +132,7 @@ inline constexpr CGNS_ENUMT(ElementType_t) cgns_types[num_element_types] = {
 
 [[nodiscard]] inline std::string cgns_type_name(CGNS_ENUMT(ElementType_t) t) {
   const int k = static_cast<int>(t);
-  return k >= 0 && k < NofValidElementTypes ? ElementTypeName[k] : "element type " + std::to_string(k);
+  return k >= 0 && k < NofValidElementTypes ? std::string(cgns_api().cg_ElementTypeName(t)) : "element type " + std::to_string(k);
 }
 
 /// Our type of a CGNS type, or nullopt-like -1 when the catalogue has none.
@@ -159,9 +157,9 @@ inline constexpr CGNS_ENUMT(ElementType_t) cgns_types[num_element_types] = {
 class CgnsFile {
  public:
   CgnsFile(const std::filesystem::path& file, int mode) : file_(file) {
-    if (cg_open(file.c_str(), mode, &fn_) != CG_OK) {
+    if (cgns_api().cg_open(file.c_str(), mode, &fn_) != CG_OK) {
       fn_ = -1;
-      throw IoError(file.string() + ": cannot open as a CGNS file (" + cg_get_error() + ")");
+      throw IoError(file.string() + ": cannot open as a CGNS file (" + cgns_api().cg_get_error() + ")");
     }
   }
   CgnsFile(const CgnsFile&) = delete;
@@ -171,7 +169,7 @@ class CgnsFile {
   [[nodiscard]] int id() const noexcept { return fn_; }
 
   void check(int status, const std::string& path) const {
-    if (status != CG_OK) throw IoError(file_.string() + ": " + path + ": " + cg_get_error());
+    if (status != CG_OK) throw IoError(file_.string() + ": " + path + ": " + cgns_api().cg_get_error());
   }
   [[noreturn]] void fail(const std::string& path, const std::string& what) const {
     throw InputError(file_.string() + ": " + path + ": " + what);
@@ -180,12 +178,12 @@ class CgnsFile {
   void close() {
     const int fn = fn_;
     fn_ = -1;
-    if (fn >= 0 && cg_close(fn) != CG_OK) throw IoError(file_.string() + ": closing failed (" + cg_get_error() + ")");
+    if (fn >= 0 && cgns_api().cg_close(fn) != CG_OK) throw IoError(file_.string() + ": closing failed (" + cgns_api().cg_get_error() + ")");
   }
 
  private:
   void close_quietly() noexcept {
-    if (fn_ >= 0) cg_close(fn_);
+    if (fn_ >= 0) cgns_api().cg_close(fn_);
     fn_ = -1;
   }
   std::filesystem::path file_;
@@ -256,19 +254,19 @@ class CgnsReader {
   [[nodiscard]] RawMesh read() {
     const int fn = cgns_.id();
     int nbases = 0;
-    cgns_.check(cg_nbases(fn, &nbases), "/");
+    cgns_.check(cgns_api().cg_nbases(fn, &nbases), "/");
     if (nbases == 0) cgns_.fail("/", "no CGNS base (expected one CGNSBase_t)");
     char name[33] = {};
     int cell_dim = 0, phys_dim = 0;
     if (nbases > 1) {
       std::string names;
       for (int b = 1; b <= nbases; ++b) {
-        cgns_.check(cg_base_read(fn, b, name, &cell_dim, &phys_dim), "/");
+        cgns_.check(cgns_api().cg_base_read(fn, b, name, &cell_dim, &phys_dim), "/");
         names += (b > 1 ? ", " : "") + std::string(name);
       }
       cgns_.fail("/", std::to_string(nbases) + " bases (" + names + "): meshmotion reads files with one base");
     }
-    cgns_.check(cg_base_read(fn, 1, name, &cell_dim, &phys_dim), "/");
+    cgns_.check(cgns_api().cg_base_read(fn, 1, name, &cell_dim, &phys_dim), "/");
     base_ = "/" + std::string(name);
     if (cell_dim != 2 && cell_dim != 3)
       cgns_.fail(base_, "cell dimension " + std::to_string(cell_dim) + " (expected 2 or 3)");
@@ -279,17 +277,17 @@ class CgnsReader {
     raw_.dim = cell_dim;
 
     int nzones = 0;
-    cgns_.check(cg_nzones(fn, 1, &nzones), base_);
+    cgns_.check(cgns_api().cg_nzones(fn, 1, &nzones), base_);
     std::vector<int> zones;
     std::string structured;
     for (int z = 1; z <= nzones; ++z) {
       CGNS_ENUMT(ZoneType_t) type{};
-      cgns_.check(cg_zone_type(fn, 1, z, &type), base_);
+      cgns_.check(cgns_api().cg_zone_type(fn, 1, z, &type), base_);
       if (type == CGNS_ENUMV(Unstructured)) {
         zones.push_back(z);
       } else {
         cgsize_t size[9] = {};
-        cgns_.check(cg_zone_read(fn, 1, z, name, size), base_);
+        cgns_.check(cgns_api().cg_zone_read(fn, 1, z, name, size), base_);
         structured += (structured.empty() ? "" : ", ") + std::string(name);
       }
     }
@@ -307,14 +305,14 @@ class CgnsReader {
     const int fn = cgns_.id();
     char name[33] = {};
     cgsize_t size[3] = {};
-    cgns_.check(cg_zone_read(fn, 1, z, name, size), base_);
+    cgns_.check(cgns_api().cg_zone_read(fn, 1, z, name, size), base_);
     zone_name_ = name;
     zone_ = base_ + "/" + zone_name_;
     const auto num_vertices = static_cast<std::int64_t>(size[0]);
     const std::vector<Index> node_of_vertex = read_coordinates(z, num_vertices);
 
     int nsections = 0;
-    cgns_.check(cg_nsections(fn, 1, z, &nsections), zone_);
+    cgns_.check(cgns_api().cg_nsections(fn, 1, z, &nsections), zone_);
     CgnsSections sections;
     bool has_facets = false;
     std::int64_t largest = 0;
@@ -348,13 +346,13 @@ class CgnsReader {
     const int fn = cgns_.id();
     const std::string path = zone_ + "/GridCoordinates";
     int ncoords = 0;
-    cgns_.check(cg_ncoords(fn, 1, z, &ncoords), path);
+    cgns_.check(cgns_api().cg_ncoords(fn, 1, z, &ncoords), path);
     static constexpr const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
     std::vector<std::string> present;
     for (int c = 1; c <= ncoords; ++c) {
       CGNS_ENUMT(DataType_t) type{};
       char cname[33] = {};
-      cgns_.check(cg_coord_info(fn, 1, z, c, &type, cname), path);
+      cgns_.check(cgns_api().cg_coord_info(fn, 1, z, c, &type, cname), path);
       present.emplace_back(cname);
     }
     std::vector<double> xyz(static_cast<std::size_t>(3 * num_vertices), 0.0);
@@ -368,7 +366,7 @@ class CgnsReader {
       }
       cgsize_t lo = 1, hi = static_cast<cgsize_t>(num_vertices);
       if (num_vertices > 0)
-        cgns_.check(cg_coord_read(fn, 1, z, names[d], CGNS_ENUMV(RealDouble), &lo, &hi, column.data()), path + "/" + names[d]);
+        cgns_.check(cgns_api().cg_coord_read(fn, 1, z, names[d], CGNS_ENUMV(RealDouble), &lo, &hi, column.data()), path + "/" + names[d]);
       for (std::int64_t i = 0; i < num_vertices; ++i) xyz[static_cast<std::size_t>(3 * i + d)] = column[static_cast<std::size_t>(i)];
     }
     std::vector<Index> node(static_cast<std::size_t>(num_vertices));
@@ -403,22 +401,22 @@ class CgnsReader {
     CGNS_ENUMT(ElementType_t) type{};
     cgsize_t start = 0, end = 0;
     int nbndry = 0, parent_flag = 0;
-    cgns_.check(cg_section_read(fn, 1, z, s, name, &type, &start, &end, &nbndry, &parent_flag), zone_);
+    cgns_.check(cgns_api().cg_section_read(fn, 1, z, s, name, &type, &start, &end, &nbndry, &parent_flag), zone_);
     const std::string path = zone_ + "/" + name;
     if (end < start) cgns_.fail(path, "element range " + std::to_string(start) + ".." + std::to_string(end) + " is empty or reversed");
     const std::int64_t count = static_cast<std::int64_t>(end) - start + 1;
     if (type == CGNS_ENUMV(NGON_n) || type == CGNS_ENUMV(NFACE_n))
       cgns_.fail(path, cgns_type_name(type) + " section: polyhedral cells are not supported (expected standard element types)");
     cgsize_t data_size = 0;
-    cgns_.check(cg_ElementDataSize(fn, 1, z, s, &data_size), path);
+    cgns_.check(cgns_api().cg_ElementDataSize(fn, 1, z, s, &data_size), path);
     std::vector<cgsize_t> data(static_cast<std::size_t>(data_size));
     std::vector<cgsize_t> offsets;
     const bool mixed = type == CGNS_ENUMV(MIXED);
     if (mixed) {
       offsets.resize(static_cast<std::size_t>(count + 1));
-      cgns_.check(cg_poly_elements_read(fn, 1, z, s, data.data(), offsets.data(), nullptr), path + "/ElementConnectivity");
+      cgns_.check(cgns_api().cg_poly_elements_read(fn, 1, z, s, data.data(), offsets.data(), nullptr), path + "/ElementConnectivity");
     } else {
-      cgns_.check(cg_elements_read(fn, 1, z, s, data.data(), nullptr), path + "/ElementConnectivity");
+      cgns_.check(cgns_api().cg_elements_read(fn, 1, z, s, data.data(), nullptr), path + "/ElementConnectivity");
     }
     // The section's group per element dimension: none when the section is named after its
     // element type (as write_cgns names elements without a group); the zone's for cells of
@@ -496,7 +494,7 @@ class CgnsReader {
   void read_bocos(int z, const CgnsSections& sections, const std::vector<Index>& node_of_vertex, bool has_facets) {
     const int fn = cgns_.id();
     int nbocos = 0;
-    cgns_.check(cg_nbocos(fn, 1, z, &nbocos), zone_ + "/ZoneBC");
+    cgns_.check(cgns_api().cg_nbocos(fn, 1, z, &nbocos), zone_ + "/ZoneBC");
     for (int bc = 1; bc <= nbocos; ++bc) {
       char name[33] = {};
       CGNS_ENUMT(BCType_t) bctype{};
@@ -505,16 +503,16 @@ class CgnsReader {
       int normal_index[3] = {};
       CGNS_ENUMT(DataType_t) normal_type{};
       int ndataset = 0;
-      cgns_.check(cg_boco_info(fn, 1, z, bc, name, &bctype, &ptset, &npnts, normal_index, &normal_size, &normal_type, &ndataset),
+      cgns_.check(cgns_api().cg_boco_info(fn, 1, z, bc, name, &bctype, &ptset, &npnts, normal_index, &normal_size, &normal_type, &ndataset),
                   zone_ + "/ZoneBC");
       const std::string path = zone_ + "/ZoneBC/" + name;
       CGNS_ENUMT(GridLocation_t) location = CGNS_ENUMV(Vertex);
-      cgns_.check(cg_boco_gridlocation_read(fn, 1, z, bc, &location), path);
+      cgns_.check(cgns_api().cg_boco_gridlocation_read(fn, 1, z, bc, &location), path);
       std::vector<cgsize_t> points(static_cast<std::size_t>(std::max<cgsize_t>(npnts, 0)));
-      if (npnts > 0) cgns_.check(cg_boco_read(fn, 1, z, bc, points.data(), nullptr), path);
+      if (npnts > 0) cgns_.check(cgns_api().cg_boco_read(fn, 1, z, bc, points.data(), nullptr), path);
       std::string group = name;
       char family[33] = {};
-      if (cg_goto(fn, 1, "Zone_t", z, "ZoneBC_t", 1, "BC_t", bc, "end") == CG_OK && cg_famname_read(family) == CG_OK)
+      if (cgns_api().cg_goto(fn, 1, "Zone_t", z, "ZoneBC_t", 1, "BC_t", bc, "end") == CG_OK && cgns_api().cg_famname_read(family) == CG_OK)
         group = family;
       const int tag = group_tag(group, cell_dim_ - 1);
 
@@ -673,22 +671,22 @@ class CgnsWriter {
     CgnsFile f(tmp, CG_MODE_WRITE);
     const int fn = f.id();
     int B = 0, Z = 0;
-    f.check(cg_base_write(fn, "Base", Dim, Dim, &B), "/Base");
+    f.check(cgns_api().cg_base_write(fn, "Base", Dim, Dim, &B), "/Base");
     // Coordinates carry the mesh's own length unit, which meshmotion does not know.
-    f.check(cg_goto(fn, B, "end"), "/Base");
-    f.check(cg_dataclass_write(CGNS_ENUMV(NormalizedByUnknownDimensional)), "/Base/DataClass");
+    f.check(cgns_api().cg_goto(fn, B, "end"), "/Base");
+    f.check(cgns_api().cg_dataclass_write(CGNS_ENUMV(NormalizedByUnknownDimensional)), "/Base/DataClass");
     cgsize_t size[3] = {static_cast<cgsize_t>(mesh_.num_nodes()), static_cast<cgsize_t>(mesh_.num_cells()), 0};
-    f.check(cg_zone_write(fn, B, "Zone", size, CGNS_ENUMV(Unstructured), &Z), "/Base/Zone");
+    f.check(cgns_api().cg_zone_write(fn, B, "Zone", size, CGNS_ENUMV(Unstructured), &Z), "/Base/Zone");
     static constexpr const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
     std::vector<double> column(static_cast<std::size_t>(mesh_.num_nodes()));
     for (int d = 0; d < Dim; ++d) {
       for (Index i = 0; i < mesh_.num_nodes(); ++i) column[static_cast<std::size_t>(i)] = mesh_.points(d, i);
       int C = 0;
       const std::string path = std::string("/Base/Zone/GridCoordinates/") + names[d];
-      f.check(cg_coord_write(fn, B, Z, CGNS_ENUMV(RealDouble), names[d], column.data(), &C), path);
+      f.check(cgns_api().cg_coord_write(fn, B, Z, CGNS_ENUMV(RealDouble), names[d], column.data(), &C), path);
       static constexpr float length[5] = {0.0F, 1.0F, 0.0F, 0.0F, 0.0F};  // mass, length, time, temperature, angle
-      f.check(cg_goto(fn, B, "Zone_t", Z, "GridCoordinates_t", 1, "DataArray_t", C, "end"), path);
-      f.check(cg_exponents_write(CGNS_ENUMV(RealSingle), length), path + "/DimensionalExponents");
+      f.check(cgns_api().cg_goto(fn, B, "Zone_t", Z, "GridCoordinates_t", 1, "DataArray_t", C, "end"), path);
+      f.check(cgns_api().cg_exponents_write(CGNS_ENUMV(RealSingle), length), path + "/DimensionalExponents");
     }
     std::vector<cgsize_t> data, offsets;
     for (const SectionPlan& plan : sections_) {
@@ -706,16 +704,16 @@ class CgnsWriter {
       int S = 0;
       const std::string path = "/Base/Zone/" + plan.name;
       if (plan.mixed)
-        f.check(cg_poly_section_write(fn, B, Z, plan.name.c_str(), CGNS_ENUMV(MIXED), start, end, 0, data.data(), offsets.data(), &S), path);
+        f.check(cgns_api().cg_poly_section_write(fn, B, Z, plan.name.c_str(), CGNS_ENUMV(MIXED), start, end, 0, data.data(), offsets.data(), &S), path);
       else
-        f.check(cg_section_write(fn, B, Z, plan.name.c_str(), cgns_type(plan.type), start, end, 0, data.data(), &S), path);
+        f.check(cgns_api().cg_section_write(fn, B, Z, plan.name.c_str(), cgns_type(plan.type), start, end, 0, data.data(), &S), path);
     }
     for (const auto& [name, numbers] : bocos_) {
       int BC = 0;
       const std::string path = "/Base/Zone/ZoneBC/" + name;
-      f.check(cg_boco_write(fn, B, Z, name.c_str(), CGNS_ENUMV(BCTypeUserDefined), CGNS_ENUMV(PointList),
+      f.check(cgns_api().cg_boco_write(fn, B, Z, name.c_str(), CGNS_ENUMV(BCTypeUserDefined), CGNS_ENUMV(PointList),
                             static_cast<cgsize_t>(numbers.size()), numbers.data(), &BC), path);
-      f.check(cg_boco_gridlocation_write(fn, B, Z, BC, Dim == 3 ? CGNS_ENUMV(FaceCenter) : CGNS_ENUMV(EdgeCenter)), path);
+      f.check(cgns_api().cg_boco_gridlocation_write(fn, B, Z, BC, Dim == 3 ? CGNS_ENUMV(FaceCenter) : CGNS_ENUMV(EdgeCenter)), path);
     }
     f.close();
   }
