@@ -65,7 +65,10 @@ Eigen::Map<const Points<Dim>> rows_of(const py::array& a, const char* what, Inde
   const bool contiguous = (a.flags() & py::array::c_style) != 0;
   if (!float64 || !contiguous || a.ndim() != 2 || a.shape(1) != Dim || (rows >= 0 && a.shape(0) != rows)) {
     std::string shape = "(";
-    for (py::ssize_t k = 0; k < a.ndim(); ++k) shape += (k ? ", " : "") + std::to_string(a.shape(k));
+    for (py::ssize_t k = 0; k < a.ndim(); ++k) {
+      if (k > 0) shape += ", ";
+      shape += std::to_string(a.shape(k));
+    }
     throw InputError(std::string(what) + ": expected a C-contiguous float64 array of shape (" +
                      (rows >= 0 ? std::to_string(rows) : std::string("n")) + ", " + std::to_string(Dim) + ") (got " +
                      py::str(a.dtype()).cast<std::string>() + ", shape " + shape + ")" +
@@ -145,7 +148,8 @@ ElementType element_type_named(const std::string& type_name) {
   for (int t = 0; t < num_element_types; ++t) {
     const auto type = static_cast<ElementType>(t);
     if (name(type) == type_name) return type;
-    known += (known.empty() ? "" : ", ") + std::string(name(type));
+    if (!known.empty()) known += ", ";
+    known += name(type);
   }
   throw InputError("unknown element type '" + type_name + "' (expected one of " + known + ")");
 }

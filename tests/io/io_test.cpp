@@ -1,8 +1,10 @@
 // Tests of the io layer: real meshes read with the counts of SOURCES.md, round trips between
 // every format variant, P2 elements of every type, VTK node orders, orientation, bad input.
 
+#include "meshmotion/core/generators.hpp"
 #include "meshmotion/core/orientation.hpp"
 #include "meshmotion/core/shape_functions.hpp"
+#include "meshmotion/curving/p2_conversion.hpp"
 #include "meshmotion/io.hpp"
 
 #include "io_support.hpp"
@@ -16,6 +18,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
@@ -400,6 +403,45 @@ TEST_CASE("VTU binary output decodes to the exact coordinates, connectivity and 
     CHECK(int{t} == expected);
   }
   CHECK(offsets.back() == static_cast<std::int64_t>(binary_array<std::int64_t>(text, "Name=\"connectivity\"").size()));
+}
+
+TEST_CASE("files written in chunks equal the formatted text, byte for byte", "[io]") {
+  // Several megabytes per file, so the writers spill their buffer (1 MiB) many times, in the
+  // middle of records as well as of base64 arrays.
+  const auto mesh = convert_to_quadratic(box_mesh({.nx = 24, .ny = 18, .nz = 12, .cells = BoxCells::tet_pyramid_prism})).mesh;
+  const auto linear = box_mesh({.nx = 30, .ny = 30, .nz = 30, .cells = BoxCells::hex_prism});
+  const auto read_back = [](const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  for (const auto& options : msh_variants) {
+    const auto file = test::scratch_path("chunked.msh");
+    write_gmsh(file, mesh, {options.msh_version, options.binary});
+    const std::string text = format_gmsh(mesh, {options.msh_version, options.binary});
+    INFO("msh " << (options.msh_version == MshVersion::v2_2 ? "2.2" : "4.1") << (options.binary ? " binary" : " ascii"));
+    REQUIRE(text.size() > 2 * detail::TextOutput::chunk);
+    CHECK(read_back(file) == text);
+  }
+  VtuFields fields;
+  fields.point_data.emplace_back("x", mesh.points);
+  fields.cell_data.emplace_back("one", Eigen::MatrixXd::Ones(1, mesh.num_cells()));
+  for (const auto encoding : {VtuEncoding::binary, VtuEncoding::ascii})
+    for (const bool facets : {false, true}) {
+      const auto file = test::scratch_path("chunked.vtu");
+      write_vtu(file, mesh, fields, {facets, encoding});
+      const std::string text = format_vtu(mesh, fields, {facets, encoding});
+      REQUIRE(text.size() > 2 * detail::TextOutput::chunk);
+      CHECK(read_back(file) == text);
+    }
+  const auto file = test::scratch_path("chunked.su2");
+  write_su2(file, linear);
+  const std::string text = format_su2(linear);
+  REQUIRE(text.size() > 2 * detail::TextOutput::chunk);
+  CHECK(read_back(file) == text);
+  const auto back = read_mesh_as<3>(file);
+  CHECK(back.points == linear.points);
+  CHECK(back.num_cells() == linear.num_cells());
+  CHECK(back.num_facets() == linear.num_facets());
 }
 
 TEST_CASE("mesh summary counts groups, edges and orientation", "[io]") {

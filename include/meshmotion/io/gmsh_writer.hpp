@@ -34,8 +34,8 @@ namespace detail {
 
 class GmshFormatter {
  public:
-  explicit GmshFormatter(bool binary) : binary_(binary) {}
-  std::string out;
+  GmshFormatter(TextOutput& output, bool binary) : out(output.text), output_(output), binary_(binary) {}
+  std::string& out;
 
   void text(std::string_view s) { out.append(s); }
   template <class T>
@@ -52,11 +52,14 @@ class GmshFormatter {
       out.push_back(sep);
     }
   }
+  // Ends a node or element line; the output may be written out after it, not within.
   void end_of_record() {
     if (!binary_) out.back() = '\n';
+    output_.spill();
   }
 
  private:
+  TextOutput& output_;
   bool binary_;
 };
 
@@ -74,7 +77,6 @@ void check_int32_ids(const Mesh<Dim>& mesh, const std::vector<const ElementBlock
 template <int Dim>
 void format_gmsh_v2(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
   const auto blocks = blocks_in_file_order(mesh);
-  if (binary) check_int32_ids(mesh, blocks);
   const bool parametric = !mesh.node_params.empty() && !binary;
   f.text(parametric ? "$ParametricNodes\n" : "$Nodes\n");
   f.ascii(mesh.num_nodes());
@@ -172,7 +174,10 @@ void format_gmsh_v4(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
     f.value<std::int32_t>(1);
     f.value<std::int32_t>(0);
     size(static_cast<std::uint64_t>(n), '\n');
-    for (Index i = 0; i < n; ++i) size(static_cast<std::uint64_t>(mesh.node_id(i)), '\n');
+    for (Index i = 0; i < n; ++i) {
+      size(static_cast<std::uint64_t>(mesh.node_id(i)), '\n');
+      f.end_of_record();
+    }
     for (Index i = 0; i < n; ++i) {
       for (int d = 0; d < 3; ++d) f.value<double>(d < Dim ? mesh.points(d, i) : 0.0);
       f.end_of_record();
@@ -230,17 +235,11 @@ void format_gmsh_v4(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
 
 }  // namespace detail
 
-/// The content of a .msh file for `mesh`. Throws InputError for an invalid mesh.
+namespace detail {
+
 template <int Dim>
-[[nodiscard]] std::string format_gmsh(const Mesh<Dim>& mesh, const GmshWriteOptions& options = {}) {
-  validate(mesh);
-  detail::GmshFormatter f(options.binary);
-  // One allocation for the whole file: appending into a growing string copied it log n times.
-  // Binary values are 8 bytes at most; ASCII ones are bounded by the shortest round-trip form.
-  std::size_t values = static_cast<std::size_t>(mesh.num_nodes()) * 5;
-  for (const auto* list : {&mesh.cells, &mesh.facets, &mesh.lower})
-    for (const auto& b : *list) values += b.connectivity.size() + 5 * static_cast<std::size_t>(b.size());
-  f.out.reserve(4096 + values * (options.binary ? 8 : 12) + (options.binary ? 0 : static_cast<std::size_t>(mesh.num_nodes()) * 3 * 14));
+void format_gmsh(TextOutput& output, const Mesh<Dim>& mesh, const GmshWriteOptions& options) {
+  GmshFormatter f(output, options.binary);
   f.text(options.version == MshVersion::v2_2 ? "$MeshFormat\n2.2 " : "$MeshFormat\n4.1 ");
   f.text(options.binary ? "1 8\n" : "0 8\n");
   if (options.binary) {
@@ -253,8 +252,6 @@ template <int Dim>
     f.ascii(mesh.groups.size());
     f.text("\n");
     for (const auto& g : mesh.groups) {
-      if (g.name.find('"') != std::string::npos || g.name.find('\n') != std::string::npos)
-        throw InputError("write_gmsh: group name '" + g.name + "' contains a quote or a line break");
       f.ascii(g.dim);
       f.text(" ");
       f.ascii(g.tag);
@@ -262,17 +259,44 @@ template <int Dim>
     }
     f.text("$EndPhysicalNames\n");
   }
-  if (options.version == MshVersion::v2_2) detail::format_gmsh_v2(f, mesh, options.binary);
-  else detail::format_gmsh_v4(f, mesh, options.binary);
-  return std::move(f.out);
+  if (options.version == MshVersion::v2_2) format_gmsh_v2(f, mesh, options.binary);
+  else format_gmsh_v4(f, mesh, options.binary);
 }
 
-/// Writes `mesh` to a Gmsh .msh file (through a temporary file and a rename).
+// What the file cannot hold, refused before anything is written.
+template <int Dim>
+void check_gmsh_writable(const Mesh<Dim>& mesh, const GmshWriteOptions& options) {
+  validate(mesh);
+  for (const auto& g : mesh.groups)
+    if (g.name.find('"') != std::string::npos || g.name.find('\n') != std::string::npos)
+      throw InputError("write_gmsh: group name '" + g.name + "' contains a quote or a line break");
+  if (options.version == MshVersion::v2_2 && options.binary) check_int32_ids(mesh, blocks_in_file_order(mesh));
+}
+
+}  // namespace detail
+
+/// The content of a .msh file for `mesh`. Throws InputError for an invalid mesh.
+template <int Dim>
+[[nodiscard]] std::string format_gmsh(const Mesh<Dim>& mesh, const GmshWriteOptions& options = {}) {
+  detail::check_gmsh_writable(mesh, options);
+  detail::TextOutput output;
+  // One allocation for the whole file: appending into a growing string copied it log n times.
+  // Binary values are 8 bytes at most; ASCII ones are bounded by the shortest round-trip form.
+  std::size_t values = static_cast<std::size_t>(mesh.num_nodes()) * 5;
+  for (const auto* list : {&mesh.cells, &mesh.facets, &mesh.lower})
+    for (const auto& b : *list) values += b.connectivity.size() + 5 * static_cast<std::size_t>(b.size());
+  output.text.reserve(4096 + values * (options.binary ? 8 : 12) +
+                      (options.binary ? 0 : static_cast<std::size_t>(mesh.num_nodes()) * 3 * 14));
+  detail::format_gmsh(output, mesh, options);
+  return std::move(output.text);
+}
+
+/// Writes `mesh` to a Gmsh .msh file, streamed through a temporary file and a rename.
 /// Throws InputError for an invalid mesh (nothing written), IoError when the file cannot be written.
 template <int Dim>
 void write_gmsh(const std::filesystem::path& file, const Mesh<Dim>& mesh, const GmshWriteOptions& options = {}) {
-  const std::string content = format_gmsh(mesh, options);
-  detail::write_file_atomically(file, content);
+  detail::check_gmsh_writable(mesh, options);
+  detail::write_streamed(file, [&](detail::TextOutput& output) { detail::format_gmsh(output, mesh, options); });
 }
 
 }  // namespace meshmotion

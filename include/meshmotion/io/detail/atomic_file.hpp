@@ -52,22 +52,63 @@ void write_through_temporary(const std::filesystem::path& file, Write&& write) {
   rename_into_place(tmp, file);
 }
 
+/// Has `write(std::ofstream&)` write `file`'s content into a temporary file beside it, then
+/// renames it into place. Throws IoError (leaving neither `file` changed nor the temporary
+/// behind) when the file cannot be created or written.
+template <class Write>
+void write_file_through_stream(const std::filesystem::path& file, Write&& write) {
+  write_through_temporary(file, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw IoError(file.string() + ": cannot create the temporary file " + tmp.string());
+    write(out);
+    out.close();
+    if (!out) throw IoError(file.string() + ": write failed (disk full?)");
+  });
+}
+
 /// Writes `contents` to `file` through a temporary file in the same folder and a rename.
 /// Throws IoError (leaving neither `file` changed nor the temporary behind) on failure.
 inline void write_file_atomically(const std::filesystem::path& file, std::string_view contents) {
-  const std::filesystem::path tmp = temporary_path_for(file);
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw IoError(file.string() + ": cannot create the temporary file " + tmp.string());
-    out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
-    out.close();
-    if (!out) {
-      std::error_code ignored;
-      std::filesystem::remove(tmp, ignored);
-      throw IoError(file.string() + ": write failed (disk full?)");
-    }
+  write_file_through_stream(file, [&](std::ofstream& out) { out.write(contents.data(), static_cast<std::streamsize>(contents.size())); });
+}
+
+/// A file's text produced in pieces: kept whole in `text` (the format_*() functions), or written
+/// to a file every `chunk` bytes (the write_*() functions, through write_streamed()). Built
+/// whole, a 17 MB file cost 17 MB of fresh pages, each faulted in and zeroed by the kernel
+/// before being copied to the page cache (on a virtual machine the larger part of writing it);
+/// streamed, the same megabyte is reused.
+class TextOutput {
+ public:
+  static constexpr std::size_t chunk = std::size_t{1} << 20;
+
+  TextOutput() = default;
+  explicit TextOutput(std::ofstream& file) : file_(&file) { text.reserve(chunk + chunk / 2); }
+
+  std::string text;
+
+  /// Writes out what is buffered once it reaches `chunk` bytes (nothing when kept in memory).
+  /// Producers call it between pieces shorter than chunk / 2, so `text` never grows.
+  void spill() {
+    if (file_ != nullptr && text.size() >= chunk) flush();
   }
-  rename_into_place(tmp, file);
+  void flush() {
+    if (file_ == nullptr) return;
+    file_->write(text.data(), static_cast<std::streamsize>(text.size()));
+    text.clear();
+  }
+
+ private:
+  std::ofstream* file_ = nullptr;
+};
+
+/// Writes `file` through a temporary and a rename, `produce(TextOutput&)` producing its text.
+template <class Produce>
+void write_streamed(const std::filesystem::path& file, Produce&& produce) {
+  write_file_through_stream(file, [&](std::ofstream& out) {
+    TextOutput text(out);
+    produce(text);
+    text.flush();
+  });
 }
 
 }  // namespace meshmotion::detail
