@@ -229,6 +229,31 @@ TEST_CASE("CGNS: mixed P1 and P2 boxes keep orientation, numbering and groups", 
     if (g.dim == 2) CHECK(back.group_nodes(back.group(g.name).tag) == box.group_nodes(g.tag));
 }
 
+TEST_CASE("CGNS: facet groups interleaved face by face are written as one section per group", "[io][cgns]") {
+  // A generated box lists its facets face by face, so that in id order the groups alternate
+  // hundreds of times; a section per run made thousands of sections.
+  const Mesh<3> box = box_mesh({.nx = 12, .ny = 12, .nz = 12, .cells = BoxCells::tet4});
+  std::size_t runs = 0;
+  for (const auto& b : box.facets)
+    for (std::size_t k = 0; k < b.tags.size(); ++k) runs += k == 0 || b.tags[k] != b.tags[k - 1] ? 1 : 0;
+  REQUIRE(runs > 200);
+  const fs::path file = test::scratch_path("interleaved.cgns");
+  write_mesh(file, box);
+  require_cgnscheck_clean(file);
+  int fn = -1, nsections = 0;
+  REQUIRE(cg_open(file.c_str(), CG_MODE_READ, &fn) == CG_OK);
+  CHECK(cg_nsections(fn, 1, 1, &nsections) == CG_OK);
+  cg_close(fn);
+  CHECK(nsections == 1 + 6);  // the tetrahedra, then one section per side
+  const Mesh<3> back = read_mesh_as<3>(file, ReadOptions{ReadOrientation::require_positive});
+  CHECK(back.points == box.points);
+  REQUIRE(back.cells.size() == 1);
+  CHECK(back.cells[0].connectivity == box.cells[0].connectivity);
+  CHECK(back.num_facets() == box.num_facets());
+  for (const auto& g : box.groups)
+    if (g.dim == 2) CHECK(back.group_nodes(back.group(g.name).tag) == box.group_nodes(g.tag));
+}
+
 TEST_CASE("CGNS: every real mesh round-trips with its groups", "[io][cgns]") {
   const auto data_dir = test::shared_data("SOURCES.md");
   if (!data_dir) {

@@ -28,7 +28,10 @@
 /// group and type (MIXED where types alternate), named after the group (after the CGNS type
 /// for elements without one); one BC per facet group, named after it, listing its facets
 /// (PointList at FaceCenter in 3D, EdgeCenter in 2D). A mesh read from a single-zone file is
-/// written back with its numbering, its sections' element ranges and its BC names. The file
+/// written back with its numbering, its sections' element ranges and its BC names. When that
+/// order interleaves groups (more than 64 runs beyond one per group, as in generated meshes
+/// whose facets go face by face), elements are grouped by group instead, in their order
+/// within each group, and numbered in that order. The file
 /// appears only once complete (temporary file and rename). The CGNS library keeps global state: do not read or write CGNS files from several
 /// threads at once.
 
@@ -750,7 +753,22 @@ class CgnsWriter {
         for (Index e = 0; e < list(k)[b].size(); ++e, ++position)
           items_.push_back({have_ids ? list(k)[b].ids[static_cast<std::size_t>(e)] : position, k, b, e});
     if (have_ids) std::stable_sort(items_.begin(), items_.end(), [](const Item& a, const Item& b) { return a.key < b.key; });
+    // Groups interleaved in that order (a generated mesh's facets, face by face) would give a
+    // section per run: thousands of sections, which every CGNS reader walks one by one (and the
+    // CGNS library writes in quadratic time). Then the elements are grouped by list and group
+    // instead, keeping their order within each group; a few runs more than groups keep the
+    // file order.
+    const auto key = [&](const Item& item) { return std::pair(item.list, tag_of(item)); };
+    std::vector<std::pair<int, int>> run_keys;
+    for (std::size_t k = 0; k < items_.size(); ++k)
+      if (k == 0 || key(items_[k]) != key(items_[k - 1])) run_keys.push_back(key(items_[k]));
+    const std::size_t runs = run_keys.size();
+    std::sort(run_keys.begin(), run_keys.end());
+    const auto distinct = static_cast<std::size_t>(std::unique(run_keys.begin(), run_keys.end()) - run_keys.begin());
+    if (runs > distinct + max_extra_sections)
+      std::stable_sort(items_.begin(), items_.end(), [&](const Item& a, const Item& b) { return key(a) < key(b); });
   }
+  static constexpr std::size_t max_extra_sections = 64;
 
   [[nodiscard]] std::string group_name(int dim, int tag) const {
     for (const PhysicalGroup& g : mesh_.groups)
