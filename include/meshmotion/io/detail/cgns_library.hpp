@@ -42,8 +42,11 @@ struct CgnsLibrary {
 inline const CgnsLibrary& cgns_api() {
   static const CgnsLibrary library = [] {
     void* handle = dlopen(MESHMOTION_CGNS_LIBRARY, RTLD_NOW | RTLD_LOCAL);
-    if (handle == nullptr)
-      throw IoError(std::string("cannot load the CGNS library " MESHMOTION_CGNS_LIBRARY " (") + dlerror() + ")");
+    if (handle == nullptr) {
+      const char* reason = dlerror();
+      throw IoError(std::string("cannot load the CGNS library " MESHMOTION_CGNS_LIBRARY " (") +
+                    (reason != nullptr ? reason : "unknown reason") + "; is libcgns installed?)");
+    }
     CgnsLibrary loaded;
 #define MESHMOTION_CGNS_LOAD(name)                                                                  \
   loaded.name = reinterpret_cast<decltype(&::name)>(dlsym(handle, #name));                         \
