@@ -23,11 +23,12 @@ TEST_CASE("element catalogue is consistent", "[core]") {
     CHECK(element_type_from_gmsh(info.gmsh_id) == t);
     CHECK(element_type_from_name(info.name) == t);
     const int ne = static_cast<int>(edges(t).size());
-    if (order(t) == 2) {
-      // Vertices + one node per edge (+ face and volume nodes for complete types).
-      CHECK(num_nodes(t) >= num_vertices(t) + ne);
+    if (order(t) >= 2) {
+      // Vertices + order - 1 nodes per edge (+ face and volume nodes for complete types).
+      CHECK(num_nodes(t) >= num_vertices(t) + ne * (order(t) - 1));
       CHECK(linear_type(t) == element_type(shape(t), 1));
-      CHECK(quadratic_type(linear_type(t), info.complete) == t);
+      CHECK(element_type(shape(t), order(t), info.complete) == t);
+      CHECK(num_nodes(t) <= max_element_nodes);
     }
     if (const auto perm = vtk_order(t); !perm.empty()) {
       // A permutation of the nodes that VTK writes.
@@ -56,7 +57,7 @@ TEST_CASE("every edge lies on exactly two facets of a 3D shape, one of a 2D shap
 }
 
 TEST_CASE("facet nodes of quadratic elements follow Gmsh's face node numbering", "[core]") {
-  std::array<int, 9> nodes{};
+  std::array<int, max_facet_nodes> nodes{};
   // hex27 face k carries node 20 + k; its edge nodes are the element's.
   for (int f = 0; f < 6; ++f) {
     REQUIRE(facet_nodes(ElementType::hex27, f, nodes) == 9);
@@ -71,6 +72,15 @@ TEST_CASE("facet nodes of quadratic elements follow Gmsh's face node numbering",
   CHECK(nodes[8] == 13);
   REQUIRE(facet_nodes(ElementType::tri6, 2, nodes) == 3);
   CHECK(std::vector<int>(nodes.begin(), nodes.begin() + 3) == std::vector<int>{2, 0, 5});
+}
+
+TEST_CASE("orders the catalogue does not hold are refused by name", "[core]") {
+  CHECK(element_type(Shape::tetrahedron, 4) == ElementType::tet35);
+  CHECK(element_type(Shape::pyramid, 3) == ElementType::pyramid30);
+  CHECK_THROWS_WITH(element_type(Shape::hexahedron, 4), Catch::Contains("no hexahedron of order 4"));
+  CHECK_THROWS_WITH(element_type(Shape::triangle, 5), Catch::Contains("no triangle of order 5"));
+  CHECK_THROWS_WITH(element_type(Shape::quadrilateral, 3, false), Catch::Contains("serendipity"));
+  CHECK_THROWS_WITH(element_type_from_gmsh(93), Catch::Contains("93"));  // hex125
 }
 
 TEST_CASE("unknown type numbers and names are errors", "[core]") {

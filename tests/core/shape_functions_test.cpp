@@ -64,16 +64,22 @@ TEST_CASE("shape functions interpolate at the reference nodes", "[core]") {
 }
 
 TEST_CASE("reference nodes follow Gmsh's layout", "[core]") {
-  // Edge nodes at edge midpoints, the hex27 volume node at the centre, pyramid apex on top.
+  // Edge nodes evenly along each edge from its first vertex, the hex27 volume node at the
+  // centre, pyramid apex on top. (python/tests/test_element_catalogue.py compares every
+  // type's nodes with Gmsh's own.)
   for (ElementType t : cell_like_types()) {
-    if (order(t) < 2) continue;
+    const int p = order(t);
+    if (p < 2) continue;
     INFO(name(t));
     const auto x = reference_nodes(t);
     const auto e = edges(t);
     for (std::size_t k = 0; k < e.size(); ++k)
-      for (std::size_t d = 0; d < 3; ++d)
-        CHECK(x[static_cast<std::size_t>(num_vertices(t)) + k][d] ==
-              Approx(0.5 * (x[static_cast<std::size_t>(e[k][0])][d] + x[static_cast<std::size_t>(e[k][1])][d])));
+      for (int j = 1; j < p; ++j)
+        for (std::size_t d = 0; d < 3; ++d) {
+          const double r = static_cast<double>(j) / p;
+          CHECK(x[static_cast<std::size_t>(num_vertices(t) + static_cast<int>(k) * (p - 1) + j - 1)][d] ==
+                Approx((1 - r) * x[static_cast<std::size_t>(e[k][0])][d] + r * x[static_cast<std::size_t>(e[k][1])][d]));
+        }
   }
   CHECK(reference_nodes(ElementType::hex27)[26] == RefPoint{0, 0, 0});
   CHECK(reference_nodes(ElementType::hex27)[20] == RefPoint{0, 0, -1});  // face (0,3,2,1)
@@ -81,6 +87,33 @@ TEST_CASE("reference nodes follow Gmsh's layout", "[core]") {
   CHECK(reference_nodes(ElementType::pyramid5)[4] == RefPoint{0, 0, 1});
   CHECK(reference_nodes(ElementType::pyramid14)[13] == RefPoint{0, 0, 0});
   CHECK(reference_nodes(ElementType::line3)[2] == RefPoint{0, 0, 0});
+}
+
+TEST_CASE("facet nodes at every order are the facet element's nodes, in its own order", "[core]") {
+  // Local facet f's nodes, mapped back through the facet's vertices, must be the reference
+  // nodes of facet_type(t, f): the rotation of the face's inside nodes included (a tet35's
+  // last face starts at vertex 3 in Gmsh's numbering and at vertex 1 in facets()).
+  std::array<int, max_facet_nodes> nodes{};
+  for (ElementType t : cell_like_types()) {
+    if (dimension(t) < 2) continue;
+    const auto x = reference_nodes(t);
+    for (int f = 0; f < static_cast<int>(facets(t).size()); ++f) {
+      INFO(name(t) << " facet " << f);
+      const ElementType ft = facet_type(t, f);
+      const int n = facet_nodes(t, f, nodes);
+      REQUIRE(n == num_nodes(ft));
+      const auto fx = reference_nodes(ft);
+      std::vector<double> w(static_cast<std::size_t>(num_vertices(ft)));
+      for (int k = 0; k < n; ++k) {
+        shape_functions(linear_type(ft), fx[static_cast<std::size_t>(k)], w);
+        RefPoint expected{0, 0, 0};
+        for (int v = 0; v < num_vertices(ft); ++v)
+          for (std::size_t d = 0; d < 3; ++d)
+            expected[d] += w[static_cast<std::size_t>(v)] * x[static_cast<std::size_t>(facets(t)[static_cast<std::size_t>(f)].vertices[static_cast<std::size_t>(v)])][d];
+        for (std::size_t d = 0; d < 3; ++d) CHECK(x[static_cast<std::size_t>(nodes[static_cast<std::size_t>(k)])][d] == Approx(expected[d]).margin(1e-12));
+      }
+    }
+  }
 }
 
 TEST_CASE("shape functions: partition of unity, derivatives, polynomial reproduction", "[core]") {

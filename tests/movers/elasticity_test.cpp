@@ -66,7 +66,7 @@ double min_signed_jacobian(const Mesh<Dim>& mesh, const Points<Dim>& points) {
   double worst = std::numeric_limits<double>::infinity();
   for (const auto& block : mesh.cells) {
     const auto& table = detail::quadrature_table(block.type);
-    detail::ElementCoords<Dim> x;
+    detail::FemCoords<Dim> x;
     detail::ElementGradients<Dim> g;
     Eigen::Matrix<double, Dim, Dim> jac;
     for (Index e = 0; e < block.size(); ++e) {
@@ -182,7 +182,7 @@ double l2_error(const Mesh<2>& mesh, const Points<2>& u, F&& exact) {
   for (const auto& block : mesh.cells) {
     const auto table = detail::make_quadrature_table(block.type, 8);
     const int n = table.num_nodes;
-    detail::ElementCoords<2> x, ue;
+    detail::FemCoords<2> x, ue;
     detail::ElementGradients<2> g;
     Eigen::Matrix2d jac;
     for (Index e = 0; e < block.size(); ++e) {

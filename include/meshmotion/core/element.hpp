@@ -27,9 +27,22 @@ enum class ElementType : std::uint8_t {
   hex8, hex20, hex27,
   prism6, prism15, prism18,
   pyramid5, pyramid13, pyramid14,
+  // Order 3 and 4 (complete Lagrange elements): appended so that the numbers above stay.
+  line4, tri10, quad16, tet20, hex64, prism40, pyramid30,
+  line5, tri15, quad25, tet35,
 };
 
-inline constexpr int num_element_types = 19;
+inline constexpr int num_element_types = 30;
+
+/// Most nodes of any element type (hex64).
+inline constexpr int max_element_nodes = 64;
+
+/// Most nodes of any element facet (the quad16 face of a hex64).
+inline constexpr int max_facet_nodes = 16;
+
+/// Highest element order of the catalogue, and per shape (hexahedra, prisms and pyramids stop
+/// at 3; Gmsh's pyramids of order 3 have 30 nodes).
+inline constexpr int max_element_order = 4;
 
 /// Geometric shape of an element, independent of its order.
 enum class Shape : std::uint8_t { point, line, triangle, quadrilateral, tetrahedron, hexahedron, prism, pyramid };
@@ -48,7 +61,7 @@ struct ElementInfo {
   std::string_view name;    ///< "tri6", "hex27", ...
   Shape shape;
   int dim;                  ///< topological dimension
-  int order;                ///< 1 or 2 (0 for a point)
+  int order;                ///< 1 to 4 (0 for a point)
   int num_nodes;
   int num_vertices;
   bool complete;            ///< all Lagrange nodes present (quad9, hex27, ...), not serendipity
@@ -79,6 +92,18 @@ inline constexpr std::array<ElementInfo, num_element_types> element_table{{
     {ElementType::pyramid5, "pyramid5", Shape::pyramid, 3, 1, 5, 5, true, 7, 14, -1},
     {ElementType::pyramid13, "pyramid13", Shape::pyramid, 3, 2, 13, 5, false, 19, 27, -1},
     {ElementType::pyramid14, "pyramid14", Shape::pyramid, 3, 2, 14, 5, true, 14, 27, -1},
+    // VTK has no classic cells past order 2, only Lagrange cells (pyramids: none in VTK 9.1).
+    {ElementType::line4, "line4", Shape::line, 1, 3, 4, 2, true, 26, -1, 68},
+    {ElementType::tri10, "tri10", Shape::triangle, 2, 3, 10, 3, true, 21, -1, 69},
+    {ElementType::quad16, "quad16", Shape::quadrilateral, 2, 3, 16, 4, true, 36, -1, 70},
+    {ElementType::tet20, "tet20", Shape::tetrahedron, 3, 3, 20, 4, true, 29, -1, 71},
+    {ElementType::hex64, "hex64", Shape::hexahedron, 3, 3, 64, 8, true, 92, -1, 72},
+    {ElementType::prism40, "prism40", Shape::prism, 3, 3, 40, 6, true, 90, -1, 73},
+    {ElementType::pyramid30, "pyramid30", Shape::pyramid, 3, 3, 30, 5, true, 118, -1, -1},
+    {ElementType::line5, "line5", Shape::line, 1, 4, 5, 2, true, 27, -1, 68},
+    {ElementType::tri15, "tri15", Shape::triangle, 2, 4, 15, 3, true, 23, -1, 69},
+    {ElementType::quad25, "quad25", Shape::quadrilateral, 2, 4, 25, 4, true, 37, -1, 70},
+    {ElementType::tet35, "tet35", Shape::tetrahedron, 3, 4, 35, 4, true, 30, -1, 71},
 }};
 
 using Edge = std::array<int, 2>;
@@ -120,6 +145,15 @@ inline constexpr std::array<LocalFacet, 5> pyramid_facets{{
     {Shape::triangle, 3, {1, 2, 4, 0}}, {Shape::triangle, 3, {2, 3, 4, 0}},
     {Shape::triangle, 3, {3, 0, 4, 0}}}};
 
+// Gmsh's order of the faces whose inside nodes a 3D element lists (see face_order()).
+inline constexpr std::array<LocalFacet, 4> tetrahedron_face_order{{
+    {Shape::triangle, 3, {0, 2, 1, 0}}, {Shape::triangle, 3, {0, 1, 3, 0}},
+    {Shape::triangle, 3, {0, 3, 2, 0}}, {Shape::triangle, 3, {3, 1, 2, 0}}}};
+inline constexpr std::array<LocalFacet, 5> pyramid_face_order{{
+    {Shape::triangle, 3, {0, 1, 4, 0}}, {Shape::triangle, 3, {3, 0, 4, 0}},
+    {Shape::triangle, 3, {1, 2, 4, 0}}, {Shape::triangle, 3, {2, 3, 4, 0}},
+    {Shape::quadrilateral, 4, {0, 3, 2, 1}}}};
+
 // VTK node i is our node vtk_order[i] (classic VTK quadratic cells).
 inline constexpr std::array<int, 10> tet10_vtk{0, 1, 2, 3, 4, 5, 6, 7, 9, 8};
 inline constexpr std::array<int, 20> hex20_vtk{0, 1, 2, 3, 4, 5, 6, 7, 8, 11, 13, 9, 16, 18, 19, 17, 10, 12, 14, 15};
@@ -138,6 +172,23 @@ inline constexpr std::array<int, 6> prism6_vtk{0, 2, 1, 3, 5, 4};
 inline constexpr std::array<int, 15> prism15_vtk{0, 2, 1, 3, 5, 4, 7, 9, 6, 13, 14, 12, 8, 11, 10};
 inline constexpr std::array<int, 18> prism18_vtk{0, 2, 1, 3, 5, 4, 7, 9, 6, 13, 14, 12, 8, 11, 10, 16, 17, 15};
 inline constexpr std::array<int, 18> prism18_vtk_lagrange{0, 1, 2, 3, 4, 5, 6, 9, 7, 12, 14, 13, 8, 10, 11, 15, 17, 16};
+// VTK's Lagrange cells past order 2, tabulated from VTK 9.1's own parametric coordinates
+// (python/tests/test_vtk_orientation.py checks them against VTK). Lines and triangles list
+// their nodes as Gmsh does. The hexahedron's vertical edges (2,6) and (3,7) are listed in the
+// order of .vtu files before version 2.2, which is what the writer declares (as hex27's).
+inline constexpr std::array<int, 16> quad16_vtk{0, 1, 2, 3, 4, 5, 6, 7, 9, 8, 11, 10, 12, 13, 15, 14};
+inline constexpr std::array<int, 25> quad25_vtk{0,  1,  2,  3,  4,  5,  6,  7,  8,  9,  12, 11, 10,
+                                                15, 14, 13, 16, 20, 17, 23, 24, 21, 19, 22, 18};
+inline constexpr std::array<int, 20> tet20_vtk{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 10, 15, 14, 13, 12, 17, 19, 18, 16};
+inline constexpr std::array<int, 35> tet35_vtk{0,  1,  2,  3,  4,  5,  6,  7,  8,  9,  10, 11, 12, 15, 14, 13, 21, 20,
+                                               19, 18, 17, 16, 25, 26, 27, 33, 31, 32, 28, 29, 30, 22, 23, 24, 34};
+inline constexpr std::array<int, 64> hex64_vtk{
+    0,  1,  2,  3,  4,  5,  6,  7,  8,  9,  14, 15, 19, 18, 10, 11, 24, 25, 28, 29, 31, 30,
+    26, 27, 12, 13, 16, 17, 22, 23, 20, 21, 40, 43, 41, 42, 44, 45, 47, 46, 36, 37, 39, 38,
+    49, 48, 50, 51, 32, 35, 33, 34, 52, 53, 55, 54, 56, 57, 59, 58, 60, 61, 63, 62};
+inline constexpr std::array<int, 40> prism40_vtk{0,  1,  2,  3,  4,  5,  6,  7,  12, 13, 9,  8,  18, 19,
+                                                 22, 23, 21, 20, 10, 11, 14, 15, 16, 17, 24, 25, 26, 27,
+                                                 29, 28, 34, 35, 37, 36, 33, 30, 32, 31, 38, 39};
 inline constexpr std::array<int, 13> pyramid13_vtk{0, 1, 2, 3, 4, 5, 8, 10, 6, 7, 9, 11, 12};
 
 template <class T, std::size_t N>
@@ -190,21 +241,59 @@ constexpr std::span<const T> as_span(const std::array<T, N>& a) {
 }
 [[nodiscard]] constexpr std::span<const LocalFacet> facets(ElementType t) { return facets(shape(t)); }
 
+/// "triangle", "hexahedron", ...
+[[nodiscard]] constexpr std::string_view shape_name(Shape s) {
+  switch (s) {
+    case Shape::point: return "point";
+    case Shape::line: return "line";
+    case Shape::triangle: return "triangle";
+    case Shape::quadrilateral: return "quadrilateral";
+    case Shape::tetrahedron: return "tetrahedron";
+    case Shape::hexahedron: return "hexahedron";
+    case Shape::prism: return "prism";
+    case Shape::pyramid: return "pyramid";
+  }
+  return "?";
+}
+
 /// The element type of a given shape and order; `complete` picks quad9/hex27/prism18/pyramid14
-/// over the serendipity quad8/hex20/prism15/pyramid13.
+/// over the serendipity quad8/hex20/prism15/pyramid13. Orders past 2 are complete Lagrange
+/// elements, up to 4 for lines, triangles, quadrilaterals and tetrahedra and up to 3 for
+/// hexahedra, prisms and pyramids; throws InputError for an order the catalogue does not hold.
 [[nodiscard]] constexpr ElementType element_type(Shape s, int element_order, bool complete = true) {
-  const bool p2 = element_order == 2;
+  constexpr ElementType none = ElementType::point1;
+  const auto pick = [element_order](ElementType p1, ElementType p2, ElementType p3, ElementType p4) {
+    switch (element_order) {
+      case 1: return p1;
+      case 2: return p2;
+      case 3: return p3;
+      case 4: return p4;
+      default: return none;
+    }
+  };
+  ElementType t = none;
+  if (element_order > 2 && !complete)
+    throw InputError("element_type: serendipity elements stop at order 2 (asked for order " + std::to_string(element_order) + ")");
   switch (s) {
     case Shape::point: return ElementType::point1;
-    case Shape::line: return p2 ? ElementType::line3 : ElementType::line2;
-    case Shape::triangle: return p2 ? ElementType::tri6 : ElementType::tri3;
-    case Shape::quadrilateral: return p2 ? (complete ? ElementType::quad9 : ElementType::quad8) : ElementType::quad4;
-    case Shape::tetrahedron: return p2 ? ElementType::tet10 : ElementType::tet4;
-    case Shape::hexahedron: return p2 ? (complete ? ElementType::hex27 : ElementType::hex20) : ElementType::hex8;
-    case Shape::prism: return p2 ? (complete ? ElementType::prism18 : ElementType::prism15) : ElementType::prism6;
-    case Shape::pyramid: return p2 ? (complete ? ElementType::pyramid14 : ElementType::pyramid13) : ElementType::pyramid5;
+    case Shape::line: t = pick(ElementType::line2, ElementType::line3, ElementType::line4, ElementType::line5); break;
+    case Shape::triangle: t = pick(ElementType::tri3, ElementType::tri6, ElementType::tri10, ElementType::tri15); break;
+    case Shape::quadrilateral:
+      t = pick(ElementType::quad4, complete ? ElementType::quad9 : ElementType::quad8, ElementType::quad16, ElementType::quad25);
+      break;
+    case Shape::tetrahedron: t = pick(ElementType::tet4, ElementType::tet10, ElementType::tet20, ElementType::tet35); break;
+    case Shape::hexahedron: t = pick(ElementType::hex8, complete ? ElementType::hex27 : ElementType::hex20, ElementType::hex64, none); break;
+    case Shape::prism: t = pick(ElementType::prism6, complete ? ElementType::prism18 : ElementType::prism15, ElementType::prism40, none); break;
+    case Shape::pyramid:
+      t = pick(ElementType::pyramid5, complete ? ElementType::pyramid14 : ElementType::pyramid13, ElementType::pyramid30, none);
+      break;
   }
-  return ElementType::point1;
+  if (t == none) {
+    throw InputError("element_type: no " + std::string(shape_name(s)) + " of order " +
+                     std::to_string(element_order) + " (orders 1 to 4 for lines, triangles, quadrilaterals and " +
+                     "tetrahedra, 1 to 3 for hexahedra, prisms and pyramids)");
+  }
+  return t;
 }
 
 /// The linear element of the same shape.
@@ -216,7 +305,8 @@ constexpr std::span<const T> as_span(const std::array<T, N>& a) {
 }
 
 /// Whether a quadratic element of this type carries a node at the centre of quadrilateral
-/// facet f (quad9 as a 2D element has its one "face" node at index 8).
+/// facet f (quad9 as a 2D element has its one "face" node at index 8). False past order 2:
+/// there, face_nodes_per_face() counts the nodes inside each face.
 [[nodiscard]] constexpr bool has_face_nodes(ElementType t) {
   return t == ElementType::quad9 || t == ElementType::hex27 || t == ElementType::prism18 ||
          t == ElementType::pyramid14;
@@ -236,33 +326,86 @@ constexpr std::span<const T> as_span(const std::array<T, N>& a) {
   return -1;
 }
 
-/// All local nodes (vertices, then edge nodes, then the centre node where the facet type has
-/// one) of local facet f of an element of type t, in the facet type's own Gmsh order.
-/// Returns the number of nodes written to `out`.
-constexpr int facet_nodes(ElementType t, int f, std::array<int, 9>& out) {
+// ---- Node layout of every order ----------------------------------------------------------
+// Gmsh's: the vertices; order - 1 nodes per edge, from edges()[k][0] to edges()[k][1]; the
+// nodes inside each face of a 3D element, face by face in Gmsh's face order (face_order()),
+// each face's own nodes laid out as an element of the face's shape and order (order - 3
+// for triangles, order - 2 for quadrilaterals) on the face's inner corners, starting at its
+// first vertex; then the nodes inside the element, laid out the same way recursively.
+
+/// The faces of a 3D shape in the order Gmsh lists their inside nodes, each as a vertex
+/// cycle starting where its nodes start. The same faces as facets(), the same orientation;
+/// tetrahedra start their last face at vertex 3 and pyramids list the base last.
+[[nodiscard]] constexpr std::span<const LocalFacet> face_order(Shape s) {
+  switch (s) {
+    case Shape::tetrahedron: return detail::as_span(detail::tetrahedron_face_order);
+    case Shape::pyramid: return detail::as_span(detail::pyramid_face_order);
+    case Shape::hexahedron:
+    case Shape::prism: return facets(s);
+    default: return {};
+  }
+}
+
+/// Nodes strictly inside one face of the given shape for an element of order p (complete types).
+[[nodiscard]] constexpr int face_nodes_per_face(Shape face, int p) {
+  if (face == Shape::triangle) return p < 3 ? 0 : (p - 1) * (p - 2) / 2;
+  if (face == Shape::quadrilateral) return p < 2 ? 0 : (p - 1) * (p - 1);
+  return 0;
+}
+
+/// Local index of the first node inside face g of face_order() (3D types; complete types only
+/// have them).
+[[nodiscard]] constexpr int first_face_node(ElementType t, int g) {
+  int n = num_vertices(t) + static_cast<int>(edges(t).size()) * (order(t) - 1);
+  if (!element_info(t).complete) return n;
+  const auto faces = face_order(shape(t));
+  for (int k = 0; k < g; ++k) n += face_nodes_per_face(faces[static_cast<std::size_t>(k)].shape, order(t));
+  return n;
+}
+
+/// All local nodes of local facet f of an element of type t, in the facet type's own order
+/// (vertices from facets(t)[f].vertices[0], edges, inside nodes). Returns the number written.
+constexpr int facet_nodes(ElementType t, int f, std::array<int, max_facet_nodes>& out) {
   const LocalFacet& facet = facets(t)[static_cast<std::size_t>(f)];
   int n = 0;
   for (int k = 0; k < facet.num_vertices; ++k) out[static_cast<std::size_t>(n++)] = facet.vertices[static_cast<std::size_t>(k)];
-  if (order(t) < 2) return n;
-  if (facet.shape == Shape::point) return n;
+  const int p = order(t);
+  if (p < 2 || facet.shape == Shape::point) return n;
   const int nv = num_vertices(t);
   const int num_facet_edges = facet.shape == Shape::line ? 1 : facet.num_vertices;
   for (int k = 0; k < num_facet_edges; ++k) {
     const int a = facet.vertices[static_cast<std::size_t>(k)];
     const int b = facet.vertices[static_cast<std::size_t>((k + 1) % facet.num_vertices)];
-    out[static_cast<std::size_t>(n++)] = nv + local_edge(t, a, b);
+    const int e = local_edge(t, a, b);
+    const bool forward = edges(t)[static_cast<std::size_t>(e)][0] == a;
+    for (int j = 0; j < p - 1; ++j) out[static_cast<std::size_t>(n++)] = nv + e * (p - 1) + (forward ? j : p - 2 - j);
   }
-  if (facet.shape == Shape::quadrilateral && has_face_nodes(t)) {
-    int quad_index = 0;
-    for (int g = 0; g < f; ++g)
-      if (facets(t)[static_cast<std::size_t>(g)].shape == Shape::quadrilateral) ++quad_index;
-    out[static_cast<std::size_t>(n++)] = nv + static_cast<int>(edges(t).size()) + quad_index;
+  if (facet.shape == Shape::line || !element_info(t).complete) return n;
+  // The face's inside nodes, rotated from face_order()'s start to the facet's. Inside nodes
+  // form at most one ring (one node per corner, or a single centre node) at every order of
+  // the catalogue, so a rotation is the whole permutation.
+  const auto faces = face_order(shape(t));
+  for (std::size_t g = 0; g < faces.size(); ++g) {
+    const LocalFacet& face = faces[g];
+    int shift = -1;
+    for (int r = 0; r < face.num_vertices && shift < 0; ++r) {
+      bool same = true;
+      for (int k = 0; k < face.num_vertices; ++k)
+        same = same && face.vertices[static_cast<std::size_t>((r + k) % face.num_vertices)] == facet.vertices[static_cast<std::size_t>(k)];
+      if (same) shift = r;
+    }
+    if (shift < 0) continue;
+    const int inside = face_nodes_per_face(face.shape, p);
+    const int first = first_face_node(t, static_cast<int>(g));
+    for (int k = 0; k < inside; ++k) out[static_cast<std::size_t>(n++)] = first + (inside == 1 ? 0 : (shift + k) % inside);
+    return n;
   }
   return n;
 }
 
 /// VTK node order: VTK's node i is our local node vtk_order(t)[i]. Empty span means identity.
-/// `lagrange` selects the order of the VTK Lagrange cell where it differs from the classic one.
+/// `lagrange` selects the order of the VTK Lagrange cell where it differs from the classic one
+/// (types past order 2 exist only as Lagrange cells).
 [[nodiscard]] constexpr std::span<const int> vtk_order(ElementType t, bool lagrange = false) {
   switch (t) {
     case ElementType::tet10: return detail::as_span(detail::tet10_vtk);
@@ -273,19 +416,34 @@ constexpr int facet_nodes(ElementType t, int f, std::array<int, 9>& out) {
     case ElementType::prism18: return lagrange ? detail::as_span(detail::prism18_vtk_lagrange) : detail::as_span(detail::prism18_vtk);
     case ElementType::pyramid13:
     case ElementType::pyramid14: return detail::as_span(detail::pyramid13_vtk);
+    case ElementType::quad16: return detail::as_span(detail::quad16_vtk);
+    case ElementType::quad25: return detail::as_span(detail::quad25_vtk);
+    case ElementType::tet20: return detail::as_span(detail::tet20_vtk);
+    case ElementType::tet35: return detail::as_span(detail::tet35_vtk);
+    case ElementType::hex64: return detail::as_span(detail::hex64_vtk);
+    case ElementType::prism40: return detail::as_span(detail::prism40_vtk);
     default: return {};
   }
 }
 
-/// SU2 uses VTK type numbers and VTK's node order (vtk_order()) for its linear elements.
-[[nodiscard]] constexpr int su2_id(ElementType t) { return element_info(t).order <= 1 ? element_info(t).vtk_id : -1; }
+/// SU2's element number: VTK's type number for linear elements (nodes in VTK's order), and
+/// for the high-order elements of SU2's DG-FEM solver the linear element's number plus
+/// 100 × (order - 1) (nodes on the lattice, su2_node_order() in core/shape_functions.hpp);
+/// -1 for the serendipity types, which SU2 does not have.
+[[nodiscard]] constexpr int su2_id(ElementType t) {
+  const ElementInfo& info = element_info(t);
+  if (info.order <= 1) return info.vtk_id;
+  if (!info.complete) return -1;
+  return element_info(linear_type(t)).vtk_id + 100 * (info.order - 1);
+}
 
 /// The type with the given Gmsh number; throws InputError for unknown numbers.
 [[nodiscard]] inline ElementType element_type_from_gmsh(int gmsh_id) {
   for (const auto& e : detail::element_table)
     if (e.gmsh_id == gmsh_id) return e.type;
   throw InputError("element_type_from_gmsh: unsupported Gmsh element type " + std::to_string(gmsh_id) +
-                   " (expected a point, linear or quadratic element: 1 to 19)");
+                   " (expected a point or a line, triangle, quadrilateral or tetrahedron of order 1 to 4, or a hexahedron, " +
+                   "prism or pyramid of order 1 to 3; the serendipity elements stop at order 2)");
 }
 
 /// The linear type with the given VTK/SU2 number; throws InputError for unknown numbers.
@@ -293,6 +451,21 @@ constexpr int facet_nodes(ElementType t, int f, std::array<int, 9>& out) {
   for (const auto& e : detail::element_table)
     if (e.vtk_id == vtk_id && e.type != ElementType::pyramid14) return e.type;
   throw InputError("element_type_from_vtk: unsupported VTK cell type " + std::to_string(vtk_id));
+}
+
+/// The type with the given SU2 number (su2_id(); a leading solution degree, 10000 × (degree + 1),
+/// is ignored); throws InputError for unknown numbers.
+[[nodiscard]] inline ElementType element_type_from_su2(int su2_number) {
+  const int id = su2_number % 10000;
+  ElementType lin{};
+  try {
+    lin = element_type_from_vtk(id % 100);
+    if (order(lin) > 1 || su2_number < 0) throw InputError("");
+  } catch (const InputError&) {
+    throw InputError("unknown SU2 element type " + std::to_string(su2_number) +
+                     " (expected 3 line, 5 tri, 9 quad, 10 tet, 12 hex, 13 prism or 14 pyramid, plus 100 per order past 1)");
+  }
+  return element_type(shape(lin), id / 100 + 1);
 }
 
 /// The type named "tri6", "hex27", ...; throws InputError for unknown names.

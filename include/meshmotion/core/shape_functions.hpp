@@ -28,6 +28,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <initializer_list>
 #include <span>
 #include <vector>
 
@@ -134,32 +135,118 @@ inline std::vector<RefPoint> vertex_coordinates(Shape s) {
   return {};
 }
 
-inline std::vector<RefPoint> make_reference_nodes(ElementType t) {
-  std::vector<RefPoint> x = vertex_coordinates(shape(t));
-  if (order(t) < 2) return x;
-  const auto mean = [&x](std::span<const int> ids) {
-    RefPoint c{0, 0, 0};
-    for (int i : ids)
-      for (int d = 0; d < 3; ++d) c[static_cast<std::size_t>(d)] += x[static_cast<std::size_t>(i)][static_cast<std::size_t>(d)];
-    for (double& v : c) v /= static_cast<double>(ids.size());
-    return c;
-  };
-  const std::size_t nv = x.size();
-  for (const auto& e : edges(t)) x.push_back(mean(e));
-  if (has_face_nodes(t)) {
-    if (shape(t) == Shape::quadrilateral) {
-      const std::array<int, 4> all{0, 1, 2, 3};
-      x.push_back(mean(all));
-    } else {
-      for (const auto& f : facets(t))
-        if (f.shape == Shape::quadrilateral) x.push_back(mean(std::span<const int>(f.vertices.data(), 4)));
+inline RefPoint mean_point(std::span<const RefPoint> corners) {
+  RefPoint c{0, 0, 0};
+  for (const auto& x : corners)
+    for (std::size_t d = 0; d < 3; ++d) c[d] += x[d] / static_cast<double>(corners.size());
+  return c;
+}
+
+// Σ_k weights[k] · corners[k].
+inline RefPoint combine(std::span<const RefPoint> corners, std::initializer_list<double> weights) {
+  RefPoint c{0, 0, 0};
+  std::size_t k = 0;
+  for (double w : weights) {
+    for (std::size_t d = 0; d < 3; ++d) c[d] += w * corners[k][d];
+    ++k;
+  }
+  return c;
+}
+
+// Multilinear map of a quadrilateral or hexahedron's corners at (s, t, r) in [0, 1]^dim.
+inline RefPoint multilinear(std::span<const RefPoint> corners, double s, double t, double r = 0.0) {
+  if (corners.size() == 4) return combine(corners, {(1 - s) * (1 - t), s * (1 - t), s * t, (1 - s) * t});
+  return combine(corners, {(1 - s) * (1 - t) * (1 - r), s * (1 - t) * (1 - r), s * t * (1 - r), (1 - s) * t * (1 - r),
+                           (1 - s) * (1 - t) * r, s * (1 - t) * r, s * t * r, (1 - s) * t * r});
+}
+
+inline void append_lattice(Shape s, int p, bool complete, std::span<const RefPoint> corners, std::vector<RefPoint>& out);
+
+// The nodes strictly inside an element of shape s and order p on the given corners: a
+// smaller element of the same shape on its inner corners, laid out recursively (Gmsh's order).
+inline void append_inside(Shape s, int p, std::span<const RefPoint> c, std::vector<RefPoint>& out) {
+  const double h = 1.0 / p;
+  switch (s) {
+    case Shape::triangle:
+      if (p >= 3) {
+        const std::array<RefPoint, 3> inner{combine(c, {1 - 2 * h, h, h}), combine(c, {h, 1 - 2 * h, h}),
+                                            combine(c, {h, h, 1 - 2 * h})};
+        append_lattice(s, p - 3, true, inner, out);
+      }
+      break;
+    case Shape::quadrilateral:
+      if (p >= 2) {
+        const std::array<RefPoint, 4> inner{multilinear(c, h, h), multilinear(c, 1 - h, h), multilinear(c, 1 - h, 1 - h),
+                                            multilinear(c, h, 1 - h)};
+        append_lattice(s, p - 2, true, inner, out);
+      }
+      break;
+    case Shape::tetrahedron:
+      if (p >= 4) {
+        const std::array<RefPoint, 4> inner{combine(c, {1 - 3 * h, h, h, h}), combine(c, {h, 1 - 3 * h, h, h}),
+                                            combine(c, {h, h, 1 - 3 * h, h}), combine(c, {h, h, h, 1 - 3 * h})};
+        append_lattice(s, p - 4, true, inner, out);
+      }
+      break;
+    case Shape::hexahedron:
+      if (p >= 2) {
+        std::array<RefPoint, 8> inner{};
+        const auto unit = vertex_coordinates(Shape::hexahedron);
+        for (std::size_t k = 0; k < 8; ++k) {
+          const RefPoint& v = unit[k];
+          inner[k] = multilinear(c, v[0] < 0 ? h : 1 - h, v[1] < 0 ? h : 1 - h, v[2] < 0 ? h : 1 - h);
+        }
+        append_lattice(s, p - 2, true, inner, out);
+      }
+      break;
+    case Shape::prism:  // the triangle's inside nodes on each inner level, bottom to top
+      for (int level = 1; level < p; ++level) {
+        const double r = level * h;
+        const std::array<RefPoint, 3> section{combine(c, {1 - r, 0, 0, r, 0, 0}), combine(c, {0, 1 - r, 0, 0, r, 0}),
+                                              combine(c, {0, 0, 1 - r, 0, 0, r})};
+        append_inside(Shape::triangle, p, section, out);
+      }
+      break;
+    case Shape::pyramid:  // order 3 at most: one node, a third of the way from the base centre to the apex
+      if (p == 3) {
+        const RefPoint base = mean_point(c.first(4));
+        out.push_back(combine(std::array<RefPoint, 2>{base, c[4]}, {2.0 / 3.0, 1.0 / 3.0}));
+      }
+      break;
+    case Shape::point:
+    case Shape::line: break;
+  }
+}
+
+// An element of shape s and order p on the given corners, in Gmsh's node order; order 0 is
+// one node at the centre (the inside of a tri10, a tet35 or a quad9 at the bottom of the
+// recursion).
+inline void append_lattice(Shape s, int p, bool complete, std::span<const RefPoint> corners, std::vector<RefPoint>& out) {
+  if (p == 0) {
+    out.push_back(mean_point(corners));
+    return;
+  }
+  out.insert(out.end(), corners.begin(), corners.end());
+  if (p < 2) return;
+  for (const auto& e : edges(s))
+    for (int j = 1; j < p; ++j) {
+      const double r = static_cast<double>(j) / p;
+      out.push_back(combine(std::array<RefPoint, 2>{corners[static_cast<std::size_t>(e[0])], corners[static_cast<std::size_t>(e[1])]},
+                            {1 - r, r}));
     }
+  if (!complete) return;
+  for (const auto& f : face_order(s)) {
+    std::array<RefPoint, 4> face{};
+    for (int k = 0; k < f.num_vertices; ++k) face[static_cast<std::size_t>(k)] = corners[static_cast<std::size_t>(f.vertices[static_cast<std::size_t>(k)])];
+    append_inside(f.shape, p, std::span<const RefPoint>(face.data(), static_cast<std::size_t>(f.num_vertices)), out);
   }
-  if (t == ElementType::hex27) {
-    std::array<int, 8> all{};
-    for (std::size_t i = 0; i < nv; ++i) all[i] = static_cast<int>(i);
-    x.push_back(mean(all));
-  }
+  append_inside(s, p, corners, out);
+}
+
+inline std::vector<RefPoint> make_reference_nodes(ElementType t) {
+  std::vector<RefPoint> x;
+  const auto corners = vertex_coordinates(shape(t));
+  append_lattice(shape(t), std::max(order(t), 1), element_info(t).complete, corners, x);
   return x;
 }
 
@@ -207,6 +294,83 @@ inline const ShapeBasis& shape_basis(ElementType t) {
   return c;
 }
 
+namespace detail {
+
+// The lattice SU2's DG-FEM solver lists a high-order element's nodes on: i along the edge from
+// vertex 0 to vertex 1, j towards the vertex across the first face (2 for simplices and
+// prisms, 3 for quadrilaterals, hexahedra and pyramid bases), k towards the next layer (3 for
+// tetrahedra and prisms, 4 for hexahedra and the pyramid apex); k outermost, i fastest.
+inline std::vector<RefPoint> su2_lattice(Shape s, int p) {
+  std::vector<RefPoint> x;
+  const auto h = [p](int i) { return static_cast<double>(i) / p; };
+  const auto c = [p](int i) { return -1.0 + 2.0 * i / p; };
+  switch (s) {
+    case Shape::point: x.push_back({0, 0, 0}); break;
+    case Shape::line:
+      for (int i = 0; i <= p; ++i) x.push_back({c(i), 0, 0});
+      break;
+    case Shape::triangle:
+      for (int j = 0; j <= p; ++j)
+        for (int i = 0; i + j <= p; ++i) x.push_back({h(i), h(j), 0});
+      break;
+    case Shape::quadrilateral:
+      for (int j = 0; j <= p; ++j)
+        for (int i = 0; i <= p; ++i) x.push_back({c(i), c(j), 0});
+      break;
+    case Shape::tetrahedron:
+      for (int k = 0; k <= p; ++k)
+        for (int j = 0; j + k <= p; ++j)
+          for (int i = 0; i + j + k <= p; ++i) x.push_back({h(i), h(j), h(k)});
+      break;
+    case Shape::hexahedron:
+      for (int k = 0; k <= p; ++k)
+        for (int j = 0; j <= p; ++j)
+          for (int i = 0; i <= p; ++i) x.push_back({c(i), c(j), c(k)});
+      break;
+    case Shape::prism:
+      for (int k = 0; k <= p; ++k)
+        for (int j = 0; j <= p; ++j)
+          for (int i = 0; i + j <= p; ++i) x.push_back({h(i), h(j), c(k)});
+      break;
+    case Shape::pyramid:
+      for (int k = 0; k <= p; ++k)
+        for (int j = 0; j <= p - k; ++j)
+          for (int i = 0; i <= p - k; ++i) x.push_back({-1.0 + h(k) + 2.0 * h(i), -1.0 + h(k) + 2.0 * h(j), h(k)});
+      break;
+  }
+  return x;
+}
+
+inline std::vector<int> make_su2_node_order(ElementType t) {
+  if (order(t) <= 1 || su2_id(t) < 0) {
+    const auto v = vtk_order(t);
+    return {v.begin(), v.end()};
+  }
+  const auto ours = shape_basis(t).nodes;
+  std::vector<int> out;
+  for (const RefPoint& x : su2_lattice(shape(t), order(t))) {
+    int found = -1;
+    for (std::size_t i = 0; i < ours.size() && found < 0; ++i)
+      if (std::abs(ours[i][0] - x[0]) + std::abs(ours[i][1] - x[1]) + std::abs(ours[i][2] - x[2]) < 1e-12) found = static_cast<int>(i);
+    out.push_back(found);
+  }
+  return out;
+}
+
+}  // namespace detail
+
+/// SU2's node order: the file's node k is our local node su2_node_order(type)[k]. Linear
+/// elements: VTK's order (vtk_order(), empty for the identity); high-order elements: the
+/// lattice of SU2's DG-FEM solver (vertex 0 first, rows along the edge to vertex 1).
+[[nodiscard]] inline std::span<const int> su2_node_order(ElementType type) {
+  static const std::array<std::vector<int>, num_element_types> orders = [] {
+    std::array<std::vector<int>, num_element_types> all;
+    for (int i = 0; i < num_element_types; ++i) all[static_cast<std::size_t>(i)] = detail::make_su2_node_order(static_cast<ElementType>(i));
+    return all;
+  }();
+  return orders[static_cast<std::size_t>(type)];
+}
+
 /// Shape function values N_i(xi), i < num_nodes(type), written to `values` (size ≥ num_nodes).
 inline void shape_functions(ElementType type, const RefPoint& xi, std::span<double> values) {
   const auto& basis = detail::shape_basis(type);
@@ -239,7 +403,7 @@ jacobian(ElementType type, const Eigen::MatrixBase<Derived>& coords, const RefPo
   constexpr int space_dim = Derived::RowsAtCompileTime;
   static_assert(space_dim >= 1 && space_dim <= 3, "jacobian: coords needs a fixed number of rows (1 to 3)");
   const int n = num_nodes(type), rd = dimension(type);
-  std::array<std::array<double, 3>, 27> grads{};
+  std::array<std::array<double, 3>, max_element_nodes> grads{};
   shape_derivatives(type, xi, std::span<std::array<double, 3>>(grads.data(), static_cast<std::size_t>(n)));
   Eigen::Matrix<double, space_dim, Eigen::Dynamic, 0, space_dim, 3> jac =
       Eigen::Matrix<double, space_dim, Eigen::Dynamic, 0, space_dim, 3>::Zero(space_dim, rd);
@@ -262,7 +426,7 @@ template <class Derived>
 [[nodiscard]] Eigen::Matrix<double, Derived::RowsAtCompileTime, 1> map_to_physical(ElementType type,
                                                                                   const Eigen::MatrixBase<Derived>& coords,
                                                                                   const RefPoint& xi) {
-  std::array<double, 27> values{};
+  std::array<double, max_element_nodes> values{};
   shape_functions(type, xi, std::span<double>(values.data(), static_cast<std::size_t>(num_nodes(type))));
   Eigen::Matrix<double, Derived::RowsAtCompileTime, 1> x = Eigen::Matrix<double, Derived::RowsAtCompileTime, 1>::Zero(coords.rows());
   for (int i = 0; i < num_nodes(type); ++i) x += coords.col(i) * values[static_cast<std::size_t>(i)];

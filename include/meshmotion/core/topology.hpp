@@ -168,7 +168,7 @@ template <MeshLike M>
       cell_block.insert(cell_block.end(), static_cast<std::size_t>(source.size(b)), b);
     }
     std::vector<ElementBlock> out;
-    std::array<int, 9> local_nodes{};
+    std::array<int, max_facet_nodes> local_nodes{};
     std::vector<Index> nodes;
     for (Index f = 0; f < topo.size(); ++f) {
       if (!topo.is_boundary(f)) continue;

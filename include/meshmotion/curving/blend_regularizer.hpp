@@ -98,7 +98,7 @@ class BlendMover {
       distance.emplace_back(mesh.points, walls[b]);
     }
     std::vector<Eigen::Triplet<double, Index>> triplets;
-    std::array<double, 9> shape{};
+    std::array<double, max_facet_nodes> shape{};
     std::vector<detail::WallPoint<Dim>> closest(walls.size());
     std::vector<double> phi(walls.size());
     evaluated_ = 0;

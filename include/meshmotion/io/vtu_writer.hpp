@@ -59,7 +59,7 @@ struct VtkCell {
 
 [[nodiscard]] inline VtkCell vtk_cell(ElementType t) {
   const ElementInfo& info = element_info(t);
-  const bool lagrange = info.order == 2 && info.vtk_lagrange_id >= 0;
+  const bool lagrange = (info.order == 2 || info.vtk_id < 0) && info.vtk_lagrange_id >= 0;
   const auto order = vtk_order(t, lagrange);
   return {lagrange ? info.vtk_lagrange_id : info.vtk_id, order,
           order.empty() ? info.num_nodes : static_cast<int>(order.size())};
@@ -187,6 +187,11 @@ class VtkCellSequence {
 template <int Dim>
 void check_vtu_writable(const Mesh<Dim>& mesh, const VtuFields& fields) {
   validate(mesh);
+  for (const auto* list : {&mesh.cells, &mesh.facets})
+    for (const auto& b : *list)
+      if (vtk_cell(b.type).type < 0)
+        throw InputError("write_vtu: VTK has no cell for " + std::string(name(b.type)) +
+                         " elements (its Lagrange pyramids are not in VTK 9.1; write .msh instead)");
   for (const auto& [array_name, values] : fields.point_data)
     if (values.cols() != mesh.num_nodes())
       throw InputError("write_vtu: point data '" + array_name + "' has " + std::to_string(values.cols()) +

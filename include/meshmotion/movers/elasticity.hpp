@@ -103,7 +103,7 @@ class ElasticityMover : public detail::LinearMechanicsMover<Dim> {
   /// Σ over the cells of their measure Σ_q w_q |det J_q| (J0's default is its mean).
   [[nodiscard]] static double total_cell_measure(const Mesh<Dim>& mesh) {
     double total = 0.0;
-    detail::ElementCoords<Dim> x;
+    detail::FemCoords<Dim> x;
     detail::ElementGradients<Dim> g;
     Eigen::Matrix<double, Dim, Dim> jacobian;
     for (const auto& block : mesh.cells) {
@@ -221,7 +221,7 @@ SparseMatrix ElasticityMover<Dim>::assemble_stiffness(const Mesh<Dim>& mesh, con
       for (const Index v : block.element(e)) touches_free = touches_free || unknown[static_cast<std::size_t>(v)];
       if (!touches_free) return;
     }
-    detail::ElementCoords<Dim> x;
+    detail::FemCoords<Dim> x;
     detail::gather_coords(mesh.points, block, e, x);
     const int n = table.num_nodes;
     detail::ElementMatrix<Dim> k = detail::ElementMatrix<Dim>::Zero(n * Dim, n * Dim);

@@ -194,7 +194,7 @@ class NonlinearElasticityMover : public detail::MoveFromMoveInto<NonlinearElasti
     for (const auto& block : mesh_.cells) {
       const detail::QuadratureTable& table = detail::quadrature_table(block.type);
       const int nn = table.num_nodes;
-      detail::ElementCoords<Dim> x, ue;
+      detail::FemCoords<Dim> x, ue;
       detail::ElementGradients<Dim> g;
       Eigen::Matrix<double, Dim, Dim> jacobian;
       for (Index e = 0; e < block.size(); ++e) {
@@ -226,7 +226,7 @@ class NonlinearElasticityMover : public detail::MoveFromMoveInto<NonlinearElasti
       const ElementBlock& block = mesh_.cells[static_cast<std::size_t>(b)];
       const detail::QuadratureTable& table = detail::quadrature_table(block.type);
       const int nn = table.num_nodes;
-      detail::ElementCoords<Dim> x, ue;
+      detail::FemCoords<Dim> x, ue;
       detail::ElementGradients<Dim> g, m;
       Eigen::Matrix<double, Dim, Dim> jacobian;
       detail::gather_coords(mesh_.points, block, e, x);

@@ -33,7 +33,7 @@ namespace meshmotion::detail {
 /// One wall facet: its element type (line2/3, tri3/6, quad4/8/9) and all its nodes.
 struct WallFacet {
   ElementType type = ElementType::line2;
-  std::array<Index, 9> nodes{};
+  std::array<Index, max_facet_nodes> nodes{};
 };
 
 /// The wall facets of the groups tagged `tags` (facet blocks of a mesh).
@@ -190,7 +190,7 @@ class WallDistance {
   [[nodiscard]] Eigen::Matrix<double, Rows, 1> interpolate(const Eigen::Matrix<double, Rows, Eigen::Dynamic>& values,
                                                            const WallPoint<Dim>& w) const {
     const WallFacet& f = facets_[static_cast<std::size_t>(w.facet)];
-    std::array<double, 9> shape{};
+    std::array<double, max_facet_nodes> shape{};
     shape_functions(f.type, w.xi, std::span<double>(shape.data(), static_cast<std::size_t>(num_nodes(f.type))));
     Eigen::Matrix<double, Rows, 1> out = Eigen::Matrix<double, Rows, 1>::Zero(values.rows());
     for (int k = 0; k < num_nodes(f.type); ++k) out += shape[static_cast<std::size_t>(k)] * values.col(f.nodes[static_cast<std::size_t>(k)]);

@@ -143,8 +143,9 @@ struct QuadraturePoint {
   return {};
 }
 
-/// Largest number of nodes of a cell type (hex27).
-inline constexpr int max_cell_nodes = 27;
+/// Largest cell the finite-element movers assemble (prism40): the element matrix of 3 × 40
+/// dofs stays on the stack (Eigen's limit is 128 KiB); a hex64's would not.
+inline constexpr int max_cell_nodes = 40;
 
 /// Shape function values and reference gradients of one cell type at its default quadrature
 /// points: values[q * n + i] = N_i(ξ_q), gradients[q * n + i][d] = ∂N_i/∂ξ_d.
@@ -198,7 +199,7 @@ struct QuadratureTable {
 
 /// Node coordinates of one element: Dim × n (n ≤ 27), on the stack.
 template <int Dim>
-using ElementCoords = Eigen::Matrix<double, Dim, Eigen::Dynamic, 0, Dim, max_cell_nodes>;
+using FemCoords = Eigen::Matrix<double, Dim, Eigen::Dynamic, 0, Dim, max_cell_nodes>;
 
 /// Physical gradients of the shape functions at a quadrature point: n × Dim, on the stack.
 template <int Dim>
@@ -211,7 +212,7 @@ using ElementMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, D
 /// Geometry of an element at quadrature point q: the Jacobian J = ∂x/∂ξ (Dim × Dim), its
 /// determinant, and the physical gradients G = (∂N/∂ξ) J⁻¹ (n × Dim). Returns det J.
 template <int Dim>
-double element_geometry(const QuadratureTable& table, int q, const ElementCoords<Dim>& x, ElementGradients<Dim>& g,
+double element_geometry(const QuadratureTable& table, int q, const FemCoords<Dim>& x, ElementGradients<Dim>& g,
                         Eigen::Matrix<double, Dim, Dim>& jacobian) {
   const int n = table.num_nodes;
   ElementGradients<Dim> reference(n, Dim);
@@ -297,6 +298,10 @@ template <int Dim, class CellFn>
 #endif
   std::vector<std::vector<Triplet>> lists(threads);
   Index entries = 0;
+  for (const auto& block : mesh.cells)
+    if (num_nodes(block.type) > max_cell_nodes)
+      throw InputError("the finite-element movers take cells of up to " + std::to_string(max_cell_nodes) + " nodes (got " +
+                       std::string(name(block.type)) + "); move the linear or P2 mesh and raise its order afterwards");
   for (const auto& block : mesh.cells) entries += block.size() * per_node_pair * num_nodes(block.type) * num_nodes(block.type);
   for (auto& l : lists) l.reserve(static_cast<std::size_t>(entries / static_cast<Index>(threads) + 64));
   for (Index b = 0; b < static_cast<Index>(mesh.cells.size()); ++b) {
@@ -322,7 +327,7 @@ template <int Dim, class CellFn>
 
 /// Node coordinates of element e of `block` into x (Dim × n).
 template <int Dim>
-void gather_coords(const Points<Dim>& points, const ElementBlock& block, Index e, ElementCoords<Dim>& x) {
+void gather_coords(const Points<Dim>& points, const ElementBlock& block, Index e, FemCoords<Dim>& x) {
   const auto nodes = block.element(e);
   x.resize(Dim, static_cast<Index>(nodes.size()));
   for (std::size_t i = 0; i < nodes.size(); ++i) x.col(static_cast<Index>(i)) = points.col(nodes[i]);
