@@ -201,8 +201,8 @@ TEST_CASE("every real mesh round-trips through all msh variants and SU2", "[io]"
   }
 }
 
-TEST_CASE("P1 and P2 elements of every type round-trip with non-contiguous ids", "[io]") {
-  for (const int element_order : {1, 2}) {
+TEST_CASE("elements of every type and order round-trip with non-contiguous ids", "[io]") {
+  for (const int element_order : {1, 2, 3, 4}) {
     for (const auto& options : msh_variants) {
       INFO("order " << element_order << " msh " << (options.msh_version == MshVersion::v2_2 ? "2.2" : "4.1") << (options.binary ? " binary" : " ascii"));
       const auto mesh3 = all_types_mesh<3>(element_order);
@@ -210,7 +210,8 @@ TEST_CASE("P1 and P2 elements of every type round-trip with non-contiguous ids",
       write_mesh(out3, mesh3, options);
       const auto back3 = read_mesh_as<3>(out3);
       require_same_mesh(mesh3, back3);
-      CHECK(back3.cells.size() == (element_order == 1 ? 4 : 7));  // P2: complete and serendipity types
+      // P2: complete and serendipity types; P3: tet20, hex64, prism40, pyramid30; P4: tet35.
+      CHECK(back3.cells.size() == std::vector<std::size_t>{4, 7, 4, 1}[static_cast<std::size_t>(element_order - 1)]);
       CHECK(back3.lower.size() == 2);  // lines and the point (Gmsh type 15)
 
       const auto mesh2 = all_types_mesh<2>(element_order);
@@ -218,18 +219,54 @@ TEST_CASE("P1 and P2 elements of every type round-trip with non-contiguous ids",
       write_mesh(out2, mesh2, options);
       require_same_mesh(mesh2, read_mesh_as<2>(out2));
     }
+    // SU2: VTK's order for linear elements, the DG-FEM lattice past order 1; serendipity
+    // types have no SU2 form.
+    INFO("order " << element_order << " su2");
+    auto su2_mesh = all_types_mesh<3>(element_order);
+    su2_mesh.lower.clear();
+    std::erase_if(su2_mesh.cells, [](const ElementBlock& b) { return !element_info(b.type).complete; });
+    std::erase_if(su2_mesh.facets, [](const ElementBlock& b) { return !element_info(b.type).complete; });
+    const auto out = test::scratch_path("all_types3.su2");
+    write_mesh(out, su2_mesh);
+    const auto back = read_mesh_as<3>(out);
+    CHECK(back.points == su2_mesh.points);
+    using Lists = std::pair<const std::vector<ElementBlock>*, const std::vector<ElementBlock>*>;
+    for (const Lists& lists : {Lists{&su2_mesh.cells, &back.cells}, Lists{&su2_mesh.facets, &back.facets}})
+      for (const auto& b : *lists.first) {
+        INFO(name(b.type));
+        const auto it = std::find_if(lists.second->begin(), lists.second->end(), [&](const ElementBlock& r) { return r.type == b.type; });
+        REQUIRE(it != lists.second->end());
+        CHECK(it->connectivity == b.connectivity);
+      }
   }
-  // SU2 round trip of the linear types
-  const auto linear = all_types_mesh<3>(1);
-  auto su2_mesh = linear;
-  su2_mesh.lower.clear();
-  const auto out = test::scratch_path("all_types3.su2");
-  write_mesh(out, su2_mesh);
-  const auto back = read_mesh_as<3>(out);
-  CHECK(back.points == su2_mesh.points);
-  CHECK(type_counts(back.cells) == type_counts(su2_mesh.cells));
-  CHECK(type_counts(back.facets) == type_counts(su2_mesh.facets));
-  CHECK_THROWS_AS(write_mesh(test::scratch_path("p2.su2"), all_types_mesh<2>(2)), InputError);
+  CHECK_THROWS_WITH(write_mesh(test::scratch_path("p2.su2"), all_types_mesh<2>(2)), Catch::Contains("serendipity"));
+}
+
+TEST_CASE("SU2's DG-FEM lattice: element numbers and node rows as SU2 lists them", "[io]") {
+  CHECK(su2_id(ElementType::tri10) == 205);
+  CHECK(su2_id(ElementType::hex27) == 112);
+  CHECK(su2_id(ElementType::tet35) == 310);
+  CHECK(su2_id(ElementType::quad8) == -1);
+  CHECK(element_type_from_su2(205) == ElementType::tri10);
+  CHECK(element_type_from_su2(30212) == ElementType::hex64);  // solution degree 2 ahead of the type
+  CHECK_THROWS_WITH(element_type_from_su2(312), Catch::Contains("no hexahedron of order 4"));
+  CHECK_THROWS_WITH(element_type_from_su2(7), Catch::Contains("unknown SU2 element type 7"));
+  // SU2's own tables (its CGNS converter lists, per SU2 node, the CGNS node; CGNS and Gmsh
+  // agree on these: vertices, then edges, then faces): a quad16's rows are 0 4 5 1 / 11 12 13 6
+  // / 10 15 14 7 / 3 9 8 2, a tet10's 0 4 1 6 5 2 / 7 8 9 / 3.
+  const auto quad16 = su2_node_order(ElementType::quad16);
+  CHECK(std::vector<int>(quad16.begin(), quad16.end()) == std::vector<int>{0, 4, 5, 1, 11, 12, 13, 6, 10, 15, 14, 7, 3, 9, 8, 2});
+  const auto tet10 = su2_node_order(ElementType::tet10);
+  CHECK(std::vector<int>(tet10.begin(), tet10.end()) == std::vector<int>{0, 4, 1, 6, 5, 2, 7, 9, 8, 3});
+  for (int t = 0; t < num_element_types; ++t) {
+    const auto type = static_cast<ElementType>(t);
+    if (order(type) < 2 || su2_id(type) < 0) continue;
+    INFO(name(type));
+    const auto perm = su2_node_order(type);
+    std::vector<int> sorted(perm.begin(), perm.end());
+    std::sort(sorted.begin(), sorted.end());
+    for (int k = 0; k < num_nodes(type); ++k) CHECK(sorted[static_cast<std::size_t>(k)] == k);
+  }
 }
 
 TEST_CASE("orientation: reference elements are positive and fix_orientation mirrors P2 nodes consistently", "[io]") {

@@ -124,7 +124,7 @@ namespace detail {
 
 namespace detail {
 
-/// CGNS element type of each catalogue type, in ElementType order.
+/// CGNS element type of each catalogue type, in ElementType order (ElementTypeNull past order 2).
 inline constexpr CGNS_ENUMT(ElementType_t) cgns_types[num_element_types] = {
     CGNS_ENUMV(NODE),     CGNS_ENUMV(BAR_2),    CGNS_ENUMV(BAR_3),    CGNS_ENUMV(TRI_3),    CGNS_ENUMV(TRI_6),
     CGNS_ENUMV(QUAD_4),   CGNS_ENUMV(QUAD_8),   CGNS_ENUMV(QUAD_9),   CGNS_ENUMV(TETRA_4),  CGNS_ENUMV(TETRA_10),
@@ -138,10 +138,11 @@ inline constexpr CGNS_ENUMT(ElementType_t) cgns_types[num_element_types] = {
   return k >= 0 && k < NofValidElementTypes ? std::string(cgns_api().cg_ElementTypeName(t)) : "element type " + std::to_string(k);
 }
 
-/// Our type of a CGNS type, or nullopt-like -1 when the catalogue has none.
+/// Our type of a CGNS type, or nullopt-like -1 when the catalogue has none (past order 2:
+/// CGNS orders their nodes unlike Gmsh, and the table holds no CGNS type for them).
 [[nodiscard]] inline int element_type_of_cgns(CGNS_ENUMT(ElementType_t) t) {
   for (int k = 0; k < num_element_types; ++k)
-    if (cgns_types[k] == t) return k;
+    if (order(static_cast<ElementType>(k)) <= 2 && cgns_types[k] == t) return k;
   return -1;
 }
 
@@ -666,6 +667,11 @@ class CgnsWriter {
  public:
   explicit CgnsWriter(const Mesh<Dim>& mesh) : mesh_(mesh) {
     validate(mesh);
+    for (const auto* list : {&mesh.cells, &mesh.facets, &mesh.lower})
+      for (const auto& b : *list)
+        if (order(b.type) > 2)
+          throw InputError("write_cgns: " + std::string(name(b.type)) +
+                           " elements: CGNS files are written up to order 2 (expected .msh or .vtu past it)");
     list_elements();
     plan_sections();
   }

@@ -151,8 +151,8 @@ inline void check_mesh_output(const std::filesystem::path& file, int order = 1) 
     throw InputError("output " + file.string() + ": unknown mesh format '" + ext + "' (expected .msh, .su2, .cgns or .vtu)");
   if (ext == ".cgns" && !have_cgns)
     throw InputError("output " + file.string() + ": writing CGNS needs the CGNS library (meshmotion was built without it)");
-  if (ext == ".su2" && order > 1)
-    throw InputError("output " + file.string() + ": .su2 holds linear elements only (expected .msh, .cgns or .vtu for order " +
+  if (ext == ".cgns" && order > 2)
+    throw InputError("output " + file.string() + ": CGNS files are written up to order 2 (expected .msh or .vtu for order " +
                      std::to_string(order) + ")");
   const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
   std::error_code ec;

@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// SU2 native mesh (.su2) reader: NDIME 2 or 3, mixed elements (VTK type numbers and node
-/// order, 0-based node indices), NPOIN before or after NELEM, an optional trailing index on
+/// order, 0-based node indices; high-order elements of SU2's DG-FEM format, type + 100 ×
+/// (order - 1) with nodes on its lattice), NPOIN before or after NELEM, an optional trailing index on
 /// point and element lines, and markers, each becoming a facet group (tag = position of the
 /// marker, from 1). Sections that are not mesh data (NZONE/IZONE, the periodic
 /// transformations of NPERIODIC/PERIODIC_INDEX, SU2_DEF's FFD boxes) are skipped.
@@ -10,6 +11,7 @@
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/shape_functions.hpp"
 #include "meshmotion/io/any_mesh.hpp"
 #include "meshmotion/io/detail/raw_mesh.hpp"
 #include "meshmotion/io/detail/read_file.hpp"
@@ -137,13 +139,12 @@ class Su2Parser {
     while (!text_.at_end() && text_.remaining().front() == '%') text_.next_line();
   }
 
-  ElementBlock& block_for(int vtk_type, int expected_dim, std::uint64_t line, int& index_out) {
+  ElementBlock& block_for(int su2_type, int expected_dim, std::uint64_t line, int& index_out) {
     ElementType type{};
     try {
-      type = element_type_from_vtk(vtk_type);
-    } catch (const InputError&) {
-      throw ParseError(text_.file(), line, "unknown SU2 element type " + std::to_string(vtk_type) +
-                                               " (expected 3 line, 5 tri, 9 quad, 10 tet, 12 hex, 13 prism or 14 pyramid)");
+      type = element_type_from_su2(su2_type);
+    } catch (const InputError& e) {
+      throw ParseError(text_.file(), line, e.what());
     }
     if (dimension(type) != expected_dim)
       throw ParseError(text_.file(), line, std::string(name(type)) + " element of dimension " + std::to_string(dimension(type)) +
@@ -167,8 +168,9 @@ class Su2Parser {
       const std::size_t first = block.connectivity.size();
       const int nodes = block.nodes_per_element();
       block.connectivity.resize(first + static_cast<std::size_t>(nodes));
-      // The file lists nodes in VTK's order: its node k is our local node order[k].
-      const auto order = vtk_order(block.type);
+      // The file lists nodes in VTK's order (SU2's lattice past order 1): its node k is our
+      // local node order[k].
+      const auto order = su2_node_order(block.type);
       for (int k = 0; k < nodes; ++k) {
         if (text_.at_line_end())
           text_.fail(std::string(name(block.type)) + " element with " + std::to_string(k) + " nodes (expected " +

@@ -2,11 +2,14 @@
 /// \file
 /// SU2 native mesh (.su2) writer. Writes NDIME, NELEM (the cells, in cell order), NPOIN (with
 /// the point index) and one marker per facet tag (named after its group, "tag_<n>" without
-/// one). SU2 holds linear elements only; node order and orientation are written as they are.
+/// one). Linear elements in VTK's node order; high-order (complete) elements as SU2's DG-FEM
+/// solver reads them: type number + 100 × (order - 1), nodes on its lattice
+/// (su2_node_order()). Orientation is written as it is.
 
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/shape_functions.hpp"
 #include "meshmotion/io/detail/atomic_file.hpp"
 #include "meshmotion/io/detail/number_format.hpp"
 
@@ -26,7 +29,8 @@ void check_su2_writable(const Mesh<Dim>& mesh) {
   for (const auto* list : {&mesh.cells, &mesh.facets})
     for (const auto& b : *list)
       if (su2_id(b.type) < 0)
-        throw InputError("write_su2: SU2 stores linear elements only (got " + std::string(name(b.type)) + ")");
+        throw InputError("write_su2: SU2 has no serendipity elements (got " + std::string(name(b.type)) +
+                         "; convert to the complete element of that order)");
 }
 
 template <int Dim>
@@ -35,7 +39,7 @@ void format_su2(TextOutput& output, const Mesh<Dim>& mesh) {
   const auto element_line = [&](const ElementBlock& b, Index e) {
     append_number(out, su2_id(b.type));
     const auto nodes = b.element(e);
-    const auto order = vtk_order(b.type);  // SU2 lists nodes in VTK's order
+    const auto order = su2_node_order(b.type);
     for (std::size_t k = 0; k < nodes.size(); ++k) {
       out.push_back('\t');
       append_number(out, nodes[order.empty() ? k : static_cast<std::size_t>(order[k])]);
