@@ -4,6 +4,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "conversion_checks.hpp"
+
 #include <algorithm>
 #include <map>
 #include <set>
@@ -37,7 +39,7 @@ void check_straight_positions(const Mesh<Dim>& q) {
           const std::array<int, 4> corners{0, 1, 2, 3};
           check_centre(corners, 8);
         } else {
-          std::array<int, 9> fn{};
+          std::array<int, max_facet_nodes> fn{};
           for (int f = 0; f < static_cast<int>(facets(b.type).size()); ++f)
             if (facet_nodes(b.type, f, fn) == 9) check_centre(std::span<const int>(fn.data(), 4), fn[8]);
           if (b.type == ElementType::hex27) {
@@ -47,52 +49,6 @@ void check_straight_positions(const Mesh<Dim>& q) {
         }
       }
     }
-}
-
-// No two nodes at the same place: with straight positions, that means every edge and face
-// node is shared by all elements using it (the mesh is conforming).
-template <int Dim>
-void check_no_duplicate_nodes(const Mesh<Dim>& q) {
-  std::vector<std::array<double, Dim>> pts;
-  for (Index i = 0; i < q.num_nodes(); ++i) {
-    std::array<double, Dim> a{};
-    for (int d = 0; d < Dim; ++d) a[static_cast<std::size_t>(d)] = q.points(d, i);
-    pts.push_back(a);
-  }
-  std::sort(pts.begin(), pts.end());
-  CHECK(std::adjacent_find(pts.begin(), pts.end()) == pts.end());
-}
-
-// Each facet element holds the same nodes as the cell facet it covers.
-template <int Dim>
-void check_facets_match_cells(const Mesh<Dim>& q) {
-  std::map<std::vector<Index>, std::vector<Index>> cell_facets;  // sorted vertices → sorted nodes
-  std::array<int, 9> fn{};
-  for (const auto& b : q.cells)
-    for (Index e = 0; e < b.size(); ++e)
-      for (int f = 0; f < static_cast<int>(facets(b.type).size()); ++f) {
-        const int n = facet_nodes(b.type, f, fn);
-        const int nv = facets(b.type)[static_cast<std::size_t>(f)].num_vertices;
-        std::vector<Index> verts, nodes;
-        for (int k = 0; k < n; ++k) (k < nv ? verts : nodes).push_back(b.element(e)[static_cast<std::size_t>(fn[static_cast<std::size_t>(k)])]);
-        std::sort(verts.begin(), verts.end());
-        std::sort(nodes.begin(), nodes.end());
-        cell_facets[verts] = nodes;
-      }
-  Index checked = 0;
-  for (const auto& b : q.facets)
-    for (Index e = 0; e < b.size(); ++e) {
-      const auto el = b.element(e);
-      const int nv = num_vertices(b.type);
-      std::vector<Index> verts(el.begin(), el.begin() + nv), nodes(el.begin() + nv, el.end());
-      std::sort(verts.begin(), verts.end());
-      std::sort(nodes.begin(), nodes.end());
-      const auto it = cell_facets.find(verts);
-      REQUIRE(it != cell_facets.end());
-      CHECK(it->second == nodes);
-      ++checked;
-    }
-  CHECK(checked == q.num_facets());
 }
 
 template <int Dim>
@@ -114,8 +70,8 @@ void check_conversion(const Mesh<Dim>& linear, bool complete) {
   }
   CHECK(q.groups.size() == linear.groups.size());
   check_straight_positions(q);
-  check_no_duplicate_nodes(q);
-  check_facets_match_cells(q);
+  test::check_no_duplicate_nodes(q);
+  test::check_facets_match_cells(q);
   // Sources: boundary nodes know a facet holding them and lie between the listed vertices.
   for (std::size_t i = 0; i < conv.sources.size(); ++i) {
     const auto& s = conv.sources[i];

@@ -227,7 +227,9 @@ TEST_CASE("certified bound is below the sampled minimum and sharp on curved elem
   // Vertices move too (by half as much): bilinear and trilinear cells are not parallelograms
   // and the tensor-product path (quad4/9, hex8/27) sees general coordinates.
   for (ElementType t : {ElementType::tri6, ElementType::quad4, ElementType::quad8, ElementType::quad9, ElementType::tet10,
-                        ElementType::hex8, ElementType::hex20, ElementType::hex27, ElementType::prism15, ElementType::prism18}) {
+                        ElementType::hex8, ElementType::hex20, ElementType::hex27, ElementType::prism15, ElementType::prism18,
+                        ElementType::tri10, ElementType::tri15, ElementType::quad16, ElementType::quad25, ElementType::tet20,
+                        ElementType::tet35, ElementType::hex64, ElementType::prism40}) {
     INFO(name(t));
     for (int trial = 0; trial < 3; ++trial) {
       if (dimension(t) == 2) {
@@ -235,13 +237,16 @@ TEST_CASE("certified bound is below the sampled minimum and sharp on curved elem
         for (Index i = 0; i < x.cols(); ++i) x.col(i) += (i < num_vertices(t) ? 0.5 : 1.0) * Eigen::Vector2d(u(rng), u(rng));
         const auto s = scaled_jacobian(t, x);
         CHECK(s.certified_min <= s.sampled_min);
-        CHECK(s.certified_min == Approx(dense_min<2>(t, x, s.linear_det, 120)).margin(2e-3));
+        // Sharp: within the margin of the smallest value of det J found, on a fine lattice or
+        // at the certification's own sampling points (both are values of the function).
+        CHECK(s.certified_min == Approx(std::min(s.sampled_min, dense_min<2>(t, x, s.linear_det, 120))).margin(2e-3));
       } else {
         auto x = affine_element<3>(t, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
         for (Index i = 0; i < x.cols(); ++i) x.col(i) += (i < num_vertices(t) ? 0.5 : 1.0) * Eigen::Vector3d(u(rng), u(rng), u(rng));
         const auto s = scaled_jacobian(t, x);
+        INFO("certified " << s.certified_min << ", sampled " << s.sampled_min << ", " << s.leaves << " leaves");
         CHECK(s.certified_min <= s.sampled_min);
-        CHECK(s.certified_min == Approx(dense_min<3>(t, x, s.linear_det, 24)).margin(5e-3));
+        CHECK(s.certified_min == Approx(std::min(s.sampled_min, dense_min<3>(t, x, s.linear_det, 24))).margin(5e-3));
       }
     }
   }
@@ -253,7 +258,9 @@ TEST_CASE("straight-sided high-order cells certify as their linear cell, with th
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-0.2, 0.2);
   for (ElementType t : {ElementType::tri6, ElementType::quad8, ElementType::quad9, ElementType::tet10, ElementType::hex20,
-                        ElementType::hex27, ElementType::prism15, ElementType::prism18}) {
+                        ElementType::hex27, ElementType::prism15, ElementType::prism18, ElementType::tri10, ElementType::tri15,
+                        ElementType::quad16, ElementType::quad25, ElementType::tet20, ElementType::tet35, ElementType::hex64,
+                        ElementType::prism40}) {
     INFO(name(t));
     const ElementType lin = linear_type(t);
     const int d = dimension(t), nv = num_vertices(t);
@@ -387,7 +394,8 @@ std::filesystem::path quality_data(const std::string& name) {
 }
 
 // Per-element min/max ratio and invalid count of ours, by element id.
-std::map<std::int64_t, ScaledJacobian> ours_by_id(const Mesh<2>& mesh) {
+template <int Dim>
+std::map<std::int64_t, ScaledJacobian> ours_by_id(const Mesh<Dim>& mesh) {
   const auto sj = scaled_jacobians(mesh);
   std::map<std::int64_t, ScaledJacobian> out;
   std::size_t k = 0;
@@ -396,17 +404,69 @@ std::map<std::int64_t, ScaledJacobian> ours_by_id(const Mesh<2>& mesh) {
   return out;
 }
 
-void check_against(const Mesh<2>& mesh, const std::map<std::int64_t, double>& gmsh_ratio_by_id, Index gmsh_invalid) {
+// Past order 2 Gmsh's plugin stops subdividing earlier than our certification: its bounds
+// are looser, by up to 1.3% on these meshes (a tet35 of sphere_box at order 4: 0.36426 from
+// Gmsh, 0.36506 certified here, 0.36519 sampled on a 60-point lattice; a tangled tri15 of the
+// boundary layer: -17.515 from Gmsh, -17.7347 here, -17.7351 sampled on a 400-point lattice),
+// so the ratios agree to 2% there and to 0.1% at order 2, and a valid cell's ratio is never
+// below Gmsh's.
+template <int Dim>
+void check_against(const Mesh<Dim>& mesh, const std::map<std::int64_t, double>& gmsh_ratio_by_id, Index gmsh_invalid) {
   const auto ours = ours_by_id(mesh);
   Index invalid = 0;
   for (const auto& [id, s] : ours) invalid += s.valid ? 0 : 1;
   CHECK(invalid == gmsh_invalid);
+  const bool past_p2 = order(mesh.cells.front().type) > 2;
   for (const auto& [id, s] : ours) {
     INFO("element " << id);
     const auto it = gmsh_ratio_by_id.find(id);
     const double expected = it == gmsh_ratio_by_id.end() ? 1.0 : it->second;
-    CHECK(s.certified_min / s.certified_max == Approx(expected).epsilon(1e-3).margin(1e-9));
+    const double ratio = s.certified_min / s.certified_max;
+    CHECK(ratio == Approx(expected).epsilon(past_p2 ? 2e-2 : 1e-3).margin(1e-9));
+    if (past_p2 && expected > 0) CHECK(ratio >= expected - 1e-9);
   }
+}
+
+bool have_gmsh() { return std::system("gmsh --version > /dev/null 2>&1") == 0; }
+
+// Runs `gmsh` on a script with the given arguments (-0: parse it and exit), which must succeed.
+void run_gmsh(const std::string& name, const std::string& script_text, const std::string& arguments = "-0") {
+  const auto script = test::scratch_path(name + ".geo");
+  {
+    std::ofstream geo(script);
+    geo << script_text;
+  }
+  REQUIRE(std::system(("gmsh \"" + script.string() + "\" " + arguments + " -nopopup > /dev/null 2>&1").c_str()) == 0);
+}
+
+// Gmsh's AnalyseMeshQuality plugin on a mesh file: min J / max J of every element it lists
+// (straight elements are left out), and how many are invalid.
+std::pair<std::map<std::int64_t, double>, Index> gmsh_plugin_ratios(const std::filesystem::path& mesh, int dim) {
+  const auto view = test::scratch_path("view_" + mesh.filename().string());
+  std::filesystem::remove(view);
+  run_gmsh("analyse_" + mesh.filename().string(),
+           "Merge \"" + mesh.string() + "\";\n"
+           "Plugin(AnalyseMeshQuality).JacobianDeterminant = 1;\n"
+           "Plugin(AnalyseMeshQuality).CreateView = 1;\n"
+           "Plugin(AnalyseMeshQuality).DimensionOfElements = " + std::to_string(dim) + ";\n"
+           "Plugin(AnalyseMeshQuality).Run;\n"
+           "Save View[0] \"" + view.string() + "\";\n");
+  std::ifstream in(view);
+  std::string line;
+  while (std::getline(in, line) && line != "$ElementData") {}
+  for (int k = 0; k < 9; ++k) std::getline(in, line);  // tags: names, time, step, components, count
+  std::map<std::int64_t, double> ratio;
+  Index invalid = 0;
+  while (std::getline(in, line) && line != "$EndElementData") {
+    std::istringstream s(line);
+    std::int64_t id = 0;
+    double v = 0;
+    s >> id >> v;
+    ratio[id] = v;
+    invalid += v <= 0 ? 1 : 0;
+  }
+  REQUIRE(!ratio.empty());
+  return {ratio, invalid};
 }
 
 #include "data/gmsh_reference.inc"
@@ -435,41 +495,59 @@ TEST_CASE("scaled Jacobian agrees with Gmsh's AnalyseMeshQuality on its own P2 m
 }
 
 TEST_CASE("scaled Jacobian agrees with a live gmsh run", "[quality]") {
-  if (std::system("gmsh --version > /dev/null 2>&1") != 0) {
+  if (!have_gmsh()) {
     WARN("skipped: gmsh is not on PATH");
     return;
   }
   for (const GmshCase& c : gmsh_cases) {
     INFO(c.file);
-    const auto script = test::scratch_path(std::string("analyse_") + c.file + ".geo");
-    const auto view = test::scratch_path(std::string("view_") + c.file);
-    {
-      std::ofstream geo(script);
-      geo << "Merge \"" << quality_data(c.file).string() << "\";\n"
-          << "Plugin(AnalyseMeshQuality).JacobianDeterminant = 1;\n"
-          << "Plugin(AnalyseMeshQuality).CreateView = 1;\n"
-          << "Plugin(AnalyseMeshQuality).DimensionOfElements = 2;\n"
-          << "Plugin(AnalyseMeshQuality).Run;\n"
-          << "Save View[0] \"" << view.string() << "\";\n";
-    }
-    std::filesystem::remove(view);
-    REQUIRE(std::system(("gmsh \"" + script.string() + "\" -nopopup -0 > /dev/null 2>&1").c_str()) == 0);
-    std::ifstream in(view);
-    std::string line;
-    while (std::getline(in, line) && line != "$ElementData") {}
-    for (int k = 0; k < 9; ++k) std::getline(in, line);  // tags: names, time, step, components, count
-    std::map<std::int64_t, double> ratio;
-    Index invalid = 0;
-    while (std::getline(in, line) && line != "$EndElementData") {
-      std::istringstream s(line);
-      std::int64_t id = 0;
-      double v = 0;
-      s >> id >> v;
-      ratio[id] = v;
-      invalid += v <= 0 ? 1 : 0;
-    }
-    REQUIRE(!ratio.empty());
+    const auto [ratio, invalid] = gmsh_plugin_ratios(quality_data(c.file), 2);
     check_against(read_mesh_as<2>(quality_data(c.file)), ratio, invalid);
+  }
+}
+
+TEST_CASE("scaled Jacobian agrees with Gmsh's AnalyseMeshQuality at orders 3 and 4", "[quality]") {
+  // Gmsh meshes the .geo files of tests/quality/data at each order (its plain snapping of
+  // thin boundary layers and of the sphere leaves invalid cells: the count must agree too).
+  if (!have_gmsh()) {
+    WARN("skipped: gmsh is not on PATH (apt-get install gmsh)");
+    return;
+  }
+  struct Case {
+    const char* geo;
+    int dim;
+    int order;
+  };
+  for (const Case& c : {Case{"boundary_layer_tri6.geo", 2, 3}, Case{"boundary_layer_tri6.geo", 2, 4},
+                        Case{"boundary_layer_quad9.geo", 2, 3}, Case{"boundary_layer_quad9.geo", 2, 4},
+                        Case{"sphere_box.geo", 3, 3}, Case{"sphere_box.geo", 3, 4}}) {
+    const std::string stem = std::filesystem::path(c.geo).stem().string() + "_p" + std::to_string(c.order);
+    INFO(stem);
+    const auto mesh_file = test::scratch_path(stem + ".msh");
+    std::filesystem::remove(mesh_file);
+    // The order is set after the .geo, which sets its own.
+    // Appends, not one concatenation: GCC 12 misreads the latter (-Wrestrict).
+    std::string script = "Merge \"";
+    script += quality_data(c.geo).string();
+    script += "\";\nMesh.ElementOrder = ";
+    script += std::to_string(c.order);
+    script += ";\n";
+    std::string arguments = "-";
+    arguments += std::to_string(c.dim);
+    arguments += " -o \"";
+    arguments += mesh_file.string();
+    arguments += "\"";
+    run_gmsh("make_" + stem, script, arguments);
+    const auto [ratio, invalid] = gmsh_plugin_ratios(mesh_file, c.dim);
+    if (c.dim == 2) {
+      const auto mesh = read_mesh_as<2>(mesh_file);
+      CHECK(order(mesh.cells.front().type) == c.order);
+      check_against(mesh, ratio, invalid);
+    } else {
+      const auto mesh = read_mesh_as<3>(mesh_file);
+      CHECK(order(mesh.cells.front().type) == c.order);
+      check_against(mesh, ratio, invalid);
+    }
   }
 }
 

@@ -1,25 +1,27 @@
 #pragma once
 /// \file
 /// Boundary snapping, the second step of the curving pipeline (thesis section 3.2): the
-/// nodes of the boundary facets of a P2 mesh (straight, as to_quadratic() makes them) are
-/// moved onto the true boundary of their group, which is known either
+/// nodes of the boundary facets of a high-order mesh (straight, as to_quadratic() or
+/// convert_to_order() make them) are moved onto the true boundary of their group, each at its
+/// place along the curved edge or face (at order 2, the midpoint), the true boundary being
+/// known either
 /// - from the linear mesh alone in 2D: a C² cubic spline through the group's vertices
-///   (BoundarySpline; corners by angle or list), each edge node going to its facet's
-///   parameter midpoint (thesis) or arc-length midpoint; vertices stay; or
+///   (BoundarySpline; corners by angle or list), an edge node at fraction r of its facet going
+///   to the spline at parameter r (thesis) or at fraction r of the arc length; vertices stay;
 /// - from the linear mesh alone in 3D: the WALF surface reconstruction of the group's
-///   triangles (SurfaceReconstruction, ridges sharp above the corner angle), each edge node
-///   going to the reconstructed edge midpoint; vertices stay; or
+///   triangles (SurfaceReconstruction, ridges sharp above the corner angle), edge nodes to the
+///   reconstructed edge, nodes inside a facet to the reconstructed triangle; vertices stay; or
 /// - from a closest-point projection (analytic or CAD geometry, any dimension): vertices
-///   off the geometry are projected, then every edge (face) node goes to the projection of
-///   the straight midpoint (centre) of its projected vertices, which places it where the
-///   true boundary is nearest rather than at the midpoint of a parameter that need not be
-///   arc length.
+///   off the geometry are projected, then every other node goes to the projection of its
+///   place on the straight facet through the projected vertices, which places it where the
+///   true boundary is nearest rather than at a parameter that need not be arc length.
 /// Groups without geometry keep their straight facets. Only displacements are returned: the
 /// caller decides how the interior follows (curving/curve_mesh.hpp).
 
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/shape_functions.hpp"
 #include "meshmotion/core/topology.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/curving/boundary_spline.hpp"
@@ -27,6 +29,7 @@
 #include "meshmotion/curving/surface_reconstruction.hpp"
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <optional>
 #include <string>
@@ -51,10 +54,17 @@ struct BoundaryGeometry {
   };
   Kind kind = Kind::straight;
   BoundaryProjection<Dim> projection{};  ///< for Kind::projection
+  /// For Kind::projection, optional: where a high-order node goes given its facet's vertices
+  /// (already on the geometry) and its weights on them; a CAD model interpolates the
+  /// vertices' parameters on their common edge or face (cad/cad_model.hpp). Without it the
+  /// node goes to the projection of its place on the straight facet.
+  BoundaryPlacement<Dim> placement{};
 
-  [[nodiscard]] static BoundaryGeometry straight() { return {Kind::straight, {}}; }
-  [[nodiscard]] static BoundaryGeometry spline() { return {Kind::spline, {}}; }
-  [[nodiscard]] static BoundaryGeometry project(BoundaryProjection<Dim> p) { return {Kind::projection, std::move(p)}; }
+  [[nodiscard]] static BoundaryGeometry straight() { return {Kind::straight, {}, {}}; }
+  [[nodiscard]] static BoundaryGeometry spline() { return {Kind::spline, {}, {}}; }
+  [[nodiscard]] static BoundaryGeometry project(BoundaryProjection<Dim> p, BoundaryPlacement<Dim> q = {}) {
+    return {Kind::projection, std::move(p), std::move(q)};
+  }
 };
 
 /// Options of snap_boundary().
@@ -78,8 +88,34 @@ struct SnappedBoundary {
 
 namespace detail {
 
-/// 3D reconstruction of group `tag`: every edge node of its (tri6) facets to the
-/// reconstructed edge midpoint; the vertices stay and join the wall.
+// Each high-order node of a facet type: its reference point, and the weights of the facet's
+// vertices there (where a straight facet has the node).
+struct FacetNodeWeights {
+  std::vector<RefPoint> reference;
+  std::vector<std::vector<double>> weights;  // [node][vertex]
+};
+
+inline const FacetNodeWeights& facet_node_weights(ElementType t) {
+  static const std::array<FacetNodeWeights, num_element_types> tables = [] {
+    std::array<FacetNodeWeights, num_element_types> all;
+    for (int i = 0; i < num_element_types; ++i) {
+      const auto type = static_cast<ElementType>(i);
+      auto& table = all[static_cast<std::size_t>(i)];
+      const auto x = reference_nodes(type);
+      table.reference.assign(x.begin(), x.end());
+      for (const RefPoint& r : x) {
+        auto& w = table.weights.emplace_back(static_cast<std::size_t>(num_vertices(type)));
+        shape_functions(linear_type(type), r, w);
+      }
+    }
+    return all;
+  }();
+  return tables[static_cast<std::size_t>(t)];
+}
+
+/// 3D reconstruction of group `tag`: every edge node of its triangle facets to the
+/// reconstructed edge at its fraction of the edge, every node inside a facet to the
+/// reconstructed triangle at its barycentric place; the vertices stay and join the wall.
 template <class Claim>
 void snap_to_reconstruction(const Mesh<3>& mesh, int tag, const SnapOptions& options, Claim&& claim) {
   std::vector<Index> triangles;
@@ -94,20 +130,33 @@ void snap_to_reconstruction(const Mesh<3>& mesh, int tag, const SnapOptions& opt
     }
   if (triangles.empty()) return;
   const SurfaceReconstruction surface(mesh.points, triangles, SurfaceReconstructionOptions{3, options.corner_angle});
-  for (const auto& block : mesh.facets)
+  Index triangle = 0;  // the reconstruction's numbering: the facets in the order given above
+  for (const auto& block : mesh.facets) {
+    const FacetNodeWeights& table = facet_node_weights(block.type);
+    const int p = order(block.type);
+    const auto local_edges = edges(block.type);
     for (Index e = 0; e < block.size(); ++e) {
       if (block.tags[static_cast<std::size_t>(e)] != tag) continue;
       const auto el = block.element(e);
       for (int k = 0; k < 3; ++k) claim(el[static_cast<std::size_t>(k)], Vec<3>(mesh.points.col(el[static_cast<std::size_t>(k)])));
-      const auto local_edges = edges(block.type);
       for (std::size_t k = 0; k < local_edges.size(); ++k)
-        claim(el[3 + k], surface.edge_midpoint(el[static_cast<std::size_t>(local_edges[k][0])], el[static_cast<std::size_t>(local_edges[k][1])]));
+        for (int j = 1; j < p; ++j)
+          claim(el[3 + k * static_cast<std::size_t>(p - 1) + static_cast<std::size_t>(j - 1)],
+                surface.edge_point(el[static_cast<std::size_t>(local_edges[k][0])], el[static_cast<std::size_t>(local_edges[k][1])],
+                                   static_cast<double>(j) / p));
+      for (std::size_t i = 3 + local_edges.size() * static_cast<std::size_t>(p - 1); i < el.size(); ++i) {
+        const auto& w = table.weights[i];
+        claim(el[i], surface.point(triangle, Vec<3>(w[0], w[1], w[2])));
+      }
+      ++triangle;
     }
+  }
 }
 
 }  // namespace detail
 
-/// Snaps the facet nodes of the groups in `geometry` (group tag → geometry) of a P2 mesh.
+/// Snaps the facet nodes of the groups in `geometry` (group tag → geometry) of a high-order
+/// mesh (any order; each node at its place along the curved edge or face).
 /// A node shared by two curved groups takes the first group's (lowest tag) position. Throws
 /// InputError for a linear mesh, a 3D reconstruction of quadrilateral facets or a projection
 /// without a callback, and what BoundarySpline, SurfaceReconstruction and the projections
@@ -116,9 +165,9 @@ template <int Dim>
 [[nodiscard]] SnappedBoundary<Dim> snap_boundary(const Mesh<Dim>& mesh, const std::map<int, BoundaryGeometry<Dim>>& geometry,
                                                  const SnapOptions& options = {}) {
   for (const auto& block : mesh.facets)
-    if (order(block.type) != 2)
+    if (order(block.type) < 2)
       throw InputError("snap_boundary: facet block " + std::string(name(block.type)) +
-                       " is not quadratic (expected a P2 mesh from to_quadratic)");
+                       " is linear (expected a high-order mesh from to_quadratic or convert_to_order)");
   std::map<Index, Vec<Dim>> target;  // node -> new position, first group wins
   const auto claim = [&](Index v, const Vec<Dim>& x) { target.emplace(v, x); };
   Index moved_vertices = 0;
@@ -148,8 +197,13 @@ template <int Dim>
             // The vertices define the spline: they belong to the curved wall and stay.
             claim(el[0], mesh.points.col(el[0]));
             claim(el[1], mesh.points.col(el[1]));
-            claim(el[2], options.midpoint == SplineMidpoint::parameter ? spline.midpoint(f->facet)
-                                                                        : spline.arc_length_midpoint(f->facet));
+            const detail::FacetNodeWeights& table = detail::facet_node_weights(block.type);
+            for (std::size_t i = 2; i < el.size(); ++i) {
+              const double r = table.weights[i][1];  // fraction of the way from el[0] to el[1]
+              const double t = f->reversed ? 1.0 - r : r;
+              claim(el[i], options.midpoint == SplineMidpoint::parameter ? spline.point(f->facet, t)
+                                                                         : spline.point(f->facet, spline.arc_length_parameter(f->facet, t)));
+            }
           }
       }
       continue;
@@ -167,22 +221,27 @@ template <int Dim>
       if (!on) ++moved_vertices;
       return vertex.emplace(v, on ? x : q).first->second;
     };
+    // Every other facet node: the projection of its place on the straight facet through
+    // the projected vertices (an edge's midpoint, a quad9's centre at order 2).
     for (const auto& block : mesh.facets) {
       const int nv = num_vertices(block.type);
-      const auto local_edges = edges(block.type);
+      const detail::FacetNodeWeights& table = detail::facet_node_weights(block.type);
       for (Index e = 0; e < block.size(); ++e) {
         if (block.tags[static_cast<std::size_t>(e)] != tag) continue;
         const auto el = block.element(e);
         for (int k = 0; k < nv; ++k) claim(el[static_cast<std::size_t>(k)], vertex_position(el[static_cast<std::size_t>(k)]));
-        for (std::size_t k = 0; k < local_edges.size(); ++k) {
-          const Vec<Dim> mid = 0.5 * (vertex_position(el[static_cast<std::size_t>(local_edges[k][0])]) +
-                                      vertex_position(el[static_cast<std::size_t>(local_edges[k][1])]));
-          claim(el[static_cast<std::size_t>(nv) + k], geo.projection(mid));
-        }
-        if (num_nodes(block.type) > nv + static_cast<int>(local_edges.size())) {  // quad9 face node
-          Vec<Dim> centre = Vec<Dim>::Zero();
-          for (int k = 0; k < nv; ++k) centre += vertex_position(el[static_cast<std::size_t>(k)]) / nv;
-          claim(el.back(), geo.projection(centre));
+        std::array<Vec<Dim>, 8> corners;
+        for (int k = 0; k < nv; ++k) corners[static_cast<std::size_t>(k)] = vertex_position(el[static_cast<std::size_t>(k)]);
+        const std::span<const Vec<Dim>> at(corners.data(), static_cast<std::size_t>(nv));
+        for (std::size_t i = static_cast<std::size_t>(nv); i < el.size(); ++i) {
+          const std::span<const double> w(table.weights[i]);
+          if (geo.placement) {
+            claim(el[i], geo.placement(at, w));
+            continue;
+          }
+          Vec<Dim> x = Vec<Dim>::Zero();
+          for (int k = 0; k < nv; ++k) x += w[static_cast<std::size_t>(k)] * at[static_cast<std::size_t>(k)];
+          claim(el[i], geo.projection(x));
         }
       }
     }

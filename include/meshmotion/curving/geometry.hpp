@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <functional>
+#include <span>
 #include <string>
 
 namespace meshmotion {
@@ -20,6 +21,11 @@ namespace meshmotion {
 /// Any callable of this signature works (the ready shapes below are such callables).
 template <int Dim>
 using BoundaryProjection = std::function<Vec<Dim>(const Vec<Dim>&)>;
+
+/// Where a high-order boundary node goes, from the vertices of its facet (on the geometry)
+/// and its weights on them (the facet's linear shape functions at the node).
+template <int Dim>
+using BoundaryPlacement = std::function<Vec<Dim>(std::span<const Vec<Dim>> vertices, std::span<const double> weights)>;
 
 namespace detail {
 

@@ -109,7 +109,7 @@ inline std::string colour(double t) {
   Index cell = 0;
   for (const auto& block : mesh.cells) {
     const int nv = num_vertices(block.type);
-    const bool curved = order(block.type) == 2;
+    const int p_order = order(block.type);
     for (Index e = 0; e < block.size(); ++e, ++cell) {
       const auto nodes = block.element(e);
       const auto p = [&](int local) { return mesh.points.col(nodes[static_cast<std::size_t>(local)]); };
@@ -132,10 +132,26 @@ inline std::string colour(double t) {
       detail::append_format(path, "<path fill=\"%s\" d=\"M%.3f %.3f", fill.c_str(), px(p(0).x()), py(p(0).y()));
       for (int k = 0; k < nv; ++k) {
         const auto b = p((k + 1) % nv);
-        if (curved) {
+        if (p_order == 2) {
           // The quadratic through a, m (at t = 1/2) and b has control point 2m - (a + b)/2.
           const Eigen::Vector2d c = 2.0 * p(nv + k) - 0.5 * (p(k) + b);
           detail::append_format(path, " Q%.3f %.3f %.3f %.3f", px(c.x()), py(c.y()), px(b.x()), py(b.y()));
+        } else if (p_order > 2) {
+          // SVG has no curves past cubics: 4 segments per edge node interval, on the edge's
+          // Lagrange polynomial through its p + 1 nodes (at t = j/p, from vertex k).
+          const auto edge_node = [&](int j) { return j == 0 ? p(k) : j == p_order ? b : p(nv + k * (p_order - 1) + j - 1); };
+          const int segments = 4 * p_order;
+          for (int s = 1; s <= segments; ++s) {
+            const double t = static_cast<double>(s) / segments;
+            Eigen::Vector2d x = Eigen::Vector2d::Zero();
+            for (int j = 0; j <= p_order; ++j) {
+              double l = 1.0;
+              for (int m = 0; m <= p_order; ++m)
+                if (m != j) l *= (t * p_order - m) / (j - m);
+              x += l * edge_node(j);
+            }
+            detail::append_format(path, " L%.3f %.3f", px(x.x()), py(x.y()));
+          }
         } else {
           detail::append_format(path, " L%.3f %.3f", px(b.x()), py(b.y()));
         }
