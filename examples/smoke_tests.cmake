@@ -134,6 +134,16 @@ smoke_test(NAME mesh_info.moved.json REQUIRES examples_moved_mesh
            KEYS file,mesh/nodes,mesh/cells
            COMMAND mesh_info "${smoke_dir}/moved.msh" --json)
 
+# Orders 3 and 4: the demo curved at order 3 (and its .su2 in SU2's DG-FEM format read back
+# by mesh_info); order 5 is refused before any work.
+smoke_test(NAME curve_mesh.order3.json
+           KEYS output,order,min_scaled_jacobian,invalid,untangle/cells_below,seconds/untangle
+           VALUES order=3,invalid=0
+           COMMAND curve_mesh --demo --order 3 -o "${smoke_dir}/demo_p3.su2" --json)
+smoke_test(NAME curve_mesh.order5 EXPECT_RC 1
+           KEYS error
+           COMMAND curve_mesh --demo --order 5 -o "${smoke_dir}/demo_p5.msh" --json)
+
 # The mechanics knobs reach the mover: stiffened elasticity as curve_mesh's regularizer and
 # as move_mesh's mover, and a bad Poisson ratio is refused.
 smoke_test(NAME curve_mesh.sle.json
@@ -219,8 +229,8 @@ smoke_test(NAME move_mesh.displacements_outside_group.json REQUIRES examples_dem
                    --displacements "${smoke_dir}/outside_node.txt" --fixed wall --json)
 
 # Outputs are checked before any work, and an input is never overwritten unasked.
-smoke_test(NAME curve_mesh.su2_output.json EXPECT_RC 1 KEYS error
-           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_curved.su2" --json)
+smoke_test(NAME curve_mesh.cgns_order3_output.json EXPECT_RC 1 KEYS error
+           COMMAND curve_mesh --demo --order 3 -o "${smoke_dir}/demo_curved_p3.cgns" --json)
 smoke_test(NAME move_mesh.unknown_output.json REQUIRES examples_demo_mesh EXPECT_RC 1 KEYS error
            COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved.cgnx" --group wall --rotate 1 --json)
 smoke_test(NAME move_mesh.output_is_input.json EXPECT_RC 1 KEYS error

@@ -13,4 +13,5 @@
 #include "meshmotion/curving/geometry.hpp"
 #include "meshmotion/curving/geometry_text.hpp"
 #include "meshmotion/curving/naca_section.hpp"
+#include "meshmotion/curving/order_conversion.hpp"
 #include "meshmotion/curving/p2_conversion.hpp"

@@ -12,12 +12,15 @@ from ._core import (  # noqa: F401  (re-exported)
     IoError,
     SolverError,
     __version__,
+    element_types,
     have_cgns,
     mover_methods,
     mover_options,
     num_threads,
     read_mesh,
+    reference_nodes,
     set_num_threads,
+    vtk_order,
 )
 from . import _core
 from .warp import Warp  # noqa: F401
@@ -82,14 +85,14 @@ def quality_report(mesh, metric="jacobian"):
 
 
 def curve_mesh(mesh, **options):
-    """Curves a linear mesh into a certified P2 mesh; returns (curved mesh, report dict).
+    """Curves a linear mesh into a certified P2 (P3, P4) mesh; returns (curved mesh, report dict).
 
-    Pipeline keywords: method ("rbf", "blend", "none" or any mover method), geometry
+    Pipeline keywords: order (2, 3 or 4), method ("rbf", "blend", "none" or any mover method), geometry
     ({group: "spline" | "reconstruct" | "straight" | "bump" | "circle:X,Y,R" |
     "naca:XXXX[,CHORD,X0,Y0]" | "sphere:X,Y,Z,R"}), sliding (group names), steps, strict,
     support_radius, support_radius_factor, per_wall_radius, active_radius_factor,
     max_support_nodes, centre_reach, blending_length, blending_factor, corner_angle,
-    spline_by_default. Every other keyword is a typed option of the mover (as in Mover()),
+    spline_by_default, untangle (True: optimize the cells below untangle_threshold, 0.1). Every other keyword is a typed option of the mover (as in Mover()),
     refused with the known keys when unknown. strict=True raises InvalidMeshError when invalid
     cells remain; otherwise report["invalid"] counts them.
     """
@@ -123,6 +126,10 @@ def to_meshio(mesh):
     import meshio
 
     cells, sets_blocks = [], []
+    for type_name, conn in list(mesh.cells) + [(t, c) for t, c, _ in mesh.facets]:
+        if type_name not in _MESHIO_TYPES:
+            raise InputError(f"to_meshio: {type_name} elements have no meshio counterpart here (orders 1 and 2 only; "
+                             "write .msh or .vtu for higher orders)")
     for type_name, conn in mesh.cells:
         order = _vtk_order(type_name)
         cells.append((_MESHIO_TYPES[type_name], conn[:, order] if order is not None else conn.copy()))

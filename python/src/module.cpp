@@ -200,9 +200,12 @@ CurveOptions<Dim> curve_options(const py::kwargs& kwargs) {
       {"support_radius", &o.support_radius},         {"support_radius_factor", &o.support_radius_factor},
       {"active_radius_factor", &o.active_radius_factor}, {"max_support_nodes", &o.max_support_nodes},
       {"centre_reach", &o.centre_reach},             {"blending_length", &o.blending_length},
-      {"blending_factor", &o.blending_factor},       {"corner_angle", &o.snap.corner_angle}};
-  const std::map<std::string, bool*> flags{
-      {"per_wall_radius", &o.per_wall_radius}, {"spline_by_default", &o.spline_by_default}, {"strict", &o.strict}};
+      {"blending_factor", &o.blending_factor},       {"corner_angle", &o.snap.corner_angle},
+      {"untangle_threshold", &o.untangle.threshold}};
+  const std::map<std::string, bool*> flags{{"per_wall_radius", &o.per_wall_radius},
+                                           {"spline_by_default", &o.spline_by_default},
+                                           {"strict", &o.strict},
+                                           {"untangle", &o.untangle.enabled}};
   for (const auto& [key_handle, value] : kwargs) {
     const auto key = py::cast<std::string>(key_handle);
     if (const auto n = numbers.find(key); n != numbers.end()) {
@@ -211,6 +214,11 @@ CurveOptions<Dim> curve_options(const py::kwargs& kwargs) {
       *f->second = bool_option(key, value);
     } else if (key == "method") {
       o.method = text_option(key, value);
+    } else if (key == "order") {
+      const double order = number_option(key, value);
+      if (order != std::floor(order) || order < 2 || order > max_element_order)
+        throw InputError("curve_mesh: option 'order' expects 2, 3 or 4 (got " + py::cast<std::string>(py::repr(value)) + ")");
+      o.order = static_cast<int>(order);
     } else if (key == "steps") {
       const double steps = number_option(key, value);
       if (!(steps >= 1.0) || steps != std::floor(steps) || steps > 1e6)
@@ -260,8 +268,19 @@ py::dict curve_report(const CurveResult<Dim>& r) {
   seconds["layer"] = r.seconds.layer;
   seconds["regularize"] = r.seconds.regularize;
   seconds["certify"] = r.seconds.certify;
+  seconds["untangle"] = r.seconds.untangle;
   seconds["total"] = r.seconds.total;
   d["seconds"] = seconds;
+  py::dict untangled;
+  untangled["cells_below"] = r.untangle.cells_below;
+  untangled["invalid_before"] = r.untangle.invalid_before;
+  untangled["invalid_after"] = r.untangle.invalid_after;
+  untangled["min_before"] = r.untangle.min_before;
+  untangled["min_after"] = r.untangle.min_after;
+  untangled["patch_cells"] = r.untangle.patch_cells;
+  untangled["free_nodes"] = r.untangle.free_nodes;
+  untangled["sweeps"] = r.untangle.sweeps;
+  d["untangle"] = untangled;
   return d;
 }
 
@@ -534,11 +553,29 @@ PYBIND11_MODULE(_core, m) {
   }, py::arg("method"), py::arg("dim") = 3, "the keys of a method with their default values (as text)");
   m.def(
       "vtk_order",
-      [](const std::string& type_name) {
-        const auto order = vtk_order(element_type_named(type_name));
+      [](const std::string& type_name, bool lagrange) {
+        const auto order = vtk_order(element_type_named(type_name), lagrange);
         return std::vector<int>(order.begin(), order.end());
       },
-      py::arg("type"), "VTK's node i is our local node order[i] (classic VTK cells); empty: the same order");
+      py::arg("type"), py::arg("lagrange") = false,
+      "VTK's node i is our local node order[i] (classic VTK cells, or VTK's Lagrange cells with lagrange=True "
+      "and past order 2); empty: the same order");
+  m.def(
+      "reference_nodes",
+      [](const std::string& type_name) {
+        const auto nodes = reference_nodes(element_type_named(type_name));
+        py::array_t<double> out({static_cast<py::ssize_t>(nodes.size()), py::ssize_t{3}});
+        auto view = out.mutable_unchecked<2>();
+        for (std::size_t i = 0; i < nodes.size(); ++i)
+          for (std::size_t d = 0; d < 3; ++d) view(static_cast<py::ssize_t>(i), static_cast<py::ssize_t>(d)) = nodes[i][d];
+        return out;
+      },
+      py::arg("type"), "reference coordinates of the nodes of an element type, in the library's (Gmsh's) order: (n, 3)");
+  m.def("element_types", [] {
+    std::vector<std::string> out;
+    for (int t = 0; t < num_element_types; ++t) out.emplace_back(name(static_cast<ElementType>(t)));
+    return out;
+  });
   m.def("set_num_threads", &set_num_threads, py::arg("n"));
   m.def("num_threads", &num_threads);
 }

@@ -232,6 +232,21 @@ def test_quality_report_has_per_cell_arrays():
     assert folded["values"].min() == folded["min"]
 
 
+def test_curve_mesh_at_order_3_and_4():
+    mesh = annulus()
+    for order, cell in ((3, "quad16"), (4, "quad25")):
+        curved, report = mm.curve_mesh(mesh, order=order, geometry={"wall": "circle:0,0,0.5"})
+        assert curved.cells[0][0] == cell and report["invalid"] == 0
+        wall = curved.groups["wall"]
+        np.testing.assert_allclose(np.linalg.norm(curved.points[wall], axis=1), 0.5, rtol=0, atol=1e-12)
+        assert set(report["untangle"]) >= {"cells_below", "invalid_after", "min_after"}
+        assert "untangle" in report["seconds"]
+        with pytest.raises(ValueError, match="no meshio counterpart"):
+            mm.to_meshio(curved)
+    with pytest.raises(ValueError, match="expects 2, 3 or 4"):
+        mm.curve_mesh(mesh, order=5)
+
+
 def test_curve_mesh_puts_the_high_order_nodes_on_the_circle():
     mesh = annulus()
     curved, report = mm.curve_mesh(mesh, geometry={"wall": "circle:0,0,0.5"})

@@ -248,6 +248,38 @@ TEST_CASE("pipeline: P2 boundary converges to a circle as h^3 or faster, linear 
   }
 }
 
+TEST_CASE("pipeline: P3 and P4 boundaries converge to a circle as h^(p+1), the spline's as h^4", "[curving][slow]") {
+  const double radius = 0.5;
+  for (const int p : {3, 4}) {
+    std::vector<double> circle_error, spline_error;
+    for (const Index n : {12, 24, 48}) {
+      const Mesh<2> linear = o_mesh(circle_mesh(n));
+      CurveOptions<2> options;
+      options.order = p;
+      options.geometry.emplace("wall", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), radius)));
+      const CurveResult<2> curved = curve_mesh(linear, options);
+      CHECK(curved.invalid() == 0);
+      CHECK(order(curved.curved.cells.front().type) == p);
+      CHECK(curved.curved.points.leftCols(n) == linear.points.leftCols(n));
+      for (const Index v : curved.curved.group_nodes("wall")) CHECK(std::abs(curved.curved.points.col(v).norm() - radius) < 1e-15);
+      circle_error.push_back(distance_to_circle(curved.curved, "wall", radius));
+      CurveOptions<2> spline;
+      spline.order = p;
+      const CurveResult<2> splined = curve_mesh(linear, spline);
+      CHECK(splined.invalid() == 0);
+      spline_error.push_back(distance_to_circle(splined.curved, "wall", radius));
+    }
+    for (std::size_t k = 1; k < circle_error.size(); ++k) {
+      const double circle_order = std::log2(circle_error[k - 1] / circle_error[k]);
+      const double spline_order = std::log2(spline_error[k - 1] / spline_error[k]);
+      INFO("P" << p << ", refinement " << k << ": projected " << circle_order << " (" << circle_error[k] << "), spline "
+               << spline_order << " (" << spline_error[k] << ")");
+      CHECK(circle_order >= p + 0.8);
+      CHECK(spline_order >= 3.8);  // the cubic spline's own accuracy
+    }
+  }
+}
+
 TEST_CASE("pipeline: boundary-layer mesh (aspect ratio >= 1000) needs the regularization", "[curving]") {
   OMeshOptions o;  // 128 x 64 cells, first cell 1e-5 for a wall spacing of 0.025
   o.triangles = GENERATE(false, true);
@@ -468,6 +500,37 @@ TEST_CASE("pipeline: bad options", "[curving]") {
   CHECK_THROWS_AS(curve_mesh(box, spline3), InputError);  // reconstruction needs triangles
 }
 
+TEST_CASE("pipeline: in 3D the groups named like walls are reconstructed by default, and said so", "[curving]") {
+  // Which groups: named like a wall and made of triangles (the reconstruction takes no quads).
+  Mesh<3> box = box_mesh({.nx = 3, .ny = 3, .nz = 3, .cells = BoxCells::tet4});
+  for (auto& g : box.groups)
+    if (g.name == "bottom") g.name = "Wall_bottom";
+  CurveOptions<3> snap;
+  snap.method = "none";
+  CHECK(curve_mesh(box, snap).curved_groups == std::vector<std::string>{"Wall_bottom"});
+  CurveOptions<3> off = snap;
+  off.reconstruct_walls_by_default = false;
+  CHECK_THROWS_WITH(curve_mesh(box, off), Catch::Contains("no group to curve in 3D"));
+  Mesh<3> hexes = box_mesh({.nx = 2, .ny = 2, .nz = 2});
+  for (auto& g : hexes.groups)
+    if (g.name == "bottom") g.name = "wall";
+  CHECK_THROWS_WITH(curve_mesh(hexes, snap), Catch::Contains("no group to curve in 3D"));  // quadrilaterals
+  // The sphere: its wall, renamed, is reconstructed without being asked.
+  MESHMOTION_REQUIRE_DATA(file, "meshopt_sphere_symmetry_linear_tet.msh");
+  Mesh<3> linear = read_mesh_as<3>(file);
+  name_unnamed_facet_groups(linear);
+  for (auto& g : linear.groups)
+    if (g.name == "7") g.name = "sphere_wall";
+  CurveOptions<3> options;
+  options.sliding.push_back("20");
+  const CurveResult<3> curved = curve_mesh(linear, options);
+  CHECK(curved.curved_groups == std::vector<std::string>{"sphere_wall"});
+  CHECK(curved.invalid() == 0);
+  double error = 0.0;
+  for (const Index v : curved.curved.group_nodes("sphere_wall")) error = std::max(error, std::abs(curved.curved.points.col(v).norm() - 0.5));
+  CHECK(error < 0.01);
+}
+
 TEST_CASE("pipeline: 3D sphere with a symmetry plane curves onto the sphere", "[curving]") {
   MESHMOTION_REQUIRE_DATA(file, "meshopt_sphere_symmetry_linear_tet.msh");
   const Mesh<3> linear = read_mesh_as<3>(file);
@@ -485,6 +548,30 @@ TEST_CASE("pipeline: 3D sphere with a symmetry plane curves onto the sphere", "[
   snap_only.method = "none";
   CHECK(curved.quality.min > curve_mesh(linear, snap_only).quality.min + 0.2);
   CHECK(curved.support_radius < 0.5);
+}
+
+TEST_CASE("pipeline: 3D sphere at order 3 puts every wall node on the sphere", "[curving][slow]") {
+  MESHMOTION_REQUIRE_DATA(file, "meshopt_sphere_symmetry_linear_tet.msh");
+  const Mesh<3> linear = read_mesh_as<3>(file);
+  CurveOptions<3> options;
+  options.order = 3;
+  options.geometry.emplace("7", BoundaryGeometry<3>::project(SphereProjection<3>(Vec<3>::Zero(), 0.5)));
+  options.sliding.push_back("20");
+  const CurveResult<3> curved = curve_mesh(linear, options);
+  INFO("min " << curved.quality.min);
+  CHECK(curved.curved.cells.front().type == ElementType::tet20);
+  CHECK(curved.invalid() == 0);
+  for (const Index v : curved.curved.group_nodes("7")) CHECK(std::abs(curved.curved.points.col(v).norm() - 0.5) < 1e-12);
+  for (const Index v : curved.curved.group_nodes("20")) CHECK(std::abs(curved.curved.points(1, v)) < 1e-12);
+  // The surface reconstruction places the P3 wall nodes too (edge and face nodes).
+  CurveOptions<3> reconstructed = options;
+  reconstructed.geometry.clear();
+  reconstructed.geometry.emplace("7", BoundaryGeometry<3>::spline());
+  const CurveResult<3> rebuilt = curve_mesh(linear, reconstructed);
+  CHECK(rebuilt.invalid() == 0);
+  double error = 0.0;
+  for (const Index v : rebuilt.curved.group_nodes("7")) error = std::max(error, std::abs(rebuilt.curved.points.col(v).norm() - 0.5));
+  CHECK(error < 0.01);
 }
 
 TEST_CASE("pipeline: 3D sphere reconstructed from the linear mesh alone", "[curving]") {

@@ -1,10 +1,10 @@
 #pragma once
 /// \file
 /// The curving pipeline (thesis chapter 3, issue 5): a linear mesh in, a certified curved
-/// P2 mesh out.
+/// mesh of order 2 (default), 3 or 4 out.
 ///
-/// 1. to_quadratic: one node per edge (face, volume) of every element type and mixed meshes;
-///    linear nodes keep their numbers, high-order nodes are appended.
+/// 1. to_quadratic (convert_to_order past 2): the high-order nodes of every element type and
+///    mixed meshes; linear nodes keep their numbers, high-order nodes are appended.
 /// 2. snap_boundary: the facet nodes of every curved group go to the true boundary (2D
 ///    spline reconstruction by default; projection callbacks for analytic/CAD geometry, the
 ///    only way in 3D). Vertices already on the geometry stay.
@@ -29,7 +29,9 @@
 #include "meshmotion/curving/blend_regularizer.hpp"
 #include "meshmotion/curving/boundary_layer.hpp"
 #include "meshmotion/curving/boundary_snapping.hpp"
+#include "meshmotion/curving/order_conversion.hpp"
 #include "meshmotion/curving/p2_conversion.hpp"
+#include "meshmotion/curving/untangle.hpp"
 #include "meshmotion/movers/any_mover.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/mover.hpp"
@@ -43,6 +45,7 @@
 #include "meshmotion/spatial/kd_tree.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -59,6 +62,10 @@ namespace meshmotion {
 /// Options of curve_mesh().
 template <int Dim>
 struct CurveOptions {
+  /// Order of the curved mesh: 2 (default), 3 or 4 (hexahedra, prisms and pyramids stop at 3;
+  /// element_type()). Every high-order boundary node goes to its place on the curved edge or
+  /// face, and the mover regularizes all of them.
+  int order = 2;
   /// Interior regularization: "rbf" (default), "blend" (curving/blend_regularizer.hpp),
   /// "none" (snap the boundary only, to see why the pipeline exists) or any other method of
   /// mover_methods() (movers/mover_options.hpp).
@@ -110,11 +117,19 @@ struct CurveOptions {
   double blending_factor = Dim == 2 ? 6.0 : 1.0;
   /// The regularization in this many increments, each re-based on the moved mesh.
   int steps = 1;
+  /// After the regularization, the nodes inside the domain around cells below a threshold of
+  /// the certified scaled Jacobian are optimized (curving/untangle.hpp); not for method "none".
+  UntangleOptions untangle{};
   /// Geometry per group name. Groups not listed: spline reconstruction in 2D when
-  /// `spline_by_default`, straight otherwise, and straight in 3D (give a projection callback,
-  /// or BoundaryGeometry::spline() for the WALF surface reconstruction of triangle facets).
+  /// `spline_by_default`, straight otherwise; in 3D the WALF surface reconstruction for
+  /// wall-named triangle groups (below), straight otherwise (give a projection callback or
+  /// BoundaryGeometry::spline() for any other).
   std::map<std::string, BoundaryGeometry<Dim>, std::less<>> geometry;
   bool spline_by_default = true;
+  /// 3D: groups not listed whose name says they are walls (detail::looks_like_wall: "wall",
+  /// "body", "wing", ...) and whose facets are triangles get the surface reconstruction;
+  /// CurveResult::curved_groups says which. false: they stay straight.
+  bool reconstruct_walls_by_default = true;
   /// Groups that slide in their plane (symmetry); other non-curved groups are fixed.
   std::vector<std::string> sliding;
   /// Corners and midpoint rule of the spline; tolerance of "already on the geometry".
@@ -133,6 +148,7 @@ struct CurveTimes {
   double snap = 0.0;
   double layer = 0.0;  ///< boundary-layer estimate for the default radius
   double regularize = 0.0;
+  double untangle = 0.0;
   double certify = 0.0;
   double total = 0.0;
 };
@@ -140,13 +156,14 @@ struct CurveTimes {
 /// What curve_mesh() produced and measured.
 template <int Dim>
 struct CurveResult {
-  Mesh<Dim> curved;                 ///< the P2 mesh; nodes 0..num_linear_nodes-1 are the input's
+  Mesh<Dim> curved;                 ///< the curved mesh; nodes 0..num_linear_nodes-1 are the input's
   Index num_linear_nodes = 0;
   CurveTimes seconds;
   std::string method;
   double support_radius = 0.0;      ///< support radius given to the mover, the largest when per wall (0 for blend and none)
   std::vector<double> wall_support_radii;  ///< per wall of `layers` when each has its own radius (rbf default)
   bool support_radius_limited = false;  ///< the default radius was shrunk to max_support_nodes
+  std::vector<std::string> curved_groups;  ///< the groups given a curved boundary (not straight)
   std::vector<WallLayer> layers;    ///< estimated layers of the curved walls (when estimated)
   Index snapped_nodes = 0;          ///< boundary nodes given a position on the true boundary
   Index moved_vertices = 0;         ///< linear vertices that were off the geometry
@@ -154,12 +171,35 @@ struct CurveResult {
   Index moved_nodes = 0;            ///< nodes not on the boundary that the regularization moved
   Index solver_iterations = 0;      ///< summed over steps
   std::vector<MoverStats> steps;    ///< per step
+  UntangleReport untangle;          ///< what the untangling did (cells_below = 0: nothing to do)
   QualityReport quality;            ///< certified scaled Jacobian
   std::vector<double> cell_quality;  ///< the certified scaled Jacobian of each cell, in cell order
   [[nodiscard]] Index invalid() const noexcept { return quality.num_invalid; }
 };
 
 namespace detail {
+
+/// Whether a group's name says it is a solid wall: it holds "wall", or names a body
+/// ("body", "airfoil", "wing", "blade", "hull", "sphere", "cylinder"), whatever the case.
+[[nodiscard]] inline bool looks_like_wall(std::string name) {
+  for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (const char* word : {"wall", "body", "airfoil", "wing", "blade", "hull", "sphere", "cylinder"})
+    if (name.find(word) != std::string::npos) return true;
+  return false;
+}
+
+/// Whether every facet of group `tag` is a triangle (what the surface reconstruction takes).
+template <int Dim>
+[[nodiscard]] bool all_triangles(const Mesh<Dim>& mesh, int tag) {
+  bool any = false;
+  for (const auto& block : mesh.facets)
+    for (const int t : block.tags)
+      if (t == tag) {
+        if (shape(block.type) != Shape::triangle) return false;
+        any = true;
+      }
+  return any;
+}
 
 /// Group names and tags of the facet groups and the geometry each gets.
 template <int Dim>
@@ -176,9 +216,11 @@ template <int Dim>
     return std::find(options.sliding.begin(), options.sliding.end(), n) != options.sliding.end();
   };
   for (const auto& g : mesh.groups)
-    if (g.dim == Dim - 1 && !out.count(g.tag))
-      out[g.tag] = (Dim == 2 && options.spline_by_default && !is_sliding(g.name)) ? BoundaryGeometry<Dim>::spline()
-                                                                                  : BoundaryGeometry<Dim>::straight();
+    if (g.dim == Dim - 1 && !out.count(g.tag)) {
+      const bool by_default = Dim == 2 ? options.spline_by_default
+                                       : options.reconstruct_walls_by_default && looks_like_wall(g.name) && all_triangles(mesh, g.tag);
+      out[g.tag] = by_default && !is_sliding(g.name) ? BoundaryGeometry<Dim>::spline() : BoundaryGeometry<Dim>::straight();
+    }
   return out;
 }
 
@@ -435,13 +477,22 @@ void regularize_and_certify(Mover& mover, const ResolvedBoundary<Dim>& boundary,
 
   detail::report_progress(options.progress, "certifying " + std::to_string(mesh.num_cells()) + " cells (scaled Jacobian)");
   const detail::Stopwatch certify_clock;
-  {
-    const std::vector<CellQuality> cells = evaluate_cells(mesh, Metric::scaled_jacobian, options.report.quality);
-    result.quality = make_report(mesh, Metric::scaled_jacobian, cells, options.report);
-    result.cell_quality.reserve(cells.size());
-    for (const CellQuality& c : cells) result.cell_quality.push_back(c.value);
-  }
+  std::vector<CellQuality> cells = evaluate_cells(mesh, Metric::scaled_jacobian, options.report.quality);
+  result.cell_quality.reserve(cells.size());
+  for (const CellQuality& c : cells) result.cell_quality.push_back(c.value);
   result.seconds.certify = certify_clock.seconds();
+  if (result.method != "none" && options.untangle.enabled) {
+    const detail::Stopwatch untangle_clock;
+    // Boundary nodes are on the geometry: they stay.
+    std::vector<char> fixed(static_cast<std::size_t>(mesh.num_nodes()), 0);
+    for (const Index v : boundary.nodes) fixed[static_cast<std::size_t>(v)] = 1;
+    if (std::any_of(result.cell_quality.begin(), result.cell_quality.end(), [&](double q) { return q < options.untangle.threshold; }))
+      detail::report_progress(options.progress, "untangling the cells below " + format_option_value(options.untangle.threshold));
+    result.untangle = untangle(mesh, fixed, result.cell_quality, options.untangle);
+    for (std::size_t c = 0; c < cells.size(); ++c) cells[c] = {result.cell_quality[c], result.cell_quality[c] > 0.0};
+    result.seconds.untangle = untangle_clock.seconds();
+  }
+  result.quality = make_report(mesh, Metric::scaled_jacobian, cells, options.report);
   if (options.strict && result.quality.num_invalid > 0) {
     const WorstElement& w = result.quality.worst.front();
     std::ostringstream where;
@@ -487,11 +538,25 @@ template <int Dim>
                      format_option_value(options.active_radius_factor) + ")");
   CurveResult<Dim> result;
   result.method = options.method;
-  detail::report_progress(options.progress, "converting " + std::to_string(linear.num_cells()) + " cells to P2");
+  if (options.order < 2 || options.order > max_element_order)
+    throw InputError("curve_mesh: order must be 2 to " + std::to_string(max_element_order) + " (got " +
+                     std::to_string(options.order) + ")");
+  detail::report_progress(options.progress, "converting " + std::to_string(linear.num_cells()) + " cells to P" +
+                                                std::to_string(options.order));
   detail::Stopwatch clock;
-  QuadraticConversion<Dim> conversion = convert_to_quadratic(linear);
-  result.curved = std::move(conversion.mesh);
-  result.num_linear_nodes = conversion.num_linear_nodes;
+  if (options.order == 2) {
+    QuadraticConversion<Dim> conversion = convert_to_quadratic(linear);
+    result.curved = std::move(conversion.mesh);
+    result.num_linear_nodes = conversion.num_linear_nodes;
+  } else {
+    for (const auto* list : {&linear.cells, &linear.facets, &linear.lower})
+      for (const auto& b : *list)
+        if (order(b.type) > 1)
+          throw InputError("curve_mesh: the mesh already has " + std::string(name(b.type)) + " elements (expected a linear mesh)");
+    OrderConversion<Dim> conversion = convert_to_order(linear, options.order);
+    result.curved = std::move(conversion.mesh);
+    result.num_linear_nodes = conversion.num_kept_nodes;
+  }
   name_unnamed_facet_groups(result.curved);
   result.seconds.quadratic = clock.seconds();
 
@@ -502,8 +567,9 @@ template <int Dim>
     if (g.dim == Dim - 1 && it != geometry.end() && it->second.kind != BoundaryGeometry<Dim>::Kind::straight)
       walls.push_back(g.name);
   }
+  result.curved_groups = walls;
   if (Dim == 3 && walls.empty())
-    throw InputError("curve_mesh: no group to curve in 3D (expected a projection callback or a surface reconstruction "
+    throw InputError("curve_mesh: no group to curve in 3D (no group named like a wall, and no projection callback or surface reconstruction "
                      "for at least one group)");
 
   detail::report_progress(options.progress, "snapping the boundary (" + std::to_string(walls.size()) + " curved groups)");
