@@ -1,0 +1,37 @@
+# The optional CAD component (include/meshmotion/cad/, src/cad/): STEP, IGES and BREP models on
+# OpenCASCADE (Debian libocct-modeling-algorithms-dev libocct-data-exchange-dev). Defines
+# meshmotion::cad, a compiled library whose header holds no OpenCASCADE type, and says what is
+# missing otherwise; the core does not depend on it.
+set(MESHMOTION_HAVE_CAD OFF)
+if(NOT MESHMOTION_WITH_CAD)
+  return()
+endif()
+find_package(OpenCASCADE CONFIG QUIET)
+if(NOT OpenCASCADE_FOUND)
+  message(STATUS "meshmotion: CAD component skipped: OpenCASCADE not found (libocct-modeling-algorithms-dev libocct-data-exchange-dev)")
+  return()
+endif()
+# The toolkits the component calls: STEP and IGES readers, BRep tools, extrema, shape analysis
+# (TKPrim: the tests build shapes). Linked by file, not through OpenCASCADE's imported targets:
+# Debian's export names libtbb.so, which only libtbb-dev installs, while the toolkits' own
+# shared objects already load the TBB they need.
+set(MESHMOTION_OCCT_LIBRARIES)
+foreach(toolkit TKSTEP TKIGES TKXSBase TKShHealing TKBRep TKTopAlgo TKGeomAlgo TKGeomBase TKG3d TKG2d TKMath TKernel TKPrim)
+  find_library(MESHMOTION_OCCT_${toolkit} ${toolkit} HINTS ${OpenCASCADE_LIBRARY_DIR})
+  if(NOT MESHMOTION_OCCT_${toolkit})
+    message(STATUS "meshmotion: CAD component skipped: OpenCASCADE toolkit ${toolkit} not found (libocct-data-exchange-dev?)")
+    return()
+  endif()
+  list(APPEND MESHMOTION_OCCT_LIBRARIES ${MESHMOTION_OCCT_${toolkit}})
+endforeach()
+set(MESHMOTION_HAVE_CAD ON)
+add_library(meshmotion_cad STATIC src/cad/cad_model.cpp)
+add_library(meshmotion::cad ALIAS meshmotion_cad)
+set_target_properties(meshmotion_cad PROPERTIES EXPORT_NAME cad POSITION_INDEPENDENT_CODE ON)
+target_include_directories(meshmotion_cad SYSTEM PRIVATE ${OpenCASCADE_INCLUDE_DIR})
+target_link_libraries(meshmotion_cad PUBLIC ${MESHMOTION_LINK_TARGET} PRIVATE ${MESHMOTION_OCCT_LIBRARIES})
+target_compile_definitions(meshmotion_cad PUBLIC MESHMOTION_HAVE_CAD)
+if(TARGET meshmotion_warnings)
+  target_link_libraries(meshmotion_cad PRIVATE meshmotion_warnings)
+endif()
+message(STATUS "meshmotion: CAD component on OpenCASCADE ${OpenCASCADE_VERSION}: STEP, IGES and BREP geometry for curving")

@@ -1,0 +1,110 @@
+#pragma once
+/// \file
+/// CAD geometry for curving (the optional component meshmotion::cad, on OpenCASCADE: Debian
+/// libocct-modeling-algorithms-dev and libocct-data-exchange-dev; CMake builds it when it finds
+/// them, and defines MESHMOTION_HAVE_CAD for what links it).
+///
+/// A CadModel is a STEP, IGES or BREP file's shape, its faces and edges numbered from 1 in
+/// OpenCASCADE's exploration order. match_cad_groups() finds, for each facet group of a mesh,
+/// the CAD entities its vertices lie on (faces in 3D, edges in 2D: a 2D mesh lies in z = 0),
+/// within a tolerance; cad_boundary() turns a match into the BoundaryGeometry curve_mesh()
+/// takes. Its placement puts a high-order node where its vertices' parameters say: a node
+/// between vertices on a common CAD edge (an edge of a 2D model, a seam or ridge of a 3D one)
+/// at the interpolated curve parameter, a node between vertices on a common face at the
+/// interpolated surface parameters (periodic parameters unwrapped across the seam), and any
+/// other node at the closest point of the group's entities.
+///
+/// The header holds no OpenCASCADE type: a program includes it and links meshmotion::cad.
+
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/types.hpp"
+#include "meshmotion/curving/boundary_snapping.hpp"
+
+#include <array>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace meshmotion {
+
+/// The closest point of one CAD entity to a point.
+struct CadPoint {
+  Vec<3> point = Vec<3>::Zero();
+  double distance = 0.0;
+  int dim = 0;      ///< 1: edge, 2: face
+  int index = 0;    ///< the entity, from 1
+  double u = 0.0;   ///< curve parameter, or surface parameters (u, v)
+  double v = 0.0;
+};
+
+/// A STEP, IGES or BREP model.
+class CadModel {
+ public:
+  /// Reads .step/.stp, .iges/.igs or .brep (by extension, any case). Throws IoError for a file
+  /// that cannot be read and InputError for another extension or a file without faces or edges.
+  [[nodiscard]] static CadModel read(const std::filesystem::path& file);
+
+  CadModel(CadModel&&) noexcept;
+  CadModel& operator=(CadModel&&) noexcept;
+  ~CadModel();
+
+  [[nodiscard]] const std::filesystem::path& file() const;
+  [[nodiscard]] int num_faces() const;
+  [[nodiscard]] int num_edges() const;
+  /// Diagonal of the model's bounding box: the scale of the default tolerance.
+  [[nodiscard]] double diagonal() const;
+
+  /// The closest point of entity (dim, index) to x. Throws InputError for an entity the model
+  /// does not have.
+  [[nodiscard]] CadPoint closest_point(int dim, int index, const Vec<3>& x) const;
+  /// The point of entity (dim, index) at parameters (u, v) (v unused on edges).
+  [[nodiscard]] Vec<3> point_at(int dim, int index, double u, double v = 0.0) const;
+  /// The period of each parameter of entity (dim, index); 0 where not periodic.
+  [[nodiscard]] std::array<double, 2> periods(int dim, int index) const;
+  /// The edges bounding face `index`.
+  [[nodiscard]] std::vector<int> face_edges(int index) const;
+  /// The closest points of the entities of dimension `dim` among `candidates` (empty: all)
+  /// that lie within `distance` of x, nearest first (bounding boxes screen the others out).
+  [[nodiscard]] std::vector<CadPoint> entities_within(int dim, const std::vector<int>& candidates, const Vec<3>& x,
+                                                      double distance) const;
+  /// The closest point of the nearest entity of dimension `dim` among `candidates` (empty: all).
+  [[nodiscard]] CadPoint nearest(int dim, const std::vector<int>& candidates, const Vec<3>& x) const;
+
+ private:
+  struct Impl;
+  explicit CadModel(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+/// What a facet group of a mesh matched on a CAD model.
+struct CadGroupMatch {
+  std::string group;
+  int dim = 0;                 ///< entity dimension: 1 (edges) for 2D meshes, 2 (faces) for 3D
+  std::vector<int> entities;   ///< the entities holding its vertices (empty: not matched)
+  double max_distance = 0.0;   ///< largest distance of a vertex to its nearest entity
+  Index farthest_node = -1;    ///< that vertex (mesh index)
+  [[nodiscard]] bool matched() const noexcept { return !entities.empty(); }
+};
+
+/// The default tolerance of match_cad_groups(): 1e-6 of the model's diagonal.
+[[nodiscard]] double default_cad_tolerance(const CadModel& model);
+
+/// Matches every facet group of `mesh` (or only `groups` when given) to the CAD entities its
+/// vertices lie on within `tolerance` (≤ 0: default_cad_tolerance()). A group with a vertex
+/// farther than the tolerance from every entity is not matched (its farthest vertex and
+/// distance say why); a group named in `groups` that does not match throws InputError naming
+/// the vertex (index and file id), its position and its distance.
+template <int Dim>
+[[nodiscard]] std::vector<CadGroupMatch> match_cad_groups(const Mesh<Dim>& mesh, const CadModel& model, double tolerance = 0.0,
+                                                          const std::vector<std::string>& groups = {});
+
+/// The boundary geometry of a matched group: closest-point projection onto its entities and
+/// the parametric placement of the file comment. `model` must outlive the result.
+template <int Dim>
+[[nodiscard]] BoundaryGeometry<Dim> cad_boundary(const CadModel& model, const CadGroupMatch& match, double tolerance = 0.0);
+
+/// One line per group: what it matched (or why not), for the programs' reports.
+[[nodiscard]] std::string describe_cad_matches(const std::vector<CadGroupMatch>& matches);
+
+}  // namespace meshmotion

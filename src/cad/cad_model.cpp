@@ -1,0 +1,519 @@
+// The CAD component (meshmotion::cad) on OpenCASCADE; see include/meshmotion/cad/cad_model.hpp.
+
+#include "meshmotion/cad/cad_model.hpp"
+
+#include "meshmotion/core/error.hpp"
+
+#include <BRepAdaptor_Curve.hxx>
+#include <BRepAdaptor_Surface.hxx>
+#include <BRepBndLib.hxx>
+#include <BRepBuilderAPI_MakeVertex.hxx>
+#include <BRepExtrema_DistShapeShape.hxx>
+#include <BRepTools.hxx>
+#include <BRep_Builder.hxx>
+#include <BRep_Tool.hxx>
+#include <Bnd_Box.hxx>
+#include <GeomAPI_ProjectPointOnCurve.hxx>
+#include <Geom_Curve.hxx>
+#include <IFSelect_ReturnStatus.hxx>
+#include <IGESControl_Reader.hxx>
+#include <Message.hxx>
+#include <Message_Messenger.hxx>
+#include <STEPControl_Reader.hxx>
+#include <ShapeAnalysis_Surface.hxx>
+#include <Standard_Failure.hxx>
+#include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Edge.hxx>
+#include <TopoDS_Face.hxx>
+#include <TopoDS_Shape.hxx>
+#include <TopoDS_Vertex.hxx>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+#include <unordered_map>
+
+namespace meshmotion {
+
+struct CadModel::Impl {
+  std::filesystem::path file;
+  TopoDS_Shape shape;
+  TopTools_IndexedMapOfShape faces, edges;
+  std::vector<Bnd_Box> face_boxes, edge_boxes;
+  std::vector<std::vector<int>> face_edges;
+  double diagonal = 0.0;
+};
+
+namespace {
+
+std::string lower_extension(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+// OpenCASCADE's translators print their progress to stdout: a program's JSON output must stay
+// clean, and failures reach the caller as exceptions.
+void quiet_occt() {
+  static const bool done = [] {
+    Message::DefaultMessenger()->ChangePrinters().Clear();
+    return true;
+  }();
+  (void)done;
+}
+
+TopoDS_Shape read_shape(const std::filesystem::path& file) {
+  quiet_occt();
+  const std::string ext = lower_extension(file);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw IoError(file.string() + ": no such file");
+  if (ext == ".step" || ext == ".stp") {
+    STEPControl_Reader reader;
+    if (reader.ReadFile(file.c_str()) != IFSelect_RetDone) throw IoError(file.string() + ": OpenCASCADE cannot read this STEP file");
+    reader.TransferRoots();
+    return reader.OneShape();
+  }
+  if (ext == ".iges" || ext == ".igs") {
+    IGESControl_Reader reader;
+    if (reader.ReadFile(file.c_str()) != IFSelect_RetDone) throw IoError(file.string() + ": OpenCASCADE cannot read this IGES file");
+    reader.TransferRoots();
+    return reader.OneShape();
+  }
+  if (ext == ".brep") {
+    TopoDS_Shape shape;
+    BRep_Builder builder;
+    if (!BRepTools::Read(shape, file.c_str(), builder)) throw IoError(file.string() + ": OpenCASCADE cannot read this BREP file");
+    return shape;
+  }
+  throw InputError(file.string() + ": unknown CAD format '" + ext + "' (expected .step, .stp, .iges, .igs or .brep)");
+}
+
+gp_Pnt to_gp(const Vec<3>& x) { return gp_Pnt(x[0], x[1], x[2]); }
+Vec<3> from_gp(const gp_Pnt& p) { return Vec<3>(p.X(), p.Y(), p.Z()); }
+
+double box_distance(const Bnd_Box& box, const gp_Pnt& p) {
+  if (box.IsVoid()) return std::numeric_limits<double>::infinity();
+  double x0, y0, z0, x1, y1, z1;
+  box.Get(x0, y0, z0, x1, y1, z1);
+  const double dx = std::max({x0 - p.X(), 0.0, p.X() - x1});
+  const double dy = std::max({y0 - p.Y(), 0.0, p.Y() - y1});
+  const double dz = std::max({z0 - p.Z(), 0.0, p.Z() - z1});
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+}  // namespace
+
+CadModel::CadModel(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+CadModel::CadModel(CadModel&&) noexcept = default;
+CadModel& CadModel::operator=(CadModel&&) noexcept = default;
+CadModel::~CadModel() = default;
+
+CadModel CadModel::read(const std::filesystem::path& file) {
+  auto impl = std::make_unique<Impl>();
+  impl->file = file;
+  try {
+    impl->shape = read_shape(file);
+  } catch (const Standard_Failure& e) {
+    throw IoError(file.string() + ": OpenCASCADE failed reading it (" + std::string(e.GetMessageString()) + ")");
+  }
+  if (impl->shape.IsNull()) throw InputError(file.string() + ": the file holds no shape");
+  TopExp::MapShapes(impl->shape, TopAbs_FACE, impl->faces);
+  TopExp::MapShapes(impl->shape, TopAbs_EDGE, impl->edges);
+  if (impl->faces.Extent() == 0 && impl->edges.Extent() == 0)
+    throw InputError(file.string() + ": the shape has no faces or edges to curve a mesh onto");
+  for (int f = 1; f <= impl->faces.Extent(); ++f) {
+    Bnd_Box box;
+    BRepBndLib::Add(impl->faces(f), box);
+    impl->face_boxes.push_back(box);
+    TopTools_IndexedMapOfShape bounding;
+    TopExp::MapShapes(impl->faces(f), TopAbs_EDGE, bounding);
+    std::vector<int> ids;
+    for (int e = 1; e <= bounding.Extent(); ++e) ids.push_back(impl->edges.FindIndex(bounding(e)));
+    impl->face_edges.push_back(std::move(ids));
+  }
+  for (int e = 1; e <= impl->edges.Extent(); ++e) {
+    Bnd_Box box;
+    BRepBndLib::Add(impl->edges(e), box);
+    impl->edge_boxes.push_back(box);
+  }
+  Bnd_Box all;
+  BRepBndLib::Add(impl->shape, all);
+  if (!all.IsVoid()) {
+    double x0, y0, z0, x1, y1, z1;
+    all.Get(x0, y0, z0, x1, y1, z1);
+    impl->diagonal = std::sqrt((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0) + (z1 - z0) * (z1 - z0));
+  }
+  return CadModel(std::move(impl));
+}
+
+const std::filesystem::path& CadModel::file() const { return impl_->file; }
+int CadModel::num_faces() const { return impl_->faces.Extent(); }
+int CadModel::num_edges() const { return impl_->edges.Extent(); }
+double CadModel::diagonal() const { return impl_->diagonal; }
+
+std::vector<int> CadModel::face_edges(int index) const {
+  if (index < 1 || index > num_faces())
+    throw InputError("CadModel: no face " + std::to_string(index) + " (the model has " + std::to_string(num_faces()) + ")");
+  return impl_->face_edges[static_cast<std::size_t>(index - 1)];
+}
+
+namespace {
+
+void check_entity(const CadModel& m, int dim, int index) {
+  const int count = dim == 2 ? m.num_faces() : dim == 1 ? m.num_edges() : 0;
+  if (index < 1 || index > count)
+    throw InputError("CadModel: no " + std::string(dim == 2 ? "face " : dim == 1 ? "edge " : "entity ") + std::to_string(index) +
+                     " of dimension " + std::to_string(dim) + " (the model has " + std::to_string(count) + ")");
+}
+
+}  // namespace
+
+CadPoint CadModel::closest_point(int dim, int index, const Vec<3>& x) const {
+  check_entity(*this, dim, index);
+  CadPoint out;
+  out.dim = dim;
+  out.index = index;
+  const gp_Pnt p = to_gp(x);
+  if (dim == 1) {
+    // The edge's own curve on its parameter range, and its ends.
+    const TopoDS_Edge& edge = TopoDS::Edge(impl_->edges(index));
+    double first = 0, last = 0;
+    const Handle(Geom_Curve) curve = BRep_Tool::Curve(edge, first, last);
+    if (curve.IsNull()) {  // a degenerate edge (a sphere's pole): its one point
+      const gp_Pnt q = BRep_Tool::Pnt(TopExp::FirstVertex(edge));
+      out.u = first;
+      out.point = from_gp(q);
+      out.distance = q.Distance(p);
+      return out;
+    }
+    double best = std::numeric_limits<double>::infinity(), t_best = first;
+    for (const double t : {first, last}) {
+      const double d = curve->Value(t).Distance(p);
+      if (d < best) best = d, t_best = t;
+    }
+    GeomAPI_ProjectPointOnCurve projection(p, curve, first, last);
+    if (projection.NbPoints() > 0 && projection.LowerDistance() < best) best = projection.LowerDistance(), t_best = projection.LowerDistanceParameter();
+    out.u = t_best;
+    out.point = from_gp(curve->Value(t_best));
+    out.distance = best;
+    return out;
+  }
+  const TopoDS_Face& face = TopoDS::Face(impl_->faces(index));
+  const TopoDS_Vertex vertex = BRepBuilderAPI_MakeVertex(p).Vertex();
+  BRepExtrema_DistShapeShape extrema(vertex, face);
+  if (!extrema.IsDone() || extrema.NbSolution() == 0)
+    throw InputError(impl_->file.string() + ": no closest point on face " + std::to_string(index));
+  out.distance = extrema.Value();
+  out.point = from_gp(extrema.PointOnShape2(1));
+  if (extrema.SupportTypeShape2(1) == BRepExtrema_IsInFace) {
+    extrema.ParOnFaceS2(1, out.u, out.v);
+  } else {
+    // On the face's boundary: its surface parameters there.
+    ShapeAnalysis_Surface surface(BRep_Tool::Surface(face));
+    const gp_Pnt2d uv = surface.ValueOfUV(extrema.PointOnShape2(1), 1e-9 * std::max(impl_->diagonal, 1e-300));
+    out.u = uv.X();
+    out.v = uv.Y();
+  }
+  return out;
+}
+
+Vec<3> CadModel::point_at(int dim, int index, double u, double v) const {
+  check_entity(*this, dim, index);
+  if (dim == 1) return from_gp(BRepAdaptor_Curve(TopoDS::Edge(impl_->edges(index))).Value(u));
+  return from_gp(BRepAdaptor_Surface(TopoDS::Face(impl_->faces(index))).Value(u, v));
+}
+
+std::array<double, 2> CadModel::periods(int dim, int index) const {
+  check_entity(*this, dim, index);
+  if (dim == 1) {
+    const BRepAdaptor_Curve c(TopoDS::Edge(impl_->edges(index)));
+    return {c.IsPeriodic() ? c.Period() : 0.0, 0.0};
+  }
+  const BRepAdaptor_Surface s(TopoDS::Face(impl_->faces(index)));
+  return {s.IsUPeriodic() ? s.UPeriod() : 0.0, s.IsVPeriodic() ? s.VPeriod() : 0.0};
+}
+
+double default_cad_tolerance(const CadModel& model) { return 1e-6 * model.diagonal(); }
+
+namespace {
+
+std::vector<int> all_entities(int count) {
+  std::vector<int> out(static_cast<std::size_t>(count));
+  for (int k = 0; k < count; ++k) out[static_cast<std::size_t>(k)] = k + 1;
+  return out;
+}
+
+}  // namespace
+
+std::vector<CadPoint> CadModel::entities_within(int dim, const std::vector<int>& candidates, const Vec<3>& x, double distance) const {
+  const std::vector<int> all = candidates.empty() ? all_entities(dim == 2 ? num_faces() : num_edges()) : std::vector<int>{};
+  const auto& boxes = dim == 2 ? impl_->face_boxes : impl_->edge_boxes;
+  std::vector<CadPoint> out;
+  for (const int e : candidates.empty() ? all : candidates) {
+    check_entity(*this, dim, e);
+    if (box_distance(boxes[static_cast<std::size_t>(e - 1)], to_gp(x)) > distance) continue;
+    const CadPoint c = closest_point(dim, e, x);
+    if (c.distance <= distance) out.push_back(c);
+  }
+  std::sort(out.begin(), out.end(), [](const CadPoint& a, const CadPoint& b) { return a.distance < b.distance; });
+  return out;
+}
+
+CadPoint CadModel::nearest(int dim, const std::vector<int>& candidates, const Vec<3>& x) const {
+  const std::vector<int> all = candidates.empty() ? all_entities(dim == 2 ? num_faces() : num_edges()) : std::vector<int>{};
+  const auto& boxes = dim == 2 ? impl_->face_boxes : impl_->edge_boxes;
+  std::vector<std::pair<double, int>> order;
+  for (const int e : candidates.empty() ? all : candidates) {
+    check_entity(*this, dim, e);
+    order.emplace_back(box_distance(boxes[static_cast<std::size_t>(e - 1)], to_gp(x)), e);
+  }
+  std::sort(order.begin(), order.end());
+  CadPoint best;
+  best.distance = std::numeric_limits<double>::infinity();
+  for (const auto& [lower_bound, e] : order) {
+    if (lower_bound > best.distance) break;  // boxes hold their entity: nothing nearer beyond
+    const CadPoint c = closest_point(dim, e, x);
+    if (c.distance < best.distance) best = c;
+  }
+  return best;
+}
+
+namespace {
+
+template <int Dim>
+Vec<3> embed(const Vec<Dim>& x) {
+  Vec<3> y = Vec<3>::Zero();
+  for (int d = 0; d < Dim; ++d) y[d] = x[d];
+  return y;
+}
+
+template <int Dim>
+Vec<Dim> restrict_to(const Vec<3>& x) {
+  return x.template head<Dim>();
+}
+
+// A vertex of a matched group on the CAD: the entities of the group within the tolerance, and
+// in 3D the edges of those faces within it (seams, ridges, the borders with other groups).
+struct VertexOnCad {
+  std::vector<CadPoint> entities;
+  std::vector<CadPoint> edges;
+};
+
+struct PointKey {
+  std::array<double, 3> x;
+  friend bool operator==(const PointKey& a, const PointKey& b) { return a.x == b.x; }
+};
+struct PointKeyHash {
+  std::size_t operator()(const PointKey& k) const noexcept {
+    std::size_t h = 0;
+    for (const double v : k.x) {
+      std::uint64_t bits = 0;
+      std::memcpy(&bits, &v, sizeof bits);
+      h ^= std::hash<std::uint64_t>{}(bits) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
+    }
+    return h;
+  }
+};
+
+VertexOnCad locate(const CadModel& model, const CadGroupMatch& match, const Vec<3>& x, double tolerance) {
+  VertexOnCad v;
+  v.entities = model.entities_within(match.dim, match.entities, x, tolerance);
+  if (match.dim == 2) {
+    std::vector<int> edges;
+    for (const CadPoint& f : v.entities)
+      for (const int e : model.face_edges(f.index))
+        if (std::find(edges.begin(), edges.end(), e) == edges.end()) edges.push_back(e);
+    if (!edges.empty()) v.edges = model.entities_within(1, edges, x, tolerance);
+  }
+  return v;
+}
+
+// Parameter `value` moved by whole periods next to `reference`.
+double unwrap(double value, double reference, double period) {
+  if (!(period > 0.0)) return value;
+  return value + period * std::round((reference - value) / period);
+}
+
+// The weighted parameters of the vertices on their common entity (dim, index), or none.
+bool interpolate_on(const CadModel& model, int dim, const std::vector<const std::vector<CadPoint>*>& lists,
+                    std::span<const double> weights, Vec<3>& out) {
+  if (lists.empty()) return false;
+  for (const CadPoint& candidate : *lists.front()) {
+    std::vector<const CadPoint*> on;
+    for (const auto* list : lists) {
+      const auto it = std::find_if(list->begin(), list->end(), [&](const CadPoint& c) { return c.index == candidate.index; });
+      if (it == list->end()) break;
+      on.push_back(&*it);
+    }
+    if (on.size() != lists.size()) continue;
+    const auto periods = model.periods(dim, candidate.index);
+    double u = 0.0, v = 0.0;
+    for (std::size_t k = 0; k < on.size(); ++k) {
+      u += weights[k] * unwrap(on[k]->u, on.front()->u, periods[0]);
+      v += weights[k] * unwrap(on[k]->v, on.front()->v, periods[1]);
+    }
+    out = model.point_at(dim, candidate.index, u, v);
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+template <int Dim>
+std::vector<CadGroupMatch> match_cad_groups(const Mesh<Dim>& mesh, const CadModel& model, double tolerance,
+                                            const std::vector<std::string>& groups) {
+  if (!(tolerance > 0.0)) tolerance = default_cad_tolerance(model);
+  const int dim = Dim - 1;
+  if ((dim == 2 ? model.num_faces() : model.num_edges()) == 0)
+    throw InputError(model.file().string() + ": the model has no " + (dim == 2 ? "faces" : "edges") + " to match a " +
+                     std::to_string(Dim) + "D mesh's groups to");
+  // Facet tags without a group are groups named by their number, as in curve_mesh().
+  std::vector<PhysicalGroup> all = mesh.groups;
+  for (const auto& block : mesh.facets)
+    for (const int tag : block.tags)
+      if (tag != 0 && std::none_of(all.begin(), all.end(), [&](const PhysicalGroup& g) { return g.dim == Dim - 1 && g.tag == tag; }))
+        all.push_back({Dim - 1, tag, std::to_string(tag)});
+  std::vector<const PhysicalGroup*> wanted;
+  for (const auto& name : groups) {
+    const auto it = std::find_if(all.begin(), all.end(), [&](const PhysicalGroup& g) { return g.name == name; });
+    if (it == all.end()) {
+      std::string known;
+      for (const auto& g : all) known += (known.empty() ? "" : ", ") + g.name;
+      throw InputError("match_cad_groups: no group named '" + name + "' (groups: " + known + ")");
+    }
+    wanted.push_back(&*it);
+  }
+  if (groups.empty())
+    for (const auto& g : all)
+      if (g.dim == Dim - 1) wanted.push_back(&g);
+  std::unordered_map<Index, std::vector<CadPoint>> on_cad;  // vertex → entities within the tolerance
+  std::vector<CadGroupMatch> out;
+  for (const PhysicalGroup* g : wanted) {
+    if (g->dim != Dim - 1)
+      throw InputError("match_cad_groups: group '" + g->name + "' has dimension " + std::to_string(g->dim) + " (expected " +
+                       std::to_string(Dim - 1) + ")");
+    CadGroupMatch m;
+    m.group = g->name;
+    m.dim = dim;
+    std::set<int> entities;
+    bool all_on = true;
+    for (const auto& block : mesh.facets) {
+      const int nv = num_vertices(block.type);
+      for (Index e = 0; e < block.size() && all_on; ++e) {
+        if (block.tags[static_cast<std::size_t>(e)] != g->tag) continue;
+        const auto el = block.element(e);
+        std::vector<int> common;
+        for (int k = 0; k < nv && all_on; ++k) {
+          const Index v = el[static_cast<std::size_t>(k)];
+          auto it = on_cad.find(v);
+          if (it == on_cad.end()) it = on_cad.emplace(v, model.entities_within(dim, {}, embed<Dim>(mesh.points.col(v)), tolerance)).first;
+          const std::vector<CadPoint>& near = it->second;
+          if (near.empty()) {
+            const CadPoint nearest = model.nearest(dim, {}, embed<Dim>(mesh.points.col(v)));
+            m.max_distance = nearest.distance;
+            m.farthest_node = v;
+            all_on = false;
+            break;
+          }
+          if (near.front().distance > m.max_distance) m.max_distance = near.front().distance, m.farthest_node = v;
+          std::vector<int> ids;
+          for (const CadPoint& c : near) ids.push_back(c.index);
+          if (k == 0) {
+            common = ids;
+          } else {
+            std::erase_if(common, [&](int id) { return std::find(ids.begin(), ids.end(), id) == ids.end(); });
+          }
+        }
+        if (!all_on) break;
+        if (!common.empty()) {
+          entities.insert(common.begin(), common.end());
+        } else {  // a facet across an edge of the model: each vertex's nearest entity
+          for (int k = 0; k < nv; ++k) entities.insert(on_cad[el[static_cast<std::size_t>(k)]].front().index);
+        }
+      }
+    }
+    if (all_on) m.entities.assign(entities.begin(), entities.end());
+    if (!m.matched() && !groups.empty()) {
+      std::ostringstream msg;
+      msg << model.file().string() << " does not fit group '" << g->name << "': ";
+      if (m.farthest_node < 0) {
+        msg << "the group has no facets";
+      } else {
+        const Vec<Dim> x = mesh.points.col(m.farthest_node);
+        msg << "node " << m.farthest_node << " (file id " << mesh.node_id(m.farthest_node) << ") at (";
+        for (int d = 0; d < Dim; ++d) msg << (d ? ", " : "") << x[d];
+        msg << ") is " << m.max_distance << " from the model's nearest " << (dim == 2 ? "face" : "edge") << " (tolerance "
+            << tolerance << ")";
+      }
+      throw InputError(msg.str());
+    }
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
+template <int Dim>
+BoundaryGeometry<Dim> cad_boundary(const CadModel& model, const CadGroupMatch& match, double tolerance) {
+  if (!match.matched()) throw InputError("cad_boundary: group '" + match.group + "' matched no CAD entity");
+  if (!(tolerance > 0.0)) tolerance = default_cad_tolerance(model);
+  const CadModel* cad = &model;
+  auto project = [cad, match](const Vec<Dim>& x) { return restrict_to<Dim>(cad->nearest(match.dim, match.entities, embed<Dim>(x)).point); };
+  auto cache = std::make_shared<std::unordered_map<PointKey, VertexOnCad, PointKeyHash>>();
+  auto place = [cad, match, tolerance, cache, project](std::span<const Vec<Dim>> vertices, std::span<const double> weights) {
+    std::vector<const std::vector<CadPoint>*> entities, edges;
+    std::vector<double> w;
+    Vec<Dim> straight = Vec<Dim>::Zero();
+    for (std::size_t k = 0; k < vertices.size(); ++k) {
+      straight += weights[k] * vertices[k];
+      if (std::abs(weights[k]) < 1e-12) continue;
+      const Vec<3> x = embed<Dim>(vertices[k]);
+      const PointKey key{{x[0], x[1], x[2]}};
+      auto it = cache->find(key);
+      if (it == cache->end()) it = cache->emplace(key, locate(*cad, match, x, tolerance)).first;
+      entities.push_back(&it->second.entities);
+      edges.push_back(&it->second.edges);
+      w.push_back(weights[k]);
+    }
+    Vec<3> at;
+    // Between two vertices on one edge of the model: along that edge (in 2D the group's own
+    // entities are edges).
+    if (w.size() == 2 && interpolate_on(*cad, 1, match.dim == 1 ? entities : edges, w, at)) return restrict_to<Dim>(at);
+    if (match.dim == 2 && interpolate_on(*cad, 2, entities, w, at)) return restrict_to<Dim>(at);
+    return project(straight);
+  };
+  return BoundaryGeometry<Dim>::project(project, place);
+}
+
+std::string describe_cad_matches(const std::vector<CadGroupMatch>& matches) {
+  std::ostringstream out;
+  for (const CadGroupMatch& m : matches) {
+    out << "group '" << m.group << "': ";
+    if (m.matched()) {
+      out << (m.dim == 2 ? "face" : "edge") << (m.entities.size() > 1 ? "s " : " ");
+      for (std::size_t k = 0; k < m.entities.size(); ++k) out << (k ? ", " : "") << m.entities[k];
+      out << " (vertices within " << m.max_distance << ")\n";
+    } else if (m.farthest_node >= 0) {
+      out << "not on the model (node " << m.farthest_node << " is " << m.max_distance << " from it)\n";
+    } else {
+      out << "no facets\n";
+    }
+  }
+  return out.str();
+}
+
+template std::vector<CadGroupMatch> match_cad_groups<2>(const Mesh<2>&, const CadModel&, double, const std::vector<std::string>&);
+template std::vector<CadGroupMatch> match_cad_groups<3>(const Mesh<3>&, const CadModel&, double, const std::vector<std::string>&);
+template BoundaryGeometry<2> cad_boundary<2>(const CadModel&, const CadGroupMatch&, double);
+template BoundaryGeometry<3> cad_boundary<3>(const CadModel&, const CadGroupMatch&, double);
+
+}  // namespace meshmotion
