@@ -25,7 +25,12 @@ foreach(toolkit TKSTEP TKIGES TKXSBase TKShHealing TKBRep TKTopAlgo TKGeomAlgo T
   list(APPEND MESHMOTION_OCCT_LIBRARIES ${MESHMOTION_OCCT_${toolkit}})
 endforeach()
 set(MESHMOTION_HAVE_CAD ON)
-add_library(meshmotion_cad STATIC src/cad/cad_model.cpp)
+# Inside another project it is built only when something links it, as meshmotion::compiled.
+set(_exclude)
+if(NOT MESHMOTION_TOP_LEVEL)
+  set(_exclude EXCLUDE_FROM_ALL)
+endif()
+add_library(meshmotion_cad STATIC ${_exclude} src/cad/cad_model.cpp)
 add_library(meshmotion::cad ALIAS meshmotion_cad)
 set_target_properties(meshmotion_cad PROPERTIES EXPORT_NAME cad POSITION_INDEPENDENT_CODE ON)
 target_include_directories(meshmotion_cad SYSTEM PRIVATE ${OpenCASCADE_INCLUDE_DIR})

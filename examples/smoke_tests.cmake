@@ -305,9 +305,9 @@ if(TARGET move_mesh_mpi)
              KEYS solver VALUES method=sle,after/invalid=0
              COMMAND move_mesh_mpi "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_mpi_sle.vtu" --group wall --rotate 2
                      --fixed farfield --method sle --petsc-solver cg_hypre --rank-files --json)
-  smoke_test(NAME move_mesh_mpi.p2_to_su2.json REQUIRES examples_demo_mesh RANKS 2 EXPECT_RC 1 KEYS error
+  smoke_test(NAME move_mesh_mpi.p2_to_openfoam.json REQUIRES examples_demo_mesh RANKS 2 EXPECT_RC 1 KEYS error
              VALUES kind=input
-             COMMAND move_mesh_mpi "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_mpi_p2.su2" --group wall --rotate 5
+             COMMAND move_mesh_mpi "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_mpi_p2_case" --group wall --rotate 5
                      --fixed farfield --json)
   smoke_test(NAME move_mesh_mpi.unknown_group.json REQUIRES examples_demo_mesh RANKS 2 EXPECT_RC 1 KEYS error
              VALUES kind=input
