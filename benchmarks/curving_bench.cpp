@@ -5,16 +5,18 @@
 // against a radius per wall), and a wall-resolution study (what limits RBF on thin layers).
 // Gmsh has no CAD of the 30P30N, so it cannot curve that mesh: the comparison with Gmsh runs
 // on cases where it has the true geometry (gmsh_peer.hpp): a NACA0012 boundary-layer mesh that gmsh itself makes (triangles, and
-// quads), and the sphere mesh with its STEP file. Gmsh's `-order 2` snapping and each
-// Mesh.HighOrderOptimize variant curve the linear mesh it saved; our pipeline curves the same
-// linear mesh with the analytic geometry; every P2 mesh is judged by our certified scaled
+// quads), and the RAE2822 and sphere meshes with their STEP files, at orders 2, 3 and 4. Gmsh's
+// `-order N` snapping and each Mesh.HighOrderOptimize variant curve the linear mesh it saved;
+// our pipeline curves the same linear mesh with the analytic geometry (NACA0012) or the same
+// STEP file (through the CAD component); every curved mesh is judged by our certified scaled
 // Jacobian and by gmsh's AnalyseMeshQuality plugin. Prints tables and one JSON line per row;
 // each JSON line holds the "histogram" of our certified scaled Jacobian (valid cells in 10
 // equal bins on [0, 1]; the invalid ones are counted by "invalid" alone), which
 // plot_results.py draws per mesh.
 // Times are this machine's; the thesis's are beside ours for reference.
 //
-// usage: curving_bench [--no-gmsh] [--gmsh-only] [--quick] [path/to/su2_30p30n_rans_L1_coarse.su2]
+// usage: curving_bench [--no-gmsh] [--gmsh-only] [--quick] [--orders=234] [--cases=naca,rae,sphere]
+//                      [path/to/su2_30p30n_rans_L1_coarse.su2]
 //   --no-gmsh    only the 30P30N, two-wall and wall-resolution tables
 //   --gmsh-only  only the Gmsh comparison
 //   --quick      Gmsh comparison without gmsh's slow variants (HighOrderOptimize 1 and 2, and 3
@@ -30,6 +32,10 @@
 #include "meshmotion/curving/naca_section.hpp"
 #include "meshmotion/io/mesh_io.hpp"
 #include "meshmotion/quality/quality_report.hpp"
+
+#ifdef MESHMOTION_HAVE_CAD
+#include "meshmotion/cad/cad_model.hpp"
+#endif
 
 #include <algorithm>
 #include <chrono>
@@ -269,6 +275,7 @@ struct PeerCase {
   std::vector<bench::GmshVariant> variants;
   std::vector<std::string> methods;
   double layer_thickness = 0.0;  // when known (the layer gmsh was asked for): one more blend row with it
+  int order = 2;
 };
 
 void print_peer_header() {
@@ -337,6 +344,7 @@ void compare_case(const PeerCase<Dim>& c, const fs::path& scratch) {
   if (c.layer_thickness > 0.0) runs.emplace_back("blend", c.layer_thickness);
   for (const auto& [method, blending_length] : runs) {
     CurveOptions<Dim> options = c.base;
+    options.order = c.order;
     options.method = method;
     options.blending_length = blending_length;
     double cpu_start = 0.0, cpu_end = 0.0;
@@ -359,8 +367,15 @@ void compare_case(const PeerCase<Dim>& c, const fs::path& scratch) {
                                    : method + " (stiffened elasticity)";
     try {
       const CurveResult<Dim> result = curve_mesh(linear, options);
-      r.cpu = cpu_end - cpu_start;
-      r.wall = std::chrono::duration<double>(wall_end - wall_start).count();
+      // The untangling runs after the first certification (serial: its CPU time is its wall time).
+      r.cpu = cpu_end - cpu_start + result.seconds.untangle;
+      r.wall = std::chrono::duration<double>(wall_end - wall_start).count() + result.seconds.untangle;
+      if (result.untangle.cells_below > 0) {
+        char untangled[96];
+        std::snprintf(untangled, sizeof untangled, "untangled %lld cells below 0.1: %.3f -> %.3f",
+                      static_cast<long long>(result.untangle.cells_below), result.untangle.min_before, result.untangle.min_after);
+        r.note = untangled;
+      }
       r.ours = result.quality;
       r.geometry_error = geometry_error(result.curved, c.wall_tag, c.wall);
       const fs::path out = scratch / (c.name + "_ours_" + method + ".msh");
@@ -395,21 +410,22 @@ void compare(const PeerCase<Dim>& c, const fs::path& scratch) {
   std::fflush(stdout);
 }
 
-// The gmsh variants of a case: -order 2 alone, then HighOrderOptimize 1..4 at gmsh's
+// The gmsh variants of a case: -order N alone, then HighOrderOptimize 1..4 at gmsh's
 // defaults, and (when `layers` > 0) again with Mesh.HighOrderNumLayers covering the layer.
-std::vector<bench::GmshVariant> gmsh_variants(int layers, bool quick) {
-  std::vector<bench::GmshVariant> out{{"-order 2 (snap, HOO=0)", 0, 0}};
+std::vector<bench::GmshVariant> gmsh_variants(int layers, bool quick, int order = 2) {
+  std::vector<bench::GmshVariant> out{{"-order " + std::to_string(order) + " (snap, HOO=0)", 0, 0, order}};
   const std::vector<std::pair<int, std::string>> optimize{
       {1, "optimization (HOO=1)"}, {2, "elastic+optimization (HOO=2)"}, {3, "elastic (HOO=3)"}, {4, "fast curving (HOO=4)"}};
   for (const int num_layers : layers > 0 ? std::vector<int>{0, layers} : std::vector<int>{0})
     for (const auto& [value, label] : optimize) {
       if (quick && (value == 1 || value == 2 || (value == 3 && num_layers > 0))) continue;
-      out.push_back({num_layers > 0 ? label + " nl=" + std::to_string(num_layers) : label, value, num_layers});
+      out.push_back({num_layers > 0 ? label + " nl=" + std::to_string(num_layers) : label, value, num_layers, order});
     }
   return out;
 }
 
-void gmsh_comparison(bool quick) {
+void gmsh_comparison(bool quick, const std::vector<int>& orders, const std::string& cases) {
+  const auto wanted = [&](const char* name) { return cases.empty() || cases.find(name) != std::string::npos; };
   const fs::path scratch = fs::temp_directory_path() / "curving_bench_gmsh";
   fs::create_directories(scratch);
   const std::string version = bench::gmsh_version(scratch);
@@ -426,60 +442,127 @@ void gmsh_comparison(bool quick) {
               "geo err: max distance of the wall's nodes to the analytic geometry.\n",
               version.c_str());
 
-  for (const bool quads : {false, true}) {
-    bench::NacaGeo geo;
-    geo.quads = quads;
-    const std::string name = quads ? "naca0012_quad" : "naca0012_tri";
-    const fs::path cad = scratch / (name + ".geo");
-    const fs::path linear = scratch / (name + "_linear.msh");
-    bench::write_text(cad, bench::naca_geo(geo));
-    const fs::path script = scratch / (name + "_mesh.geo");
-    bench::write_text(script, "Include \"" + cad.string() + "\";\nMesh.SaveParametric = 1;\nMesh 2;\nSave \"" +
-                                  linear.string() + "\";\n");
-    const bench::GmshRun run = bench::run_gmsh(script);
-    const bench::GmshTimer meshing = bench::sum_timers(run.log, {"Done meshing 1D", "Done meshing 2D"});
-    if (run.exit_code != 0 || !fs::exists(linear)) {
-      std::printf("%s: gmsh could not mesh the geometry (exit %d, log %s.log)\n", name.c_str(), run.exit_code,
-                  script.string().c_str());
-      continue;
+  for (const int order : wanted("naca") ? orders : std::vector<int>{})
+    for (const bool quads : {false, true}) {
+      bench::NacaGeo geo;
+      geo.quads = quads;
+      const std::string name = quads ? "naca0012_quad" : "naca0012_tri";
+      const fs::path cad = scratch / (name + ".geo");
+      const fs::path linear = scratch / (name + "_linear.msh");
+      bench::write_text(cad, bench::naca_geo(geo));
+      const fs::path script = scratch / (name + "_mesh.geo");
+      bench::write_text(script, "Include \"" + cad.string() + "\";\nMesh.SaveParametric = 1;\nMesh 2;\nSave \"" +
+                                    linear.string() + "\";\n");
+      const bench::GmshRun run = bench::run_gmsh(script);
+      const bench::GmshTimer meshing = bench::sum_timers(run.log, {"Done meshing 1D", "Done meshing 2D"});
+      if (run.exit_code != 0 || !fs::exists(linear)) {
+        std::printf("%s: gmsh could not mesh the geometry (exit %d, log %s.log)\n", name.c_str(), run.exit_code,
+                    script.string().c_str());
+        continue;
+      }
+      std::printf("\n%s: gmsh made the linear mesh in %.3f s CPU (%.3f s wall): NACA0012, unit chord, first cell %g,\n"
+                  "growth %g, %d layers (%g thick), farfield circle R = %g; %s.\n",
+                  name.c_str(), meshing.cpu, meshing.wall, geo.first_height, geo.growth, geo.layers(), geo.layer_thickness,
+                  geo.farfield_radius, quads ? "recombined into quads" : "triangles");
+      PeerCase<2> c;
+      c.name = name + "_p" + std::to_string(order);
+      c.order = order;
+      c.cad_lines = "Include \"" + cad.string() + "\";\n";
+      c.linear = linear;
+      c.wall_tag = 1;
+      c.wall = NacaProjection(naca4("0012"));
+      c.base.geometry.emplace("wall", BoundaryGeometry<2>::project(c.wall));
+      c.base.geometry.emplace("farfield", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>(0.5, 0.0), geo.farfield_radius)));
+      c.variants = gmsh_variants(2 * geo.layers(), quick, order);
+      c.layer_thickness = geo.layer_thickness;
+      c.methods = {"none", "rbf", "blend", "sle"};
+      compare(c, scratch);
     }
-    std::printf("\n%s: gmsh made the linear mesh in %.3f s CPU (%.3f s wall): NACA0012, unit chord, first cell %g,\n"
-                "growth %g, %d layers (%g thick), farfield circle R = %g; %s.\n",
-                name.c_str(), meshing.cpu, meshing.wall, geo.first_height, geo.growth, geo.layers(), geo.layer_thickness,
-                geo.farfield_radius, quads ? "recombined into quads" : "triangles");
-    PeerCase<2> c;
-    c.name = name;
-    c.cad_lines = "Include \"" + cad.string() + "\";\n";
-    c.linear = linear;
-    c.wall_tag = 1;
-    c.wall = NacaProjection(naca4("0012"));
-    c.base.geometry.emplace("wall", BoundaryGeometry<2>::project(c.wall));
-    c.base.geometry.emplace("farfield", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>(0.5, 0.0), geo.farfield_radius)));
-    c.variants = gmsh_variants(2 * geo.layers(), quick);
-    c.layer_thickness = geo.layer_thickness;
-    c.methods = {"none", "rbf", "blend", "sle"};
-    compare(c, scratch);
-  }
 
   const fs::path data = fs::path(MESHMOTION_SHARED_DATA_DIR);
   const fs::path sphere = data / "meshopt_sphere_symmetry_linear_tet.msh", step = data / "meshopt_Sphere25CSymmetry.stp";
+  const fs::path rae = data / "meshopt_rae2822_linear_tri.msh", rae_step = data / "meshopt_rae2822Square.stp";
+#ifdef MESHMOTION_HAVE_CAD
+  // Both tools on the STEP files: ours through the CAD component, every group the model fits.
+  if (!wanted("rae")) {
+  } else if (fs::exists(rae) && fs::exists(rae_step)) {
+    static const CadModel model = CadModel::read(rae_step);
+    Mesh<2> mesh = read_mesh_as<2>(rae);
+    name_unnamed_facet_groups(mesh);  // the file names no group: its tags are the groups
+    const auto matches = match_cad_groups(mesh, model);
+    std::printf("\nrae2822: the linear mesh of the data folder (made by gmsh from the STEP file, parametric\n"
+                "coordinates kept) merged onto that STEP file; ours: the same STEP file through OpenCASCADE:\n%s",
+                describe_cad_matches(matches).c_str());
+    for (const int order : orders) {
+      PeerCase<2> c;
+      c.name = "rae2822_p" + std::to_string(order);
+      c.order = order;
+      c.cad_lines = "Merge \"" + rae_step.string() + "\";\nMesh.SaveAll = 1;\n";
+      c.linear = rae;
+      // The wall (for the geometry error column): the smallest matched group, the airfoil.
+      double smallest = std::numeric_limits<double>::infinity();
+      for (const auto& m : matches)
+        if (m.matched()) {
+          c.base.geometry.insert_or_assign(m.group, cad_boundary<2>(model, m));
+          const std::vector<Index> nodes = mesh.group_nodes(m.group);
+          Points<2> at(2, static_cast<Index>(nodes.size()));
+          for (std::size_t k = 0; k < nodes.size(); ++k) at.col(static_cast<Index>(k)) = mesh.points.col(nodes[k]);
+          const double size = (at.rowwise().maxCoeff() - at.rowwise().minCoeff()).norm();
+          if (size < smallest) {
+            smallest = size;
+            c.wall_tag = mesh.group(m.group).tag;
+            c.wall = c.base.geometry.at(m.group).projection;
+          }
+        }
+      c.variants = gmsh_variants(0, quick, order);
+      c.methods = {"none", "rbf", "blend"};
+      compare(c, scratch);
+    }
+  } else {
+    std::printf("\nrae2822: %s or its STEP file not found, skipped\n", rae.string().c_str());
+  }
+#else
+  std::printf("\nrae2822: skipped (built without the CAD component: OpenCASCADE not found)\n");
+#endif
+  if (!wanted("sphere")) return;
   if (!fs::exists(sphere) || !fs::exists(step)) {
     std::printf("\nsphere: %s or its STEP file not found, skipped\n", sphere.string().c_str());
     return;
   }
-  PeerCase<3> c;
-  c.name = "sphere_tet";
-  c.cad_lines = "Merge \"" + step.string() + "\";\nMesh.SaveAll = 1;\n";  // the tets have no physical group
-  c.linear = sphere;
-  c.wall_tag = 7;
-  c.wall = SphereProjection<3>(Vec<3>::Zero(), 0.5);
-  c.base.geometry.emplace("7", BoundaryGeometry<3>::project(c.wall));
-  c.base.sliding = {"20"};
-  c.variants = gmsh_variants(0, quick);
-  c.methods = {"none", "rbf", "blend", "sle"};
   std::printf("\nsphere_tet: the linear mesh of the data folder (made by gmsh from the STEP file, parametric\n"
-              "coordinates kept) merged onto that STEP file; ours: sphere radius 0.5 on group 7, group 20 sliding.\n");
-  compare(c, scratch);
+              "coordinates kept) merged onto that STEP file; ours: %s on group 7, group 20 sliding.\n",
+#ifdef MESHMOTION_HAVE_CAD
+              "the same STEP file through OpenCASCADE"
+#else
+              "the sphere of radius 0.5 (built without the CAD component)"
+#endif
+  );
+  for (const int order : orders) {
+    PeerCase<3> c;
+    c.name = "sphere_tet_p" + std::to_string(order);
+    c.order = order;
+    c.cad_lines = "Merge \"" + step.string() + "\";\nMesh.SaveAll = 1;\n";  // the tets have no physical group
+    c.linear = sphere;
+    c.wall_tag = 7;
+#ifdef MESHMOTION_HAVE_CAD
+    static const CadModel model = CadModel::read(step);
+    static const Mesh<3> mesh = [&] {
+      Mesh<3> m = read_mesh_as<3>(sphere);
+      name_unnamed_facet_groups(m);
+      return m;
+    }();
+    static const auto matches = match_cad_groups(mesh, model, 0.0, {"7"});
+    c.base.geometry.emplace("7", cad_boundary<3>(model, matches.front()));
+    c.wall = c.base.geometry.at("7").projection;
+#else
+    c.wall = SphereProjection<3>(Vec<3>::Zero(), 0.5);
+    c.base.geometry.emplace("7", BoundaryGeometry<3>::project(c.wall));
+#endif
+    c.base.sliding = {"20"};
+    c.variants = gmsh_variants(0, quick, order);
+    c.methods = {"none", "rbf", "blend", "sle"};
+    compare(c, scratch);
+  }
 }
 
 }  // namespace
@@ -487,14 +570,22 @@ void gmsh_comparison(bool quick) {
 int main(int argc, char** argv) {
   bench::tune_memory(argc, argv);
   bool with_gmsh = true, with_thesis = true, quick = false;
+  std::vector<int> orders{2, 3, 4};
+  std::string cases;
   fs::path file = fs::path(MESHMOTION_SHARED_DATA_DIR) / "su2_30p30n_rans_L1_coarse.su2";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--no-gmsh") with_gmsh = false;
     else if (a == "--gmsh-only") with_thesis = false;
     else if (a == "--quick") quick = true;
+    else if (a.rfind("--cases=", 0) == 0) cases = a.substr(8);
+    else if (a.rfind("--orders=", 0) == 0) {
+      orders.clear();
+      for (const char ch : a.substr(9))
+        if (ch >= '2' && ch <= '4') orders.push_back(ch - '0');
+    }
     else if (a == "--help" || a == "-h") {
-      std::printf("usage: curving_bench [--no-gmsh] [--gmsh-only] [--quick] [30p30n.su2]\n");
+      std::printf("usage: curving_bench [--no-gmsh] [--gmsh-only] [--quick] [--orders=234] [--cases=naca,rae,sphere] [30p30n.su2]\n");
       return 0;
     } else file = a;
   }
@@ -503,6 +594,6 @@ int main(int argc, char** argv) {
     two_walls_table();
     wall_resolution_table();
   }
-  if (with_gmsh) gmsh_comparison(quick);
+  if (with_gmsh) gmsh_comparison(quick, orders, cases);
   return 0;
 }

@@ -166,14 +166,15 @@ struct GmshVariant {
   std::string label;
   int high_order_optimize = 0;  ///< the Mesh.HighOrderOptimize value it reproduces
   int num_layers = 0;           ///< Mesh.HighOrderNumLayers (0: gmsh's default, 6)
+  int order = 2;                ///< SetOrder
 };
 
-/// Script lines of a variant: `SetOrder 2` and the OptimizeMesh calls of GenerateMesh for
+/// Script lines of a variant: `SetOrder N` and the OptimizeMesh calls of GenerateMesh for
 /// Mesh.HighOrderOptimize = v.high_order_optimize.
 [[nodiscard]] inline std::string high_order_commands(const GmshVariant& v) {
   std::string s;
   if (v.num_layers > 0) s += "Mesh.HighOrderNumLayers = " + std::to_string(v.num_layers) + ";\n";
-  s += "SetOrder 2;\n";
+  s += "SetOrder " + std::to_string(v.order) + ";\n";
   if (v.high_order_optimize == 2 || v.high_order_optimize == 3) s += "OptimizeMesh \"HighOrderElastic\";\n";
   if (v.high_order_optimize == 1 || v.high_order_optimize == 2) s += "OptimizeMesh \"HighOrder\";\n";
   if (v.high_order_optimize == 4) s += "OptimizeMesh \"HighOrderFastCurving\";\n";
