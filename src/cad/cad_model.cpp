@@ -36,6 +36,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <map>
 #include <set>
@@ -343,25 +344,38 @@ double unwrap(double value, double reference, double period) {
   return value + period * std::round((reference - value) / period);
 }
 
-// The weighted parameters of the vertices on their common entity (dim, index), or none.
-bool interpolate_on(const CadModel& model, int dim, const std::vector<const std::vector<CadPoint>*>& lists,
-                    std::span<const double> weights, Vec<3>& out) {
-  if (lists.empty()) return false;
-  for (const CadPoint& candidate : *lists.front()) {
-    std::vector<const CadPoint*> on;
-    for (const auto* list : lists) {
-      const auto it = std::find_if(list->begin(), list->end(), [&](const CadPoint& c) { return c.index == candidate.index; });
-      if (it == list->end()) break;
-      on.push_back(&*it);
-    }
-    if (on.size() != lists.size()) continue;
-    const auto periods = model.periods(dim, candidate.index);
-    double u = 0.0, v = 0.0;
-    for (std::size_t k = 0; k < on.size(); ++k) {
-      u += weights[k] * unwrap(on[k]->u, on.front()->u, periods[0]);
-      v += weights[k] * unwrap(on[k]->v, on.front()->v, periods[1]);
-    }
-    out = model.point_at(dim, candidate.index, u, v);
+// Where the arc length along t ↦ curve(t), t in [0, 1], reaches `fraction` of the whole: the
+// high-order nodes of an edge go at equal lengths, not at equal parameters, which a CAD
+// parametrization need not make equal (Gmsh places them the same way). A polyline of 16
+// chords measures it: the edge of a mesh spans a small arc, where chords are exact to far
+// below the placement's effect on quality, and the point found stays on the model.
+double equal_length_parameter(const std::function<Vec<3>(double)>& curve, double fraction) {
+  constexpr int pieces = 16;
+  std::array<double, pieces + 1> length{};
+  Vec<3> previous = curve(0.0);
+  for (int k = 1; k <= pieces; ++k) {
+    const Vec<3> x = curve(static_cast<double>(k) / pieces);
+    length[static_cast<std::size_t>(k)] = length[static_cast<std::size_t>(k - 1)] + (x - previous).norm();
+    previous = x;
+  }
+  if (!(length.back() > 0.0)) return fraction;
+  const double target = fraction * length.back();
+  int k = 1;
+  while (k < pieces && length[static_cast<std::size_t>(k)] < target) ++k;
+  const double a = length[static_cast<std::size_t>(k - 1)], b = length[static_cast<std::size_t>(k)];
+  return (static_cast<double>(k - 1) + (b > a ? (target - a) / (b - a) : 0.0)) / pieces;
+}
+
+// The point at fraction `t` of the arc length between two vertices along an edge of the
+// model they share (their parameter range on it, unwrapped on a closed edge), or none.
+bool along_common_edge(const CadModel& model, const std::vector<const std::vector<CadPoint>*>& ends, double t, Vec<3>& out) {
+  for (const CadPoint& a : *ends[0]) {
+    const auto b = std::find_if(ends[1]->begin(), ends[1]->end(), [&](const CadPoint& c) { return c.index == a.index; });
+    if (b == ends[1]->end()) continue;
+    const double period = model.periods(1, a.index)[0];
+    const double du = unwrap(b->u, a.u, period) - a.u;
+    const auto along = [&](double s) { return model.point_at(1, a.index, a.u + s * du); };
+    out = along(equal_length_parameter(along, t));
     return true;
   }
   return false;
@@ -487,8 +501,11 @@ BoundaryGeometry<Dim> cad_boundary(const CadModel& model, const CadGroupMatch& m
     Vec<3> at;
     // Between two vertices on one edge of the model: along that edge (in 2D the group's own
     // entities are edges).
-    if (w.size() == 2 && interpolate_on(*cad, 1, match.dim == 1 ? entities : edges, w, at)) return restrict_to<Dim>(at);
-    if (match.dim == 2 && interpolate_on(*cad, 2, entities, w, at)) return restrict_to<Dim>(at);
+    if (w.size() == 2 && along_common_edge(*cad, match.dim == 1 ? entities : edges, w[1], at)) return restrict_to<Dim>(at);
+    // Across a face (and inside one): the projection of the straight place, on the nearest
+    // curve of the surface to the straight edge. A parameter line would follow the face's
+    // parametrization instead: two vertices on one latitude of a sphere would be joined along
+    // the latitude, not the great circle (0.21 against 0.30 at P2 on the sphere's STEP file).
     return project(straight);
   };
   return BoundaryGeometry<Dim>::project(project, place);

@@ -8,11 +8,12 @@
 /// OpenCASCADE's exploration order. match_cad_groups() finds, for each facet group of a mesh,
 /// the CAD entities its vertices lie on (faces in 3D, edges in 2D: a 2D mesh lies in z = 0),
 /// within a tolerance; cad_boundary() turns a match into the BoundaryGeometry curve_mesh()
-/// takes. Its placement puts a high-order node where its vertices' parameters say: a node
-/// between vertices on a common CAD edge (an edge of a 2D model, a seam or ridge of a 3D one)
-/// at the interpolated curve parameter, a node between vertices on a common face at the
-/// interpolated surface parameters (periodic parameters unwrapped across the seam), and any
-/// other node at the closest point of the group's entities.
+/// takes. Its placement puts a node between two vertices on a common CAD edge (an edge of a
+/// 2D model, a seam or ridge of a 3D one) along that edge at its fraction of the arc length
+/// between them (periodic parameters unwrapped across the seam), as Gmsh does; any other edge
+/// node goes to the closest point of the group's entities to its straight place (a curve of
+/// the surface close to the geodesic, where a parameter line need not be), and the nodes
+/// inside a facet to the closest point of their place on the facet curved by its edges.
 ///
 /// The header holds no OpenCASCADE type: a program includes it and links meshmotion::cad.
 
