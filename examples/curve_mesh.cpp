@@ -56,6 +56,7 @@ struct Arguments {
   int steps = 1;
   int order = 2;
   bool no_untangle = false;
+  bool mover_inner_nodes = false;
   double untangle_threshold = 0.1;
   std::vector<std::string> geometry;
   double cad_tolerance = 0.0;  // 0: 1e-6 of the CAD model's diagonal
@@ -102,6 +103,7 @@ CurveOptions<Dim> curve_options(const Arguments& args) {
   options.steps = args.steps;
   options.order = args.order;
   options.untangle.enabled = !args.no_untangle;
+  options.inner_nodes = !args.mover_inner_nodes;
   options.untangle.threshold = args.untangle_threshold;
   options.sliding = args.sliding;
   options.strict = args.strict;
@@ -284,7 +286,8 @@ int main(int argc, char** argv) {
   app.add_option("-o,--output", args.output, "curved mesh to write (.msh, .cgns; .su2 for linear); a .vtu is written beside it");
   examples::add_version_flag(app);
   app.add_flag("--demo", args.demo, "curve the built-in boundary-layer mesh around a cylinder");
-  examples::add_mover_options(app, args.mover, "interior regularization: blend, none, or ");
+  args.mover.method = "blend";  // curve_mesh()'s default (CurveOptions::method)
+  examples::add_mover_options(app, args.mover, "interior regularization (default blend): blend, none, or ");
   app.add_option("--support-radius", args.support_radius,
                  "support radius of the movers with one (rbf; 0: from the boundary-layer thickness)");
   app.add_option("--active-factor", args.active_factor,
@@ -298,9 +301,12 @@ int main(int argc, char** argv) {
                  "default radius = this x the thickest wall layer (default: 4 in 2D, 1 in 3D)")
       ->check(positive);
   app.add_option("--blending-length", args.blending_length, "blend: length (0: --blending-factor x each wall's layer thickness)");
-  app.add_option("--blending-factor", args.blending_factor, "blend: default length = this x each wall's layer (default: 6 in 2D, 1 in 3D)")
+  app.add_option("--blending-factor", args.blending_factor, "blend: default length = this x each wall's layer (default 6)")
       ->check(positive);
   app.add_option("--steps", args.steps, "regularize in this many increments")->capture_default_str();
+  app.add_flag("--mover-inner-nodes", args.mover_inner_nodes,
+               "keep the regularization's nodes inside the faces and cells next to a curved wall (default: re-placed from "
+               "the nodes around them)");
   app.add_flag("--no-untangle", args.no_untangle, "leave the regularized mesh as it is (no optimization of the cells below the threshold)");
   app.add_option("--untangle-threshold", args.untangle_threshold,
                  "optimize the high-order nodes around cells whose certified scaled Jacobian is below this")

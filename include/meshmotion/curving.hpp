@@ -12,6 +12,7 @@
 #include "meshmotion/curving/function_graph.hpp"
 #include "meshmotion/curving/geometry.hpp"
 #include "meshmotion/curving/geometry_text.hpp"
+#include "meshmotion/curving/inner_nodes.hpp"
 #include "meshmotion/curving/naca_section.hpp"
 #include "meshmotion/curving/order_conversion.hpp"
 #include "meshmotion/curving/p2_conversion.hpp"

@@ -92,7 +92,9 @@ def curve_mesh(mesh, **options):
     "naca:XXXX[,CHORD,X0,Y0]" | "sphere:X,Y,Z,R"}), sliding (group names), steps, strict,
     support_radius, support_radius_factor, per_wall_radius, active_radius_factor,
     max_support_nodes, centre_reach, blending_length, blending_factor, corner_angle,
-    spline_by_default, untangle (True: optimize the cells below untangle_threshold, 0.1). Every other keyword is a typed option of the mover (as in Mover()),
+    spline_by_default, untangle (True: optimize the cells below untangle_threshold, 0.1),
+    inner_nodes (True: re-place the nodes inside the faces and cells next to a curved wall from
+    the nodes around them). Every other keyword is a typed option of the mover (as in Mover()),
     refused with the known keys when unknown. strict=True raises InvalidMeshError when invalid
     cells remain; otherwise report["invalid"] counts them.
     """

@@ -205,7 +205,8 @@ CurveOptions<Dim> curve_options(const py::kwargs& kwargs) {
   const std::map<std::string, bool*> flags{{"per_wall_radius", &o.per_wall_radius},
                                            {"spline_by_default", &o.spline_by_default},
                                            {"strict", &o.strict},
-                                           {"untangle", &o.untangle.enabled}};
+                                           {"untangle", &o.untangle.enabled},
+                                           {"inner_nodes", &o.inner_nodes}};
   for (const auto& [key_handle, value] : kwargs) {
     const auto key = py::cast<std::string>(key_handle);
     if (const auto n = numbers.find(key); n != numbers.end()) {
@@ -240,8 +241,12 @@ CurveOptions<Dim> curve_options(const py::kwargs& kwargs) {
     }
   }
   if (o.method == "blend" || o.method == "none") {
-    if (!mover.empty())
-      throw InputError("curve_mesh: method '" + o.method + "' takes no mover option (got '" + mover.front().first + "')");
+    if (!mover.empty()) {
+      std::vector<std::string> known{"method", "order", "steps", "sliding", "geometry"};
+      for (const auto& entry : numbers) known.push_back(entry.first);
+      for (const auto& entry : flags) known.push_back(entry.first);
+      throw InputError("curve_mesh: " + unknown_key_message("method '" + o.method + "' (it takes no mover option)", mover.front().first, known));
+    }
   } else {
     o.mover_options = mover_config<Dim>(o.method, mover).options;
   }

@@ -107,6 +107,7 @@ TEST_CASE("the pipeline untangles after the regularization and reports it", "[cu
   CurveOptions<2> options;
   options.order = 3;
   options.geometry.emplace("wall", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 0.5)));
+  options.method = "rbf";
   options.support_radius = 0.003;  // a support inside the first layers: the regularization alone leaves tangles
   options.untangle.enabled = false;
   const CurveResult<2> plain = curve_mesh(linear, options);

@@ -40,6 +40,7 @@
 #include <span>
 #include <utility>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace meshmotion {
@@ -47,11 +48,16 @@ namespace meshmotion {
 /// Options of BlendMover.
 struct BlendOptions {
   /// Blending length for every wall; 0 (default): `layer_factor` × each wall's boundary-layer
-  /// thickness (estimate_boundary_layer), or `fallback_spacings` × its largest facet when it
-  /// has no anisotropic layer.
+  /// thickness (estimate_boundary_layer), or, on a wall without an anisotropic layer,
+  /// `fallback_spacings` × the size of the facet closest to each node.
   double blending_length = 0.0;
   BoundaryLayerOptions layer{};
-  double fallback_spacings = 3.0;
+  /// A wall without a layer has only its own spacing to size its motion by, and the spacing
+  /// varies along it (the RAE2822's leading-edge facets are 8 times shorter than its
+  /// largest). At 2 the RAE2822 reaches 0.826, 0.851 and 0.833 at orders 2 to 4 (1: 0.816,
+  /// 0.832, 0.809; 3: 0.781, 0.773, 0.692) and the sphere 0.749 and 0.813 at orders 2 and 3
+  /// (docs/curving.md, "Walls without a layer").
+  double fallback_spacings = 2.0;
   /// The default length in layer thicknesses. φ is steepest at a quarter of the length, so at
   /// 1 the steepest gradient lies inside the layer's thin cells; at k it lies k/4 layers out,
   /// in cells that tolerate it, and the gradient within the layer falls roughly as 1/k
@@ -97,6 +103,9 @@ class BlendMover {
       reach.push_back(lengths_[b] + largest_facet(mesh.points, walls[b]));
       distance.emplace_back(mesh.points, walls[b]);
     }
+    const auto length_at = [&](std::size_t b, Index facet) {
+      return facet_lengths_[b].empty() ? lengths_[b] : facet_lengths_[b][static_cast<std::size_t>(facet)];
+    };
     std::vector<Eigen::Triplet<double, Index>> triplets;
     std::array<double, max_facet_nodes> shape{};
     std::vector<detail::WallPoint<Dim>> closest(walls.size());
@@ -115,7 +124,8 @@ class BlendMover {
         phi[b] = 0.0;
         if (distance[b].nearest_vertex(x).second >= reach[b]) continue;
         closest[b] = distance[b].closest(x);
-        phi[b] = rbf_value(RbfKernel::wendland2, closest[b].distance, lengths_[b]);
+        const double length = length_at(b, closest[b].facet);
+        phi[b] = length > 0.0 ? rbf_value(RbfKernel::wendland2, closest[b].distance, length) : 0.0;
         any = any || phi[b] > 0.0;
       }
       if (!any) continue;
@@ -129,7 +139,7 @@ class BlendMover {
         for (std::size_t c = 0; c < walls.size(); ++c)
           if (c != b && phi[c] > 0.0)
             weight *= 1.0 - rbf_value(RbfKernel::wendland2, closest[c].distance,
-                                      std::min(lengths_[c], closest[b].distance + closest[c].distance));
+                                      std::min(length_at(c, closest[c].facet), closest[b].distance + closest[c].distance));
         const detail::WallFacet& f = distance[b].facets()[static_cast<std::size_t>(closest[b].facet)];
         shape_functions(f.type, closest[b].xi, std::span<double>(shape.data(), static_cast<std::size_t>(num_nodes(f.type))));
         for (int j = 0; j < num_nodes(f.type); ++j)
@@ -239,21 +249,79 @@ class BlendMover {
     return largest;
   }
 
-  [[nodiscard]] std::vector<double> wall_lengths(const Mesh<Dim>& mesh, const std::vector<std::vector<detail::WallFacet>>& walls) const {
+  // Each wall's length (for a wall without a layer: the largest of its facets' lengths, which
+  // facet_lengths_ holds).
+  [[nodiscard]] std::vector<double> wall_lengths(const Mesh<Dim>& mesh, const std::vector<std::vector<detail::WallFacet>>& walls) {
     std::vector<double> lengths(walls.size(), options_.blending_length);
+    facet_lengths_.assign(walls.size(), {});
     if (options_.blending_length > 0.0) return lengths;
     const BoundaryLayerEstimate layer = estimate_boundary_layer(mesh, walls, options_.layer);
     for (std::size_t b = 0; b < walls.size(); ++b) {
       lengths[b] = options_.layer_factor * layer.walls[b].thickness;
-      if (!(lengths[b] > 0.0)) lengths[b] = options_.fallback_spacings * largest_facet(mesh.points, walls[b]);
+      if (lengths[b] > 0.0) continue;
+      const std::vector<Vec<Dim>> inward = inward_directions(mesh, walls[b]);
+      for (std::size_t i = 0; i < walls[b].size(); ++i) {
+        const detail::WallFacet& f = walls[b][i];
+        const auto sides = edges(f.type);
+        double size = 0.0;
+        for (const auto& side : sides)
+          size += (mesh.points.col(f.nodes[static_cast<std::size_t>(side[0])]) - mesh.points.col(f.nodes[static_cast<std::size_t>(side[1])])).norm();
+        // A facet bulging away from its cell only enlarges it: the snapped cell, its inside
+        // nodes placed from its edges, is better left alone than sheared by a blend (the
+        // NACA0012's farfield circle: 0.9964 alone, 0.978 blended over one facet).
+        Vec<Dim> bulge = Vec<Dim>::Zero();
+        for (int j = num_vertices(f.type); j < num_nodes(f.type); ++j)
+          bulge += boundary_.displacements.col(slot_[static_cast<std::size_t>(f.nodes[static_cast<std::size_t>(j)])]);
+        const bool away = bulge.dot(inward[i]) < 0.0;
+        facet_lengths_[b].push_back(!away ? options_.fallback_spacings * size / static_cast<double>(sides.size()) : 0.0);
+        lengths[b] = std::max(lengths[b], facet_lengths_[b].back());
+      }
     }
     return lengths;
+  }
+
+  // For each facet of a wall, the direction from its centroid to that of the cell holding it
+  // (zero when no cell holds it).
+  [[nodiscard]] static std::vector<Vec<Dim>> inward_directions(const Mesh<Dim>& mesh, const std::vector<detail::WallFacet>& wall) {
+    std::unordered_map<Index, std::vector<std::pair<std::size_t, Index>>> cells_at;  // wall vertex -> (block, cell)
+    for (const auto& f : wall)
+      for (int j = 0; j < num_vertices(f.type); ++j) cells_at.try_emplace(f.nodes[static_cast<std::size_t>(j)]);
+    for (std::size_t blk = 0; blk < mesh.cells.size(); ++blk) {
+      const ElementBlock& block = mesh.cells[blk];
+      for (Index c = 0; c < block.size(); ++c) {
+        const auto el = block.element(c);
+        for (int j = 0; j < num_vertices(block.type); ++j)
+          if (const auto it = cells_at.find(el[static_cast<std::size_t>(j)]); it != cells_at.end()) it->second.emplace_back(blk, c);
+      }
+    }
+    const auto centroid = [&](const ElementType type, const auto& nodes) {
+      Vec<Dim> x = Vec<Dim>::Zero();
+      for (int j = 0; j < num_vertices(type); ++j) x += mesh.points.col(nodes[static_cast<std::size_t>(j)]);
+      return Vec<Dim>(x / num_vertices(type));
+    };
+    std::vector<Vec<Dim>> out(wall.size(), Vec<Dim>::Zero());
+    for (std::size_t i = 0; i < wall.size(); ++i) {
+      const detail::WallFacet& f = wall[i];
+      for (const auto& [blk, c] : cells_at[f.nodes[0]]) {
+        const auto el = mesh.cells[blk].element(c);
+        const int nv = num_vertices(mesh.cells[blk].type);
+        const bool holds = std::all_of(f.nodes.begin(), f.nodes.begin() + num_vertices(f.type), [&](Index v) {
+          return std::find(el.begin(), el.begin() + nv, v) != el.begin() + nv;
+        });
+        if (holds) {
+          out[i] = centroid(mesh.cells[blk].type, el) - centroid(f.type, f.nodes);
+          break;
+        }
+      }
+    }
+    return out;
   }
 
   BlendOptions options_;
   ResolvedBoundary<Dim> boundary_;
   std::vector<Index> slot_;  // node -> boundary index, -1 inside
   std::vector<double> lengths_;
+  std::vector<std::vector<double>> facet_lengths_;  // per facet of each wall without a layer
   Eigen::SparseMatrix<double, Eigen::ColMajor, Index> operator_;  // boundary × nodes
   Index evaluated_ = 0;
   MoverStats stats_;

@@ -12,9 +12,11 @@
 ///   triangles (SurfaceReconstruction, ridges sharp above the corner angle), edge nodes to the
 ///   reconstructed edge, nodes inside a facet to the reconstructed triangle; vertices stay; or
 /// - from a closest-point projection (analytic or CAD geometry, any dimension): vertices
-///   off the geometry are projected, then every other node goes to the projection of its
-///   place on the straight facet through the projected vertices, which places it where the
-///   true boundary is nearest rather than at a parameter that need not be arc length.
+///   off the geometry are projected, then every edge node goes to the projection of its
+///   place on the straight facet through the projected vertices (or where the geometry's
+///   placement puts it), which places it where the true boundary is nearest rather than at a
+///   parameter that need not be arc length; nodes inside a facet go to the projection of
+///   their place on the facet curved by its edges (inner_nodes.hpp).
 /// Groups without geometry keep their straight facets. Only displacements are returned: the
 /// caller decides how the interior follows (curving/curve_mesh.hpp).
 
@@ -26,6 +28,7 @@
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/curving/boundary_spline.hpp"
 #include "meshmotion/curving/geometry.hpp"
+#include "meshmotion/curving/inner_nodes.hpp"
 #include "meshmotion/curving/surface_reconstruction.hpp"
 
 #include <algorithm>
@@ -54,10 +57,11 @@ struct BoundaryGeometry {
   };
   Kind kind = Kind::straight;
   BoundaryProjection<Dim> projection{};  ///< for Kind::projection
-  /// For Kind::projection, optional: where a high-order node goes given its facet's vertices
-  /// (already on the geometry) and its weights on them; a CAD model interpolates the
-  /// vertices' parameters on their common edge or face (cad/cad_model.hpp). Without it the
-  /// node goes to the projection of its place on the straight facet.
+  /// For Kind::projection, optional: where an edge node goes given its facet's vertices
+  /// (already on the geometry) and its weights on them; a CAD model follows the vertices'
+  /// common CAD edge at equal arc lengths (cad/cad_model.hpp). Without it the node goes to the
+  /// projection of its place on the straight facet. Nodes inside a facet always go to the
+  /// projection of their place on the facet curved by its edges.
   BoundaryPlacement<Dim> placement{};
 
   [[nodiscard]] static BoundaryGeometry straight() { return {Kind::straight, {}, {}}; }
@@ -233,7 +237,8 @@ template <int Dim>
         std::array<Vec<Dim>, 8> corners;
         for (int k = 0; k < nv; ++k) corners[static_cast<std::size_t>(k)] = vertex_position(el[static_cast<std::size_t>(k)]);
         const std::span<const Vec<Dim>> at(corners.data(), static_cast<std::size_t>(nv));
-        for (std::size_t i = static_cast<std::size_t>(nv); i < el.size(); ++i) {
+        const auto inside_first = static_cast<std::size_t>(detail::first_inside_node(block.type));
+        for (std::size_t i = static_cast<std::size_t>(nv); i < std::min(el.size(), inside_first); ++i) {
           const std::span<const double> w(table.weights[i]);
           if (geo.placement) {
             claim(el[i], geo.placement(at, w));
@@ -243,6 +248,23 @@ template <int Dim>
           for (int k = 0; k < nv; ++k) x += w[static_cast<std::size_t>(k)] * at[static_cast<std::size_t>(k)];
           claim(el[i], geo.projection(x));
         }
+        if (inside_first >= el.size()) continue;
+        // Nodes inside a face follow its curved edges (inner_nodes.hpp), then go to the
+        // geometry: placed from the vertices alone, they would ignore how the edges bend
+        // (on a sphere near its pole, parameter lines are far from great circles).
+        Eigen::Matrix<double, Dim, Eigen::Dynamic> x(Dim, static_cast<Index>(el.size()));
+        for (std::size_t i = 0; i < el.size(); ++i) {
+          if (i < inside_first) {
+            x.col(static_cast<Index>(i)) = target.at(el[i]);
+            continue;
+          }
+          x.col(static_cast<Index>(i)).setZero();
+          for (int k = 0; k < nv; ++k) x.col(static_cast<Index>(i)) += table.weights[i][static_cast<std::size_t>(k)] * at[static_cast<std::size_t>(k)];
+        }
+        std::array<int, max_facet_nodes> inside{};
+        for (std::size_t i = inside_first; i < el.size(); ++i) inside[i - inside_first] = static_cast<int>(i);
+        detail::extend_inside<Dim>(block.type, x, std::span<const int>(inside.data(), el.size() - inside_first));
+        for (std::size_t i = inside_first; i < el.size(); ++i) claim(el[i], geo.projection(x.col(static_cast<Index>(i))));
       }
     }
   }

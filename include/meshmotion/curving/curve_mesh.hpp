@@ -29,6 +29,7 @@
 #include "meshmotion/curving/blend_regularizer.hpp"
 #include "meshmotion/curving/boundary_layer.hpp"
 #include "meshmotion/curving/boundary_snapping.hpp"
+#include "meshmotion/curving/inner_nodes.hpp"
 #include "meshmotion/curving/order_conversion.hpp"
 #include "meshmotion/curving/p2_conversion.hpp"
 #include "meshmotion/curving/untangle.hpp"
@@ -66,10 +67,13 @@ struct CurveOptions {
   /// element_type()). Every high-order boundary node goes to its place on the curved edge or
   /// face, and the mover regularizes all of them.
   int order = 2;
-  /// Interior regularization: "rbf" (default), "blend" (curving/blend_regularizer.hpp),
-  /// "none" (snap the boundary only, to see why the pipeline exists) or any other method of
-  /// mover_methods() (movers/mover_options.hpp).
-  std::string method = "rbf";
+  /// Interior regularization: "blend" (default; curving/blend_regularizer.hpp), "rbf", "none"
+  /// (snap the boundary only, to see why the pipeline exists) or any other method of
+  /// mover_methods() (movers/mover_options.hpp). The blend is the default since it reached
+  /// the best minimum on every case of curving_bench but the 30P30N quadrilaterals (0.637
+  /// against the RBF's 0.641): the NACA0012 boundary-layer triangles, the RAE2822 and sphere
+  /// STEP files, at orders 2 to 4 (docs/curving.md, "Against Gmsh").
+  std::string method = "blend";
   /// Typed options of a registered `method` (its MoverOptions alternative); empty: the
   /// method's defaults. The pipeline sets what it measures in them, asking the options what
   /// they take: the support radius (and a radius per centre) of movers with one
@@ -90,7 +94,8 @@ struct CurveOptions {
   /// for 0.06 s more), 1 in 3D (on the bump 2 costs 6× the time); docs/curving.md.
   double support_radius_factor = Dim == 2 ? 4.0 : 1.0;
   /// Method "rbf" with the default radius: each curved wall's centres get the radius of its
-  /// own layer (walls without a layer: 3 of their node spacings), and the other boundary
+  /// own layer (walls without a layer: each node 2 node spacings of its own facets,
+  /// local_spacing_radii()), and the other boundary
   /// centres the radius of the nearest moving wall node, so a thin layer is not overrun by the
   /// support of a thick one. false: the thickest layer's radius everywhere (the thesis's one
   /// radius). Differing radii make the RBF system nonsymmetric (sparse LU instead of
@@ -110,13 +115,19 @@ struct CurveOptions {
   double centre_reach = 2.0;
   /// Blending length of method "blend"; 0: blending_factor × each wall's layer thickness.
   double blending_length = 0.0;
-  /// 6 in 2D: the NACA0012 wall cells of gmsh's boundary-layer triangles rise from 0.957 at 1
-  /// to 0.992 at 6 (gmsh's best variant: 0.990), the 30P30N triangles from 0.798 to 0.825, and
-  /// every factor up to 20 keeps the 30P30N valid; 1 in 3D, where no case measured a larger
-  /// one (docs/curving.md, "Blending length").
-  double blending_factor = Dim == 2 ? 6.0 : 1.0;
+  /// 6: the NACA0012 wall cells of gmsh's boundary-layer triangles rise from 0.957 at 1 to
+  /// 0.992 at 6 (gmsh's best variant: 0.990), the 30P30N triangles from 0.798 to 0.825, and
+  /// every factor up to 20 keeps the 30P30N valid; the coarse 3D bump-in-channel hexahedra
+  /// rise from 0.881 at 1 to 0.955 at 3 and 0.958 at 6 (docs/curving.md, "Blending length").
+  double blending_factor = 6.0;
   /// The regularization in this many increments, each re-based on the moved mesh.
   int steps = 1;
+  /// After the regularization, the nodes inside the faces and cells of the cells touching a
+  /// curved wall that the regularization left where they were (method "none", or beyond its
+  /// reach) are placed from the nodes around them (curving/inner_nodes.hpp), as Gmsh places
+  /// them from its curved edges. false: they stay straight. Nothing to do for P2 triangles and
+  /// tetrahedra.
+  bool inner_nodes = true;
   /// After the regularization, the nodes inside the domain around cells below a threshold of
   /// the certified scaled Jacobian are optimized (curving/untangle.hpp); not for method "none".
   UntangleOptions untangle{};
@@ -326,9 +337,35 @@ template <int Dim>
 /// Default support radii from the wall layers (see CurveOptions::support_radius).
 struct DefaultRadii {
   double uniform = 0.0;          ///< one radius for every wall: the thickest layer's
-  std::vector<double> per_wall;  ///< each wall's own: its layer's, or its node spacing's without a layer
+  std::vector<double> per_wall;  ///< each wall's own: its layer's, or its largest local radius without a layer
+  std::vector<double> per_node;  ///< nodes of walls without a layer: local_spacing_radii() (0 elsewhere)
   bool limited = false;          ///< some wall's layer radius was shrunk to max_support_nodes
 };
+
+/// For the nodes of the facets tagged `tag`: `factor` × the node spacing of the largest facet
+/// holding the node (its mean vertex-to-vertex edge length over the order), written into
+/// `radii` (num_nodes entries). A wall without a boundary layer has nothing else to size its
+/// motion by, and its spacing varies: on the RAE2822 the leading edge's cells are 0.007 wide
+/// where the wall's median spacing gives a radius of 0.058, which spreads the leading edge's
+/// displacement over many cells and lowers the snapped quality (0.79 to 0.61 at P2). With
+/// factor 2 the RBF raises it instead at orders 2 to 4; 1 leaves it as snapped, 4 lowers it
+/// (docs/curving.md, "A radius per node on walls without a layer").
+template <int Dim>
+void local_spacing_radii(const Mesh<Dim>& mesh, int tag, double factor, std::vector<double>& radii) {
+  for (const auto& block : mesh.facets) {
+    const auto sides = edges(block.type);
+    const int p = order(block.type);
+    for (Index e = 0; e < block.size(); ++e) {
+      if (block.tags[static_cast<std::size_t>(e)] != tag) continue;
+      const auto el = block.element(e);
+      double length = 0.0;
+      for (const auto& side : sides)
+        length += (mesh.points.col(el[static_cast<std::size_t>(side[0])]) - mesh.points.col(el[static_cast<std::size_t>(side[1])])).norm();
+      const double radius = factor * length / static_cast<double>(sides.size() * static_cast<std::size_t>(p));
+      for (const Index v : el) radii[static_cast<std::size_t>(v)] = std::max(radii[static_cast<std::size_t>(v)], radius);
+    }
+  }
+}
 
 /// suggest_support_radius() over the snapped nodes for which keep(node) holds, with 3 wall
 /// node spacings; 0 for fewer than two such nodes. Curving displacements are tiny, so the
@@ -353,7 +390,8 @@ template <int Dim, class Keep>
 
 /// The default radii of the curved `walls` (wall_of: wall_of_nodes()): support_radius_factor ×
 /// each wall's layer thickness, limited to max_support_nodes boundary nodes per support around
-/// the wall's moving nodes; a wall without a layer gets spacing_radius() of its own nodes.
+/// the wall's moving nodes; a wall without a layer gets a radius per node, 2 × its facets' node
+/// spacing (local_spacing_radii(); per_wall: the largest of them).
 /// The uniform radius is the largest layer radius, or spacing_radius() of every snapped node
 /// when no wall has a layer.
 template <int Dim>
@@ -378,17 +416,24 @@ template <int Dim>
   if (!(out.uniform > 0.0)) out.uniform = 1.0;  // nothing moves: any radius
   for (std::size_t w = 0; w < layers.size(); ++w)
     if (!(out.per_wall[w] > 0.0)) {
-      const double own = spacing_radius(mesh, snapped, [&](Index v) { return wall_of[static_cast<std::size_t>(v)] == static_cast<int>(w); });
-      out.per_wall[w] = own > 0.0 ? own : out.uniform;
+      if (out.per_node.empty()) out.per_node.assign(static_cast<std::size_t>(mesh.num_nodes()), 0.0);
+      local_spacing_radii(mesh, layers[w].tag, 2.0, out.per_node);
+      for (const Index v : moving[w]) out.per_wall[w] = std::max(out.per_wall[w], out.per_node[static_cast<std::size_t>(v)]);
+      if (!(out.per_wall[w] > 0.0)) out.per_wall[w] = out.uniform;
     }
   return out;
 }
 
-/// The radius of each entry of `given`: its wall's, or for a node on no curved wall (fixed,
-/// sliding) the wall's of the nearest node that moves.
+/// The radius of each entry of `given`: its own (per_node, when positive) or its wall's, or
+/// for a node on no curved wall (fixed, sliding) that of the nearest node that moves.
 template <int Dim>
 [[nodiscard]] std::vector<double> entry_radii(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& given,
-                                              const std::vector<int>& wall_of, const std::vector<double>& per_wall) {
+                                              const std::vector<int>& wall_of, const std::vector<double>& per_wall,
+                                              const std::vector<double>& per_node) {
+  const auto radius_of = [&](Index v) {
+    if (!per_node.empty() && per_node[static_cast<std::size_t>(v)] > 0.0) return per_node[static_cast<std::size_t>(v)];
+    return per_wall[static_cast<std::size_t>(wall_of[static_cast<std::size_t>(v)])];
+  };
   std::vector<Index> moving;
   for (const Index v : moving_nodes(given))
     if (wall_of[static_cast<std::size_t>(v)] >= 0) moving.push_back(v);
@@ -398,10 +443,9 @@ template <int Dim>
   const double largest = *std::max_element(per_wall.begin(), per_wall.end());
   std::vector<double> radii(given.nodes.size(), largest);
   for (std::size_t k = 0; k < given.nodes.size(); ++k) {
-    int w = wall_of[static_cast<std::size_t>(given.nodes[k])];
-    if (w < 0 && !moving.empty())
-      w = wall_of[static_cast<std::size_t>(moving[tree.nearest(Vec<Dim>(mesh.points.col(given.nodes[k]))).first])];
-    if (w >= 0) radii[k] = per_wall[static_cast<std::size_t>(w)];
+    Index v = given.nodes[k];
+    if (wall_of[static_cast<std::size_t>(v)] < 0 && !moving.empty()) v = moving[tree.nearest(Vec<Dim>(mesh.points.col(v))).first];
+    if (wall_of[static_cast<std::size_t>(v)] >= 0) radii[k] = radius_of(v);
   }
   return radii;
 }
@@ -470,6 +514,21 @@ void regularize_and_certify(Mover& mover, const ResolvedBoundary<Dim>& boundary,
       }
     result.steps.push_back(mover.stats());
     result.solver_iterations += mover.stats().iterations;
+  }
+  if (options.inner_nodes) {
+    // Faces on the boundary keep the nodes the snapping (or the sliding) gave them, and the
+    // nodes the regularization moved keep its place: only what it left straight follows the
+    // curved edges.
+    std::vector<char> curved(static_cast<std::size_t>(mesh.num_nodes()), 0), kept = moved;
+    for (std::size_t k = 0; k < boundary.nodes.size(); ++k) {
+      const auto v = static_cast<std::size_t>(boundary.nodes[k]);
+      kept[v] = 1;
+      curved[v] = boundary.displacements.col(static_cast<Index>(k)).squaredNorm() > 0.0;
+    }
+    const Points<Dim> before = mesh.points;
+    place_inner_nodes(mesh, curved, kept);
+    for (Index v = 0; v < mesh.num_nodes(); ++v)
+      if (mesh.points.col(v) != before.col(v)) moved[static_cast<std::size_t>(v)] = 1;
   }
   for (const Index v : boundary.nodes) moved[static_cast<std::size_t>(v)] = 0;
   result.moved_nodes = static_cast<Index>(std::count(moved.begin(), moved.end(), 1));
@@ -603,6 +662,7 @@ template <int Dim>
     const bool radial = std::visit([]<class O>(const O&) { return TakesSupportRadius<O>; }, config->options);
     result.support_radius = options.support_radius;
     std::vector<int> wall_of;
+    std::vector<double> per_node;
     if (!(result.support_radius > 0.0)) {
       wall_of = detail::wall_of_nodes(result.curved, walls);
       const detail::DefaultRadii radii = detail::default_support_radii(result.curved, boundary, snapped, result.layers, wall_of, options);
@@ -610,6 +670,7 @@ template <int Dim>
       result.support_radius_limited = radii.limited;
       if (radial && options.per_wall_radius) {
         result.wall_support_radii = radii.per_wall;
+        per_node = radii.per_node;
         result.support_radius = *std::max_element(radii.per_wall.begin(), radii.per_wall.end());
       }
     }
@@ -619,12 +680,13 @@ template <int Dim>
     const ResolvedBoundary<Dim> given =
         trim ? detail::near_motion(result.curved, boundary, options.centre_reach * result.support_radius) : boundary;
     const auto& per_wall = result.wall_support_radii;
-    const bool varying = std::any_of(per_wall.begin(), per_wall.end(), [&](double r) { return r != per_wall.front(); });
+    const bool varying =
+        !per_node.empty() || std::any_of(per_wall.begin(), per_wall.end(), [&](double r) { return r != per_wall.front(); });
     std::visit(
         [&]<class O>(O& o) {
           if constexpr (TakesSupportRadius<O>) {
             o.support_radius = result.support_radius;
-            o.support_radii = varying ? detail::entry_radii(result.curved, given, wall_of, per_wall) : std::vector<double>{};
+            o.support_radii = varying ? detail::entry_radii(result.curved, given, wall_of, per_wall, per_node) : std::vector<double>{};
           }
           if constexpr (TakesActiveRadius<O>)
             if (!(o.active_radius > 0.0)) o.active_radius = options.active_radius_factor * result.support_radius;
