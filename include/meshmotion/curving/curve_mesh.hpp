@@ -9,17 +9,19 @@
 ///    spline reconstruction by default; projection callbacks for analytic/CAD geometry, the
 ///    only way in 3D). Vertices already on the geometry stay.
 /// 3. Regularization: the boundary displacements of step 2 are propagated into the domain by
-///    a mover (RBF with Wendland C2 by default, the blending regularizer, or any MeshMover):
+///    a mover (the blending regularizer by default, RBF with Wendland C2, or any MeshMover):
 ///    curved groups are prescribed, other groups fixed or sliding. Only the nodes the mover
 ///    gives a nonzero displacement change. The motion may be split into `steps`, each a
-///    fresh setup on the mesh moved so far (thesis table 4.2).
+///    fresh setup on the mesh moved so far (thesis table 4.2). The nodes inside faces and
+///    cells it left straight then follow the curved edges (curving/inner_nodes.hpp).
 /// 4. Certification: the certified scaled Jacobian (thesis eq. 3.3) of every cell; strict
 ///    mode throws InvalidMeshError when invalid cells remain, default mode reports them.
+/// 5. Untangling of the cells below a threshold (curving/untangle.hpp).
 ///
-/// The default RBF support radius follows the boundary layer (curving/boundary_layer.hpp):
-/// `support_radius_factor` × each curved wall's own layer thickness (one radius per wall, the
-/// RBF centres of a wall take its radius). docs/curving.md gives the measured effect of larger
-/// radii and of one radius for all walls.
+/// The blend's default length and the RBF's default support radius follow the boundary layer
+/// (curving/boundary_layer.hpp): a factor × each curved wall's own layer thickness, or on a
+/// wall without a layer a few of its node spacings at each node. docs/curving.md gives the
+/// measured effect of other lengths and radii and of one radius for all walls.
 
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
