@@ -282,7 +282,7 @@ int main(int argc, char** argv) {
   meshmotion::tune_process_memory(argc, argv);  // may restart the program once (core/process_memory.hpp)
   CLI::App app{"Curve a linear mesh into a certified P2 (P3, P4) mesh (spline or CAD boundary, RBF or blending interior)"};
   Arguments args;
-  app.add_option("input", args.input, "linear mesh (.msh, .su2, .cgns); none: the built-in demo");
+  app.add_option("input", args.input, "linear mesh (.msh, .su2, .cgns, .vtu); none: the built-in demo");
   app.add_option("-o,--output", args.output, "curved mesh to write (.msh, .cgns; .su2 for linear); a .vtu is written beside it");
   examples::add_version_flag(app);
   app.add_flag("--demo", args.demo, "curve the built-in boundary-layer mesh around a cylinder");

@@ -16,7 +16,7 @@
 int main(int argc, char** argv) {
   meshmotion::tune_process_memory(argc, argv);  // may restart the program once (core/process_memory.hpp)
   using namespace meshmotion;
-  CLI::App app{"Print the contents of a mesh file (.msh, .su2 or .cgns) or OpenFOAM case"};
+  CLI::App app{"Print the contents of a mesh file (.msh, .su2, .cgns or .vtu) or OpenFOAM case"};
   examples::add_version_flag(app);
   std::string file;
   bool json = false;

@@ -120,7 +120,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Mesh quality report: Knupp size/shape/skew metrics and the certified scaled Jacobian of P1/P2 cells"};
   examples::add_version_flag(app);
   Settings s;
-  app.add_option("file", s.file, "mesh file (.msh, .su2, .cgns) or OpenFOAM case folder")->required()->check(CLI::ExistingPath);
+  app.add_option("file", s.file, "mesh file (.msh, .su2, .cgns, .vtu) or OpenFOAM case folder")->required()->check(CLI::ExistingPath);
   app.add_option("--metric", s.metrics, "shape, skew, size, size-shape, size-skew or jacobian (repeatable; default shape, skew, size, jacobian)");
   app.add_flag("--json", s.json, "print one JSON object instead of the table");
   app.add_option("--vtu", s.vtu, "write the mesh with one cell array per metric");

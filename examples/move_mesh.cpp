@@ -103,7 +103,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Move a mesh whose boundary group rotates, translates or moves by given displacements"};
   examples::add_version_flag(app);
   Arguments a;
-  app.add_option("input", a.input, "Input mesh (.msh, .su2, .cgns) or OpenFOAM case folder")->check(CLI::ExistingPath);
+  app.add_option("input", a.input, "Input mesh (.msh, .su2, .cgns, .vtu) or OpenFOAM case folder")->check(CLI::ExistingPath);
   app.add_option("-o,--output", a.output, "Output mesh (.msh, .su2, .cgns, .vtu), or an OpenFOAM case (its points replaced; give --overwrite when it is the input) or a time folder of it (case/0.001: its polyMesh/points)");
   examples::add_motion_options(app, a.motion);
   examples::add_mover_options(app, a.mover, "");

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// The io layer: Gmsh .msh, SU2 .su2, CGNS and OpenFOAM reading and writing, VTK .vtu writing,
+/// The io layer: Gmsh .msh, SU2 .su2, CGNS, VTK .vtu and OpenFOAM reading and writing,
 /// checkMesh measures of polyMesh cells, mesh summaries.
 
 #include "meshmotion/io/any_mesh.hpp"
@@ -12,4 +12,5 @@
 #include "meshmotion/io/openfoam_quality.hpp"
 #include "meshmotion/io/su2_reader.hpp"
 #include "meshmotion/io/su2_writer.hpp"
+#include "meshmotion/io/vtu_reader.hpp"
 #include "meshmotion/io/vtu_writer.hpp"

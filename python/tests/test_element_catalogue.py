@@ -162,3 +162,30 @@ def test_vtu_cells_past_order_2_read_back_through_vtk(type_name):
     expected = vtk_ref[:, :dim] @ a.T + 0.5
     got = np.array([cell.GetPoints().GetPoint(k)[:dim] for k in range(n)])
     np.testing.assert_allclose(got, expected, atol=1e-12)
+
+
+@pytest.mark.parametrize("type_name", [t for t in VTK_TYPES if DIM[family(t)] >= 2])
+@pytest.mark.parametrize("mode", ["Binary", "Ascii"])
+def test_vtu_written_by_vtk_reads_back(type_name, mode):
+    """Our .vtu read by VTK and written again by VTK's own writer (file version 2.2, its
+    hexahedron edge order, UInt32 headers) reads back into the same cell."""
+    vtk = pytest.importorskip("vtk", reason="python3-vtk9 is not installed")
+    dim = DIM[family(type_name)]
+    points = mm.reference_nodes(type_name)[:, :dim] * 0.7 + 0.3
+    mesh = mm.from_arrays(points, {type_name: np.arange(len(points))[None, :]}, {})
+    ours = scratch(f"vtk_roundtrip_{type_name}.vtu")
+    mm.write_mesh(ours, mesh)
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(ours))
+    reader.Update()
+    theirs = scratch(f"vtk_roundtrip_{type_name}_{mode}.vtu")
+    writer = vtk.vtkXMLUnstructuredGridWriter()
+    writer.SetFileName(str(theirs))
+    writer.SetInputData(reader.GetOutput())
+    getattr(writer, f"SetDataModeTo{mode}")()
+    writer.SetCompressorTypeToNone()
+    assert writer.Write() == 1
+    back = mm.read_mesh(theirs)
+    np.testing.assert_array_equal(back.points, mesh.points)
+    assert back.cells[0][0] == type_name
+    np.testing.assert_array_equal(back.cells[0][1], mesh.cells[0][1])

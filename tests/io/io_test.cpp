@@ -442,6 +442,77 @@ TEST_CASE("VTU binary output decodes to the exact coordinates, connectivity and 
   CHECK(offsets.back() == static_cast<std::int64_t>(binary_array<std::int64_t>(text, "Name=\"connectivity\"").size()));
 }
 
+TEST_CASE("VTU input: every type and order round-trips through .vtu, binary and ASCII, facets with their tags", "[io]") {
+  // VTK 9.1 has no Lagrange pyramid, and writes a pyramid14 as its 13-node pyramid.
+  const auto vtk_has = [](const ElementBlock& b) { return b.type != ElementType::pyramid30 && b.type != ElementType::pyramid14; };
+  const auto check = [&]<int Dim>(Mesh<Dim> mesh, VtuEncoding encoding) {
+    mesh.lower.clear();
+    std::erase_if(mesh.cells, [&](const ElementBlock& b) { return !vtk_has(b); });
+    std::erase_if(mesh.facets, [&](const ElementBlock& b) { return !vtk_has(b); });
+    const auto file = test::scratch_path("all_types.vtu");
+    write_vtu(file, mesh, {}, {true, encoding});
+    const Mesh<Dim> back = read_mesh_as<Dim>(file);
+    CHECK(back.points == mesh.points);
+    using Lists = std::pair<const std::vector<ElementBlock>*, const std::vector<ElementBlock>*>;
+    for (const Lists& lists : {Lists{&mesh.cells, &back.cells}, Lists{&mesh.facets, &back.facets}}) {
+      REQUIRE(lists.first->size() == lists.second->size());
+      for (std::size_t k = 0; k < lists.first->size(); ++k) {
+        INFO(name((*lists.first)[k].type));
+        CHECK((*lists.second)[k].type == (*lists.first)[k].type);
+        CHECK((*lists.second)[k].connectivity == (*lists.first)[k].connectivity);
+        CHECK((*lists.second)[k].tags == (*lists.first)[k].tags);
+      }
+    }
+  };
+  for (const int element_order : {1, 2, 3, 4})
+    for (const auto encoding : {VtuEncoding::binary, VtuEncoding::ascii}) {
+      INFO("order " << element_order << (encoding == VtuEncoding::binary ? " binary" : " ascii"));
+      check(all_types_mesh<3>(element_order), encoding);
+      check(all_types_mesh<2>(element_order), encoding);
+    }
+  // Without facet_tag (written without the facets) the file's cells are all there is.
+  const Mesh<2> square = rectangle_mesh({.nx = 2, .ny = 2, .cells = RectangleCells::tri3});
+  const auto file = test::scratch_path("square.vtu");
+  write_mesh(file, square);
+  const Mesh<2> back = read_mesh_as<2>(file);
+  CHECK(back.points == square.points);
+  CHECK(back.num_facets() == 0);
+}
+
+TEST_CASE("VTU input: bad files are refused with the file, the line and the reason", "[io]") {
+  const Mesh<2> square = rectangle_mesh({.nx = 2, .ny = 2, .cells = RectangleCells::tri3});
+  const std::string ascii = format_vtu(square, {}, {false, VtuEncoding::ascii});
+  const auto refused = [](const std::string& text, const std::string& reason) {
+    const auto file = test::scratch_path("bad.vtu");
+    std::ofstream(file, std::ios::binary) << text;
+    INFO(reason);
+    CHECK_THROWS_AS(read_mesh(file), ParseError);
+    CHECK_THROWS_WITH(read_mesh(file), Catch::Contains("bad.vtu:") && Catch::Contains(reason));
+  };
+  const auto replace = [&](std::string text, const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    REQUIRE(at != std::string::npos);
+    return text.replace(at, from.size(), to);
+  };
+  refused("not xml", "no <VTKFile>");
+  refused(replace(ascii, "byte_order", "compressor=\"vtkZLibDataCompressor\" byte_order"), "compressed data");
+  refused(replace(ascii, "<Cells>", "<Cellz>"), "no <Cells> section");
+  refused(replace(ascii, "format=\"ascii\"", "format=\"appended\""), "appended data is not read");
+  refused(replace(ascii, "Name=\"offsets\" format=\"ascii\">\n", "Name=\"offsets\" format=\"ascii\">\n0\n"),
+          "'offsets' has 9 values (expected 8)");
+  refused(replace(ascii, "Name=\"types\" format=\"ascii\">\n5", "Name=\"types\" format=\"ascii\">\n42"),
+          "VTK type 42 with 3 nodes");
+  refused(replace(ascii, "Name=\"connectivity\" format=\"ascii\">\n0", "Name=\"connectivity\" format=\"ascii\">\n99"),
+          "names node 99");
+  refused(replace(ascii, "Name=\"connectivity\" format=\"ascii\">\n0", "Name=\"connectivity\" format=\"ascii\">\nx"),
+          "'x");
+  refused(replace(ascii, "NumberOfComponents=\"3\" format=\"ascii\">\n0 0 0", "NumberOfComponents=\"3\" format=\"ascii\">\n0 0 1"),
+          "point 0 has z = 1");
+  const std::string binary = format_vtu(square, {});
+  refused(replace(binary, "Name=\"types\" format=\"binary\">\n          ", "Name=\"types\" format=\"binary\">\n          !"),
+          "'!' is not a base64 character");
+}
+
 TEST_CASE("files written in chunks equal the formatted text, byte for byte", "[io]") {
   // Several megabytes per file, so the writers spill their buffer (1 MiB) many times, in the
   // middle of records as well as of base64 arrays.

@@ -2,7 +2,7 @@
 /// \file
 /// Reading and writing meshes by file extension: .msh (Gmsh 2.2/4.1, ASCII or binary, detected
 /// on reading), .su2 (SU2), .cgns (CGNS, when built with the CGNS library: io/cgns.hpp) and
-/// .vtu (VTK, write only); a folder is an OpenFOAM case (io/openfoam.hpp): read as its
+/// .vtu (VTK XML, io/vtu_reader.hpp and io/vtu_writer.hpp); a folder is an OpenFOAM case (io/openfoam.hpp): read as its
 /// polyMesh, written by replacing its points.
 
 #include "meshmotion/core/error.hpp"
@@ -16,6 +16,7 @@
 #include "meshmotion/io/openfoam.hpp"
 #include "meshmotion/io/su2_reader.hpp"
 #include "meshmotion/io/su2_writer.hpp"
+#include "meshmotion/io/vtu_reader.hpp"
 #include "meshmotion/io/vtu_writer.hpp"
 
 #include <concepts>
@@ -74,7 +75,7 @@ void apply_orientation(Mesh<Dim>& mesh, const std::filesystem::path& file, ReadO
 
 }  // namespace detail
 
-/// Reads a mesh, choosing the format by extension (.msh, .su2 or .cgns) or, for a folder, as an
+/// Reads a mesh, choosing the format by extension (.msh, .su2, .cgns or .vtu) or, for a folder, as an
 /// OpenFOAM case. The result is 3D if the file
 /// holds 3D elements (SU2: NDIME 3), else 2D. The mesh is validated, and its orientation
 /// handled as `options` says.
@@ -89,8 +90,9 @@ void apply_orientation(Mesh<Dim>& mesh, const std::filesystem::path& file, ReadO
     if (ext == ".msh") return read_gmsh(file);
     if (ext == ".su2") return read_su2(file);
     if (ext == ".cgns") return read_cgns(file);
+    if (ext == ".vtu") return read_vtu(file);
     throw InputError("read_mesh: " + file.string() + ": unknown mesh format '" + ext +
-                     "' (expected .msh, .su2, .cgns or an OpenFOAM case folder)");
+                     "' (expected .msh, .su2, .cgns, .vtu or an OpenFOAM case folder)");
   }();
   std::visit([&](auto& m) { detail::apply_orientation(m, file, options.orientation); }, mesh);
   return mesh;
