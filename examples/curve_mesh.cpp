@@ -63,7 +63,7 @@ struct Arguments {
   std::vector<std::string> groups;
   std::vector<std::string> sliding;
   double corner_angle = 30.0;
-  bool arc_length = false;
+  bool parameter_midpoint = false;
   bool strict = false;
   bool json = false;
   bool overwrite = false;
@@ -108,7 +108,7 @@ CurveOptions<Dim> curve_options(const Arguments& args) {
   options.sliding = args.sliding;
   options.strict = args.strict;
   options.snap.corner_angle = args.corner_angle;
-  options.snap.midpoint = args.arc_length ? SplineMidpoint::arc_length : SplineMidpoint::parameter;
+  options.snap.midpoint = args.parameter_midpoint ? SplineMidpoint::parameter : SplineMidpoint::arc_length;
   if (cad_geometry(args)) return options;  // the groups come from the model (run())
   std::vector<std::string> groups = args.groups;
   if (groups.empty() && !args.geometry.empty()) groups.push_back("wall");
@@ -322,7 +322,8 @@ int main(int argc, char** argv) {
                  "CAD file: how far a vertex may be from the model (default: 1e-6 of the model's diagonal)");
   app.add_option("--sliding", args.sliding, "groups sliding in their plane (symmetry)");
   app.add_option("--corner-angle", args.corner_angle, "spline corners above this angle (degrees)")->capture_default_str();
-  app.add_flag("--arc-length", args.arc_length, "spline: arc-length midpoint instead of the parameter midpoint");
+  app.add_flag("--parameter-midpoint", args.parameter_midpoint,
+               "spline: nodes at fractions of the facet's parameter (the thesis) instead of its arc length");
   app.add_flag("--single-radius", args.single_radius,
                "rbf default radius: the thickest wall layer's for every wall, not each wall's own");
   app.add_flag("--strict", args.strict, "write nothing when invalid cells remain (exit 2)");

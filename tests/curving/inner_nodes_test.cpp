@@ -185,3 +185,34 @@ TEST_CASE("walls without a layer: the RBF radius of each wall node is twice its 
       CHECK(curved.wall_support_radii[static_cast<std::size_t>(w)] == Approx(2.0 * 2.0 * r * std::sin(std::numbers::pi / 32) / p));
   }
 }
+
+TEST_CASE("spline walls: each node at its fraction of the facet's arc length by default", "[curving]") {
+  // An ellipse O-mesh (nodes evenly spaced in angle, so facets of varying length): the
+  // spline's parameter runs at a varying speed along a facet, the arc length does not.
+  OMeshOptions o;
+  o.semi_axis_y = 0.2;
+  o.n_around = 48;
+  o.n_radial = 16;
+  const Mesh<2> linear = o_mesh(o);
+  const auto unevenness = [&](SplineMidpoint midpoint) {
+    CurveOptions<2> options;
+    options.method = "none";
+    options.snap.midpoint = midpoint;
+    const CurveResult<2> curved = curve_mesh(linear, options);
+    double worst = 0.0;
+    const int wall = curved.curved.group("wall").tag;
+    for (const auto& b : curved.curved.facets)
+      for (Index e = 0; e < b.size(); ++e) {
+        if (b.tags[static_cast<std::size_t>(e)] != wall) continue;
+        const auto el = b.element(e);
+        const Vec<2> a = curved.curved.points.col(el[0]), c = curved.curved.points.col(el[1]), m = curved.curved.points.col(el[2]);
+        worst = std::max(worst, std::abs((m - a).norm() - (m - c).norm()) / (a - c).norm());
+      }
+    return worst;
+  };
+  REQUIRE(CurveOptions<2>{}.snap.midpoint == SplineMidpoint::arc_length);
+  const double arc = unevenness(SplineMidpoint::arc_length), parameter = unevenness(SplineMidpoint::parameter);
+  INFO("arc length: " << arc << ", parameter: " << parameter);
+  CHECK(arc < 1e-3);
+  CHECK(parameter > 1e-2);
+}

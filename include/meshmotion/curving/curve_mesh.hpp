@@ -72,9 +72,9 @@ struct CurveOptions {
   /// Interior regularization: "blend" (default; curving/blend_regularizer.hpp), "rbf", "none"
   /// (snap the boundary only, to see why the pipeline exists) or any other method of
   /// mover_methods() (movers/mover_options.hpp). The blend is the default since it reached
-  /// the best minimum on every case of curving_bench but the 30P30N quadrilaterals (0.637
-  /// against the RBF's 0.641): the NACA0012 boundary-layer triangles, the RAE2822 and sphere
-  /// STEP files, at orders 2 to 4 (docs/curving.md, "Against Gmsh").
+  /// the best minimum on every case of curving_bench: the NACA0012 boundary-layer triangles,
+  /// the RAE2822 and sphere STEP files at orders 2 to 4 (docs/curving.md, "Against Gmsh"),
+  /// and a tie with the RBF on the 30P30N quadrilaterals (0.7077).
   std::string method = "blend";
   /// Typed options of a registered `method` (its MoverOptions alternative); empty: the
   /// method's defaults. The pipeline sets what it measures in them, asking the options what
