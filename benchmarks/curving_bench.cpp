@@ -373,10 +373,11 @@ void compare_case(const PeerCase<Dim>& c, const fs::path& scratch) {
       // The untangling runs after the first certification (serial: its CPU time is its wall time).
       r.cpu = cpu_end - cpu_start + result.seconds.untangle;
       r.wall = std::chrono::duration<double>(wall_end - wall_start).count() + result.seconds.untangle;
-      if (result.untangle.cells_below > 0) {
-        char untangled[96];
-        std::snprintf(untangled, sizeof untangled, "untangled %lld cells below 0.1: %.3f -> %.3f",
-                      static_cast<long long>(result.untangle.cells_below), result.untangle.min_before, result.untangle.min_after);
+      if (result.untangle.cells_below > 0 || result.untangle.raise_rounds > 0) {
+        char untangled[128];
+        std::snprintf(untangled, sizeof untangled, "untangled %lld cells below 0.1, raised %d rounds: %.3f -> %.3f",
+                      static_cast<long long>(result.untangle.cells_below), result.untangle.raise_rounds, result.untangle.min_before,
+                      result.untangle.min_after);
         r.note = untangled;
       }
       r.ours = result.quality;

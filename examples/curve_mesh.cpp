@@ -58,6 +58,7 @@ struct Arguments {
   bool no_untangle = false;
   bool mover_inner_nodes = false;
   double untangle_threshold = 0.1;
+  int raise_rounds = UntangleOptions{}.raise_rounds;
   std::vector<std::string> geometry;
   double cad_tolerance = 0.0;  // 0: 1e-6 of the CAD model's diagonal
   std::vector<std::string> groups;
@@ -105,6 +106,7 @@ CurveOptions<Dim> curve_options(const Arguments& args) {
   options.untangle.enabled = !args.no_untangle;
   options.inner_nodes = !args.mover_inner_nodes;
   options.untangle.threshold = args.untangle_threshold;
+  options.untangle.raise_rounds = args.raise_rounds;
   options.sliding = args.sliding;
   options.strict = args.strict;
   options.snap.corner_angle = args.corner_angle;
@@ -210,7 +212,8 @@ int run(Mesh<Dim> linear, const Arguments& args) {
     const UntangleReport& u = result.untangle;
     w.key("untangle").begin_object().key("cells_below").value(u.cells_below).key("invalid_before").value(u.invalid_before);
     w.key("invalid_after").value(u.invalid_after).key("min_before").value(u.min_before).key("min_after").value(u.min_after);
-    w.key("patch_cells").value(u.patch_cells).key("free_nodes").value(u.free_nodes).key("sweeps").value(u.sweeps).end_object();
+    w.key("patch_cells").value(u.patch_cells).key("free_nodes").value(u.free_nodes).key("sweeps").value(u.sweeps);
+    w.key("raise_rounds").value(u.raise_rounds).end_object();
     w.key("min_scaled_jacobian").value(q.min).key("mean_scaled_jacobian").value(q.mean).key("invalid").value(q.num_invalid);
     w.key("quality");
     write_json(w, q);
@@ -254,13 +257,13 @@ void print_summary(const CurveResult<Dim>& result, const Arguments& args, const 
               result.max_boundary_displacement);
   std::printf("  interior nodes moved: %lld, solver iterations: %lld\n", static_cast<long long>(result.moved_nodes),
               static_cast<long long>(result.solver_iterations));
-  if (result.untangle.cells_below > 0) {
+  if (result.untangle.cells_below > 0 || result.untangle.raise_rounds > 0) {
     const UntangleReport& u = result.untangle;
-    std::printf("  untangling: %lld cells below the threshold (%lld invalid), min %.4f -> %.4f, %lld invalid after "
-                "(%lld cells, %lld free nodes, %d sweeps)\n",
-                static_cast<long long>(u.cells_below), static_cast<long long>(u.invalid_before), u.min_before, u.min_after,
-                static_cast<long long>(u.invalid_after), static_cast<long long>(u.patch_cells), static_cast<long long>(u.free_nodes),
-                u.sweeps);
+    std::printf("  untangling: %lld cells below the threshold (%lld invalid), %d rounds raising the worst, min %.4f -> %.4f, "
+                "%lld invalid after (%lld cells, %lld free nodes, %d sweeps)\n",
+                static_cast<long long>(u.cells_below), static_cast<long long>(u.invalid_before), u.raise_rounds, u.min_before,
+                u.min_after, static_cast<long long>(u.invalid_after), static_cast<long long>(u.patch_cells),
+                static_cast<long long>(u.free_nodes), u.sweeps);
   }
   std::printf("  certified scaled Jacobian: min %.4f, mean %.4f, invalid %lld of %lld\n", q.min, q.mean,
               static_cast<long long>(q.num_invalid), static_cast<long long>(q.num_elements));
@@ -310,6 +313,10 @@ int main(int argc, char** argv) {
   app.add_flag("--no-untangle", args.no_untangle, "leave the regularized mesh as it is (no optimization of the cells below the threshold)");
   app.add_option("--untangle-threshold", args.untangle_threshold,
                  "optimize the high-order nodes around cells whose certified scaled Jacobian is below this")
+      ->capture_default_str();
+  app.add_option("--raise-rounds", args.raise_rounds,
+                 "then raise the worst cells: rounds of optimization around them while the minimum rises (0: none)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--order", args.order, "order of the curved mesh: 2, 3 or 4 (hexahedra, prisms and pyramids: 2 or 3)")
       ->capture_default_str();

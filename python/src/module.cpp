@@ -225,6 +225,11 @@ CurveOptions<Dim> curve_options(const py::kwargs& kwargs) {
       if (!(steps >= 1.0) || steps != std::floor(steps) || steps > 1e6)
         throw InputError("curve_mesh: option 'steps' expects a positive integer (got " + py::cast<std::string>(py::repr(value)) + ")");
       o.steps = static_cast<int>(steps);
+    } else if (key == "raise_rounds") {
+      const double rounds = number_option(key, value);
+      if (!(rounds >= 0.0) || rounds != std::floor(rounds) || rounds > 1e6)
+        throw InputError("curve_mesh: option 'raise_rounds' expects an integer >= 0 (got " + py::cast<std::string>(py::repr(value)) + ")");
+      o.untangle.raise_rounds = static_cast<int>(rounds);
     } else if (key == "sliding") {
       if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value))
         throw InputError("curve_mesh: option 'sliding' expects a list of group names (got " +
@@ -242,7 +247,7 @@ CurveOptions<Dim> curve_options(const py::kwargs& kwargs) {
   }
   if (o.method == "blend" || o.method == "none") {
     if (!mover.empty()) {
-      std::vector<std::string> known{"method", "order", "steps", "sliding", "geometry"};
+      std::vector<std::string> known{"method", "order", "steps", "raise_rounds", "sliding", "geometry"};
       for (const auto& entry : numbers) known.push_back(entry.first);
       for (const auto& entry : flags) known.push_back(entry.first);
       throw InputError("curve_mesh: " + unknown_key_message("method '" + o.method + "' (it takes no mover option)", mover.front().first, known));
@@ -285,6 +290,7 @@ py::dict curve_report(const CurveResult<Dim>& r) {
   untangled["patch_cells"] = r.untangle.patch_cells;
   untangled["free_nodes"] = r.untangle.free_nodes;
   untangled["sweeps"] = r.untangle.sweeps;
+  untangled["raise_rounds"] = r.untangle.raise_rounds;
   d["untangle"] = untangled;
   return d;
 }

@@ -245,6 +245,14 @@ def test_curve_mesh_at_order_3_and_4():
             mm.to_meshio(curved)
     with pytest.raises(ValueError, match="expects 2, 3 or 4"):
         mm.curve_mesh(mesh, order=5)
+    # The rounds raising the worst cells never lower the minimum; none leaves it as it was.
+    _, raised = mm.curve_mesh(mesh, order=3, geometry={"wall": "circle:0,0,0.5"})
+    _, plain = mm.curve_mesh(mesh, order=3, geometry={"wall": "circle:0,0,0.5"}, raise_rounds=0)
+    assert plain["untangle"]["raise_rounds"] == 0
+    assert raised["quality"]["min"] >= plain["quality"]["min"]
+    assert (raised["untangle"]["raise_rounds"] > 0) == (raised["quality"]["min"] > plain["quality"]["min"])
+    with pytest.raises(ValueError, match="raise_rounds"):
+        mm.curve_mesh(mesh, raise_rounds=-1)
 
 
 def test_curve_mesh_puts_the_high_order_nodes_on_the_circle():

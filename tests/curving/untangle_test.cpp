@@ -20,14 +20,14 @@ namespace {
 // A square of 8 × 8 cells at order p whose high-order nodes inside the domain were shaken by
 // up to 60% of the node spacing (a regularization gone wrong): tangled cells everywhere, the
 // boundary intact.
-Mesh<2> shaken_mesh(RectangleCells cells, int p, std::vector<char>& fixed) {
+Mesh<2> shaken_mesh(RectangleCells cells, int p, std::vector<char>& fixed, double share = 0.6) {
   const Mesh<2> linear = rectangle_mesh({.nx = 8, .ny = 8, .cells = cells});
   Mesh<2> m = to_order(linear, p);
   fixed.assign(static_cast<std::size_t>(m.num_nodes()), 0);
   for (const auto& b : boundary_facets(m))
     for (const Index v : b.connectivity) fixed[static_cast<std::size_t>(v)] = 1;
   std::mt19937 rng(1);
-  const double amplitude = 0.6 * 0.125 / p;
+  const double amplitude = share * 0.125 / p;
   std::uniform_real_distribution<double> shake(-amplitude, amplitude);
   for (Index v = linear.num_nodes(); v < m.num_nodes(); ++v)
     if (!fixed[static_cast<std::size_t>(v)])
@@ -96,7 +96,13 @@ TEST_CASE("untangling: nothing below the threshold, nothing moves; switched off,
   CHECK(m.points == before.points);
   UntangleOptions low;
   low.threshold = -1e9;
+  low.raise_rounds = 0;
   CHECK(untangle(m, fixed, quality, low).cells_below == 0);
+  CHECK(m.points == before.points);
+  UntangleOptions no_budget = low;
+  no_budget.raise_rounds = 4;
+  no_budget.raise_budget = 0.0;
+  CHECK(untangle(m, fixed, quality, no_budget).evaluations == 0);
   CHECK(m.points == before.points);
   std::vector<double> short_quality(3, 1.0);
   CHECK_THROWS_WITH(untangle(m, fixed, short_quality, {}), Catch::Contains("3 cell values"));
@@ -121,4 +127,28 @@ TEST_CASE("the pipeline untangles after the regularization and reports it", "[cu
   CHECK(untangled.invalid() <= plain.invalid());
   CHECK(untangled.quality.min == untangled.untangle.min_after);
   CHECK(untangled.quality.min >= plain.quality.min);
+}
+
+TEST_CASE("raising the worst cells lifts the certified minimum of a valid mesh, boundary kept", "[curving]") {
+  // Shaken by 15% of the spacing at P2, 5% at P3: valid everywhere, with a few poor cells.
+  for (const int p : {2, 3}) {
+    INFO("order " << p);
+    std::vector<char> fixed;
+    Mesh<2> m = shaken_mesh(RectangleCells::tri3, p, fixed, p == 2 ? 0.15 : 0.05);
+    const Mesh<2> before = m;
+    std::vector<double> quality = cell_quality(m, Metric::scaled_jacobian);
+    REQUIRE(*std::min_element(quality.begin(), quality.end()) > 0.1);  // nothing to untangle
+    const UntangleReport report = untangle(m, fixed, quality, {});
+    INFO("min " << report.min_before << " -> " << report.min_after << " in " << report.raise_rounds << " rounds, "
+                << report.evaluations << " evaluations");
+    CHECK(report.cells_below == 0);
+    CHECK(report.raise_rounds >= 1);
+    CHECK(report.min_after > report.min_before + 0.02);
+    // Within its budget: 4 evaluations per cell, and a node's last search may overrun it.
+    CHECK(report.evaluations <= 4 * m.num_cells() + 200);
+    const auto certified = cell_quality(m, Metric::scaled_jacobian);
+    CHECK(*std::min_element(certified.begin(), certified.end()) == Approx(report.min_after).margin(1e-12));
+    for (Index v = 0; v < m.num_nodes(); ++v)
+      if (fixed[static_cast<std::size_t>(v)]) CHECK(m.points.col(v) == before.points.col(v));
+  }
 }
