@@ -10,6 +10,7 @@
 #include <BRepBuilderAPI_MakeVertex.hxx>
 #include <BRepExtrema_DistShapeShape.hxx>
 #include <BRepTools.hxx>
+#include <BRepTopAdaptor_FClass2d.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
@@ -39,9 +40,12 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <mutex>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace meshmotion {
 
@@ -52,6 +56,10 @@ struct CadModel::Impl {
   std::vector<Bnd_Box> face_boxes, edge_boxes;
   std::vector<std::vector<int>> face_edges;
   double diagonal = 0.0;
+  // Each face's classifier of parameter points (inside, on or outside its boundary), built on
+  // first use; the mutex keeps the model's const methods safe to call from several threads.
+  std::vector<std::unique_ptr<BRepTopAdaptor_FClass2d>> classifiers;
+  std::mutex classifiers_mutex;
 };
 
 namespace {
@@ -141,6 +149,7 @@ CadModel CadModel::read(const std::filesystem::path& file) {
     for (int e = 1; e <= bounding.Extent(); ++e) ids.push_back(impl->edges.FindIndex(bounding(e)));
     impl->face_edges.push_back(std::move(ids));
   }
+  impl->classifiers.resize(static_cast<std::size_t>(impl->faces.Extent()));
   for (int e = 1; e <= impl->edges.Extent(); ++e) {
     Bnd_Box box;
     BRepBndLib::Add(impl->edges(e), box);
@@ -225,6 +234,53 @@ CadPoint CadModel::closest_point(int dim, int index, const Vec<3>& x) const {
     out.v = uv.Y();
   }
   return out;
+}
+
+CadPoint CadModel::closest_point_near(int dim, int index, const Vec<3>& x, double u0, double v0) const {
+  check_entity(*this, dim, index);
+  if (dim != 2) return closest_point(dim, index, x);
+  const TopoDS_Face& face = TopoDS::Face(impl_->faces(index));
+  const BRepAdaptor_Surface surface(face);
+  // Newton's method on the squared distance, to round-off: from a start next to the answer it
+  // converges in a few steps (OpenCASCADE's local extremum stops at its parameter tolerance,
+  // 1e-9, which moved a sphere's edge nodes 5e-7 off their great circles).
+  const gp_Pnt p = to_gp(x);
+  double u = u0, v = v0;
+  bool converged = false;
+  for (int iteration = 0; iteration < 30 && !converged; ++iteration) {
+    gp_Pnt s;
+    gp_Vec su, sv, suu, svv, suv;
+    surface.D2(u, v, s, su, sv, suu, svv, suv);
+    const gp_Vec r(p, s);
+    const double gu = r.Dot(su), gv = r.Dot(sv);
+    const double huu = su.Dot(su) + r.Dot(suu), hvv = sv.Dot(sv) + r.Dot(svv), huv = su.Dot(sv) + r.Dot(suv);
+    const double det = huu * hvv - huv * huv;
+    if (!(det > 1e-14 * (su.SquareMagnitude() * sv.SquareMagnitude())) || !(huu > 0.0)) break;  // not a minimum, or degenerate
+    const double du = (hvv * gu - huv * gv) / det, dv = (huu * gv - huv * gu) / det;
+    u -= du;
+    v -= dv;
+    converged = std::abs(du) * su.Magnitude() + std::abs(dv) * sv.Magnitude() < 1e-14 * std::max(impl_->diagonal, 1e-300);
+  }
+  if (converged) {
+    CadPoint out;
+    out.dim = 2;
+    out.index = index;
+    out.u = u;
+    out.v = v;
+    TopAbs_State state;
+    {
+      const std::lock_guard<std::mutex> lock(impl_->classifiers_mutex);
+      auto& classifier = impl_->classifiers[static_cast<std::size_t>(index - 1)];
+      if (!classifier) classifier = std::make_unique<BRepTopAdaptor_FClass2d>(face, 1e-9 * std::max(impl_->diagonal, 1e-300));
+      state = classifier->Perform(gp_Pnt2d(out.u, out.v));
+    }
+    if (state == TopAbs_IN || state == TopAbs_ON) {
+      out.point = from_gp(surface.Value(u, v));
+      out.distance = (out.point - x).norm();
+      return out;
+    }
+  }
+  return closest_point(dim, index, x);
 }
 
 Vec<3> CadModel::point_at(int dim, int index, double u, double v) const {
@@ -381,6 +437,43 @@ bool along_common_edge(const CadModel& model, const std::vector<const std::vecto
   return false;
 }
 
+// A vertex's place from the mesh file (an entity tag and parameters): the model's point there
+// when the model has that entity and the point is within the tolerance of the vertex.
+std::optional<CadPoint> from_file(const CadModel& model, const NodeParametrization& p, const Vec<3>& x, double tolerance) {
+  if (p.entity_tag < 1 || p.entity_tag > (p.entity_dim == 2 ? model.num_faces() : model.num_edges())) return std::nullopt;
+  CadPoint c;
+  c.dim = p.entity_dim;
+  c.index = p.entity_tag;
+  c.u = p.u;
+  c.v = p.v;
+  c.point = model.point_at(c.dim, c.index, c.u, c.v);
+  c.distance = (c.point - x).norm();
+  if (!(c.distance <= tolerance)) return std::nullopt;
+  return c;
+}
+
+// The closest point to x of a face every vertex lies on, searched from the vertices' weighted
+// parameters there (unwrapped across a seam next to the first vertex's), or none.
+std::optional<CadPoint> near_common_face(const CadModel& model, const std::vector<const std::vector<CadPoint>*>& vertices,
+                                         const std::vector<double>& weights, const Vec<3>& x) {
+  if (vertices.empty()) return std::nullopt;
+  for (const CadPoint& first : *vertices[0]) {
+    const std::array<double, 2> period = model.periods(2, first.index);
+    double u = 0.0, v = 0.0, total = 0.0;
+    bool shared = true;
+    for (std::size_t k = 0; k < vertices.size() && shared; ++k) {
+      const auto on = std::find_if(vertices[k]->begin(), vertices[k]->end(), [&](const CadPoint& c) { return c.index == first.index; });
+      shared = on != vertices[k]->end();
+      if (!shared) break;
+      u += weights[k] * unwrap(on->u, first.u, period[0]);
+      v += weights[k] * unwrap(on->v, first.v, period[1]);
+      total += weights[k];
+    }
+    if (shared && total > 0.0) return model.closest_point_near(2, first.index, x, u / total, v / total);
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 template <int Dim>
@@ -411,6 +504,8 @@ std::vector<CadGroupMatch> match_cad_groups(const Mesh<Dim>& mesh, const CadMode
     for (const auto& g : all)
       if (g.dim == Dim - 1) wanted.push_back(&g);
   std::unordered_map<Index, std::vector<CadPoint>> on_cad;  // vertex → entities within the tolerance
+  std::unordered_set<Index> file_placed;                     // vertices on_cad has from the file
+  const auto is_from_file = [&](Index v) { return file_placed.count(v) > 0; };
   std::vector<CadGroupMatch> out;
   for (const PhysicalGroup* g : wanted) {
     if (g->dim != Dim - 1)
@@ -420,6 +515,7 @@ std::vector<CadGroupMatch> match_cad_groups(const Mesh<Dim>& mesh, const CadMode
     m.group = g->name;
     m.dim = dim;
     std::set<int> entities;
+    std::set<Index> counted;
     bool all_on = true;
     for (const auto& block : mesh.facets) {
       const int nv = num_vertices(block.type);
@@ -430,7 +526,20 @@ std::vector<CadGroupMatch> match_cad_groups(const Mesh<Dim>& mesh, const CadMode
         for (int k = 0; k < nv && all_on; ++k) {
           const Index v = el[static_cast<std::size_t>(k)];
           auto it = on_cad.find(v);
-          if (it == on_cad.end()) it = on_cad.emplace(v, model.entities_within(dim, {}, embed<Dim>(mesh.points.col(v)), tolerance)).first;
+          if (it == on_cad.end()) {
+            const Vec<3> x = embed<Dim>(mesh.points.col(v));
+            std::vector<CadPoint> near;
+            if (!mesh.node_params.empty() && mesh.node_params[static_cast<std::size_t>(v)].entity_dim == dim) {
+              if (const auto p = from_file(model, mesh.node_params[static_cast<std::size_t>(v)], x, tolerance)) {
+                near.push_back(*p);
+                file_placed.insert(v);
+              } else {
+                ++m.file_mismatches;
+              }
+            }
+            if (near.empty()) near = model.entities_within(dim, {}, x, tolerance);
+            it = on_cad.emplace(v, std::move(near)).first;
+          }
           const std::vector<CadPoint>& near = it->second;
           if (near.empty()) {
             const CadPoint nearest = model.nearest(dim, {}, embed<Dim>(mesh.points.col(v)));
@@ -440,6 +549,13 @@ std::vector<CadGroupMatch> match_cad_groups(const Mesh<Dim>& mesh, const CadMode
             break;
           }
           if (near.front().distance > m.max_distance) m.max_distance = near.front().distance, m.farthest_node = v;
+          if (counted.insert(v).second) {
+            ++m.vertices;
+            if (is_from_file(v)) {
+              ++m.by_file;
+              m.located.emplace_back(embed<Dim>(mesh.points.col(v)), near.front());
+            }
+          }
           std::vector<int> ids;
           for (const CadPoint& c : near) ids.push_back(c.index);
           if (k == 0) {
@@ -483,6 +599,9 @@ BoundaryGeometry<Dim> cad_boundary(const CadModel& model, const CadGroupMatch& m
   const CadModel* cad = &model;
   auto project = [cad, match](const Vec<Dim>& x) { return restrict_to<Dim>(cad->nearest(match.dim, match.entities, embed<Dim>(x)).point); };
   auto cache = std::make_shared<std::unordered_map<PointKey, VertexOnCad, PointKeyHash>>();
+  // A vertex the file places inside an entity is on that entity alone, and on none of its
+  // edges (Gmsh gives a vertex on an edge the edge's tag).
+  for (const auto& [x, on] : match.located) cache->emplace(PointKey{{x[0], x[1], x[2]}}, VertexOnCad{{on}, {}});
   auto place = [cad, match, tolerance, cache, project](std::span<const Vec<Dim>> vertices, std::span<const double> weights) {
     std::vector<const std::vector<CadPoint>*> entities, edges;
     std::vector<double> w;
@@ -506,6 +625,9 @@ BoundaryGeometry<Dim> cad_boundary(const CadModel& model, const CadGroupMatch& m
     // curve of the surface to the straight edge. A parameter line would follow the face's
     // parametrization instead: two vertices on one latitude of a sphere would be joined along
     // the latitude, not the great circle (0.21 against 0.30 at P2 on the sphere's STEP file).
+    // On a face all the vertices share, the search starts from their weighted parameters.
+    if (match.dim == 2)
+      if (const auto on = near_common_face(*cad, entities, w, embed<Dim>(straight))) return restrict_to<Dim>(on->point);
     return project(straight);
   };
   return BoundaryGeometry<Dim>::project(project, place);
@@ -518,7 +640,11 @@ std::string describe_cad_matches(const std::vector<CadGroupMatch>& matches) {
     if (m.matched()) {
       out << (m.dim == 2 ? "face" : "edge") << (m.entities.size() > 1 ? "s " : " ");
       for (std::size_t k = 0; k < m.entities.size(); ++k) out << (k ? ", " : "") << m.entities[k];
-      out << " (vertices within " << m.max_distance << ")\n";
+      out << " (vertices within " << m.max_distance;
+      if (m.by_file > 0) out << "; " << m.by_file << " of " << m.vertices << " located by the file's entity tags and parameters";
+      if (m.file_mismatches > 0)
+        out << "; " << m.file_mismatches << " whose entity tag and parameters in the file do not fit the model, located by distance";
+      out << ")\n";
     } else if (m.farthest_node >= 0) {
       out << "not on the model (node " << m.farthest_node << " is " << m.max_distance << " from it)\n";
     } else {

@@ -59,6 +59,11 @@ class CadModel {
   /// The closest point of entity (dim, index) to x. Throws InputError for an entity the model
   /// does not have.
   [[nodiscard]] CadPoint closest_point(int dim, int index, const Vec<3>& x) const;
+  /// The closest point of face `index` to x found by a local search from parameters (u0, v0),
+  /// for a point next to known points of the face (much cheaper than closest_point()'s global
+  /// search). Falls back to closest_point() when the search fails or ends outside the face's
+  /// boundary. Edges (dim 1) take closest_point().
+  [[nodiscard]] CadPoint closest_point_near(int dim, int index, const Vec<3>& x, double u0, double v0) const;
   /// The point of entity (dim, index) at parameters (u, v) (v unused on edges).
   [[nodiscard]] Vec<3> point_at(int dim, int index, double u, double v = 0.0) const;
   /// The period of each parameter of entity (dim, index); 0 where not periodic.
@@ -85,6 +90,16 @@ struct CadGroupMatch {
   std::vector<int> entities;   ///< the entities holding its vertices (empty: not matched)
   double max_distance = 0.0;   ///< largest distance of a vertex to its nearest entity
   Index farthest_node = -1;    ///< that vertex (mesh index)
+  Index vertices = 0;          ///< vertices of the group's facets
+  /// Of them, those the mesh file places inside an entity of the model (Gmsh's entity tag and
+  /// parameters, Mesh::node_params) within the tolerance: located without a search.
+  Index by_file = 0;
+  /// Those the file places inside an entity of the group's dimension that the model does not
+  /// have there (another numbering, or another model): located by distance instead.
+  Index file_mismatches = 0;
+  /// The vertices located by the file, with their place on the model (cad_boundary() starts
+  /// from them).
+  std::vector<std::pair<Vec<3>, CadPoint>> located;
   [[nodiscard]] bool matched() const noexcept { return !entities.empty(); }
 };
 
@@ -92,7 +107,11 @@ struct CadGroupMatch {
 [[nodiscard]] double default_cad_tolerance(const CadModel& model);
 
 /// Matches every facet group of `mesh` (or only `groups` when given) to the CAD entities its
-/// vertices lie on within `tolerance` (≤ 0: default_cad_tolerance()). A group with a vertex
+/// vertices lie on within `tolerance` (≤ 0: default_cad_tolerance()). A vertex the mesh file
+/// puts inside an entity (Gmsh's `$ParametricNodes` or parametric node blocks: the entity's tag
+/// and the node's parameters) is on that entity of the model when the model's point at those
+/// parameters is within the tolerance (Gmsh numbers a STEP file's entities as OpenCASCADE
+/// explores them, as CadModel does); any other vertex is located by distance. A group with a vertex
 /// farther than the tolerance from every entity is not matched (its farthest vertex and
 /// distance say why); a group named in `groups` that does not match throws InputError naming
 /// the vertex (index and file id), its position and its distance.
