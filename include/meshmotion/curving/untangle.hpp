@@ -117,11 +117,12 @@ class PatchOptimizer {
   }
 
   // Optimizes the nodes of the `seeds` cells and of `layers` rings around them towards every
-  // cell at or above `target`, stopping once evaluations() reaches `max_evaluations`, then
-  // certifies the touched cells again into `quality`; a result with more invalid cells or a
-  // lower certified minimum is undone.
+  // cell at or above `target`, stopping once evaluations() reaches `max_evaluations` (and,
+  // with `raise`, after a sweep that did not lift the seeds' lowest value), then certifies the
+  // touched cells again into `quality`; a result with more invalid cells or a lower certified
+  // minimum is undone.
   Pass run(const std::vector<Index>& seeds, double target, int layers, int max_sweeps, long long max_evaluations,
-           std::vector<double>& quality) {
+           bool raise, std::vector<double>& quality) {
     Pass pass;
     std::vector<char> in_patch(where_.size(), 0);
     std::vector<Index> frontier = seeds, patch = seeds;
@@ -171,6 +172,12 @@ class PatchOptimizer {
     std::vector<Vec<Dim>> original;
     for (const Index v : free_nodes) original.emplace_back(mesh_.points.col(v));
     double total = patch_deficit();
+    const auto lowest_seed = [&] {
+      double low = std::numeric_limits<double>::infinity();
+      for (const Index c : seeds) low = std::min(low, bound(c));
+      return low;
+    };
+    double lowest = raise ? lowest_seed() : 0.0;
     for (int sweep = 0; sweep < max_sweeps && evaluations_ < max_evaluations; ++sweep) {
       ++pass.sweeps;
       for (const Index v : free_nodes) {
@@ -200,7 +207,12 @@ class PatchOptimizer {
         }
       }
       const double now = patch_deficit();
-      const bool progress = now < total * (1.0 - 1e-3);
+      bool progress = now < total * (1.0 - 1e-3);
+      if (raise) {
+        const double low = lowest_seed();
+        progress = progress && low > lowest;
+        lowest = low;
+      }
       total = now;
       if (!progress || now == 0.0) break;
     }
@@ -307,7 +319,7 @@ UntangleReport untangle(Mesh<Dim>& mesh, std::span<const char> fixed, std::vecto
   };
   if (!below.empty()) {
     const auto pass = optimizer.run(below, options.threshold, options.layers, options.max_sweeps,
-                                    std::numeric_limits<long long>::max(), quality);
+                                    std::numeric_limits<long long>::max(), false, quality);
     add(pass);
     report.reverted = pass.reverted;
   }
@@ -327,7 +339,7 @@ UntangleReport untangle(Mesh<Dim>& mesh, std::span<const char> fixed, std::vecto
     const double target = low + options.raise_margin;
     std::vector<Index> seeds;
     for (std::size_t k = 0; k < count && quality[static_cast<std::size_t>(order[k])] < target; ++k) seeds.push_back(order[k]);
-    add(optimizer.run(seeds, target, options.raise_layers, options.max_sweeps, budget, quality));
+    add(optimizer.run(seeds, target, options.raise_layers, options.max_sweeps, budget, true, quality));
     if (!(minimum() > low + 1e-4)) break;
     ++report.raise_rounds;
   }
