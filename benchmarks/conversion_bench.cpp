@@ -1,4 +1,5 @@
-// conversion_bench: P1 → P2 conversion speed (issue 22). The 30P30N RANS mesh's quadrilaterals
+// conversion_bench: P1 → P2 conversion speed (issue 22), and P1 → P3/P4 (convert_to_order, any
+// shape of the catalogue; rows named -p3/-p4). The 30P30N RANS mesh's quadrilaterals
 // (../shared/data; skipped when absent) and structured boxes of tetrahedra and hexahedra up to
 // 5M cells, to show the time per cell staying flat. For each mesh: the first conversion in the
 // process (memory fresh from the kernel, as in a program run once) and the median of repeated
@@ -13,6 +14,7 @@
 
 #include "bench_memory.hpp"
 #include "meshmotion/core/generators.hpp"
+#include "meshmotion/curving/order_conversion.hpp"
 #include "meshmotion/curving/p2_conversion.hpp"
 #include "meshmotion/io.hpp"
 
@@ -54,32 +56,34 @@ double fresh_memory_rate(std::size_t megabytes, bool huge) {
 #endif
 }
 
+// The first conversion of `mesh` to `order` in the process and the median of `repeats` more
+// (order 2: convert_to_quadratic; 3 and 4: convert_to_order).
 template <int Dim>
-void run_case(const std::string& name, const Mesh<Dim>& mesh, int repeats, std::vector<std::string>& json) {
+void run_case(const std::string& name, const Mesh<Dim>& mesh, int repeats, std::vector<std::string>& json, int order = 2) {
+  const auto convert = [&] {
+    return order == 2 ? convert_to_quadratic(mesh).mesh.num_nodes() : convert_to_order(mesh, order).mesh.num_nodes();
+  };
   auto t = Clock::now();
-  Index p2_nodes = 0;
-  {
-    const auto first = convert_to_quadratic(mesh);
-    p2_nodes = first.mesh.num_nodes();
-  }
+  const Index nodes = convert();
   const double first_s = seconds_since(t);
   std::vector<double> times;
   for (int r = 0; r < repeats; ++r) {
     t = Clock::now();
-    const auto again = convert_to_quadratic(mesh);
+    (void)convert();
     times.push_back(seconds_since(t));
   }
   std::sort(times.begin(), times.end());
   const double median_s = times[times.size() / 2];
   const double cells = static_cast<double>(mesh.num_cells());
-  std::printf("%-22s %10lld %10lld %10.2f %10.2f %12.1f\n", name.c_str(), static_cast<long long>(mesh.num_cells()),
-              static_cast<long long>(p2_nodes), 1e3 * first_s, 1e3 * median_s, 1e9 * median_s / cells);
+  const std::string label = order == 2 ? name : name + "-p" + std::to_string(order);
+  std::printf("%-22s %10lld %10lld %10.2f %10.2f %12.1f\n", label.c_str(), static_cast<long long>(mesh.num_cells()),
+              static_cast<long long>(nodes), 1e3 * first_s, 1e3 * median_s, 1e9 * median_s / cells);
   char line[512];
   std::snprintf(line, sizeof line,
-                "{\"bench\":\"conversion\",\"case\":\"%s\",\"cells\":%lld,\"p2_nodes\":%lld,\"first_s\":%.5f,\"median_s\":%.5f,"
-                "\"ns_per_cell\":%.1f}",
-                name.c_str(), static_cast<long long>(mesh.num_cells()), static_cast<long long>(p2_nodes), first_s, median_s,
-                1e9 * median_s / cells);
+                "{\"bench\":\"conversion\",\"case\":\"%s\",\"order\":%d,\"cells\":%lld,\"%s\":%lld,\"first_s\":%.5f,"
+                "\"median_s\":%.5f,\"ns_per_cell\":%.1f}",
+                label.c_str(), order, static_cast<long long>(mesh.num_cells()), order == 2 ? "p2_nodes" : "nodes",
+                static_cast<long long>(nodes), first_s, median_s, 1e9 * median_s / cells);
   json.emplace_back(line);
 }
 
@@ -115,10 +119,11 @@ int main(int argc, char** argv) {
                 huge, small_pages, huge_pages);
   json.emplace_back(line);
 
-  std::printf("%-22s %10s %10s %10s %10s %12s\n", "case", "cells", "P2 nodes", "first ms", "median ms", "ns/cell");
+  std::printf("%-22s %10s %10s %10s %10s %12s\n", "case", "cells", "nodes", "first ms", "median ms", "ns/cell");
   if (std::filesystem::exists(file)) {
     const Mesh<2> airfoil = read_mesh_as<2>(file);
     run_case("30p30n-quads", airfoil, 11, json);
+    for (const int order : {3, 4}) run_case("30p30n-quads", airfoil, 5, json, order);
   } else {
     std::printf("conversion_bench: %s not found, 30P30N case skipped\n", file.string().c_str());
   }
@@ -127,6 +132,11 @@ int main(int argc, char** argv) {
   const std::vector<Index> hex_sides = quick ? std::vector<Index>{40, 80} : std::vector<Index>{40, 100, 175};
   for (const Index n : hex_sides) run_case("box-hex8-" + std::to_string(n), box(n, BoxCells::hex8), quick ? 3 : 5, json);
   run_case("box-mixed-" + std::to_string(quick ? 30 : 90), box(quick ? 30 : 90, BoxCells::tet_pyramid_prism), 3, json);
+  // Past P2: tetrahedra to P3 and P4, hexahedra and the mix to P3 (the catalogue's highest).
+  const Index tets = quick ? 20 : 48, hexes = quick ? 40 : 100, mixed = quick ? 20 : 40;
+  for (const int order : {3, 4}) run_case("box-tet4-" + std::to_string(tets), box(tets, BoxCells::tet4), 3, json, order);
+  run_case("box-hex8-" + std::to_string(hexes), box(hexes, BoxCells::hex8), 3, json, 3);
+  run_case("box-mixed-" + std::to_string(mixed), box(mixed, BoxCells::tet_pyramid_prism), 3, json, 3);
   for (const auto& j : json) std::printf("%s\n", j.c_str());
   return 0;
 }

@@ -42,26 +42,27 @@ struct OrderConversion {
 
 namespace detail {
 
-// A node's place between the linear vertices: up to 8 (vertex, weight) pairs, sorted by
-// vertex, the weights scaled to integers. The scale is divisible by every denominator of the
-// catalogue's lattices (powers of 2, 3 and 5 up to order 4), so equal places give equal keys.
+// A shared node's place between the linear vertices: the vertices of the edge or face it lies
+// on (at most 4; the nodes inside a cell are its own and have no key) and their weights,
+// sorted by vertex, the weights scaled to integers. The scale is divisible by every
+// denominator of the catalogue's lattices (powers of 2, 3 and 5 up to order 4), so equal
+// places give equal keys, and below 2^31. Keys are kept small: the table holds one per edge
+// and face node, and filling fresh memory for larger ones dominated the conversion past P2.
 struct LatticeKey {
-  std::array<std::pair<Index, std::int64_t>, 8> terms{};
+  std::array<Index, 4> vertices{};
+  std::array<std::int32_t, 4> weights{};
   int size = 0;
   friend bool operator==(const LatticeKey& a, const LatticeKey& b) {
-    if (a.size != b.size) return false;
-    for (std::size_t k = 0; k < static_cast<std::size_t>(a.size); ++k)
-      if (a.terms[k] != b.terms[k]) return false;
-    return true;
+    return a.size == b.size && a.vertices == b.vertices && a.weights == b.weights;
   }
 };
 
 struct LatticeKeyHash {
   std::size_t operator()(const LatticeKey& k) const noexcept {
     std::uint64_t h = 0x9e3779b97f4a7c15ULL;
-    for (int i = 0; i < k.size; ++i) {
-      h ^= static_cast<std::uint64_t>(k.terms[static_cast<std::size_t>(i)].first) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
-      h ^= static_cast<std::uint64_t>(k.terms[static_cast<std::size_t>(i)].second) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
+    for (std::size_t i = 0; i < static_cast<std::size_t>(k.size); ++i) {
+      h ^= static_cast<std::uint64_t>(k.vertices[i]) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
+      h ^= static_cast<std::uint64_t>(k.weights[i]) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
     }
     return static_cast<std::size_t>(h);
   }
@@ -69,15 +70,20 @@ struct LatticeKeyHash {
 
 inline constexpr double lattice_key_scale = 4096.0 * 729.0 * 25.0;
 
-// The key of a node from its local vertex weights and the element's nodes, sorted by
-// inserting each term in place (at most 8).
+// The key of a node on an edge or face from its local vertex weights and the element's
+// nodes, sorted by inserting each term in place.
 inline LatticeKey lattice_key(const std::vector<std::pair<int, double>>& weights, std::span<const Index> element) {
   LatticeKey key;
   for (const auto& [v, w] : weights) {
-    const std::pair<Index, std::int64_t> term{element[static_cast<std::size_t>(v)], std::llround(w * lattice_key_scale)};
+    const Index vertex = element[static_cast<std::size_t>(v)];
+    const auto scaled = static_cast<std::int32_t>(std::lround(w * lattice_key_scale));
     std::size_t at = static_cast<std::size_t>(key.size);
-    for (; at > 0 && term < key.terms[at - 1]; --at) key.terms[at] = key.terms[at - 1];
-    key.terms[at] = term;
+    for (; at > 0 && std::pair(vertex, scaled) < std::pair(key.vertices[at - 1], key.weights[at - 1]); --at) {
+      key.vertices[at] = key.vertices[at - 1];
+      key.weights[at] = key.weights[at - 1];
+    }
+    key.vertices[at] = vertex;
+    key.weights[at] = scaled;
     ++key.size;
   }
   return key;
@@ -104,6 +110,22 @@ inline OrderTable make_order_table(ElementType source, ElementType target) {
     shape_functions(source, x, values);
   }
   return table;
+}
+
+// A new node's parameters: the weighted mean of its vertices' when they all lie on the same
+// CAD entity, otherwise unknown (inside the volume, entity dimension Dim).
+template <int Dim>
+NodeParametrization weighted_parameters(const std::vector<NodeParametrization>& params,
+                                               const std::vector<std::pair<int, double>>& weights, std::span<const Index> element) {
+  const NodeParametrization& first = params[static_cast<std::size_t>(element[static_cast<std::size_t>(weights.front().first)])];
+  double u = 0.0, v = 0.0;
+  for (const auto& [local, w] : weights) {
+    const NodeParametrization& p = params[static_cast<std::size_t>(element[static_cast<std::size_t>(local)])];
+    if (p.entity_dim != first.entity_dim || p.entity_tag != first.entity_tag) return {Dim, 0, 0.0, 0.0};
+    u += w * p.u;
+    v += w * p.v;
+  }
+  return {first.entity_dim, first.entity_tag, u, v};
 }
 
 }  // namespace detail
@@ -149,9 +171,20 @@ template <int Dim>
 
   Mesh<Dim>& mesh = out.mesh;
   mesh.groups = input.groups;
-  std::vector<Vec<Dim>> added;                   // positions of new nodes
-  std::vector<detail::LatticeKey> added_key;     // their keys (for node parameters)
+  const bool with_params = !input.node_params.empty();
+  std::vector<Vec<Dim>> added;                       // positions of new nodes
+  std::vector<NodeParametrization> added_params;     // and their parameters (when the input has them)
   std::unordered_map<detail::LatticeKey, Index, detail::LatticeKeyHash> node_of;
+  // Room for every new node (the cells' nodes past their vertices bound them, edge and face
+  // nodes counted once per cell): growing these copies them into fresh memory, which costs
+  // more than the lookups.
+  std::size_t bound = 0;
+  for (const auto& b : input.cells)
+    bound += static_cast<std::size_t>(b.size()) *
+             static_cast<std::size_t>(num_nodes(element_type(shape(b.type), target_order)) - num_vertices(b.type));
+  added.reserve(bound);
+  if (with_params) added_params.reserve(bound);
+  node_of.reserve(bound / 2);
   std::array<std::unique_ptr<detail::OrderTable>, num_element_types> tables{};
   for (const auto* list : {&input.cells, &input.facets, &input.lower}) {
     std::vector<ElementBlock>& out_list = list == &input.cells ? mesh.cells : list == &input.facets ? mesh.facets : mesh.lower;
@@ -161,6 +194,7 @@ template <int Dim>
       auto& table = tables[static_cast<std::size_t>(t)];
       if (!table) table = std::make_unique<detail::OrderTable>(detail::make_order_table(t, target));
       const int n = num_nodes(target), nv = num_vertices(t);
+      const bool own_interior = list == &input.cells;
       ElementBlock q{target, {}, b.tags, b.ids};
       q.connectivity.reserve(static_cast<std::size_t>(b.size() * n));
       for (Index e = 0; e < b.size(); ++e) {
@@ -170,15 +204,22 @@ template <int Dim>
             q.connectivity.push_back(new_index[static_cast<std::size_t>(el[static_cast<std::size_t>(i)])]);
             continue;
           }
-          const detail::LatticeKey key = detail::lattice_key(table->weights[static_cast<std::size_t>(i)], el);
-          const auto [it, inserted] = node_of.try_emplace(key, out.num_kept_nodes + static_cast<Index>(added.size()));
-          if (inserted) {
+          const auto& weights = table->weights[static_cast<std::size_t>(i)];
+          const auto add = [&] {
             Vec<Dim> x = Vec<Dim>::Zero();
             const auto& values = table->source_values[static_cast<std::size_t>(i)];
             for (std::size_t k = 0; k < values.size(); ++k) x += values[k] * input.points.col(el[k]);
             added.push_back(x);
-            added_key.push_back(key);
+            if (with_params) added_params.push_back(detail::weighted_parameters<Dim>(input.node_params, weights, el));
+          };
+          // A node inside a cell (weights on all its vertices) is that cell's alone.
+          if (own_interior && static_cast<int>(weights.size()) == nv) {
+            q.connectivity.push_back(out.num_kept_nodes + static_cast<Index>(added.size()));
+            add();
+            continue;
           }
+          const auto [it, inserted] = node_of.try_emplace(detail::lattice_key(weights, el), out.num_kept_nodes + static_cast<Index>(added.size()));
+          if (inserted) add();
           q.connectivity.push_back(it->second);
         }
       }
@@ -195,24 +236,9 @@ template <int Dim>
     std::int64_t next = *std::max_element(input.node_ids.begin(), input.node_ids.end()) + 1;
     for (std::size_t i = 0; i < added.size(); ++i) mesh.node_ids.push_back(next++);
   }
-  if (!input.node_params.empty()) {
+  if (with_params) {
     for (const Index v : out.kept) mesh.node_params.push_back(input.node_params[static_cast<std::size_t>(v)]);
-    for (const auto& key : added_key) {
-      const NodeParametrization& first = input.node_params[static_cast<std::size_t>(key.terms[0].first)];
-      NodeParametrization param{Dim, 0, 0.0, 0.0};
-      bool same = true;
-      double u = 0.0, v = 0.0;
-      for (int k = 0; k < key.size; ++k) {
-        const auto& [vertex, scaled] = key.terms[static_cast<std::size_t>(k)];
-        const NodeParametrization& p = input.node_params[static_cast<std::size_t>(vertex)];
-        same = same && p.entity_dim == first.entity_dim && p.entity_tag == first.entity_tag;
-        const double w = static_cast<double>(scaled) / detail::lattice_key_scale;
-        u += w * p.u;
-        v += w * p.v;
-      }
-      if (same) param = {first.entity_dim, first.entity_tag, u, v};
-      mesh.node_params.push_back(param);
-    }
+    mesh.node_params.insert(mesh.node_params.end(), added_params.begin(), added_params.end());
   }
   return out;
 }
