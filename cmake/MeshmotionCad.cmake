@@ -34,9 +34,11 @@ add_library(meshmotion_cad STATIC ${_exclude} src/cad/cad_model.cpp)
 add_library(meshmotion::cad ALIAS meshmotion_cad)
 set_target_properties(meshmotion_cad PROPERTIES EXPORT_NAME cad POSITION_INDEPENDENT_CODE ON)
 target_include_directories(meshmotion_cad SYSTEM PRIVATE ${OpenCASCADE_INCLUDE_DIR})
-target_link_libraries(meshmotion_cad PUBLIC ${MESHMOTION_LINK_TARGET} PRIVATE ${MESHMOTION_OCCT_LIBRARIES})
+# The header-only core, not meshmotion::compiled: linking the component must not build the
+# whole compiled library (a consumer links meshmotion::compiled beside it for fast builds).
+target_link_libraries(meshmotion_cad PUBLIC meshmotion::meshmotion PRIVATE ${MESHMOTION_OCCT_LIBRARIES})
 target_compile_definitions(meshmotion_cad PUBLIC MESHMOTION_HAVE_CAD)
 if(TARGET meshmotion_warnings)
-  target_link_libraries(meshmotion_cad PRIVATE meshmotion_warnings)
+  target_link_libraries(meshmotion_cad PRIVATE $<BUILD_INTERFACE:meshmotion_warnings>)
 endif()
 message(STATUS "meshmotion: CAD component on OpenCASCADE ${OpenCASCADE_VERSION}: STEP, IGES and BREP geometry for curving")

@@ -40,10 +40,12 @@ add_test(NAME "cmake: consumer through find_package"
 add_test(NAME "cmake: consumer through add_subdirectory"
   COMMAND ${CMAKE_COMMAND} ${_consumer_args} -DSTEP=add_subdirectory -P "${CMAKE_CURRENT_SOURCE_DIR}/consumer/consumer_test.cmake")
 set_tests_properties("cmake: install into a prefix" PROPERTIES FIXTURES_SETUP meshmotion_installed LABELS cmake)
+# The pass expression alone would ignore a failure after the first program (the CAD consumer).
 set_tests_properties("cmake: consumer through find_package" PROPERTIES
-  FIXTURES_REQUIRED meshmotion_installed LABELS cmake PASS_REGULAR_EXPRESSION "consumer: 20 nodes")
+  FIXTURES_REQUIRED meshmotion_installed LABELS cmake PASS_REGULAR_EXPRESSION "consumer: 20 nodes"
+  FAIL_REGULAR_EXPRESSION "consumer test \\([a-z_]+\\): failed")
 set_tests_properties("cmake: consumer through add_subdirectory" PROPERTIES
-  LABELS cmake PASS_REGULAR_EXPRESSION "consumer: 20 nodes")
+  LABELS cmake PASS_REGULAR_EXPRESSION "consumer: 20 nodes" FAIL_REGULAR_EXPRESSION "consumer test \\([a-z_]+\\): failed")
 set_tests_properties("cmake: every public header compiles alone" PROPERTIES LABELS cmake)
 
 # The exact predicates and certified bounds need IEEE arithmetic: -ffast-math is an #error.
