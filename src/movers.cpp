@@ -2,7 +2,7 @@
 // MESHMOTION_INSTANTIATE_DIM (CMake compiles this file once for 2 and once for 3): the
 // definitions behind the extern template declarations consumers see.
 
-#include "meshmotion/movers/any_mover.hpp"
+#include "meshmotion/movers/mover_options.hpp"
 #include "meshmotion/movers/elasticity.hpp"
 #include "meshmotion/movers/rbf.hpp"
 

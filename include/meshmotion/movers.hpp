@@ -2,10 +2,14 @@
 /// \file
 /// The movers layer: the mover contract, boundary specification, rigid motions, the step
 /// driver and the movers themselves (interpolation: RBF, DGM, DGRBF, DGRBF2, improved DGM;
-/// mechanics: lineal and torsional springs, linear, stiffened and neo-Hookean elasticity).
+/// mechanics: lineal and torsional springs, linear, stiffened and neo-Hookean elasticity;
+/// wall-distance blending; the boundary alone) and their registry by method name.
 
 #include "meshmotion/movers/any_mover.hpp"
+#include "meshmotion/movers/blend.hpp"
 #include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/boundary_layer.hpp"
+#include "meshmotion/movers/boundary_only.hpp"
 #include "meshmotion/movers/delaunay_graph_options.hpp"
 #include "meshmotion/movers/dgm.hpp"
 #include "meshmotion/movers/dgrbf.hpp"

@@ -3,7 +3,7 @@
 
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/core/mesh_like.hpp"
-#include "meshmotion/movers/any_mover.hpp"
+#include "meshmotion/movers/mover_options.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/rbf.hpp"
 #include "meshmotion/movers/step_driver.hpp"

@@ -143,6 +143,35 @@ inline void parse_option_value(std::string_view key, std::string_view text, std:
   out = std::move(values);
 }
 
+/// Text as it is, less surrounding white space.
+inline void parse_option_value(std::string_view, std::string_view text, std::string& out) { out = std::string(detail::trim(text)); }
+
+/// Comma-separated names (empty text: an empty list); an empty name is refused.
+inline void parse_option_value(std::string_view key, std::string_view text, std::vector<std::string>& out) {
+  std::vector<std::string> names;
+  const std::string_view t = detail::trim(text);
+  std::size_t at = 0;
+  while (!t.empty() && at <= t.size()) {
+    const std::size_t comma = std::min(t.find(',', at), t.size());
+    const std::string_view item = detail::trim(t.substr(at, comma - at));
+    if (item.empty()) detail::bad_option_value(key, text, "comma-separated names");
+    names.emplace_back(item);
+    at = comma + 1;
+  }
+  out = std::move(names);
+}
+
+/// Comma-separated integers (empty text: an empty list).
+template <std::integral T>
+  requires(!std::same_as<T, bool>)
+void parse_option_value(std::string_view key, std::string_view text, std::vector<T>& out) {
+  std::vector<T> values;
+  std::vector<std::string> items;
+  parse_option_value(key, text, items);
+  for (const std::string& item : items) parse_option_value(key, item, values.emplace_back());
+  out = std::move(values);
+}
+
 /// Exactly N comma-separated finite numbers.
 template <int N>
 void parse_option_value(std::string_view key, std::string_view text, Vec<N>& out) {
@@ -202,6 +231,25 @@ template <std::integral T>
   }
   return out;
 }
+[[nodiscard]] inline std::string format_option_value(const std::string& s) { return s; }
+[[nodiscard]] inline std::string format_option_value(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) {
+    if (!out.empty()) out += ',';
+    out += n;
+  }
+  return out;
+}
+template <std::integral T>
+  requires(!std::same_as<T, bool>)
+[[nodiscard]] std::string format_option_value(const std::vector<T>& v) {
+  std::string out;
+  for (const T x : v) {
+    if (!out.empty()) out += ',';
+    out += std::to_string(x);
+  }
+  return out;
+}
 template <int N>
 [[nodiscard]] std::string format_option_value(const Vec<N>& v) {
   return format_option_value(std::vector<double>(v.data(), v.data() + N));
@@ -214,6 +262,59 @@ template <class E>
   requires std::is_enum_v<E> && requires(E e) { option_choices(e); }
 [[nodiscard]] std::string format_option_value(E e) {
   return std::string(name(e));
+}
+
+/// What text a field takes, for listings and the docs' tables.
+[[nodiscard]] inline std::string option_type_name(const double&) { return "number"; }
+[[nodiscard]] inline std::string option_type_name(const bool&) { return "bool"; }
+[[nodiscard]] inline std::string option_type_name(const std::string&) { return "text"; }
+[[nodiscard]] inline std::string option_type_name(const std::vector<double>&) { return "numbers"; }
+[[nodiscard]] inline std::string option_type_name(const std::vector<std::string>&) { return "names"; }
+template <std::integral T>
+  requires(!std::same_as<T, bool>)
+[[nodiscard]] std::string option_type_name(const T&) {
+  return std::is_signed_v<T> ? "integer" : "integer >= 0";
+}
+template <std::integral T>
+  requires(!std::same_as<T, bool>)
+[[nodiscard]] std::string option_type_name(const std::vector<T>&) {
+  return "integers";
+}
+template <int N>
+[[nodiscard]] std::string option_type_name(const Vec<N>&) {
+  return std::to_string(N) + " numbers";
+}
+template <int N>
+[[nodiscard]] std::string option_type_name(const std::optional<Vec<N>>&) {
+  return std::to_string(N) + " numbers or none";
+}
+template <class E>
+  requires std::is_enum_v<E> && requires(E e) { option_choices(e); }
+[[nodiscard]] std::string option_type_name(const E&) {
+  std::string out;
+  for (const E e : option_choices(E{})) {
+    if (!out.empty()) out += '|';
+    out += name(e);
+  }
+  return out;
+}
+
+/// One option as the listings and the docs show it.
+struct OptionDoc {
+  std::string key;
+  std::string type;   ///< option_type_name()
+  std::string value;  ///< its value (the default, for a default-made struct) as text
+  std::string doc;    ///< one line
+};
+
+/// Every key of an options struct with a visit_options description, in its order.
+template <class Options>
+[[nodiscard]] std::vector<OptionDoc> option_docs(Options o) {
+  std::vector<OptionDoc> out;
+  visit_options(o, [&](const std::string& key, auto& field, std::string_view doc) {
+    out.push_back({key, option_type_name(field), format_option_value(field), std::string(doc)});
+  });
+  return out;
 }
 
 /// Splits "key=value key2=value2" (whitespace- or newline-separated; '#' starts a comment to

@@ -20,6 +20,10 @@ using Index = std::ptrdiff_t;
 /// Coordinates of nodes, one column per node: dim × n_nodes.
 template <int Dim>
 using Points = Eigen::Matrix<double, Dim, Eigen::Dynamic>;
+/// A read-only view of a caller's Dim × n array (a Points, an Eigen::Map over a solver's or
+/// numpy's memory, a block of columns): movers take their displacements this way, without a copy.
+template <int Dim>
+using PointsView = Eigen::Ref<const Points<Dim>>;
 
 /// One point or vector in Dim dimensions.
 template <int Dim>

@@ -1,30 +1,15 @@
 #pragma once
 /// \file
-/// AnyMover<Dim> and make_mover(): movers chosen by name at run time (the `--method` of the
-/// example programs) from their typed options (movers/mover_options.hpp). A new mover joins
-/// with an entry in mover_methods(), its options in MoverOptions and a line in make_mover().
+/// AnyMover<Dim>: any MeshMover behind one type, for movers chosen at run time (make_mover()
+/// in movers/mover_options.hpp builds the registered ones by method name).
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/movers/detail/mover_support.hpp"
-#include "meshmotion/movers/dgm.hpp"
-#include "meshmotion/movers/dgrbf.hpp"
-#include "meshmotion/movers/dgrbf2.hpp"
-#include "meshmotion/movers/elasticity.hpp"
-#include "meshmotion/movers/improved_dgm.hpp"
 #include "meshmotion/movers/mover.hpp"
-#include "meshmotion/movers/mover_options.hpp"
-#include "meshmotion/movers/nonlinear_elasticity.hpp"
-#include "meshmotion/movers/rbf.hpp"
-#include "meshmotion/movers/rbf_kernels.hpp"
-#include "meshmotion/movers/spring.hpp"
-#include "meshmotion/movers/torsion_spring.hpp"
 
 #include <concepts>
 #include <memory>
-#include <string>
-#include <string_view>
-#include <variant>
 
 namespace meshmotion {
 
@@ -46,16 +31,16 @@ class AnyMover {
   void setup(const M& mesh, const ResolvedBoundary<Dim>& boundary) {
     self_->setup(to_mesh(mesh), boundary);
   }
-  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
+  [[nodiscard]] Points<Dim> move(PointsView<Dim> d) {
     Points<Dim> out;
     self_->move_into(d, out);
     return out;
   }
-  void move_into(const Points<Dim>& d, Points<Dim>& out) { self_->move_into(d, out); }
+  void move_into(PointsView<Dim> d, Points<Dim>& out) { self_->move_into(d, out); }
   /// Into the caller's own storage (an Eigen::Map over a solver's array of Dim × n_nodes
   /// doubles): the RBF mover writes there directly, the others through a buffer of their own
   /// (no allocation after the first move). Throws InputError when its shape is not Dim × n_nodes.
-  void move_into(const Points<Dim>& d, Eigen::Ref<Points<Dim>> out) { self_->move_into_storage(d, out); }
+  void move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) { self_->move_into_storage(d, out); }
   [[nodiscard]] MoverStats stats() const { return self_->stats(); }
 
   /// True when the mover offers derivative_forward and derivative_reverse (the movers linear
@@ -65,32 +50,32 @@ class AnyMover {
   /// displacements (RBF, springs, torsion springs, linear and stiffened elasticity, DGM,
   /// improved DGM, DGRBF).
   /// Throws InputError when the mover has no derivatives.
-  [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w) { return self_->derivative_forward(w); }
+  [[nodiscard]] Points<Dim> derivative_forward(PointsView<Dim> w) { return self_->derivative_forward(w); }
   /// Jᵀ v for v (Dim × n_nodes): the gradient of ⟨v, move(d)⟩ with respect to d.
   /// Throws InputError when the mover has no derivatives.
-  [[nodiscard]] Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>> v) { return self_->derivative_reverse(v); }
+  [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) { return self_->derivative_reverse(v); }
 
  private:
   struct Concept {
     virtual ~Concept() = default;
     virtual void setup(const Mesh<Dim>&, const ResolvedBoundary<Dim>&) = 0;
-    virtual void move_into(const Points<Dim>&, Points<Dim>&) = 0;
-    virtual void move_into_storage(const Points<Dim>&, Eigen::Ref<Points<Dim>>) = 0;
+    virtual void move_into(PointsView<Dim>, Points<Dim>&) = 0;
+    virtual void move_into_storage(PointsView<Dim>, Eigen::Ref<Points<Dim>>) = 0;
     [[nodiscard]] virtual MoverStats stats() const = 0;
     [[nodiscard]] virtual bool has_derivatives() const = 0;
-    [[nodiscard]] virtual Points<Dim> derivative_forward(const Points<Dim>&) = 0;
-    [[nodiscard]] virtual Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>>) = 0;
+    [[nodiscard]] virtual Points<Dim> derivative_forward(PointsView<Dim>) = 0;
+    [[nodiscard]] virtual Points<Dim> derivative_reverse(PointsView<Dim>) = 0;
   };
   template <class M>
   struct Model final : Concept {
-    static constexpr bool differentiable = requires(M& m, const Points<Dim>& v, Eigen::Ref<const Points<Dim>> r) {
+    static constexpr bool differentiable = requires(M& m, const Points<Dim>& v, PointsView<Dim> r) {
       { m.derivative_forward(v) } -> std::same_as<Points<Dim>>;
       { m.derivative_reverse(r) } -> std::same_as<Points<Dim>>;
     };
     explicit Model(M m) : mover(std::move(m)) {}
     void setup(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& b) override { mover.setup(mesh, b); }
-    void move_into(const Points<Dim>& d, Points<Dim>& out) override { mover.move_into(d, out); }
-    void move_into_storage(const Points<Dim>& d, Eigen::Ref<Points<Dim>> out) override {
+    void move_into(PointsView<Dim> d, Points<Dim>& out) override { mover.move_into(d, out); }
+    void move_into_storage(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) override {
       if constexpr (requires { mover.move_into(d, out); }) {
         mover.move_into(d, out);
       } else {  // a user's mover with only the Points<Dim> form
@@ -100,11 +85,11 @@ class AnyMover {
     }
     [[nodiscard]] MoverStats stats() const override { return mover.stats(); }
     [[nodiscard]] bool has_derivatives() const override { return differentiable; }
-    [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w) override {
+    [[nodiscard]] Points<Dim> derivative_forward(PointsView<Dim> w) override {
       if constexpr (differentiable) return mover.derivative_forward(w);
       else no_derivatives();
     }
-    [[nodiscard]] Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>> v) override {
+    [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) override {
       if constexpr (differentiable) return mover.derivative_reverse(v);
       else no_derivatives();
     }
@@ -118,38 +103,4 @@ class AnyMover {
   std::shared_ptr<Concept> self_;
 };
 
-/// The mover `config` describes, with its typed options. Throws InputError when the options
-/// are not those of the method (MoverConfig::check) or the method is unknown.
-template <int Dim>
-[[nodiscard]] AnyMover<Dim> make_mover(const MoverConfig<Dim>& config) {
-  config.check();
-  return std::visit(
-      [&]<class O>(const O& o) -> AnyMover<Dim> {
-        if constexpr (std::same_as<O, RbfOptions>) return AnyMover<Dim>(RbfMover<Dim>(o));
-        else if constexpr (std::same_as<O, DgmOptions>) return AnyMover<Dim>(DgmMover<Dim>(o));
-        else if constexpr (std::same_as<O, ImprovedDgmOptions>) return AnyMover<Dim>(ImprovedDgmMover<Dim>(o));
-        else if constexpr (std::same_as<O, DgrbfOptions>) return AnyMover<Dim>(DgrbfMover<Dim>(o));
-        else if constexpr (std::same_as<O, Dgrbf2Options<Dim>>) return AnyMover<Dim>(Dgrbf2Mover<Dim>(o));
-        else if constexpr (std::same_as<O, SpringOptions>) return AnyMover<Dim>(SpringMover<Dim>(o));
-        else if constexpr (std::same_as<O, TorsionSpringOptions>) return AnyMover<Dim>(TorsionSpringMover<Dim>(o));
-        else if constexpr (std::same_as<O, ElasticityOptions>) return AnyMover<Dim>(ElasticityMover<Dim>(o));
-        else return AnyMover<Dim>(NonlinearElasticityMover<Dim>(o));
-      },
-      config.options);
-}
-
-/// The mover `method` with its defaults and `values` set over them (mover_config()).
-template <int Dim>
-[[nodiscard]] AnyMover<Dim> make_mover(std::string_view method, const KeyValues& values = {}) {
-  return make_mover(mover_config<Dim>(method, values));
-}
-
 }  // namespace meshmotion
-
-// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
-#ifdef MESHMOTION_COMPILED
-namespace meshmotion {
-extern template AnyMover<2> make_mover<2>(const MoverConfig<2>&);
-extern template AnyMover<3> make_mover<3>(const MoverConfig<3>&);
-}  // namespace meshmotion
-#endif

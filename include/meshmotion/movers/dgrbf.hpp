@@ -57,15 +57,15 @@ class DgrbfMover : public detail::MoveFromMoveInto<DgrbfMover<Dim>, Dim> {
   /// InputError for a wrong shape or a non-finite value.
   /// move() (inherited) returns the same; move_into writes into `out`, resized only when its
   /// shape differs.
-  void move_into(const Points<Dim>& d, Points<Dim>& out) {
+  void move_into(PointsView<Dim> d, Points<Dim>& out) {
     base_.move_displacements(d, Points<Dim>(Dim, 0), false, out);
   }
 
   /// Forward derivative J w (Dim × n_nodes) for a boundary displacement change w: the mover is
   /// linear, so this is the interpolation of w (no inversion check, not counted as a move).
-  [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w) { return base_.derivative_forward(w, Points<Dim>(Dim, 0)); }
+  [[nodiscard]] Points<Dim> derivative_forward(PointsView<Dim> w) { return base_.derivative_forward(w, Points<Dim>(Dim, 0)); }
   /// Reverse derivative Jᵀ v (Dim × boundary.size()) for v (Dim × n_nodes); sliding entries zero.
-  [[nodiscard]] Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>> v) const { return base_.derivative_reverse(v); }
+  [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) const { return base_.derivative_reverse(v); }
 
  private:
   DgrbfOptions options_;

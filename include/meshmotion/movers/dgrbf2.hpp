@@ -99,7 +99,7 @@ class Dgrbf2Mover : public detail::MoveFromMoveInto<Dgrbf2Mover<Dim>, Dim> {
   /// InputError for a wrong shape or a non-finite value.
   /// move() (inherited) returns the same; move_into writes into `out`, resized only when its
   /// shape differs.
-  void move_into(const Points<Dim>& d, Points<Dim>& out) {
+  void move_into(PointsView<Dim> d, Points<Dim>& out) {
     base_.timed_move(d, [&] {
       choose_centre(d);
       base_.template interpolate<rows>(
@@ -136,7 +136,7 @@ class Dgrbf2Mover : public detail::MoveFromMoveInto<Dgrbf2Mover<Dim>, Dim> {
   }
 
   /// The centre: given, or the centroid of the moving boundary nodes of this move.
-  void choose_centre(const Points<Dim>& d) {
+  void choose_centre(PointsView<Dim> d) {
     if (options_.center) {
       centre_ = *options_.center;
       return;

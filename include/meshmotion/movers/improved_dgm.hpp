@@ -123,7 +123,7 @@ class ImprovedDgmMover : public detail::MoveFromMoveInto<ImprovedDgmMover<Dim>, 
   /// inverts (DgmOptions::check_inversion).
   /// move() (inherited) returns the same; move_into writes into `out`, resized only when its
   /// shape differs.
-  void move_into(const Points<Dim>& d, Points<Dim>& out) {
+  void move_into(PointsView<Dim> d, Points<Dim>& out) {
     detail::timed_move<Dim>("ImprovedDgmMover::move", base_.ready(), d, base_.boundary().nodes, stats_, [&] {
       rbf_.move_into(d, stage_);
       base_.interpolate_displacements(d, Points<Dim>(stage_.rightCols(static_cast<Index>(layer_.size()))),
@@ -136,14 +136,14 @@ class ImprovedDgmMover : public detail::MoveFromMoveInto<ImprovedDgmMover<Dim>, 
   /// Forward derivative J w (Dim × n_nodes) for a boundary displacement change w: both stages
   /// are linear, so this is the RBF stage's change at the layer followed by the graph's
   /// interpolation (no inversion check, not counted as a move). Throws as move().
-  [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w) {
+  [[nodiscard]] Points<Dim> derivative_forward(PointsView<Dim> w) {
     if (!base_.ready()) throw InputError("ImprovedDgmMover::derivative_forward: setup() was not called");
     const Points<Dim> stage = rbf_.derivative_forward(w);
     return base_.derivative_forward(w, Points<Dim>(stage.rightCols(static_cast<Index>(layer_.size()))));
   }
   /// Reverse derivative Jᵀ v (Dim × boundary.size()) for v (Dim × n_nodes): the graph's
   /// transpose, whose layer share goes back through the RBF stage's. Sliding entries zero.
-  [[nodiscard]] Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>> v) {
+  [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) {
     if (!base_.ready()) throw InputError("ImprovedDgmMover::derivative_reverse: setup() was not called");
     const Points<Dim> graph_bar = base_.derivative_reverse(v);
     const Index m = base_.boundary().size(), n_layer = static_cast<Index>(layer_.size());

@@ -26,13 +26,28 @@ struct MoverStats {
   Index nonzeros = 0;          ///< stored nonzeros of the system and evaluation operators
 };
 
+template <class F>
+void visit_fields(const MoverStats& s, F&& f) {
+  f("setup_seconds", s.setup_seconds, "the last setup");
+  f("move_seconds", s.move_seconds, "the last move");
+  f("moves", s.moves, "moves since the last setup");
+  f("factorizations", s.factorizations, "numeric factorizations since the last setup");
+  f("iterations", s.iterations, "solver iterations of the last move (0 for direct solvers)");
+  f("residual", s.residual, "largest relative solver residual of the last move");
+  f("fell_back", s.fell_back, "an iterative solver failed and a direct one answered");
+  f("boundary_nodes", s.boundary_nodes, "constrained nodes after merging coincident ones");
+  f("evaluated_nodes", s.evaluated_nodes, "nodes whose displacement the mover computes");
+  f("nonzeros", s.nonzeros, "stored nonzeros of the system and evaluation operators");
+}
+
 /// A mesh mover in Dim = M::dim dimensions.
 ///
 /// - `setup(mesh, boundary)`: `mesh` any MeshLike (Mesh<Dim> is checked here), `boundary` a
 ///   ResolvedBoundary<Dim>; copies what it needs, so the mesh may change afterwards.
 /// - `move(d)`: d is Dim × boundary.size() (columns in boundary.nodes order; entries of
 ///   sliding nodes are ignored); returns the displacement of every node, Dim × n_nodes,
-///   with boundary nodes at their targets.
+///   with boundary nodes at their targets. The library's movers take d as a PointsView, so a
+///   solver's or numpy's array (an Eigen::Map) is read in place.
 /// - `move_into(d, out)`: the same into caller storage (resized only when its shape differs).
 /// - `stats()`: MoverStats.
 template <class M>

@@ -1,12 +1,17 @@
 #pragma once
 /// \file
-/// The typed options of every mover, by method name, and their one text form.
+/// Every mover by method name: the one table of registered methods, their typed options and
+/// the one text form of those options.
 ///
 /// A mover chosen at run time is a MoverConfig: its method name and its typed options struct
 /// (RbfOptions, ElasticityOptions, ...). Text (command line, config file, Python keywords)
 /// reaches those structs through MoverConfig::set, which knows every key of the method and
 /// refuses any other (naming the known ones), refuses malformed values, and reads numbers
 /// exactly (core/option_text.hpp). MoverConfig::values() writes them back the same way.
+///
+/// Registering a mover is one entry in registered_movers() (its options struct must have a
+/// visit_options description here): its name, options type, summary and defaults then reach
+/// MoverOptions, mover_methods(), make_mover(), the programs' flags and Python.
 ///
 /// \code
 /// MoverConfig<2> c = mover_config<2>("rbf", parse_key_values("support_radius=4.9e-6 kernel=wendland4"));
@@ -16,6 +21,10 @@
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/option_text.hpp"
+#include "meshmotion/movers/any_mover.hpp"
+#include "meshmotion/movers/blend.hpp"
+#include "meshmotion/movers/boundary_layer.hpp"
+#include "meshmotion/movers/boundary_only.hpp"
 #include "meshmotion/movers/delaunay_graph_options.hpp"
 #include "meshmotion/movers/dgm.hpp"
 #include "meshmotion/movers/dgrbf.hpp"
@@ -30,8 +39,12 @@
 #include "meshmotion/solvers/solver_options.hpp"
 
 #include <array>
+#include <cstddef>
 #include <string>
 #include <string_view>
+#include <tuple>
+#include <type_traits>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -139,10 +152,89 @@ void visit_options(NonlinearElasticityOptions& o, F&& f, const std::string& pref
   visit_options(o.solver, f, prefix);
 }
 
-/// The typed options of every registered mover.
+template <class F>
+void visit_options(BoundaryLayerOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "aspect_ratio_threshold", o.aspect_ratio_threshold,
+    "cells at least this anisotropic (longest/shortest edge) form a wall's boundary layer");
+}
+
+template <class F>
+void visit_options(BlendOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "blending_length", o.blending_length, "blending length of every wall (0: blending_factor x each wall's layer)");
+  f(prefix + "blending_factor", o.blending_factor, "default blending length, in layer thicknesses of each wall");
+  f(prefix + "fallback_spacings", o.fallback_spacings, "walls without a layer: blending length in facet sizes at each node");
+  visit_options(o.layer, f, prefix);
+}
+
+template <class F>
+void visit_options(BoundaryOnlyOptions&, F&&, const std::string& = {}) {}
+
+/// One registered method: the mover it builds, its options type, its name, a line saying
+/// what it is, and what its defaults change in the options struct's own (nullptr: nothing).
+template <class Mover, class Options>
+struct RegisteredMover {
+  using mover_type = Mover;
+  using options_type = Options;
+  std::string_view name;
+  std::string_view summary;
+  void (*tune)(Options&) = nullptr;
+};
+
+/// Every method make_mover() builds, in the order programs list them: the one table.
 template <int Dim>
-using MoverOptions = std::variant<RbfOptions, DgmOptions, ImprovedDgmOptions, DgrbfOptions, Dgrbf2Options<Dim>,
-                                  SpringOptions, TorsionSpringOptions, ElasticityOptions, NonlinearElasticityOptions>;
+[[nodiscard]] constexpr auto registered_movers() {
+  return std::tuple{
+      RegisteredMover<RbfMover<Dim>, RbfOptions>{"rbf", "radial basis function interpolation (thesis 2.2.2)"},
+      RegisteredMover<DgmMover<Dim>, DgmOptions>{"dgm", "Delaunay graph mapping (thesis 2.2.1)"},
+      RegisteredMover<ImprovedDgmMover<Dim>, ImprovedDgmOptions>{"idgm", "Delaunay graph mapping with an RBF-moved layer"},
+      RegisteredMover<DgrbfMover<Dim>, DgrbfOptions>{"dgrbf", "Delaunay graph with per-simplex RBF (thesis 2.2.3)"},
+      RegisteredMover<Dgrbf2Mover<Dim>, Dgrbf2Options<Dim>>{"dgrbf2", "DGRBF with rigid rotations exact (thesis 2.2.4)"},
+      RegisteredMover<SpringMover<Dim>, SpringOptions>{"spring", "lineal springs (thesis 2.1.1)"},
+      RegisteredMover<TorsionSpringMover<Dim>, TorsionSpringOptions>{"torsion", "torsion springs (thesis 2.1.2)"},
+      RegisteredMover<ElasticityMover<Dim>, ElasticityOptions>{"le", "linear elasticity (thesis 2.1.3)"},
+      RegisteredMover<ElasticityMover<Dim>, ElasticityOptions>{"sle", "stiffened linear elasticity, chi 2.75 (thesis table 4.2)",
+                                                               [](ElasticityOptions& o) { o.stiffening_exponent = 2.75; }},
+      RegisteredMover<NonlinearElasticityMover<Dim>, NonlinearElasticityOptions>{"nle",
+                                                                                 "neo-Hookean nonlinear elasticity (thesis 2.1.4)"},
+      RegisteredMover<BlendMover<Dim>, BlendOptions>{"blend", "wall-distance blending of the moving walls (no solve)",
+                                                     [](BlendOptions& o) { o.blending_factor = 6.0; }},
+      RegisteredMover<BoundaryOnlyMover<Dim>, BoundaryOnlyOptions>{"none", "the prescribed boundary nodes alone"},
+  };
+}
+
+namespace detail {
+
+template <class Variant, class T>
+struct with_alternative;
+template <class... Ts, class T>
+struct with_alternative<std::variant<Ts...>, T> {
+  using type = std::conditional_t<(std::is_same_v<T, Ts> || ...), std::variant<Ts...>, std::variant<Ts..., T>>;
+};
+
+template <class Variant, class... Entries>
+struct options_variant {
+  using type = Variant;
+};
+template <class Variant, class First, class... Rest>
+struct options_variant<Variant, First, Rest...> {
+  using type = typename options_variant<typename with_alternative<Variant, typename First::options_type>::type, Rest...>::type;
+};
+
+template <class Table>
+struct options_of_table;
+template <class First, class... Rest>
+struct options_of_table<std::tuple<First, Rest...>> {
+  using type = typename options_variant<std::variant<typename First::options_type>, Rest...>::type;
+};
+
+template <int Dim, std::size_t I>
+using registered_entry = std::tuple_element_t<I, decltype(registered_movers<Dim>())>;
+
+}  // namespace detail
+
+/// The typed options of every registered mover (each options type once).
+template <int Dim>
+using MoverOptions = typename detail::options_of_table<decltype(registered_movers<Dim>())>::type;
 
 /// Options a caller such as the curving pipeline sets from what it measured, when the
 /// mover's options have them (the pipeline asks through these instead of naming methods).
@@ -155,35 +247,63 @@ template <class O>
 concept TakesActiveRadius = requires(O o) {
   { o.active_radius } -> std::same_as<double&>;
 };
+/// A blending length, derived from the walls' layers when 0.
+template <class O>
+concept TakesBlendingLength = requires(O o) {
+  { o.blending_length } -> std::same_as<double&>;
+};
+/// How the walls' boundary layers are recognized.
+template <class O>
+concept TakesLayerOptions = requires(O o) {
+  { o.layer } -> std::same_as<BoundaryLayerOptions&>;
+};
 
-/// A registered method: its name, a line saying what it is, its default options.
+/// A registered method at run time (mover_methods()).
 template <int Dim>
 struct MoverMethod {
   std::string_view name;
   std::string_view summary;
   MoverOptions<Dim> (*defaults)();
+  AnyMover<Dim> (*make)(const MoverOptions<Dim>&);
+  /// false: the mover leaves the interior as it is (its options say so: moves_interior).
+  bool moves_interior = true;
 };
 
-/// Every method make_mover() builds, in the order programs list them.
+namespace detail {
+
+template <int Dim, std::size_t I>
+[[nodiscard]] MoverOptions<Dim> registered_defaults() {
+  using Options = typename registered_entry<Dim, I>::options_type;
+  Options o{};
+  if (const auto tune = std::get<I>(registered_movers<Dim>()).tune) tune(o);
+  return o;
+}
+
+template <int Dim, std::size_t I>
+[[nodiscard]] AnyMover<Dim> registered_make(const MoverOptions<Dim>& options) {
+  using Entry = registered_entry<Dim, I>;
+  return AnyMover<Dim>(typename Entry::mover_type(std::get<typename Entry::options_type>(options)));
+}
+
+template <int Dim, std::size_t... I>
+[[nodiscard]] auto method_array(std::index_sequence<I...>) {
+  constexpr auto table = registered_movers<Dim>();
+  return std::array<MoverMethod<Dim>, sizeof...(I)>{MoverMethod<Dim>{
+      std::get<I>(table).name, std::get<I>(table).summary, &registered_defaults<Dim, I>, &registered_make<Dim, I>,
+      [] {
+        using Options = typename registered_entry<Dim, I>::options_type;
+        if constexpr (requires { Options::moves_interior; }) return Options::moves_interior;
+        else return true;
+      }()}...};
+}
+
+}  // namespace detail
+
+/// Every method make_mover() builds, in the order of registered_movers().
 template <int Dim>
-[[nodiscard]] const std::array<MoverMethod<Dim>, 10>& mover_methods() {
-  static const std::array<MoverMethod<Dim>, 10> methods{{
-      {"rbf", "radial basis function interpolation (thesis 2.2.2)", [] { return MoverOptions<Dim>(RbfOptions{}); }},
-      {"dgm", "Delaunay graph mapping (thesis 2.2.1)", [] { return MoverOptions<Dim>(DgmOptions{}); }},
-      {"idgm", "Delaunay graph mapping with an RBF-moved layer", [] { return MoverOptions<Dim>(ImprovedDgmOptions{}); }},
-      {"dgrbf", "Delaunay graph with per-simplex RBF (thesis 2.2.3)", [] { return MoverOptions<Dim>(DgrbfOptions{}); }},
-      {"dgrbf2", "DGRBF with rigid rotations exact (thesis 2.2.4)", [] { return MoverOptions<Dim>(Dgrbf2Options<Dim>{}); }},
-      {"spring", "lineal springs (thesis 2.1.1)", [] { return MoverOptions<Dim>(SpringOptions{}); }},
-      {"torsion", "torsion springs (thesis 2.1.2)", [] { return MoverOptions<Dim>(TorsionSpringOptions{}); }},
-      {"le", "linear elasticity (thesis 2.1.3)", [] { return MoverOptions<Dim>(ElasticityOptions{}); }},
-      {"sle", "stiffened linear elasticity, chi 2.75 (thesis table 4.2)",
-       [] {
-         ElasticityOptions o;
-         o.stiffening_exponent = 2.75;
-         return MoverOptions<Dim>(o);
-       }},
-      {"nle", "neo-Hookean nonlinear elasticity (thesis 2.1.4)", [] { return MoverOptions<Dim>(NonlinearElasticityOptions{}); }},
-  }};
+[[nodiscard]] const auto& mover_methods() {
+  static const auto methods =
+      detail::method_array<Dim>(std::make_index_sequence<std::tuple_size_v<decltype(registered_movers<Dim>())>>{});
   return methods;
 }
 
@@ -226,11 +346,11 @@ struct MoverConfig {
     });
     return out;
   }
-  /// Every key with a line of help and its current value: "key (value): help".
-  [[nodiscard]] std::vector<std::string> describe() const {
-    std::vector<std::string> out;
+  /// Every key with its type, current value and line of help.
+  [[nodiscard]] std::vector<OptionDoc> docs() const {
+    std::vector<OptionDoc> out;
     for_each_field([&](const std::string& key, auto& value, std::string_view help) {
-      out.push_back(key + " (" + format_option_value(value) + "): " + std::string(help));
+      out.push_back({key, option_type_name(value), format_option_value(value), std::string(help)});
     });
     return out;
   }
@@ -278,4 +398,26 @@ template <int Dim>
   return c;
 }
 
+/// The mover `config` describes, with its typed options. Throws InputError when the options
+/// are not those of the method (MoverConfig::check) or the method is unknown.
+template <int Dim>
+[[nodiscard]] AnyMover<Dim> make_mover(const MoverConfig<Dim>& config) {
+  config.check();
+  return mover_method<Dim>(config.method).make(config.options);
+}
+
+/// The mover `method` with its defaults and `values` set over them (mover_config()).
+template <int Dim>
+[[nodiscard]] AnyMover<Dim> make_mover(std::string_view method, const KeyValues& values = {}) {
+  return make_mover(mover_config<Dim>(method, values));
+}
+
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template AnyMover<2> make_mover<2>(const MoverConfig<2>&);
+extern template AnyMover<3> make_mover<3>(const MoverConfig<3>&);
+}  // namespace meshmotion
+#endif

@@ -107,7 +107,7 @@ class NonlinearElasticityMover : public detail::MoveFromMoveInto<NonlinearElasti
   /// or the line search cannot keep the elements valid (try more load_steps).
   /// move() (inherited) returns the same; move_into writes into `out`, resized only when its
   /// shape differs.
-  void move_into(const Points<Dim>& d, Points<Dim>& out) {
+  void move_into(PointsView<Dim> d, Points<Dim>& out) {
     detail::timed_move<Dim>("NonlinearElasticityMover::move", ready_, d, boundary_nodes_, stats_, [&] { newton(d, out); });
   }
 
@@ -118,7 +118,7 @@ class NonlinearElasticityMover : public detail::MoveFromMoveInto<NonlinearElasti
   };
 
   /// The load-stepped Newton solve of move_into (inputs checked).
-  void newton(const Points<Dim>& d, Points<Dim>& out) {
+  void newton(PointsView<Dim> d, Points<Dim>& out) {
     const Index n = mesh_.num_nodes();
     out.setZero(Dim, n);
     Points<Dim> applied = Points<Dim>::Zero(Dim, d.cols());

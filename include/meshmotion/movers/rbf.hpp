@@ -133,22 +133,22 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   /// displacements (naming them); SolverError when an iterative solve fails.
   /// move() (inherited) returns the same; move_into writes into `out`, resized only when its
   /// shape differs.
-  void move_into(const Points<Dim>& d, Points<Dim>& out);
+  void move_into(PointsView<Dim> d, Points<Dim>& out);
   /// move_into() straight into the caller's own Dim × n_nodes storage (an Eigen::Map over a
   /// solver's or numpy's array), with no intermediate copy. Throws InputError when its shape
   /// is not Dim × n_nodes.
-  void move_into(const Points<Dim>& d, Eigen::Ref<Points<Dim>> out);
+  void move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out);
 
   /// Forward derivative J w: the displacement change of every node (Dim × n_nodes) for a
   /// boundary displacement change w (Dim × boundary.size()). The mover is linear in the
   /// displacements, so this is move(w); coincident nodes must agree in w too.
-  [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w);
+  [[nodiscard]] Points<Dim> derivative_forward(PointsView<Dim> w);
 
   /// Reverse derivative Jᵀ v: for v (Dim × n_nodes), the gradient with respect to the
   /// boundary displacements (Dim × boundary.size()) of ⟨v, move(d)⟩. Sliding nodes' entries are
   /// zero (their input is ignored); a merged centre's gradient goes to its first constrained
   /// node. Throws InputError for a wrong shape or a non-finite value.
-  [[nodiscard]] Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>> v);
+  [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v);
 
  private:
   using Operator = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
@@ -222,7 +222,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
 
   /// A move: apply() checked, timed and counted, with the solver's report in stats_.
   template <class Out>
-  void timed_apply(const Points<Dim>& d, Out& out) {
+  void timed_apply(PointsView<Dim> d, Out& out) {
     detail::timed_move<Dim>("RbfMover::move", ready_, d, boundary_nodes_, stats_, [&] {
       apply(d, out);
       const SolverReport& r = with_all([](auto& system) -> const SolverReport& { return system.report(); });
@@ -235,7 +235,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   /// The linear map boundary displacements → node displacements, into a Points<Dim> (resized)
   /// or an Eigen::Ref of the right shape.
   template <class Out>
-  void apply(const Points<Dim>& d, Out& out) {
+  void apply(PointsView<Dim> d, Out& out) {
     const Index k = n_centres_;
     const auto m = static_cast<Index>(boundary_nodes_.size());
     values_.resize(k, Dim);
@@ -307,7 +307,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   /// Transpose of evaluate_interior: ᾱ = Eᵀ v_eval, β̄ = Σ q(x_i) v_iᵀ over interior nodes.
   /// The seed's rows are gathered into a buffer kept across calls (a reverse product per
   /// optimization iteration should not pay fresh pages for a volume-sized array).
-  void interior_transpose(const Eigen::Ref<const Points<Dim>>& v, Eigen::MatrixXd& alpha_bar, Poly& beta_bar) {
+  void interior_transpose(const PointsView<Dim>& v, Eigen::MatrixXd& alpha_bar, Poly& beta_bar) {
     const Index k = n_centres_;
     const auto gather = [&](const std::vector<Index>& nodes) {
       seed_rows_.resize(static_cast<Index>(nodes.size()), Dim);
@@ -523,17 +523,17 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
 }
 
 template <int Dim>
-void RbfMover<Dim>::move_into(const Points<Dim>& d, Points<Dim>& out) {
+void RbfMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& out) {
   timed_apply(d, out);
 }
 
 template <int Dim>
-void RbfMover<Dim>::move_into(const Points<Dim>& d, Eigen::Ref<Points<Dim>> out) {
+void RbfMover<Dim>::move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) {
   timed_apply(d, out);
 }
 
 template <int Dim>
-Points<Dim> RbfMover<Dim>::derivative_forward(const Points<Dim>& w) {
+Points<Dim> RbfMover<Dim>::derivative_forward(PointsView<Dim> w) {
   require_ready("derivative_forward");
   detail::check_displacements<Dim>("RbfMover::derivative_forward", w, boundary_nodes_);
   Points<Dim> out;
@@ -542,7 +542,7 @@ Points<Dim> RbfMover<Dim>::derivative_forward(const Points<Dim>& w) {
 }
 
 template <int Dim>
-Points<Dim> RbfMover<Dim>::derivative_reverse(Eigen::Ref<const Points<Dim>> v) {
+Points<Dim> RbfMover<Dim>::derivative_reverse(PointsView<Dim> v) {
   require_ready("derivative_reverse");
   detail::check_node_field<Dim>("RbfMover::derivative_reverse", v, points_.cols());
   const Index m = static_cast<Index>(boundary_nodes_.size());

@@ -15,6 +15,7 @@
 #include <concepts>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace meshmotion {
@@ -68,6 +69,45 @@ template <MeshMover Mover>
     result.steps.push_back(std::move(info));
   }
   return result;
+}
+
+/// What a move did, as the programs report it (move_mesh --json, its text).
+struct MoveReport {
+  std::string method;
+  int steps = 1;
+  Index nodes = 0;
+  double setup_seconds = 0.0;  ///< summed over the steps
+  double move_seconds = 0.0;   ///< summed over the steps
+  QualityReport before;        ///< of the mesh given
+  QualityReport after;         ///< of the moved mesh
+  std::vector<MoverStats> mover_steps;
+};
+
+template <class F>
+void visit_fields(const MoveReport& r, F&& f) {
+  f("method", r.method, "the mover");
+  f("steps", r.steps, "increments, each a setup on the mesh moved so far");
+  f("nodes", r.nodes, "nodes of the mesh");
+  f("setup_seconds", r.setup_seconds, "the mover's setups, summed over the steps");
+  f("move_seconds", r.move_seconds, "the mover's moves, summed over the steps");
+  f("before", r.before, "quality of the mesh given");
+  f("after", r.after, "quality of the moved mesh");
+  f("mover_steps", r.mover_steps, "the mover's stats per step");
+}
+
+/// The report of `result` (run with StepOptions::report_quality) for `method` from `before`,
+/// the quality of the mesh given in the same metric.
+template <int Dim>
+[[nodiscard]] MoveReport move_report(std::string method, QualityReport before, const StepResult<Dim>& result) {
+  MoveReport r{std::move(method), static_cast<int>(result.steps.size()), result.mesh.num_nodes(), 0.0, 0.0,
+               std::move(before), {}, {}};
+  for (const StepInfo& s : result.steps) {
+    r.setup_seconds += s.stats.setup_seconds;
+    r.move_seconds += s.stats.move_seconds;
+    r.mover_steps.push_back(s.stats);
+  }
+  if (!result.steps.empty() && result.steps.back().quality) r.after = *result.steps.back().quality;
+  return r;
 }
 
 /// run_steps() on a solver's own mesh type (any MeshLike), copied into a Mesh<Dim>; the

@@ -111,8 +111,8 @@ class DistributedElasticityMover {
 
   /// Collective. Displacement (Dim × part.size(), ghosts included) for the displacements `d`
   /// (Dim × boundary.size()) of this rank's boundary entries; owned entries are read.
-  void move_into(const Points<Dim>& d, Points<Dim>& out);
-  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
+  void move_into(PointsView<Dim> d, Points<Dim>& out);
+  [[nodiscard]] Points<Dim> move(PointsView<Dim> d) {
     Points<Dim> out;
     move_into(d, out);
     return out;
@@ -448,7 +448,7 @@ void DistributedElasticityMover<Dim>::setup_mesh(const PartitionView<Dim>& part,
 }
 
 template <int Dim>
-void DistributedElasticityMover<Dim>::move_into(const Points<Dim>& d, Points<Dim>& out) {
+void DistributedElasticityMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& out) {
   using meshmotion::parallel::detail::petsc_check;
   const meshmotion::detail::Stopwatch watch;
   collective(comm_, [&] {

@@ -88,8 +88,8 @@ class DistributedRbfMover {
   /// `d` (Dim × boundary.size()) of this rank's boundary entries; only owned entries are
   /// read. Throws on every rank for a wrong shape or a non-finite value on any rank, and what
   /// RbfMover::move throws.
-  void move_into(const Points<Dim>& d, Points<Dim>& out);
-  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
+  void move_into(PointsView<Dim> d, Points<Dim>& out);
+  [[nodiscard]] Points<Dim> move(PointsView<Dim> d) {
     Points<Dim> out;
     move_into(d, out);
     return out;
@@ -99,7 +99,7 @@ class DistributedRbfMover {
   /// owned nodes with respect to this rank's boundary entries (Dim × boundary.size()): owned
   /// entries carry it, ghost and sliding entries are zero, so the ranks' gradients add up to
   /// the serial one.
-  [[nodiscard]] Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>> v);
+  [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v);
 
  private:
   void require_ready(const char* where) const {
@@ -110,7 +110,7 @@ class DistributedRbfMover {
   [[nodiscard]] std::string petsc_obstacle(const std::vector<int>& kinds, bool radius_per_entry, const Points<Dim>& centres) const;
   void setup_petsc(const PartitionView<Dim>& part, Points<Dim> centres);
   void move_petsc(Points<Dim>& out);
-  [[nodiscard]] Points<Dim> reverse_petsc(const Eigen::Ref<const Points<Dim>>& v);
+  [[nodiscard]] Points<Dim> reverse_petsc(const PointsView<Dim>& v);
 
   MPI_Comm comm_ = MPI_COMM_NULL;
   RbfMover<Dim> inner_;      ///< replicated: over the gathered centres followed by the local interior nodes
@@ -263,7 +263,7 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
 }
 
 template <int Dim>
-void DistributedRbfMover<Dim>::move_into(const Points<Dim>& d, Points<Dim>& out) {
+void DistributedRbfMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& out) {
   const meshmotion::detail::Stopwatch watch;
   collective(comm_, [&] {
     require_ready("move");
@@ -298,7 +298,7 @@ void DistributedRbfMover<Dim>::move_into(const Points<Dim>& d, Points<Dim>& out)
 }
 
 template <int Dim>
-Points<Dim> DistributedRbfMover<Dim>::derivative_reverse(Eigen::Ref<const Points<Dim>> v) {
+Points<Dim> DistributedRbfMover<Dim>::derivative_reverse(PointsView<Dim> v) {
   collective(comm_, [&] {
     require_ready("derivative_reverse");
     meshmotion::detail::check_node_field<Dim>("DistributedRbfMover::derivative_reverse", v, n_local_);
@@ -373,7 +373,7 @@ void DistributedRbfMover<Dim>::move_petsc(Points<Dim>& out) {
 }
 
 template <int Dim>
-Points<Dim> DistributedRbfMover<Dim>::reverse_petsc(const Eigen::Ref<const Points<Dim>>& v) {
+Points<Dim> DistributedRbfMover<Dim>::reverse_petsc(const PointsView<Dim>& v) {
   const Index m = global_boundary_size();
   constexpr int poly = (Dim + 1) * Dim;
   // One buffer summed over the ranks: ᾱ (m × Dim), the boundary nodes' own terms (Dim × m), β̄.

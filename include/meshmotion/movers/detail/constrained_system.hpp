@@ -81,7 +81,7 @@ class ConstrainedSystem {
   /// Displacement of every node (Dim × n_nodes) for Dirichlet values d (Dim × m, boundary
   /// order; sliding columns ignored). The iterative solvers start from the previous solution.
   /// `force` (optional, n_nodes * components × columns) adds a load: K u = force.
-  void solve(const Points<Dim>& d, Points<Dim>& out, const Eigen::MatrixXd* force = nullptr) {
+  void solve(PointsView<Dim> d, Points<Dim>& out, const Eigen::MatrixXd* force = nullptr) {
     const auto m = static_cast<Index>(boundary_nodes_.size());
     const Index c = components_;
     const Index columns = c == 1 ? Dim : 1;
@@ -115,7 +115,7 @@ class ConstrainedSystem {
   /// of ⟨v, solve(d)⟩ with respect to d. With u = S d − P A⁻¹ C d (A = Pᵀ K P symmetric,
   /// C = Pᵀ K S) it is Sᵀ v − Cᵀ A⁻¹ Pᵀ v: one more solve with the same factorization.
   /// Sliding columns are zero (solve() ignores them).
-  void solve_transpose(const Eigen::Ref<const Points<Dim>>& v, Points<Dim>& gradient) {
+  void solve_transpose(const PointsView<Dim>& v, Points<Dim>& gradient) {
     const auto m = static_cast<Index>(boundary_nodes_.size());
     const Index c = components_;
     const Index columns = c == 1 ? Dim : 1;

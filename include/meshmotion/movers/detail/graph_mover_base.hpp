@@ -90,7 +90,7 @@ class GraphMoverBase {
   /// timed_move for the mover using this base: checks `d` (Dim × boundary.size(), finite,
   /// after setup), runs body(), counts and times the move in stats().
   template <class Body>
-  void timed_move(const Points<Dim>& d, Body&& body) {
+  void timed_move(PointsView<Dim> d, Body&& body) {
     detail::timed_move<Dim>(who_ + "::move", ready_, d, boundary_.nodes, stats_, std::forward<Body>(body));
   }
 
@@ -100,19 +100,19 @@ class GraphMoverBase {
   /// node at `position` for its interpolated value (a Rows vector). With `check_inversion`,
   /// throws InvalidMeshError naming an inverted graph simplex. Writes Dim × n into `out`.
   template <int Rows, class Encode, class Decode>
-  void move(const Points<Dim>& d, const Points<Dim>& extra_displacements, Encode&& encode, Decode&& decode,
+  void move(PointsView<Dim> d, const Points<Dim>& extra_displacements, Encode&& encode, Decode&& decode,
             bool check_inversion, Points<Dim>& out) {
     timed_move(d, [&] { interpolate<Rows>(d, extra_displacements, encode, decode, check_inversion, out); });
   }
 
   /// move() interpolating the displacements themselves (DGM, DGRBF).
-  void move_displacements(const Points<Dim>& d, const Points<Dim>& extra_displacements, bool check_inversion,
+  void move_displacements(PointsView<Dim> d, const Points<Dim>& extra_displacements, bool check_inversion,
                           Points<Dim>& out) {
     timed_move(d, [&] { interpolate_displacements(d, extra_displacements, check_inversion, out); });
   }
 
   /// move_displacements() without its checks and timing (the improved DGM times its whole move).
-  void interpolate_displacements(const Points<Dim>& d, const Points<Dim>& extra_displacements, bool check_inversion,
+  void interpolate_displacements(PointsView<Dim> d, const Points<Dim>& extra_displacements, bool check_inversion,
                                  Points<Dim>& out) {
     interpolate<Dim>(
         d, extra_displacements, [](const Points<Dim>&, const Points<Dim>& u) -> const Points<Dim>& { return u; },
@@ -122,7 +122,7 @@ class GraphMoverBase {
   /// Forward derivative of interpolate_displacements() (linear in the boundary change `w`,
   /// Dim × boundary.size(), and the extra nodes' change `extra`, Dim × extra.size()): their
   /// interpolation, without the inversion check.
-  [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w, const Points<Dim>& extra) {
+  [[nodiscard]] Points<Dim> derivative_forward(PointsView<Dim> w, const Points<Dim>& extra) {
     if (!ready_) throw InputError(who_ + "::derivative_forward: setup() was not called");
     check_displacements<Dim>(who_ + "::derivative_forward", w, boundary_.nodes);
     Points<Dim> out;
@@ -134,7 +134,7 @@ class GraphMoverBase {
   /// ⟨v, move(d)⟩ with respect to the graph nodes' displacements (Dim × graph size: the
   /// boundary entries, then the extra nodes). Sliding entries are zero (move() ignores them);
   /// their share reaches the nodes they are interpolated from.
-  [[nodiscard]] Points<Dim> derivative_reverse(const Eigen::Ref<const Points<Dim>>& v) const {
+  [[nodiscard]] Points<Dim> derivative_reverse(const PointsView<Dim>& v) const {
     if (!ready_) throw InputError(who_ + "::derivative_reverse: setup() was not called");
     check_node_field<Dim>(who_ + "::derivative_reverse", v, points_.cols());
     const auto n_graph = static_cast<Index>(graph_nodes_.size());
@@ -161,7 +161,7 @@ class GraphMoverBase {
   /// The interpolation of move() without its checks and timing (for movers that time a
   /// larger move themselves).
   template <int Rows, class Encode, class Decode>
-  void interpolate(const Points<Dim>& d, const Points<Dim>& extra_displacements, Encode&& encode, Decode&& decode,
+  void interpolate(PointsView<Dim> d, const Points<Dim>& extra_displacements, Encode&& encode, Decode&& decode,
                    bool check_inversion, Points<Dim>& out) {
     const auto m = boundary_.size();
     const auto n_graph = static_cast<Index>(graph_nodes_.size());

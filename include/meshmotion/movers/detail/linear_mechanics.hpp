@@ -62,16 +62,16 @@ class LinearMechanicsMover {
   /// nodes get their targets exactly, sliding nodes stay on their planes. Throws InputError
   /// for a wrong shape, a non-finite value or a missing setup; SolverError when an
   /// iterative solve does not converge.
-  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
+  [[nodiscard]] Points<Dim> move(PointsView<Dim> d) {
     Points<Dim> out;
     move_into(d, out);
     return out;
   }
 
   /// move() into `out` (resized only when its shape differs).
-  void move_into(const Points<Dim>& d, Points<Dim>& out);
+  void move_into(PointsView<Dim> d, Points<Dim>& out);
   /// move() into an Eigen::Map (or any Eigen::Ref) of the caller's Dim × n_nodes array.
-  void move_into(const Points<Dim>& d, Eigen::Ref<Points<Dim>> out) {
+  void move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) {
     move_into(d, scratch_);
     copy_to_caller<Dim>((name_ + "::move_into").c_str(), scratch_, out);
   }
@@ -79,13 +79,13 @@ class LinearMechanicsMover {
   /// Forward derivative J w (Dim × n_nodes) for a boundary displacement change w (Dim ×
   /// boundary.size()): the mover is linear in the displacements, so this is move(w), without
   /// counting as a move. Throws as move().
-  [[nodiscard]] Points<Dim> derivative_forward(const Points<Dim>& w);
+  [[nodiscard]] Points<Dim> derivative_forward(PointsView<Dim> w);
 
   /// Reverse derivative Jᵀ v: for v (Dim × n_nodes), the gradient of ⟨v, move(d)⟩ with respect
   /// to d (Dim × boundary.size()); one solve with the factorization of setup (the reduced
   /// matrix is symmetric). Sliding nodes' entries are zero (move() ignores their input).
   /// Throws InputError for a missing setup, a wrong shape or a non-finite value.
-  [[nodiscard]] Points<Dim> derivative_reverse(Eigen::Ref<const Points<Dim>> v);
+  [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v);
 
  protected:
   explicit LinearMechanicsMover(std::string name) : name_(std::move(name)) {}
@@ -130,7 +130,7 @@ class LinearMechanicsMover {
 };
 
 template <int Dim>
-void LinearMechanicsMover<Dim>::move_into(const Points<Dim>& d, Points<Dim>& out) {
+void LinearMechanicsMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& out) {
   timed_move<Dim>(name_ + "::move", ready_, d, boundary_nodes_, stats_, [&] {
     system_.solve(d, out);
     system_.record(stats_);
@@ -138,7 +138,7 @@ void LinearMechanicsMover<Dim>::move_into(const Points<Dim>& d, Points<Dim>& out
 }
 
 template <int Dim>
-Points<Dim> LinearMechanicsMover<Dim>::derivative_forward(const Points<Dim>& w) {
+Points<Dim> LinearMechanicsMover<Dim>::derivative_forward(PointsView<Dim> w) {
   if (!ready_) throw InputError(name_ + "::derivative_forward: setup() was not called");
   check_displacements<Dim>(name_ + "::derivative_forward", w, boundary_nodes_);
   Points<Dim> out;
@@ -147,7 +147,7 @@ Points<Dim> LinearMechanicsMover<Dim>::derivative_forward(const Points<Dim>& w) 
 }
 
 template <int Dim>
-Points<Dim> LinearMechanicsMover<Dim>::derivative_reverse(Eigen::Ref<const Points<Dim>> v) {
+Points<Dim> LinearMechanicsMover<Dim>::derivative_reverse(PointsView<Dim> v) {
   if (!ready_) throw InputError(name_ + "::derivative_reverse: setup() was not called");
   check_node_field<Dim>(name_ + "::derivative_reverse", v, num_nodes_);
   Points<Dim> gradient;

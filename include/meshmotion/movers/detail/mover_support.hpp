@@ -56,7 +56,7 @@ void check_boundary(std::string_view where, const ResolvedBoundary<Dim>& b, Inde
 
 /// Throws InputError unless d is finite and Dim × nodes.size().
 template <int Dim>
-void check_displacements(std::string_view where, const Points<Dim>& d, const std::vector<Index>& nodes) {
+void check_displacements(std::string_view where, PointsView<Dim> d, const std::vector<Index>& nodes) {
   const auto m = static_cast<Index>(nodes.size());
   if (d.cols() != m)
     throw InputError(std::string(where) + ": got " + std::to_string(d.cols()) + " displacement columns (expected " +
@@ -70,7 +70,7 @@ void check_displacements(std::string_view where, const Points<Dim>& d, const std
 /// Throws InputError unless v (a field over the nodes, e.g. a reverse derivative's seed) is
 /// finite and Dim × n_nodes, naming the first non-finite node.
 template <int Dim>
-void check_node_field(std::string_view where, const Eigen::Ref<const Points<Dim>>& v, Index n_nodes) {
+void check_node_field(std::string_view where, const PointsView<Dim>& v, Index n_nodes) {
   if (v.cols() != n_nodes)
     throw InputError(std::string(where) + ": got " + std::to_string(v.cols()) + " columns (expected " +
                      std::to_string(n_nodes) + ", one per node)");
@@ -81,7 +81,7 @@ void check_node_field(std::string_view where, const Eigen::Ref<const Points<Dim>
 /// One move: throws InputError unless `ready` (setup ran) and `d` fits `nodes`
 /// (check_displacements), runs body(), then counts the move and records its time in `stats`.
 template <int Dim, class Body>
-void timed_move(std::string_view where, bool ready, const Points<Dim>& d, const std::vector<Index>& nodes,
+void timed_move(std::string_view where, bool ready, PointsView<Dim> d, const std::vector<Index>& nodes,
                 MoverStats& stats, Body&& body) {
   const Stopwatch watch;
   if (!ready) throw InputError(std::string(where) + ": setup() was not called");
@@ -108,13 +108,13 @@ template <class Derived, int Dim>
 class MoveFromMoveInto {
  public:
   /// move_into() into an Eigen::Map (or any Eigen::Ref) of the caller's Dim × n_nodes array.
-  void move_into(const Points<Dim>& d, Eigen::Ref<Points<Dim>> out) {
+  void move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) {
     static_cast<Derived&>(*this).move_into(d, scratch_);
     copy_to_caller<Dim>("move_into", scratch_, out);
   }
   /// Displacement of every node (Dim × n_nodes) for boundary displacements `d`
   /// (Dim × boundary.size()); see the mover's move_into for what it throws.
-  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
+  [[nodiscard]] Points<Dim> move(PointsView<Dim> d) {
     Points<Dim> out;
     static_cast<Derived&>(*this).move_into(d, out);
     return out;

@@ -1,7 +1,9 @@
 #pragma once
 /// \file
 /// BlendMover: wall-distance blending, a regularizer for curved boundary-layer meshes that
-/// needs no linear solve (beyond the thesis; issue 5, `--method blend`).
+/// needs no linear solve (beyond the thesis; issue 5, method "blend", the curving pipeline's
+/// default). Like every mover it propagates prescribed boundary displacements; its walls are
+/// the connected sets of prescribed facets.
 ///
 /// The prescribed (moving) boundary nodes are split into walls: connected sets of facets
 /// whose nodes are all prescribed. Every other node x takes
@@ -24,8 +26,8 @@
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/shape_functions.hpp"
 #include "meshmotion/core/types.hpp"
-#include "meshmotion/curving/boundary_layer.hpp"
-#include "meshmotion/curving/detail/wall_distance.hpp"
+#include "meshmotion/movers/boundary_layer.hpp"
+#include "meshmotion/movers/detail/wall_distance.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
@@ -45,24 +47,23 @@
 
 namespace meshmotion {
 
-/// Options of BlendMover.
+/// Options of BlendMover (their keys: visit_options in movers/mover_options.hpp).
 struct BlendOptions {
-  /// Blending length for every wall; 0 (default): `layer_factor` × each wall's boundary-layer
+  /// Blending length for every wall; 0 (default): `blending_factor` × each wall's boundary-layer
   /// thickness (estimate_boundary_layer), or, on a wall without an anisotropic layer,
   /// `fallback_spacings` × the size of the facet closest to each node.
   double blending_length = 0.0;
   BoundaryLayerOptions layer{};
   /// A wall without a layer has only its own spacing to size its motion by, and the spacing
-  /// varies along it (the RAE2822's leading-edge facets are 8 times shorter than its
-  /// largest). At 2 the RAE2822 reaches 0.826, 0.851 and 0.833 at orders 2 to 4 (1: 0.816,
-  /// 0.832, 0.809; 3: 0.781, 0.773, 0.692) and the sphere 0.749 and 0.813 at orders 2 and 3
-  /// (docs/curving.md, "Walls without a layer").
+  /// varies along it (on the RAE2822 the leading-edge facets are 8 times shorter than the
+  /// largest): each node blends over a few of its own facets (docs/curving.md, "Walls without
+  /// a layer").
   double fallback_spacings = 2.0;
   /// The default length in layer thicknesses. φ is steepest at a quarter of the length, so at
   /// 1 the steepest gradient lies inside the layer's thin cells; at k it lies k/4 layers out,
-  /// in cells that tolerate it, and the gradient within the layer falls roughly as 1/k
-  /// (docs/curving.md, "Blending length").
-  double layer_factor = 1.0;
+  /// in cells that tolerate it, and the gradient within the layer falls roughly as 1/k. The
+  /// registered method "blend" starts at 6 (docs/curving.md, "Blending length").
+  double blending_factor = 1.0;
 };
 
 /// Wall-distance blending mover (models MeshMover).
@@ -80,8 +81,8 @@ class BlendMover {
     const detail::Stopwatch clock;
     if (!(options_.blending_length >= 0.0))
       throw InputError("BlendMover::setup: negative blending length (got " + std::to_string(options_.blending_length) + ")");
-    if (!(options_.layer_factor > 0.0))
-      throw InputError("BlendMover::setup: layer factor " + std::to_string(options_.layer_factor) + " (expected > 0)");
+    if (!(options_.blending_factor > 0.0))
+      throw InputError("BlendMover::setup: blending factor " + std::to_string(options_.blending_factor) + " (expected > 0)");
     const Index n = mesh.num_nodes();
     const Index m = boundary.size();
     boundary_ = boundary;
@@ -162,14 +163,14 @@ class BlendMover {
   /// (Dim × boundary.size(), columns in boundary.nodes order; entries of fixed and sliding
   /// nodes are ignored). Throws InputError for a wrong shape, a non-finite entry, or a call
   /// before setup.
-  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
+  [[nodiscard]] Points<Dim> move(PointsView<Dim> d) {
     Points<Dim> out;
     move_into(d, out);
     return out;
   }
 
   /// move() into caller storage.
-  void move_into(const Points<Dim>& d, Points<Dim>& out) {
+  void move_into(PointsView<Dim> d, Points<Dim>& out) {
     const detail::Stopwatch clock;
     if (d.cols() != operator_.rows() || slot_.empty())
       throw InputError("BlendMover::move: " + std::to_string(d.cols()) + " displacements (expected " +
@@ -257,7 +258,7 @@ class BlendMover {
     if (options_.blending_length > 0.0) return lengths;
     const BoundaryLayerEstimate layer = estimate_boundary_layer(mesh, walls, options_.layer);
     for (std::size_t b = 0; b < walls.size(); ++b) {
-      lengths[b] = options_.layer_factor * layer.walls[b].thickness;
+      lengths[b] = options_.blending_factor * layer.walls[b].thickness;
       if (lengths[b] > 0.0) continue;
       const std::vector<Vec<Dim>> inward = inward_directions(mesh, walls[b]);
       for (std::size_t i = 0; i < walls[b].size(); ++i) {

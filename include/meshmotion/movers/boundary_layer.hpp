@@ -24,7 +24,7 @@
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/topology.hpp"
 #include "meshmotion/core/types.hpp"
-#include "meshmotion/curving/detail/wall_distance.hpp"
+#include "meshmotion/movers/detail/wall_distance.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -52,6 +52,15 @@ struct WallLayer {
   double max_thickness = 0.0;  ///< largest over the wall's vertices
   Index layer_cells = 0;       ///< anisotropic cells credited to this wall
 };
+
+template <class F>
+void visit_fields(const WallLayer& w, F&& f) {
+  f("group", w.group, "wall group");
+  f("tag", w.tag, "its tag");
+  f("thickness", w.thickness, "median layer thickness over the wall's vertices");
+  f("max_thickness", w.max_thickness, "largest layer thickness at a wall vertex");
+  f("layer_cells", w.layer_cells, "anisotropic cells credited to the wall");
+}
 
 /// Layer thickness per wall and per wall vertex.
 struct BoundaryLayerEstimate {
