@@ -89,7 +89,7 @@ void run_level(int level, bool all_centres) {
     const CurveResult<3>& r = runs[runs.size() / 2];
     const double seconds = r.seconds.total;
     if (baseline == 0.0) baseline = seconds;
-    const Index centres = r.steps.empty() ? 0 : r.steps.back().boundary_nodes;
+    const Index centres = r.mover_steps.empty() ? 0 : r.mover_steps.back().boundary_nodes;
     const QualityReport& q = r.quality;
     std::printf("%-6s %-14s %8lld %6lld %6lld %7.4f %8.4f %8.5f %5lld | %6.3f %6.3f %6.3f %6.3f %6.3f %7.3f %6.2f %7.0f | %7ld %6ld %5.2f %6.3f %6.2f\n",
                 name, c.label, static_cast<long long>(points), static_cast<long long>(centres),

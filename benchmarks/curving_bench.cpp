@@ -214,11 +214,13 @@ void wall_resolution_table() {
       options.geometry.emplace("wall", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), rho)));
       options.geometry.emplace("farfield", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 20.0)));
       if (std::string(method) == "rbf") options.support_radius = factor * layer;
-      else if (factor > 0.0) options.blending_factor = factor;
+      else if (factor > 0.0) set_curve_options(options, {{"blending_factor", format_option_value(factor)}});
       const CurveResult<2> r = curve_mesh(linear, options);
       if (layer == 0.0) layer = r.layers.front().thickness;
+      const double blending_factor =
+          factor > 0.0 ? factor : std::get<BlendOptions>(mover_config<2>("blend").options).blending_factor;
       const double length = std::string(method) == "rbf" ? r.wall_support_radii.empty() ? r.support_radius : r.wall_support_radii.front()
-                                                         : options.blending_factor * layer;
+                                                         : blending_factor * layer;
       const double loss = 1.0 - r.quality.min;
       if (std::string(method) == "rbf") {
         rbf_lowest = std::min(rbf_lowest, loss / (h / rho));
@@ -349,7 +351,7 @@ void compare_case(const PeerCase<Dim>& c, const fs::path& scratch) {
     CurveOptions<Dim> options = c.base;
     options.order = c.order;
     options.method = method;
-    options.blending_length = blending_length;
+    if (blending_length > 0.0) set_curve_options(options, {{"blending_length", format_option_value(blending_length)}});
     double cpu_start = 0.0, cpu_end = 0.0;
     std::chrono::steady_clock::time_point wall_start, wall_end;
     options.progress = [&](const std::string& line) {  // the clocks stop when certification starts

@@ -17,6 +17,7 @@
 #include "meshmotion/curving/geometry_text.hpp"
 #include "meshmotion/io/mesh_io.hpp"
 #include "meshmotion/io/vtu_writer.hpp"
+#include "meshmotion/movers/step_driver.hpp"
 #include "meshmotion/quality/svg_picture.hpp"
 
 #include "mover_arguments.hpp"
@@ -29,6 +30,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cctype>
+#include <cstdint>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -47,32 +49,17 @@ struct Arguments {
   std::string input;
   std::string output;
   bool demo = false;
-  double support_radius = 0.0;
-  std::optional<double> active_factor;
-  bool single_radius = false;
-  double support_factor = 0.0;  // unset: the library's default for the dimension
-  double blending_length = 0.0;
-  double blending_factor = 0.0;  // unset: the library's default for the dimension
-  int steps = 1;
-  int order = 2;
-  bool no_untangle = false;
-  bool mover_inner_nodes = false;
-  double untangle_threshold = 0.1;
-  int raise_rounds = UntangleOptions{}.raise_rounds;
   std::vector<std::string> geometry;
   double cad_tolerance = 0.0;  // 0: 1e-6 of the CAD model's diagonal
   std::vector<std::string> groups;
-  std::vector<std::string> sliding;
-  double corner_angle = 30.0;
-  bool parameter_midpoint = false;
-  bool strict = false;
   bool json = false;
   bool overwrite = false;
   bool keep_orientation = false;
   std::string svg;
   std::vector<double> zoom;
   bool svg_no_markers = false;
-  examples::MoverArguments mover;
+  // curve_mesh()'s keys and the mover's, from their flags, --option and --options-file.
+  examples::MoverArguments options;
 };
 
 // A --geometry naming a STEP, IGES or BREP file (any case) rather than an analytic shape.
@@ -84,41 +71,11 @@ bool is_cad_file(const std::string& text) {
 
 bool cad_geometry(const Arguments& args) { return args.geometry.size() == 1 && is_cad_file(args.geometry.front()); }
 
+// The options given, without the geometry (whose text needs the mesh's dimension).
 template <int Dim>
-CurveOptions<Dim> curve_options(const Arguments& args) {
+CurveOptions<Dim> given_curve_options(const Arguments& args) {
   CurveOptions<Dim> options;
-  options.method = args.mover.method;
-  const KeyValues given = examples::given_options(args.mover);
-  if (options.method == "blend" || options.method == "none") {
-    if (!given.empty())
-      throw InputError("curve_mesh: method '" + options.method + "' takes no mover option (got '" + given.front().first + "')");
-  } else {
-    options.mover_options = mover_config<Dim>(options.method, given).options;
-  }
-  if (args.active_factor) options.active_radius_factor = *args.active_factor;
-  options.support_radius = args.support_radius;
-  options.per_wall_radius = !args.single_radius;
-  if (args.support_factor > 0.0) options.support_radius_factor = args.support_factor;
-  options.blending_length = args.blending_length;
-  if (args.blending_factor > 0.0) options.blending_factor = args.blending_factor;
-  options.steps = args.steps;
-  options.order = args.order;
-  options.untangle.enabled = !args.no_untangle;
-  options.inner_nodes = !args.mover_inner_nodes;
-  options.untangle.threshold = args.untangle_threshold;
-  options.untangle.raise_rounds = args.raise_rounds;
-  options.sliding = args.sliding;
-  options.strict = args.strict;
-  options.snap.corner_angle = args.corner_angle;
-  options.snap.midpoint = args.parameter_midpoint ? SplineMidpoint::parameter : SplineMidpoint::arc_length;
-  if (cad_geometry(args)) return options;  // the groups come from the model (run())
-  std::vector<std::string> groups = args.groups;
-  if (groups.empty() && !args.geometry.empty()) groups.push_back("wall");
-  if (!args.geometry.empty() && args.geometry.size() != 1 && args.geometry.size() != groups.size())
-    throw InputError("--geometry: " + std::to_string(args.geometry.size()) + " geometries for " +
-                     std::to_string(groups.size()) + " groups (expected one for all, or one per --group)");
-  for (std::size_t g = 0; g < groups.size() && !args.geometry.empty(); ++g)
-    options.geometry.insert_or_assign(groups[g], geometry_from_text<Dim>(args.geometry[args.geometry.size() == 1 ? 0 : g]));
+  set_curve_options(options, examples::given_options(args.options));
   if (!args.json)
     options.progress = [start = std::chrono::steady_clock::now()](const std::string& line) {
       const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -127,13 +84,24 @@ CurveOptions<Dim> curve_options(const Arguments& args) {
   return options;
 }
 
+template <int Dim>
+CurveOptions<Dim> curve_options(const Arguments& args) {
+  CurveOptions<Dim> options = given_curve_options<Dim>(args);
+  if (cad_geometry(args)) return options;  // the groups come from the model (run())
+  std::vector<std::string> groups = args.groups;
+  if (groups.empty() && !args.geometry.empty()) groups.push_back("wall");
+  if (!args.geometry.empty() && args.geometry.size() != 1 && args.geometry.size() != groups.size())
+    throw InputError("--geometry: " + std::to_string(args.geometry.size()) + " geometries for " +
+                     std::to_string(groups.size()) + " groups (expected one for all, or one per --group)");
+  for (std::size_t g = 0; g < groups.size() && !args.geometry.empty(); ++g)
+    options.geometry.insert_or_assign(groups[g], geometry_from_text<Dim>(args.geometry[args.geometry.size() == 1 ? 0 : g]));
+  return options;
+}
+
 std::filesystem::path with_extension(const std::filesystem::path& file, const char* extension) {
   std::filesystem::path p = file;
   return p.replace_extension(extension);
 }
-
-template <int Dim>
-void print_summary(const CurveResult<Dim>& result, const Arguments& args, const std::filesystem::path& vtu);
 
 template <int Dim>
 int run(Mesh<Dim> linear, const Arguments& args) {
@@ -170,7 +138,7 @@ int run(Mesh<Dim> linear, const Arguments& args) {
       std::snprintf(numbers, sizeof numbers, "): min %.4g, mean %.4g, %lld of %lld cells invalid", result.quality.min,
                     result.quality.mean, static_cast<long long>(result.quality.num_invalid),
                     static_cast<long long>(result.quality.num_elements));
-      svg.title = "certified scaled Jacobian of the P" + std::to_string(args.order) + " mesh (" + result.method + numbers;
+      svg.title = "certified scaled Jacobian of the P" + std::to_string(result.order) + " mesh (" + result.method + numbers;
       if (args.zoom.size() == 4) svg.zoom = std::array<double, 4>{args.zoom[0], args.zoom[1], args.zoom[2], args.zoom[3]};
       // Invalid cells are magenta and ringed: the scale keeps the valid range [0, 1] instead of
       // stretching down to the worst negative value (which left every valid cell one colour).
@@ -186,41 +154,24 @@ int run(Mesh<Dim> linear, const Arguments& args) {
     w.key("input").value(args.demo ? std::string("demo: boundary-layer O-mesh around a cylinder") : args.input);
     w.key("output").value(args.output).key("vtu").value(vtu.string());
     w.key("dim").value(Dim).key("nodes").value(result.curved.num_nodes()).key("cells").value(result.curved.num_cells());
-    w.key("method").value(result.method).key("steps").value(args.steps).key("support_radius").value(result.support_radius);
-    w.key("support_radius_limited").value(result.support_radius_limited);
-    w.key("order").value(args.order);
-    w.key("curved_groups").begin_array();
-    for (const auto& g : result.curved_groups) w.value(g);
-    w.end_array();
     if (!cad_report.empty()) w.key("cad_groups").value(cad_report);
-    w.key("walls").begin_array();
-    for (std::size_t k = 0; k < result.layers.size(); ++k) {
-      w.begin_object().key("group").value(result.layers[k].group).key("layer_thickness").value(result.layers[k].thickness);
-      if (!result.wall_support_radii.empty()) w.key("support_radius").value(result.wall_support_radii[k]);
-      w.end_object();
-    }
-    w.end_array();
-    w.key("seconds").begin_object();
-    w.key("quadratic").value(result.seconds.quadratic).key("snap").value(result.seconds.snap);
-    w.key("layer").value(result.seconds.layer).key("regularize").value(result.seconds.regularize);
-    w.key("untangle").value(result.seconds.untangle);
-    w.key("certify").value(result.seconds.certify).key("total").value(result.seconds.total);
+    w.key("min_scaled_jacobian").value(q.min).key("mean_scaled_jacobian").value(q.mean);
+    write_json_fields(w, result);
+    w.key("options").begin_object();
+    for (const OptionDoc& d : option_docs(options)) w.key(d.key).value(d.value);
+    for (const OptionDoc& d : MoverConfig<Dim>{options.method, *options.mover_options}.docs()) w.key(d.key).value(d.value);
     w.end_object();
-    w.key("solver_iterations").value(result.solver_iterations);
-    w.key("snapped_nodes").value(result.snapped_nodes).key("moved_vertices").value(result.moved_vertices);
-    w.key("moved_nodes").value(result.moved_nodes);
-    const UntangleReport& u = result.untangle;
-    w.key("untangle").begin_object().key("cells_below").value(u.cells_below).key("invalid_before").value(u.invalid_before);
-    w.key("invalid_after").value(u.invalid_after).key("min_before").value(u.min_before).key("min_after").value(u.min_after);
-    w.key("patch_cells").value(u.patch_cells).key("free_nodes").value(u.free_nodes).key("sweeps").value(u.sweeps);
-    w.key("raise_rounds").value(u.raise_rounds).end_object();
-    w.key("min_scaled_jacobian").value(q.min).key("mean_scaled_jacobian").value(q.mean).key("invalid").value(q.num_invalid);
-    w.key("quality");
-    write_json(w, q);
     w.end_object();
     std::cout << "\n";
   } else {
-    print_summary(result, args, vtu);
+    std::printf("curved %lld cells, %lld nodes (%lld linear) at order %d with %s\n",
+                static_cast<long long>(result.curved.num_cells()), static_cast<long long>(result.curved.num_nodes()),
+                static_cast<long long>(result.num_linear_nodes), result.order, result.method.c_str());
+    write_text(std::cout, result, 2);
+    std::cout.flush();
+    if (q.num_invalid == 0)
+      std::printf("wrote %s, %s%s%s\n", args.output.c_str(), vtu.string().c_str(), args.svg.empty() ? "" : ", ",
+                  args.svg.c_str());
   }
   if (q.num_invalid > 0) {
     std::fflush(stdout);
@@ -231,52 +182,62 @@ int run(Mesh<Dim> linear, const Arguments& args) {
   return examples::exit_ok;
 }
 
-template <int Dim>
-void print_summary(const CurveResult<Dim>& result, const Arguments& args, const std::filesystem::path& vtu) {
-  const QualityReport& q = result.quality;
-  std::printf("curved %lld cells, %lld nodes (%lld linear) with %s", static_cast<long long>(result.curved.num_cells()),
-              static_cast<long long>(result.curved.num_nodes()), static_cast<long long>(result.num_linear_nodes),
-              result.method.c_str());
-  if (!result.wall_support_radii.empty())
-    std::printf(", a support radius per wall%s", result.support_radius_limited ? " (limited to keep the system sparse)" : "");
-  else if (result.support_radius > 0.0)
-    std::printf(", support radius %.4g%s", result.support_radius,
-                result.support_radius_limited ? " (limited to keep the system sparse)" : "");
-  std::printf(", %d step(s), order %d\n", args.steps, args.order);
-  std::printf("  curved groups:");
-  for (const auto& g : result.curved_groups) std::printf(" %s", g.c_str());
-  std::printf("\n");
-  for (std::size_t k = 0; k < result.layers.size(); ++k) {
-    const auto& layer = result.layers[k];
-    std::printf("  wall '%s': boundary layer %.4g thick (max %.4g)", layer.group.c_str(), layer.thickness, layer.max_thickness);
-    if (!result.wall_support_radii.empty()) std::printf(", support radius %.4g", result.wall_support_radii[k]);
-    std::printf("\n");
+// A table cell: '|' escaped, "(empty)" for nothing.
+std::string cell(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '|') out += '\\';
+    out += c;
   }
-  std::printf("  boundary: %lld nodes snapped, %lld vertices moved onto the geometry, largest move %.3g\n",
-              static_cast<long long>(result.snapped_nodes), static_cast<long long>(result.moved_vertices),
-              result.max_boundary_displacement);
-  std::printf("  interior nodes moved: %lld, solver iterations: %lld\n", static_cast<long long>(result.moved_nodes),
-              static_cast<long long>(result.solver_iterations));
-  if (result.untangle.cells_below > 0 || result.untangle.raise_rounds > 0) {
-    const UntangleReport& u = result.untangle;
-    std::printf("  untangling: %lld cells below the threshold (%lld invalid), %d rounds raising the worst, min %.4f -> %.4f, "
-                "%lld invalid after (%lld cells, %lld free nodes, %d sweeps)\n",
-                static_cast<long long>(u.cells_below), static_cast<long long>(u.invalid_before), u.raise_rounds, u.min_before,
-                u.min_after, static_cast<long long>(u.invalid_after), static_cast<long long>(u.patch_cells),
-                static_cast<long long>(u.free_nodes), u.sweeps);
+  return out.empty() ? "(empty)" : out;
+}
+
+template <class Report>
+void print_fields_table(const char* title, const char* what) {
+  std::printf("\n### %s\n%s\n\n| key | what it is |\n|---|---|\n", title, what);
+  visit_fields(Report{}, [](std::string_view key, const auto&, std::string_view doc) {
+    std::printf("| `%s` | %s |\n", std::string(key).c_str(), std::string(doc).c_str());
+  });
+}
+
+// docs/options.md: every option and report field from the library's one description.
+void print_options_markdown() {
+  std::printf("# Options and results\n\n"
+              "Generated by `curve_mesh --options-markdown` from the library's descriptions (`visit_options`,\n"
+              "`visit_fields`); a test fails when this file and the descriptions differ. Each key is the\n"
+              "command-line flag (`--key-with-dashes`; a bool also takes `--no-key`), the `--option KEY=VALUE`\n"
+              "and options-file key, the Python keyword, and the JSON or Python dict key of a report.\n\n"
+              "## curve_mesh\n\n`geometry` has its own text (`--geometry`, Python's `geometry={group: text}`); every key\n"
+              "of the chosen `method`'s mover is a key of curve_mesh too (below).\n\n"
+              "| key | type | default | what it does |\n|---|---|---|---|\n");
+  const std::vector<OptionDoc> plane = option_docs(CurveOptions<2>{}), space = option_docs(CurveOptions<3>{});
+  for (std::size_t k = 0; k < plane.size(); ++k) {
+    const std::string value = plane[k].value == space[k].value ? cell(plane[k].value) : cell(plane[k].value) + " (3D: " + cell(space[k].value) + ")";
+    std::printf("| `%s` | %s | %s | %s |\n", plane[k].key.c_str(), cell(plane[k].type).c_str(), value.c_str(), plane[k].doc.c_str());
   }
-  std::printf("  certified scaled Jacobian: min %.4f, mean %.4f, invalid %lld of %lld\n", q.min, q.mean,
-              static_cast<long long>(q.num_invalid), static_cast<long long>(q.num_elements));
-  if (!q.worst.empty())
-    std::printf("  worst cell: %s %lld at (%.4g, %.4g, %.4g): %.4f\n", std::string(name(q.worst[0].type)).c_str(),
-                static_cast<long long>(q.worst[0].file_id), q.worst[0].centroid[0], q.worst[0].centroid[1],
-                q.worst[0].centroid[2], q.worst[0].value);
-  std::printf("  seconds: P%d %.3f, snap %.3f, layer %.3f, regularize %.3f, certify %.3f, untangle %.3f, total %.3f\n",
-              args.order, result.seconds.quadratic, result.seconds.snap, result.seconds.layer, result.seconds.regularize,
-              result.seconds.certify, result.seconds.untangle, result.seconds.total);
-  if (q.num_invalid == 0)
-    std::printf("wrote %s, %s%s%s\n", args.output.c_str(), vtu.string().c_str(), args.svg.empty() ? "" : ", ",
-                args.svg.c_str());
+  std::printf("\n## Movers (`--method`)\n");
+  for (const auto& m : mover_methods<3>()) {
+    std::printf("\n### %s\n%s.\n", std::string(m.name).c_str(), std::string(m.summary).c_str());
+    const std::vector<OptionDoc> docs = mover_config<3>(std::string(m.name)).docs();
+    if (docs.empty()) {
+      std::printf("\nNo options.\n");
+      continue;
+    }
+    std::printf("\n| key | type | default | what it does |\n|---|---|---|---|\n");
+    for (const OptionDoc& d : docs)
+      std::printf("| `%s` | %s | %s | %s |\n", d.key.c_str(), cell(d.type).c_str(), cell(d.value).c_str(), d.doc.c_str());
+  }
+  std::printf("\n## Reports\n");
+  print_fields_table<CurveResult<3>>("curve_mesh's report",
+                                     "`curve_mesh --json` (beside input, output, vtu, dim, nodes, cells, options) and Python's report dict.");
+  print_fields_table<CurveTimes>("seconds", "Seconds per stage of the pipeline.");
+  print_fields_table<WallLayer>("layers", "One per curved wall whose layer was estimated.");
+  print_fields_table<UntangleReport>("untangle", "What the untangling did.");
+  print_fields_table<QualityReport>("quality", "A quality report (`mesh_quality --json`, Python's quality_report).");
+  print_fields_table<WorstElement>("worst", "One of the lowest cells.");
+  print_fields_table<TypeQuality>("per_type", "The cells of one element type.");
+  print_fields_table<MoverStats>("mover_steps", "A mover's stats (Python's Mover.stats).");
+  print_fields_table<MoveReport>("move_mesh's report", "`move_mesh --json` (beside input, output, support_radius, options).");
 }
 
 }  // namespace
@@ -289,37 +250,24 @@ int main(int argc, char** argv) {
   app.add_option("-o,--output", args.output, "curved mesh to write (.msh, .cgns; .su2 for linear); a .vtu is written beside it");
   examples::add_version_flag(app);
   app.add_flag("--demo", args.demo, "curve the built-in boundary-layer mesh around a cylinder");
-  args.mover.method = "blend";  // curve_mesh()'s default (CurveOptions::method)
-  examples::add_mover_options(app, args.mover, "interior regularization (default blend): blend, none, or ");
-  app.add_option("--support-radius", args.support_radius,
-                 "support radius of the movers with one (rbf; 0: from the boundary-layer thickness)");
-  app.add_option("--active-factor", args.active_factor,
-                 "le/sle: solve within this x the support radius of the curved walls (default 4; 0: whole mesh)");
-  const auto positive = [](const std::string& value) {
-    char* end = nullptr;
-    const double x = std::strtod(value.c_str(), &end);
-    return end != value.c_str() && *end == '\0' && x > 0.0 ? std::string() : "must be a number > 0 (got " + value + ")";
+  // Every key of curve_mesh() and of the movers is a flag (--list-options: those of --method).
+  examples::add_option_flags(app, option_docs(CurveOptions<3>{}), args.options.given, "Curving options");
+  // The flags of earlier versions, kept for their users' scripts.
+  const auto alias = [&](const std::string& flag, const std::string& key, const std::string& value, const std::string& help) {
+    if (value.empty())
+      app.add_option_function<std::string>(flag, [&args, key](const std::string& v) { args.options.given.emplace_back(key, v); },
+                                           "= --" + help)
+          ->group("Curving options");
+    else
+      app.add_flag_function(flag, [&args, key, value](std::int64_t) { args.options.given.emplace_back(key, value); }, "= --" + help)
+          ->group("Curving options");
   };
-  app.add_option("--support-factor", args.support_factor,
-                 "default radius = this x the thickest wall layer (default: 4 in 2D, 1 in 3D)")
-      ->check(positive);
-  app.add_option("--blending-length", args.blending_length, "blend: length (0: --blending-factor x each wall's layer thickness)");
-  app.add_option("--blending-factor", args.blending_factor, "blend: default length = this x each wall's layer (default 6)")
-      ->check(positive);
-  app.add_option("--steps", args.steps, "regularize in this many increments")->capture_default_str();
-  app.add_flag("--mover-inner-nodes", args.mover_inner_nodes,
-               "keep the regularization's nodes inside the faces and cells next to a curved wall (default: re-placed from "
-               "the nodes around them)");
-  app.add_flag("--no-untangle", args.no_untangle, "leave the regularized mesh as it is (no optimization of the cells below the threshold)");
-  app.add_option("--untangle-threshold", args.untangle_threshold,
-                 "optimize the high-order nodes around cells whose certified scaled Jacobian is below this")
-      ->capture_default_str();
-  app.add_option("--raise-rounds", args.raise_rounds,
-                 "then raise the worst cells: rounds of optimization around them while the minimum rises (0: none)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  app.add_option("--order", args.order, "order of the curved mesh: 2, 3 or 4 (hexahedra, prisms and pyramids: 2 or 3)")
-      ->capture_default_str();
+  alias("--active-factor", "active_radius_factor", "", "active-radius-factor");
+  alias("--support-factor", "support_radius_factor", "", "support-radius-factor");
+  alias("--single-radius", "per_wall_radius", "false", "no-per-wall-radius");
+  alias("--mover-inner-nodes", "inner_nodes", "false", "no-inner-nodes");
+  alias("--parameter-midpoint", "midpoint", "parameter", "midpoint parameter");
+  examples::add_mover_options(app, args.options, "", false);
   app.add_option("--geometry", args.geometry,
                  "true boundary: spline | reconstruct | straight | bump | circle:X,Y,R | naca:XXXX[,CHORD,X0,Y0] | sphere:X,Y,Z,R "
                  "(one for all --group, or one per group), or a CAD file (.step, .stp, .iges, .igs, .brep) for every group it fits");
@@ -327,17 +275,12 @@ int main(int argc, char** argv) {
                  "groups the --geometry applies to (default: wall; with a CAD file, every group the model fits)");
   app.add_option("--cad-tolerance", args.cad_tolerance,
                  "CAD file: how far a vertex may be from the model (default: 1e-6 of the model's diagonal)");
-  app.add_option("--sliding", args.sliding, "groups sliding in their plane (symmetry)");
-  app.add_option("--corner-angle", args.corner_angle, "spline corners above this angle (degrees)")->capture_default_str();
-  app.add_flag("--parameter-midpoint", args.parameter_midpoint,
-               "spline: nodes at fractions of the facet's parameter (the thesis) instead of its arc length");
-  app.add_flag("--single-radius", args.single_radius,
-               "rbf default radius: the thickest wall layer's for every wall, not each wall's own");
-  app.add_flag("--strict", args.strict, "write nothing when invalid cells remain (exit 2)");
   app.add_flag("--overwrite", args.overwrite, "allow the output to be the input file");
   app.add_flag("--keep-orientation", args.keep_orientation,
                "refuse a mesh whose cells are all negatively oriented instead of reorienting it");
   app.add_flag("--json", args.json, "print one JSON object");
+  bool markdown = false;
+  app.add_flag("--options-markdown", markdown, "print docs/options.md (every option and report field) and exit");
   app.add_option("--svg", args.svg, "2D: write an SVG picture coloured by quality");
   app.add_option("--zoom", args.zoom, "SVG zoom box x0,x1,y0,y1 (only cells reaching into it are written)")
       ->delimiter(',')
@@ -349,23 +292,33 @@ int main(int argc, char** argv) {
 
   args.demo = args.demo || args.input.empty();
   return examples::guarded(args.json, [&] {
-    if (args.mover.method != "blend" && args.mover.method != "none" && examples::list_options<2>(args.mover))
+    if (markdown) {
+      print_options_markdown();
       return examples::exit_ok;
+    }
+    if (args.options.list_options) {
+      const CurveOptions<3> options = given_curve_options<3>(args);
+      examples::print_option_docs("curve_mesh with method " + options.method + ": " +
+                                      std::string(mover_method<3>(options.method).summary),
+                                  curve_option_docs<3>(options.method));
+      return examples::exit_ok;
+    }
     if (args.demo) {
-      if (args.output.empty()) args.output = "cylinder_p" + std::to_string(args.order) + ".msh";
+      if (args.output.empty()) args.output = "cylinder_p" + std::to_string(given_curve_options<3>(args).order) + ".msh";
       if (args.svg.empty()) args.svg = with_extension(args.output, ".svg").string();
       if (args.zoom.empty()) args.zoom = {0.47, 0.53, -0.03, 0.03};
       if (args.geometry.empty()) {
         args.groups = {"wall"};
         args.geometry = {"circle:0,0,0.5"};
       }
-      examples::check_output({}, args.output, args.order, args.overwrite);
+      examples::check_output({}, args.output, given_curve_options<3>(args).order, args.overwrite);
       return run(o_mesh({}), args);  // 128 x 64 quads, first cell 1e-5 for a 0.025 wall spacing
     }
     if (args.output.empty()) throw InputError("curve_mesh: no output file (expected -o OUTPUT)");
     // The curved mesh is of order --order, and a .vtu goes beside it: both are checked before any work.
-    examples::check_output(args.input, args.output, args.order, args.overwrite);
-    examples::check_output(args.input, with_extension(args.output, ".vtu"), args.order, args.overwrite);
+    const int order = given_curve_options<3>(args).order;
+    examples::check_output(args.input, args.output, order, args.overwrite);
+    examples::check_output(args.input, with_extension(args.output, ".vtu"), order, args.overwrite);
     AnyMesh mesh = read_mesh(args.input);
     return std::visit([&](auto& m) { return run(std::move(m), args); }, mesh);
   });

@@ -8,7 +8,7 @@
 // Exit codes: 0 moved and valid, 1 error (nothing written), 2 written with invalid cells
 // (the last line says so) or refused by --strict.
 
-#include "meshmotion/core/json.hpp"
+#include "meshmotion/core/fields.hpp"
 #include "meshmotion/io.hpp"
 #include "meshmotion/movers.hpp"
 #include "meshmotion/quality.hpp"
@@ -54,12 +54,8 @@ int run(const Arguments& a, Mesh<Dim> mesh) {
   AnyMover<Dim> mover = make_mover(config);
   const QualityReport before = quality_report(mesh, Metric::skew);
   const StepResult<Dim> result = run_steps(mover, mesh, spec, StepOptions{a.steps, Metric::skew});
-  double setup = 0.0, move = 0.0;
-  for (const auto& s : result.steps) {
-    setup += s.stats.setup_seconds;
-    move += s.stats.move_seconds;
-  }
-  const QualityReport& after = *result.steps.back().quality;
+  const MoveReport report = move_report(a.mover.method, before, result);
+  const QualityReport& after = report.after;
   const bool invalid = after.num_invalid > 0;
   if (invalid && a.strict)
     throw InvalidMeshError("move_mesh: " + std::to_string(after.num_invalid) + " of " + std::to_string(after.num_elements) +
@@ -67,26 +63,19 @@ int run(const Arguments& a, Mesh<Dim> mesh) {
   write_mesh(a.output, result.mesh);
   if (a.json) {
     JsonWriter w(std::cout);
-    w.begin_object().key("input").value(a.input).key("output").value(a.output).key("method").value(a.mover.method);
+    w.begin_object().key("input").value(a.input).key("output").value(a.output);
     if (radius) w.key("support_radius").value(*radius);
     w.key("options").begin_object();
     for (const auto& [k, v] : config.values()) w.key(k).value(v);
     w.end_object();
-    w.key("steps").value(a.steps).key("nodes").value(mesh.num_nodes());
-    w.key("setup_seconds").value(setup).key("move_seconds").value(move);
-    w.key("before").begin_object().key("min").value(before.min).key("mean").value(before.mean);
-    w.key("invalid").value(before.num_invalid).end_object();
-    w.key("after").begin_object().key("min").value(after.min).key("mean").value(after.mean);
-    w.key("invalid").value(after.num_invalid).end_object();
+    write_json_fields(w, report);
     w.end_object();
     std::cout << "\n";
   } else {
     std::cout << "moved " << mesh.num_nodes() << " nodes with " << a.mover.method;
     if (radius) std::cout << " (support radius " << format_option_value(*radius) << ")";
-    std::cout << ", " << a.steps << " step(s)\n"
-              << "  setup " << setup << " s, move " << move << " s\n"
-              << "  skew before: min " << before.min << " mean " << before.mean << " invalid " << before.num_invalid << "\n"
-              << "  skew after:  min " << after.min << " mean " << after.mean << " invalid " << after.num_invalid << "\n";
+    std::cout << "\n";
+    write_text(std::cout, report, 2);
   }
   if (invalid) {
     std::cerr << "wrote " << a.output << " WITH " << after.num_invalid << " INVALID CELLS of " << after.num_elements << "\n";
@@ -106,7 +95,7 @@ int main(int argc, char** argv) {
   app.add_option("input", a.input, "Input mesh (.msh, .su2, .cgns, .vtu) or OpenFOAM case folder")->check(CLI::ExistingPath);
   app.add_option("-o,--output", a.output, "Output mesh (.msh, .su2, .cgns, .vtu), or an OpenFOAM case (its points replaced; give --overwrite when it is the input) or a time folder of it (case/0.001: its polyMesh/points)");
   examples::add_motion_options(app, a.motion);
-  examples::add_mover_options(app, a.mover, "");
+  examples::add_mover_options(app, a.mover, known_methods<3>());
   app.add_option("--steps", a.steps, "Number of steps")->check(CLI::PositiveNumber);
   app.add_flag("--strict", a.strict, "write nothing when invalid cells remain (exit 2)");
   app.add_flag("--overwrite", a.overwrite, "allow the output to be the input file");

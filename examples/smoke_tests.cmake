@@ -162,8 +162,19 @@ smoke_test(NAME curve_mesh.bad_poisson_ratio.json EXPECT_RC 1
 smoke_test(NAME curve_mesh.blend.json
            KEYS output,min_scaled_jacobian,invalid
            COMMAND curve_mesh --demo -o "${smoke_dir}/demo_blend.msh" --method blend --blending-factor 4 --json)
-smoke_test(NAME curve_mesh.bad_blending_factor EXPECT_RC 105
-           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_bad_blend.msh" --method blend --blending-factor 0)
+smoke_test(NAME curve_mesh.bad_blending_factor.json EXPECT_RC 1 KEYS error VALUES kind=input
+           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_bad_blend.msh" --method blend --blending-factor 0 --json)
+# The options come from one description: curve_mesh's JSON echoes every key it ran with, a
+# misspelled key is refused naming the known ones, and a key of another method is refused.
+smoke_test(NAME curve_mesh.options_echoed.json
+           KEYS options/raise_rounds,options/blending_factor,mover_steps/0/setup_seconds,layers
+           VALUES options/order=2,options/blending_factor=3,options/midpoint=parameter,options/untangle=false
+           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_echo.msh" --blending-factor 3 --parameter-midpoint
+                   --no-untangle --json)
+smoke_test(NAME curve_mesh.misspelled_option.json EXPECT_RC 1 KEYS error VALUES kind=input
+           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_typo.msh" --option blending_facter=3 --json)
+smoke_test(NAME curve_mesh.option_of_another_method.json EXPECT_RC 1 KEYS error VALUES kind=input
+           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_other.msh" --kernel wendland4 --json)
 
 # SVG pictures: invalid cells ringed (the default) or not; snapping alone leaves invalid cells.
 smoke_test(NAME curve_mesh.svg_no_markers.json EXPECT_RC 2
@@ -314,3 +325,10 @@ if(TARGET move_mesh_mpi)
              COMMAND move_mesh_mpi "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_mpi_bad.msh" --group nosuch --rotate 5
                      --json)
 endif()
+
+# docs/options.md is what the library's option and report descriptions say: regenerate it with
+#   build/examples/curve_mesh --options-markdown > docs/options.md
+add_test(NAME examples.curve_mesh.options_markdown_matches_docs
+         COMMAND "${CMAKE_COMMAND}" -DPROGRAM=$<TARGET_FILE:curve_mesh> -DDOC=${PROJECT_SOURCE_DIR}/docs/options.md
+                 -P "${CMAKE_CURRENT_LIST_DIR}/compare_output.cmake")
+set_tests_properties(examples.curve_mesh.options_markdown_matches_docs PROPERTIES LABELS examples)

@@ -169,7 +169,7 @@ int main_body(int argc, char** argv) {
   app.add_option("input", a.input, "Input mesh (.msh, .su2)")->check(CLI::ExistingFile);
   app.add_option("-o,--output", a.output, "Output mesh (.msh, .su2, .vtu), written by rank 0");
   examples::add_motion_options(app, a.motion);
-  examples::add_mover_options(app, a.mover, "");
+  examples::add_mover_options(app, a.mover, known_methods<3>());
   app.add_option("--petsc-solver", a.solver, "le/sle: PETSc solver automatic (mumps in 2D, cg_gamg in 3D) | cg_gamg | cg_hypre | mumps")->capture_default_str();
   app.add_option("--petsc-tolerance", a.tolerance, "le/sle: relative residual of CG (displacement units)")->capture_default_str();
   app.add_flag("--rank-files", a.rank_files, "also write each rank's part as OUTPUT's stem + .rankR + extension");

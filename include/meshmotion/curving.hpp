@@ -1,11 +1,9 @@
 #pragma once
 /// \file
 /// The curving layer: P1 → P2 conversion, boundary reconstruction (2D splines) and analytic
-/// projections, boundary snapping, boundary-layer estimate, the blending regularizer and the
-/// curve_mesh pipeline (docs/curving.md).
+/// projections, boundary snapping, and the curve_mesh pipeline (docs/curving.md). Its default
+/// regularizer, the blending mover, is a mover like the others (movers/blend.hpp).
 
-#include "meshmotion/curving/blend_regularizer.hpp"
-#include "meshmotion/curving/boundary_layer.hpp"
 #include "meshmotion/curving/boundary_snapping.hpp"
 #include "meshmotion/curving/boundary_spline.hpp"
 #include "meshmotion/curving/curve_mesh.hpp"

@@ -9,8 +9,8 @@
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/core/shape_functions.hpp"
 #include "meshmotion/core/topology.hpp"
-#include "meshmotion/curving/blend_regularizer.hpp"
-#include "meshmotion/curving/boundary_layer.hpp"
+#include "meshmotion/movers/blend.hpp"
+#include "meshmotion/movers/boundary_layer.hpp"
 #include "meshmotion/curving/curve_mesh.hpp"
 #include "meshmotion/curving/function_graph.hpp"
 #include "meshmotion/curving/geometry.hpp"
@@ -145,7 +145,7 @@ TEST_CASE("blend mover: one wall's field vanishes on the other wall", "[curving]
   CHECK(u(1, 9 + 4) > 0.98e-3);
 }
 
-TEST_CASE("blend mover: the default length is layer_factor wall layers, and longer is better on a thin layer", "[curving]") {
+TEST_CASE("blend mover: the default length is blending_factor wall layers, and longer is better on a thin layer", "[curving]") {
   // The O-mesh triangles of docs/curving.md "Blending length" at 64 wall facets: a bow of
   // h^2/(8 rho) that a blend over one layer bends most inside the layer's thin cells.
   OMeshOptions o;
@@ -161,22 +161,22 @@ TEST_CASE("blend mover: the default length is layer_factor wall layers, and long
   const ResolvedBoundary<2> boundary = spec.resolve(linear);
   for (const double factor : {1.0, 6.0}) {
     BlendOptions options;
-    options.layer_factor = factor;
+    options.blending_factor = factor;
     BlendMover<2> mover(options);
     mover.setup(linear, boundary);
     REQUIRE(mover.blending_lengths().size() == 1);
     CHECK(mover.blending_lengths()[0] == Approx(factor * thickness).epsilon(1e-12));
   }
   BlendOptions zero;
-  zero.layer_factor = 0.0;
-  CHECK_THROWS_WITH(BlendMover<2>(zero).setup(linear, boundary), Catch::Contains("layer factor 0"));
+  zero.blending_factor = 0.0;
+  CHECK_THROWS_WITH(BlendMover<2>(zero).setup(linear, boundary), Catch::Contains("blending factor 0"));
 
   CurveOptions<2> curve;
   curve.method = "blend";
   curve.geometry.emplace("wall", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 0.5)));
-  REQUIRE(curve.blending_factor == 6.0);
+  REQUIRE(std::get<BlendOptions>(mover_config<2>("blend").options).blending_factor == 6.0);
   const CurveResult<2> six = curve_mesh(linear, curve);
-  curve.blending_factor = 1.0;
+  set_curve_options(curve, {{"blending_factor", "1"}});
   const CurveResult<2> one = curve_mesh(linear, curve);
   INFO("blend over 1 layer: " << one.quality.min << ", over 6: " << six.quality.min);
   CHECK(one.invalid() == 0);
@@ -289,6 +289,9 @@ TEST_CASE("pipeline: boundary-layer mesh (aspect ratio >= 1000) needs the regula
   options.method = "none";
   const CurveResult<2> snapped = curve_mesh(linear, options);
   CHECK(snapped.invalid() > 0);
+  // "none" leaves the interior to the snapping: the untangling does not repair it either.
+  CHECK(snapped.untangle.cells_below == 0);
+  CHECK(snapped.untangle.evaluations == 0);
   // Snapping alone moves no vertex and no edge node off the boundary: only the centres of the
   // quadrilaterals on the wall and on the (spline-curved) farfield follow their curved edges
   // (inner_nodes.hpp); the triangles have none at P2.
@@ -715,7 +718,7 @@ TEST_CASE("pipeline: the coarse 3D bump-in-channel curves onto the analytic bump
   CurveOptions<3> all_centres = options;
   all_centres.centre_reach = 0.0;
   const CurveResult<3> thesis = curve_mesh(linear, all_centres);
-  CHECK(curved.steps.back().boundary_nodes < thesis.steps.back().boundary_nodes / 3);
+  CHECK(curved.mover_steps.back().boundary_nodes < thesis.mover_steps.back().boundary_nodes / 3);
   CHECK(curved.quality.min == Approx(thesis.quality.min).margin(1e-3));
   CHECK((curved.curved.points - thesis.curved.points).cwiseAbs().maxCoeff() < 0.02 * curved.max_boundary_displacement);
   const Mesh<3> straight = convert_to_quadratic(linear).mesh;

@@ -37,6 +37,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -47,6 +48,10 @@ enum class SplineMidpoint {
   parameter,   ///< r(1/2), the thesis's choice
   arc_length,  ///< the point halving the facet's arc length
 };
+[[nodiscard]] constexpr std::string_view name(SplineMidpoint m) { return m == SplineMidpoint::parameter ? "parameter" : "arc_length"; }
+[[nodiscard]] constexpr std::array<SplineMidpoint, 2> option_choices(SplineMidpoint) {
+  return {SplineMidpoint::arc_length, SplineMidpoint::parameter};
+}
 
 /// How the true boundary of one group is known.
 template <int Dim>
@@ -87,6 +92,15 @@ struct SnapOptions {
   /// diagonal) is already on the geometry and stays.
   double on_geometry_tolerance = 1e-12;
 };
+
+template <class F>
+void visit_options(SnapOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "corner_angle", o.corner_angle, "spline corners: facet directions differing by more (degrees)");
+  f(prefix + "corner_nodes", o.corner_nodes, "spline corners whatever their angle (node indices, comma-separated)");
+  f(prefix + "midpoint", o.midpoint, "spline facet nodes at fractions of its arc_length, or of its parameter (the thesis)");
+  f(prefix + "on_geometry_tolerance", o.on_geometry_tolerance,
+    "a vertex closer than this x the mesh diagonal to its projection is on the geometry and stays");
+}
 
 /// Result of snap_boundary(): the nodes that move and by how much.
 template <int Dim>

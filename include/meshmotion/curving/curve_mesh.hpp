@@ -19,17 +19,16 @@
 /// 5. Untangling of the cells below a threshold (curving/untangle.hpp).
 ///
 /// The blend's default length and the RBF's default support radius follow the boundary layer
-/// (curving/boundary_layer.hpp): a factor × each curved wall's own layer thickness, or on a
+/// (movers/boundary_layer.hpp): a factor × each curved wall's own layer thickness, or on a
 /// wall without a layer a few of its node spacings at each node. docs/curving.md gives the
 /// measured effect of other lengths and radii and of one radius for all walls.
 
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
+#include "meshmotion/core/fields.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/topology.hpp"
 #include "meshmotion/core/types.hpp"
-#include "meshmotion/curving/blend_regularizer.hpp"
-#include "meshmotion/curving/boundary_layer.hpp"
 #include "meshmotion/curving/boundary_snapping.hpp"
 #include "meshmotion/curving/inner_nodes.hpp"
 #include "meshmotion/curving/order_conversion.hpp"
@@ -37,6 +36,7 @@
 #include "meshmotion/curving/untangle.hpp"
 #include "meshmotion/movers/any_mover.hpp"
 #include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/boundary_layer.hpp"
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/movers/mover_options.hpp"
 #include "meshmotion/movers/rbf.hpp"
@@ -56,87 +56,70 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <variant>
 #include <vector>
 
 namespace meshmotion {
 
-/// Options of curve_mesh().
+/// Options of curve_mesh(). Their keys, types and one-line docs are in visit_options() below:
+/// the programs' flags, Python's keywords, options files and docs/options.md come from there.
+/// Measured effects of the defaults are in docs/curving.md.
 template <int Dim>
 struct CurveOptions {
   /// Order of the curved mesh: 2 (default), 3 or 4 (hexahedra, prisms and pyramids stop at 3;
-  /// element_type()). Every high-order boundary node goes to its place on the curved edge or
-  /// face, and the mover regularizes all of them.
+  /// element_type()).
   int order = 2;
-  /// Interior regularization: "blend" (default; curving/blend_regularizer.hpp), "rbf", "none"
-  /// (snap the boundary only, to see why the pipeline exists) or any other method of
-  /// mover_methods() (movers/mover_options.hpp). The blend is the default since it reached
-  /// the best minimum on every case of curving_bench: the NACA0012 boundary-layer triangles,
-  /// the RAE2822 and sphere STEP files at orders 2 to 4 (docs/curving.md, "Against Gmsh"),
-  /// and a tie with the RBF on the 30P30N quadrilaterals (0.7077).
+  /// Interior regularization: any registered method (mover_methods(), movers/mover_options.hpp).
+  /// "blend" (wall-distance blending) is the default: it reached the best minimum on every
+  /// case of curving_bench; "none" snaps the boundary alone, to show why the pipeline exists.
   std::string method = "blend";
-  /// Typed options of a registered `method` (its MoverOptions alternative); empty: the
-  /// method's defaults. The pipeline sets what it measures in them, asking the options what
-  /// they take: the support radius (and a radius per centre) of movers with one
-  /// (TakesSupportRadius), and the active region of those with one (TakesActiveRadius) unless
-  /// these options set it.
+  /// Typed options of `method` (its MoverOptions alternative); empty: the method's defaults.
+  /// The pipeline sets what it measures in them, asking the options what they take: the
+  /// support radius (and a radius per centre) of movers with one (TakesSupportRadius), the
+  /// active region of those with one (TakesActiveRadius) unless these options set it, the
+  /// layer recognition of those that blend over layers (TakesLayerOptions).
   std::optional<MoverOptions<Dim>> mover_options{};
   /// Movers with an active region (TakesActiveRadius: le, sle) solve only within this many
-  /// support radii of the curved walls: on the 30P30N, 4 gives the whole-mesh result to 4
-  /// digits of minimum quality with a sixth of the unknowns (docs/mechanics.md, "Active
-  /// region"); 0: the whole mesh.
+  /// support radii of the curved walls; 0: the whole mesh.
   double active_radius_factor = 4.0;
   /// Support radius of the movers that take one (TakesSupportRadius); 0:
-  /// support_radius_factor × each wall's estimated layer for "rbf" (per_wall_radius), × the
-  /// thickest one for the other movers
-  /// (suggest_support_radius() with 3 wall node spacings when no wall has an anisotropic layer).
+  /// support_radius_factor × each wall's estimated layer (per_wall_radius), or × the thickest
+  /// one (suggest_support_radius() with 3 wall node spacings when no wall has a layer).
   double support_radius = 0.0;
-  /// 4 in 2D (on the 30P30N triangles the minimum quality rises from 0.47 at 1 to 0.80 at 4,
-  /// for 0.06 s more), 1 in 3D (on the bump 2 costs 6× the time); docs/curving.md.
+  /// 4 in 2D, 1 in 3D (a larger 3D support multiplies the factorization's cost).
   double support_radius_factor = Dim == 2 ? 4.0 : 1.0;
-  /// Method "rbf" with the default radius: each curved wall's centres get the radius of its
-  /// own layer (walls without a layer: each node 2 node spacings of its own facets,
-  /// local_spacing_radii()), and the other boundary
-  /// centres the radius of the nearest moving wall node, so a thin layer is not overrun by the
-  /// support of a thick one. false: the thickest layer's radius everywhere (the thesis's one
-  /// radius). Differing radii make the RBF system nonsymmetric (sparse LU instead of
-  /// Cholesky); docs/curving.md, "A radius per wall".
+  /// With the default radius, each curved wall's centres get the radius of its own layer
+  /// (walls without a layer: each node 2 node spacings of its own facets,
+  /// local_spacing_radii()), and the other boundary centres the radius of the nearest moving
+  /// wall node, so a thin layer is not overrun by the support of a thick one. false: the
+  /// thickest layer's radius everywhere (the thesis's one radius). Differing radii make the
+  /// RBF system nonsymmetric (sparse LU instead of Cholesky).
   bool per_wall_radius = true;
-  /// A default radius (support_radius = 0) is shrunk until a support holds at most this many
-  /// boundary nodes on average around the moving ones; 0: no limit. On the 3D bump's medium
-  /// level the layer-based radius (0.177) takes minutes to factorize; the limit of 100 gives
-  /// 0.1035 (docs/curving.md, "Support radius"). 2D supports grow only linearly with the
+  /// A default radius is shrunk until a support holds at most this many boundary nodes on
+  /// average around the moving ones; 0: no limit. 2D supports grow only linearly with the
   /// radius and are not limited by default.
   double max_support_nodes = Dim == 2 ? 0.0 : 100.0;
-  /// Method "rbf": boundary nodes that stay put (fixed, sliding, or snapped with zero
-  /// displacement) are RBF centres only within this many support radii of a node the snapping
-  /// moved; farther ones keep their place without a centre. 0 keeps every boundary node a
-  /// centre (the thesis). At 2 the 3D bump's minimum quality is unchanged to 4 digits with a
-  /// sixth of the centres (docs/curving.md, "Centres near the motion").
+  /// Boundary nodes that stay put (fixed, sliding, or snapped with zero displacement) are RBF
+  /// centres only within this many support radii of a node the snapping moved; 0 keeps every
+  /// boundary node a centre (the thesis). A compact kernel couples centres only through
+  /// overlapping supports, so farther ones barely change the interpolant.
   double centre_reach = 2.0;
-  /// Blending length of method "blend"; 0: blending_factor × each wall's layer thickness.
-  double blending_length = 0.0;
-  /// 6: the NACA0012 wall cells of gmsh's boundary-layer triangles rise from 0.957 at 1 to
-  /// 0.992 at 6 (gmsh's best variant: 0.990), the 30P30N triangles from 0.798 to 0.825, and
-  /// every factor up to 20 keeps the 30P30N valid; the coarse 3D bump-in-channel hexahedra
-  /// rise from 0.881 at 1 to 0.955 at 3 and 0.958 at 6 (docs/curving.md, "Blending length").
-  double blending_factor = 6.0;
   /// The regularization in this many increments, each re-based on the moved mesh.
   int steps = 1;
   /// After the regularization, the nodes inside the faces and cells of the cells touching a
-  /// curved wall that the regularization left where they were (method "none", or beyond its
-  /// reach) are placed from the nodes around them (curving/inner_nodes.hpp), as Gmsh places
-  /// them from its curved edges. false: they stay straight. Nothing to do for P2 triangles and
-  /// tetrahedra.
+  /// curved wall that it left where they were are placed from the nodes around them
+  /// (curving/inner_nodes.hpp), as Gmsh places them from its curved edges. false: they stay.
   bool inner_nodes = true;
   /// After the regularization, the nodes inside the domain around cells below a threshold of
-  /// the certified scaled Jacobian are optimized (curving/untangle.hpp); not for method "none".
+  /// the certified scaled Jacobian are optimized (curving/untangle.hpp); not for movers that
+  /// leave the interior alone (method "none").
   UntangleOptions untangle{};
   /// Geometry per group name. Groups not listed: spline reconstruction in 2D when
   /// `spline_by_default`, straight otherwise; in 3D the WALF surface reconstruction for
   /// wall-named triangle groups (below), straight otherwise (give a projection callback or
-  /// BoundaryGeometry::spline() for any other).
+  /// BoundaryGeometry::spline() for any other). Text: geometry_from_text().
   std::map<std::string, BoundaryGeometry<Dim>, std::less<>> geometry;
   bool spline_by_default = true;
   /// 3D: groups not listed whose name says they are walls (detail::looks_like_wall: "wall",
@@ -155,6 +138,31 @@ struct CurveOptions {
   std::function<void(const std::string&)> progress{};
 };
 
+/// The keys of CurveOptions: every field text may set (`geometry` has its own text form,
+/// geometry_from_text(); `mover_options` takes the keys of the method, MoverConfig).
+template <int Dim, class F>
+void visit_options(CurveOptions<Dim>& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "order", o.order, "order of the curved mesh: 2, 3 or 4 (hexahedra, prisms and pyramids: 2 or 3)");
+  f(prefix + "method", o.method, "interior regularization: a registered mover (its options are keys too)");
+  f(prefix + "support_radius", o.support_radius, "support radius of the movers with one (0: from each wall's boundary layer)");
+  f(prefix + "support_radius_factor", o.support_radius_factor, "default support radius = this x the wall's layer thickness");
+  f(prefix + "per_wall_radius", o.per_wall_radius, "default radius: each wall its own (false: the thickest wall's for all)");
+  f(prefix + "max_support_nodes", o.max_support_nodes, "shrink a default radius to this many boundary nodes per support (0: no limit)");
+  f(prefix + "centre_reach", o.centre_reach, "RBF centres only within this x the radius of a moving node (0: every boundary node)");
+  f(prefix + "active_radius_factor", o.active_radius_factor, "le/sle: solve within this x the support radius of the curved walls (0: whole mesh)");
+  f(prefix + "steps", o.steps, "regularize in this many increments");
+  f(prefix + "inner_nodes", o.inner_nodes, "re-place the nodes inside faces and cells next to a curved wall from the nodes around them");
+  visit_options(o.untangle, f, prefix);
+  f(prefix + "spline_by_default", o.spline_by_default, "2D: groups without a geometry get a spline");
+  f(prefix + "reconstruct_walls_by_default", o.reconstruct_walls_by_default,
+    "3D: wall-named triangle groups without a geometry get the surface reconstruction");
+  f(prefix + "sliding", o.sliding, "groups sliding in their plane (symmetry), comma-separated");
+  visit_options(o.snap, f, prefix);
+  visit_options(o.layer, f, prefix);
+  visit_options(o.report, f, prefix);
+  f(prefix + "strict", o.strict, "write nothing when invalid cells remain");
+}
+
 /// Wall-clock seconds of each stage.
 struct CurveTimes {
   double quadratic = 0.0;
@@ -166,14 +174,26 @@ struct CurveTimes {
   double total = 0.0;
 };
 
+template <class F>
+void visit_fields(const CurveTimes& t, F&& f) {
+  f("quadratic", t.quadratic, "conversion to the curved order");
+  f("snap", t.snap, "snapping the boundary to the geometry");
+  f("layer", t.layer, "estimating the walls' boundary layers");
+  f("regularize", t.regularize, "the mover's setup and moves");
+  f("untangle", t.untangle, "optimizing the cells below the threshold");
+  f("certify", t.certify, "certifying the scaled Jacobian");
+  f("total", t.total, "the whole pipeline");
+}
+
 /// What curve_mesh() produced and measured.
 template <int Dim>
 struct CurveResult {
   Mesh<Dim> curved;                 ///< the curved mesh; nodes 0..num_linear_nodes-1 are the input's
   Index num_linear_nodes = 0;
+  int order = 2;
   CurveTimes seconds;
   std::string method;
-  double support_radius = 0.0;      ///< support radius given to the mover, the largest when per wall (0 for blend and none)
+  double support_radius = 0.0;      ///< support radius given to the mover, the largest when per wall (0 for movers without one)
   std::vector<double> wall_support_radii;  ///< per wall of `layers` when each has its own radius (rbf default)
   bool support_radius_limited = false;  ///< the default radius was shrunk to max_support_nodes
   std::vector<std::string> curved_groups;  ///< the groups given a curved boundary (not straight)
@@ -183,12 +203,101 @@ struct CurveResult {
   double max_boundary_displacement = 0.0;
   Index moved_nodes = 0;            ///< nodes not on the boundary that the regularization moved
   Index solver_iterations = 0;      ///< summed over steps
-  std::vector<MoverStats> steps;    ///< per step
+  std::vector<MoverStats> mover_steps;  ///< the mover's stats per step
   UntangleReport untangle;          ///< what the untangling did (cells_below = 0: nothing to do)
   QualityReport quality;            ///< certified scaled Jacobian
   std::vector<double> cell_quality;  ///< the certified scaled Jacobian of each cell, in cell order
   [[nodiscard]] Index invalid() const noexcept { return quality.num_invalid; }
 };
+
+/// The report of CurveResult: every field but the mesh and the per-cell values.
+template <int Dim, class F>
+void visit_fields(const CurveResult<Dim>& r, F&& f) {
+  f("method", r.method, "the mover that regularized the interior");
+  f("order", r.order, "order of the curved mesh");
+  f("num_linear_nodes", r.num_linear_nodes, "nodes of the input (numbered first in the curved mesh)");
+  f("curved_groups", r.curved_groups, "groups given a curved boundary");
+  f("support_radius", r.support_radius, "support radius given to the mover (the largest when per wall; 0 without one)");
+  f("wall_support_radii", r.wall_support_radii, "per wall of layers, when each has its own radius");
+  f("support_radius_limited", r.support_radius_limited, "the default radius was shrunk to max_support_nodes");
+  f("layers", r.layers, "estimated boundary layers of the curved walls");
+  f("snapped_nodes", r.snapped_nodes, "boundary nodes given their place on the geometry");
+  f("moved_vertices", r.moved_vertices, "linear vertices that were off the geometry");
+  f("max_boundary_displacement", r.max_boundary_displacement, "largest move of a boundary node");
+  f("moved_nodes", r.moved_nodes, "nodes off the boundary that the regularization moved");
+  f("solver_iterations", r.solver_iterations, "iterative solver iterations, summed over the steps");
+  f("mover_steps", r.mover_steps, "the mover's stats per step");
+  f("untangle", r.untangle, "what the untangling did");
+  f("invalid", r.invalid(), "cells whose certified scaled Jacobian is not positive");
+  f("quality", r.quality, "certified scaled Jacobian of the curved mesh");
+  f("seconds", r.seconds, "wall-clock seconds per stage");
+}
+
+namespace detail {
+
+/// "curve_mesh: " before the message of e, whose own "meshmotion: " prefix InputError adds again.
+[[nodiscard]] inline std::string curve_mesh_message(const Error& e) {
+  std::string_view message = e.what();
+  constexpr std::string_view prefix = "meshmotion: ";
+  if (message.starts_with(prefix)) message.remove_prefix(prefix.size());
+  return "curve_mesh: " + std::string(message);
+}
+
+}  // namespace detail
+
+/// Sets curve_mesh()'s options from text: its own keys (visit_options above), "method" first
+/// wherever it stands, and every other key as an option of the method's mover
+/// (MoverConfig::set). Throws InputError for a key neither takes (naming the known ones), a
+/// malformed value, or an unknown method.
+template <int Dim>
+void set_curve_options(CurveOptions<Dim>& options, const KeyValues& values) {
+  CurveOptions<Dim> o = options;  // `options` changes only when every value is taken
+  std::vector<std::string> own;
+  visit_options(o, [&](const std::string& key, auto&, std::string_view) { own.push_back(key); });
+  for (const auto& [key, text] : values)
+    if (key == "method") parse_option_value(key, text, o.method);
+  MoverConfig<Dim> config;
+  try {
+    config = mover_config<Dim>(o.method);
+  } catch (const InputError& e) {
+    throw InputError(detail::curve_mesh_message(e));
+  }
+  if (o.mover_options && o.mover_options->index() == config.options.index()) config.options = *o.mover_options;
+  KeyValues mover;
+  for (const auto& [key, text] : values) {
+    if (key == "method") continue;
+    bool found = false;
+    visit_options(o, [&](const std::string& k, auto& field, std::string_view) {
+      if (k != key) return;
+      parse_option_value(key, text, field);
+      found = true;
+    });
+    if (found) continue;
+    const std::vector<std::string> theirs = config.keys();
+    if (std::find(theirs.begin(), theirs.end(), key) == theirs.end()) {
+      std::vector<std::string> known = own;
+      known.insert(known.end(), theirs.begin(), theirs.end());
+      throw InputError("curve_mesh: " + unknown_key_message("curve_mesh with method '" + o.method + "'", key, known));
+    }
+    mover.emplace_back(key, text);
+  }
+  config.set(mover);
+  o.mover_options = config.options;
+  options = std::move(o);
+}
+
+/// Every key of curve_mesh() with method `method`: its own, then the mover's, each with its
+/// default as text and its doc line. The mover's keys that the pipeline's own shadow (the
+/// support radius) are left out.
+template <int Dim>
+[[nodiscard]] std::vector<OptionDoc> curve_option_docs(const std::string& method) {
+  CurveOptions<Dim> o;
+  o.method = method;
+  std::vector<OptionDoc> docs = option_docs(o);
+  for (OptionDoc& d : mover_config<Dim>(method).docs())
+    if (std::none_of(docs.begin(), docs.end(), [&](const OptionDoc& own) { return own.key == d.key; })) docs.push_back(std::move(d));
+  return docs;
+}
 
 namespace detail {
 
@@ -452,33 +561,6 @@ template <int Dim>
   return radii;
 }
 
-/// The "none" method: the snapped boundary nodes move, nothing else (models MeshMover).
-template <int Dim>
-class SnapOnlyMover {
- public:
-  static constexpr int dim = Dim;
-  void setup(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) {
-    num_nodes_ = mesh.num_nodes();
-    boundary_ = boundary;
-  }
-  [[nodiscard]] Points<Dim> move(const Points<Dim>& d) {
-    Points<Dim> out;
-    move_into(d, out);
-    return out;
-  }
-  void move_into(const Points<Dim>& d, Points<Dim>& out) {
-    out.setZero(Dim, num_nodes_);
-    for (Index k = 0; k < boundary_.size(); ++k)
-      if (boundary_.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed)
-        out.col(boundary_.nodes[static_cast<std::size_t>(k)]) = d.col(k);
-  }
-  [[nodiscard]] MoverStats stats() const { return {}; }
-
- private:
-  Index num_nodes_ = 0;
-  ResolvedBoundary<Dim> boundary_;
-};
-
 inline void report_progress(const std::function<void(const std::string&)>& progress, const std::string& line) {
   if (progress) progress(line);
 }
@@ -514,7 +596,7 @@ void regularize_and_certify(Mover& mover, const ResolvedBoundary<Dim>& boundary,
         mesh.points.col(v) += u.col(v);
         moved[static_cast<std::size_t>(v)] = 1;
       }
-    result.steps.push_back(mover.stats());
+    result.mover_steps.push_back(mover.stats());
     result.solver_iterations += mover.stats().iterations;
   }
   if (options.inner_nodes) {
@@ -542,7 +624,7 @@ void regularize_and_certify(Mover& mover, const ResolvedBoundary<Dim>& boundary,
   result.cell_quality.reserve(cells.size());
   for (const CellQuality& c : cells) result.cell_quality.push_back(c.value);
   result.seconds.certify = certify_clock.seconds();
-  if (result.method != "none" && options.untangle.enabled) {
+  if (options.untangle.enabled) {
     const detail::Stopwatch untangle_clock;
     // Boundary nodes are on the geometry: they stay.
     std::vector<char> fixed(static_cast<std::size_t>(mesh.num_nodes()), 0);
@@ -582,23 +664,25 @@ template <int Dim>
 [[nodiscard]] CurveResult<Dim> curve_mesh(const Mesh<Dim>& linear, const CurveOptions<Dim>& options = {}) {
   const detail::Stopwatch total;
   // The method and its options are checked before any work.
-  std::optional<MoverConfig<Dim>> config;
-  if (options.method != "blend" && options.method != "none") {
-    try {
-      config = MoverConfig<Dim>{options.method, options.mover_options ? *options.mover_options
-                                                                      : mover_method<Dim>(options.method).defaults()};
-      config->check();
-    } catch (const InputError& e) {
-      throw InputError("curve_mesh: " + std::string(e.what()) + " (or blend, none)");
-    }
-  } else if (options.mover_options) {
-    throw InputError("curve_mesh: method '" + options.method + "' takes no mover options");
+  MoverConfig<Dim> config;
+  bool moves_interior = true;
+  try {
+    const MoverMethod<Dim>& method = mover_method<Dim>(options.method);
+    config = MoverConfig<Dim>{options.method, options.mover_options ? *options.mover_options : method.defaults()};
+    config.check();
+    moves_interior = method.moves_interior;
+  } catch (const InputError& e) {
+    throw InputError(detail::curve_mesh_message(e));
   }
   if (!(options.active_radius_factor >= 0.0))
     throw InputError("curve_mesh: active_radius_factor must be non-negative (got " +
                      format_option_value(options.active_radius_factor) + ")");
+  check_untangle_options(options.untangle);
+  if (options.centre_reach < 0.0)
+    throw InputError("curve_mesh: centre_reach must be non-negative (got " + format_option_value(options.centre_reach) + ")");
   CurveResult<Dim> result;
   result.method = options.method;
+  result.order = options.order;
   if (options.order < 2 || options.order > max_element_order)
     throw InputError("curve_mesh: order must be 2 to " + std::to_string(max_element_order) + " (got " +
                      std::to_string(options.order) + ")");
@@ -642,29 +726,28 @@ template <int Dim>
   const ResolvedBoundary<Dim> boundary = detail::curving_boundary(result.curved, snapped, options.sliding);
   result.seconds.snap = clock.seconds();
 
-  const bool estimate = !walls.empty() && options.method != "none" &&
-                        (options.method == "blend" ? options.blending_length <= 0.0 : options.support_radius <= 0.0);
+  // What the mover's options take decides what the pipeline measures for it: a support radius
+  // and the centres near the motion, an active region, a blending length, the layers' test.
+  const auto takes = [&](auto wants) { return std::visit([&]<class O>(const O&) { return wants.template operator()<O>(); }, config.options); };
+  const bool radial = takes([]<class O>() { return TakesSupportRadius<O>; });
+  const bool sized = radial || takes([]<class O>() { return TakesActiveRadius<O>; });
+  const bool blends = takes([]<class O>() { return TakesBlendingLength<O>; });
+  const bool default_length =
+      blends && std::visit([]<class O>(const O& o) {
+        if constexpr (TakesBlendingLength<O>) return o.blending_length <= 0.0;
+        else return false;
+      }, config.options);
+  const bool estimate = !walls.empty() && ((sized && options.support_radius <= 0.0) || default_length);
   if (estimate) {
     detail::report_progress(options.progress, "estimating the boundary layer of the curved walls");
     clock = detail::Stopwatch{};
     result.layers = estimate_boundary_layer(result.curved, std::span<const std::string>(walls), options.layer).walls;
     result.seconds.layer = clock.seconds();
   }
-  if (options.method == "blend") {
-    BlendOptions blend;
-    blend.blending_length = options.blending_length;
-    blend.layer_factor = options.blending_factor;
-    blend.layer = options.layer;
-    BlendMover<Dim> mover(blend);
-    regularize_and_certify(mover, boundary, options, result);
-  } else if (options.method == "none") {
-    detail::SnapOnlyMover<Dim> mover;
-    regularize_and_certify(mover, boundary, options, result);
-  } else {
-    const bool radial = std::visit([]<class O>(const O&) { return TakesSupportRadius<O>; }, config->options);
+  std::vector<int> wall_of;
+  std::vector<double> per_node;
+  if (sized) {
     result.support_radius = options.support_radius;
-    std::vector<int> wall_of;
-    std::vector<double> per_node;
     if (!(result.support_radius > 0.0)) {
       wall_of = detail::wall_of_nodes(result.curved, walls);
       const detail::DefaultRadii radii = detail::default_support_radii(result.curved, boundary, snapped, result.layers, wall_of, options);
@@ -676,26 +759,31 @@ template <int Dim>
         result.support_radius = *std::max_element(radii.per_wall.begin(), radii.per_wall.end());
       }
     }
-    if (options.centre_reach < 0.0)
-      throw InputError("curve_mesh: centre_reach must be non-negative (got " + std::to_string(options.centre_reach) + ")");
-    const bool trim = radial && options.centre_reach > 0.0;
-    const ResolvedBoundary<Dim> given =
-        trim ? detail::near_motion(result.curved, boundary, options.centre_reach * result.support_radius) : boundary;
-    const auto& per_wall = result.wall_support_radii;
-    const bool varying =
-        !per_node.empty() || std::any_of(per_wall.begin(), per_wall.end(), [&](double r) { return r != per_wall.front(); });
-    std::visit(
-        [&]<class O>(O& o) {
-          if constexpr (TakesSupportRadius<O>) {
-            o.support_radius = result.support_radius;
-            o.support_radii = varying ? detail::entry_radii(result.curved, given, wall_of, per_wall, per_node) : std::vector<double>{};
-          }
-          if constexpr (TakesActiveRadius<O>)
-            if (!(o.active_radius > 0.0)) o.active_radius = options.active_radius_factor * result.support_radius;
-        },
-        config->options);
-    AnyMover<Dim> mover = make_mover(*config);
+  }
+  const bool trim = radial && options.centre_reach > 0.0;
+  const ResolvedBoundary<Dim> given =
+      trim ? detail::near_motion(result.curved, boundary, options.centre_reach * result.support_radius) : boundary;
+  const auto& per_wall = result.wall_support_radii;
+  const bool varying =
+      !per_node.empty() || std::any_of(per_wall.begin(), per_wall.end(), [&](double r) { return r != per_wall.front(); });
+  std::visit(
+      [&]<class O>(O& o) {
+        if constexpr (TakesSupportRadius<O>) {
+          o.support_radius = result.support_radius;
+          o.support_radii = varying ? detail::entry_radii(result.curved, given, wall_of, per_wall, per_node) : std::vector<double>{};
+        }
+        if constexpr (TakesActiveRadius<O>)
+          if (!(o.active_radius > 0.0)) o.active_radius = options.active_radius_factor * result.support_radius;
+        if constexpr (TakesLayerOptions<O>) o.layer = options.layer;
+      },
+      config.options);
+  AnyMover<Dim> mover = make_mover(config);
+  if (moves_interior) {
     regularize_and_certify(mover, boundary, given, options, result);
+  } else {
+    CurveOptions<Dim> snap_only = options;
+    snap_only.untangle.enabled = false;
+    regularize_and_certify(mover, boundary, given, snap_only, result);
   }
   result.seconds.total = total.seconds();
   return result;

@@ -27,6 +27,7 @@
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/quality/scaled_jacobian.hpp"
 
@@ -36,6 +37,8 @@
 #include <numeric>
 #include <span>
 #include <string>
+#include <string_view>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -74,6 +77,36 @@ struct UntangleReport {
   long long evaluations = 0; ///< cell evaluations of the optimization (each a Bézier bound of det J)
   bool reverted = false;     ///< the untangling's result was worse than its input and was undone
 };
+
+/// The keys of UntangleOptions (core/fields.hpp): flat, since they sit among the curving
+/// pipeline's own keys.
+template <class F>
+void visit_options(UntangleOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "untangle", o.enabled, "optimize the cells below untangle_threshold after the regularization");
+  f(prefix + "untangle_threshold", o.threshold, "optimize the high-order nodes around cells whose certified scaled Jacobian is below this");
+  f(prefix + "untangle_layers", o.layers, "rings of neighbouring cells that move with a cell below the threshold");
+  f(prefix + "untangle_sweeps", o.max_sweeps, "node sweeps at most per pass");
+  f(prefix + "raise_rounds", o.raise_rounds, "then rounds raising the worst cells while the minimum rises (0: none)");
+  f(prefix + "raise_cells", o.raise_cells, "worst cells optimized per round");
+  f(prefix + "raise_layers", o.raise_layers, "rings of cells around them that move too");
+  f(prefix + "raise_margin", o.raise_margin, "cells within this of the minimum are the worst; the round aims at minimum + margin");
+  f(prefix + "raise_budget", o.raise_budget, "the rounds' cell evaluations at most, per cell of the mesh");
+}
+
+template <class F>
+void visit_fields(const UntangleReport& r, F&& f) {
+  f("cells_below", r.cells_below, "cells under the threshold before");
+  f("invalid_before", r.invalid_before, "invalid cells before");
+  f("invalid_after", r.invalid_after, "invalid cells after");
+  f("min_before", r.min_before, "certified minimum over all cells before");
+  f("min_after", r.min_after, "certified minimum over all cells after");
+  f("patch_cells", r.patch_cells, "cells in the optimized patches (summed over the passes)");
+  f("free_nodes", r.free_nodes, "nodes allowed to move (summed over the passes)");
+  f("sweeps", r.sweeps, "node sweeps of every pass");
+  f("raise_rounds", r.raise_rounds, "rounds that raised the minimum");
+  f("evaluations", r.evaluations, "cell evaluations of the optimization (each a Bezier bound of det J)");
+  f("reverted", r.reverted, "the result was worse than the input and was undone");
+}
 
 namespace detail {
 
@@ -285,6 +318,16 @@ class PatchOptimizer {
 
 }  // namespace detail
 
+/// Throws InputError naming the key of a negative count, margin or budget.
+inline void check_untangle_options(const UntangleOptions& options) {
+  UntangleOptions copy = options;
+  visit_options(copy, [](const std::string& key, auto& value, std::string_view) {
+    if constexpr (!std::is_same_v<std::remove_cvref_t<decltype(value)>, bool>)
+      if (key != "untangle_threshold" && !(value >= 0))
+        throw InputError("untangle: option '" + key + "' must be non-negative (got " + format_option_value(value) + ")");
+  });
+}
+
 /// Optimizes the nodes around the cells of `mesh` whose value in `quality` (the certified
 /// scaled Jacobian of each cell, in cell order) is below options.threshold, then raises the
 /// worst cells (options.raise_rounds); nodes with fixed[node] set do not move. `quality` is
@@ -296,6 +339,7 @@ UntangleReport untangle(Mesh<Dim>& mesh, std::span<const char> fixed, std::vecto
     throw InputError("untangle: " + std::to_string(quality.size()) + " cell values and " + std::to_string(fixed.size()) +
                      " node flags for a mesh of " + std::to_string(mesh.num_cells()) + " cells and " +
                      std::to_string(mesh.num_nodes()) + " nodes");
+  check_untangle_options(options);
   UntangleReport report;
   if (quality.empty()) return report;
   const auto minimum = [&] { return *std::min_element(quality.begin(), quality.end()); };

@@ -33,6 +33,7 @@ inline constexpr std::array<Metric, 6> all_metrics{Metric::relative_size, Metric
                                                   "size_shape",    "size_skew", "scaled_jacobian"};
   return names[static_cast<std::size_t>(m)];
 }
+[[nodiscard]] constexpr std::string_view name(Metric m) { return metric_name(m); }
 
 /// The metric of that name; also accepts "size", "size-shape", "size-skew", "jacobian" and
 /// "scaled-jacobian". Throws InputError for other names.

@@ -4,8 +4,8 @@
 /// worst elements (id, type, value, centroid) and a breakdown per element type; printed as a
 /// table or written as JSON.
 
-#include "meshmotion/core/json.hpp"
 #include "meshmotion/core/element.hpp"
+#include "meshmotion/core/fields.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/core/types.hpp"
@@ -54,12 +54,63 @@ struct QualityReport {
   std::vector<TypeQuality> per_type;         ///< in the order of mesh.cells
 };
 
+template <class F>
+void visit_fields(const WorstElement& e, F&& f) {
+  f("id", e.id, "position in cell order");
+  f("file_id", e.file_id, "the element id of the file (or of a written .msh)");
+  f("type", e.type, "element type");
+  f("value", e.value, "the metric's value");
+  f("valid", e.valid, "not inverted, not degenerate");
+  f("centroid", e.centroid, "mean of the vertices (z = 0 in 2D)");
+}
+
+template <class F>
+void visit_fields(const TypeQuality& t, F&& f) {
+  f("type", t.type, "element type");
+  f("elements", t.num_elements, "cells of the type");
+  f("invalid", t.num_invalid, "invalid cells of the type");
+  f("min", t.min, "lowest value");
+  f("max", t.max, "highest value");
+  f("mean", t.mean, "mean value");
+}
+
+template <class F>
+void visit_fields(const QualityReport& r, F&& f) {
+  f("metric", r.metric, "quality metric");
+  f("elements", r.num_elements, "cells");
+  f("invalid", r.num_invalid, "invalid cells (inverted or degenerate)");
+  f("min", r.min, "lowest value");
+  f("max", r.max, "highest value");
+  f("mean", r.mean, "mean value");
+  f("histogram", r.histogram, "cells per equal bin of [0, 1] (values outside in the end bins)");
+  f("worst", r.worst, "the lowest cells, lowest first");
+  f("per_type", r.per_type, "statistics per element type, in the order of the mesh's blocks");
+}
+
 /// Options of quality_report().
 struct ReportOptions {
   int bins = 10;
   int num_worst = 10;
   QualityOptions quality{};
 };
+
+template <class F>
+void visit_options(ScaledJacobianOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "certify", o.certify, "certified Bezier bounds (false: sampled extremes only)");
+  f(prefix + "sharp", o.sharp, "refine both bounds to the tolerance (false: stop once validity is decided)");
+  f(prefix + "sharp_max", o.sharp_max, "with sharp: refine the upper bound too");
+  f(prefix + "tolerance", o.tolerance, "gap between a Bezier bound and the sampled extreme");
+  f(prefix + "max_depth", o.max_depth, "deepest subdivision level");
+  f(prefix + "max_leaves", o.max_leaves, "subdomains per cell at most");
+}
+
+template <class F>
+void visit_options(ReportOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "histogram_bins", o.bins, "bins of the quality histogram");
+  f(prefix + "num_worst", o.num_worst, "worst cells listed");
+  f(prefix + "reference_measure", o.quality.reference_measure, "size metrics: the measure of relative size 1 (0: the mean)");
+  visit_options(o.quality.jacobian, f, prefix + "jacobian_");
+}
 
 /// Builds the report from per-cell results already computed (cell order).
 template <int Dim>
@@ -147,31 +198,6 @@ template <MeshLike M>
   requires(!std::same_as<M, Mesh<mesh_dim<M>>>)
 [[nodiscard]] QualityReport quality_report(const M& mesh, Metric metric, const ReportOptions& options = {}) {
   return quality_report(to_mesh(mesh), metric, options);
-}
-
-/// Writes the report as one JSON object.
-inline void write_json(JsonWriter& w, const QualityReport& r) {
-  w.begin_object();
-  w.key("metric").value(metric_name(r.metric));
-  w.key("elements").value(r.num_elements).key("invalid").value(r.num_invalid);
-  w.key("min").value(r.min).key("max").value(r.max).key("mean").value(r.mean);
-  w.key("histogram").array(r.histogram);
-  w.key("worst").begin_array();
-  for (const auto& e : r.worst) {
-    w.begin_object().key("id").value(e.id).key("file_id").value(e.file_id).key("type").value(name(e.type));
-    w.key("value").value(e.value).key("valid").value(e.valid);
-    w.key("centroid").begin_array().value(e.centroid[0]).value(e.centroid[1]).value(e.centroid[2]).end_array();
-    w.end_object();
-  }
-  w.end_array();
-  w.key("per_type").begin_array();
-  for (const auto& t : r.per_type) {
-    w.begin_object().key("type").value(name(t.type)).key("elements").value(t.num_elements);
-    w.key("invalid").value(t.num_invalid).key("min").value(t.min).key("max").value(t.max).key("mean").value(t.mean);
-    w.end_object();
-  }
-  w.end_array();
-  w.end_object();
 }
 
 /// The report as a JSON string.
