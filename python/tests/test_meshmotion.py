@@ -243,7 +243,7 @@ def test_curve_mesh_at_order_3_and_4():
         assert "untangle" in report["seconds"]
         with pytest.raises(ValueError, match="no meshio counterpart"):
             mm.to_meshio(curved)
-    with pytest.raises(ValueError, match="expects 2, 3 or 4"):
+    with pytest.raises(ValueError, match="order must be 2 to 4"):
         mm.curve_mesh(mesh, order=5)
     # The rounds raising the worst cells never lower the minimum; none leaves it as it was.
     _, raised = mm.curve_mesh(mesh, order=3, geometry={"wall": "circle:0,0,0.5"})
@@ -270,15 +270,17 @@ def test_curve_mesh_puts_the_high_order_nodes_on_the_circle():
         mm.curve_mesh(mesh, suport_radius=0.3)
     with pytest.raises(ValueError, match="circle:X,Y,R"):
         mm.curve_mesh(mesh, geometry={"wall": "circle:0,0"})
-    with pytest.raises(ValueError, match="expects a number"):
+    with pytest.raises(ValueError, match="expected a finite number"):
         mm.curve_mesh(mesh, support_radius="big")
+    with pytest.raises(ValueError, match="expected a finite number"):
+        mm.curve_mesh(mesh, support_radius=True)
     with pytest.raises(ValueError, match="expects a string"):
         mm.curve_mesh(mesh, method=5)
     with pytest.raises(ValueError, match="list of group names"):
         mm.curve_mesh(mesh, sliding="wall")
     with pytest.raises(ValueError, match="expects a dict"):
         mm.curve_mesh(mesh, geometry="circle:0,0,0.5")
-    with pytest.raises(ValueError, match="takes no mover option"):
+    with pytest.raises(ValueError, match="unknown option 'kernel' for curve_mesh with method 'blend'"):
         mm.curve_mesh(mesh, method="blend", kernel="wendland4")
     _, sle = mm.curve_mesh(mesh, method="sle", geometry={"wall": "circle:0,0,0.5"}, poisson_ratio=0.3)
     assert sle["method"] == "sle" and sle["invalid"] == 0
@@ -337,3 +339,25 @@ def test_meshio_round_trip():
         mm.from_meshio(meshio.Mesh(np.array([[0, 0, 1.0], [1, 0, 0], [0, 1, 0]]), [("triangle", np.array([[0, 1, 2]]))]))
     with pytest.raises(ValueError, match="not supported"):
         mm.from_meshio(meshio.Mesh(np.zeros((3, 3)), [("polygon", np.array([[0, 1, 2]]))]))
+
+
+def test_curve_mesh_keywords_and_report_come_from_one_description():
+    # Every keyword curve_options() lists is taken with its default, and the report holds
+    # exactly the fields of its description (with the mover's stats per step).
+    options = mm.curve_options("rbf")
+    keys = [o["key"] for o in options]
+    assert len(keys) == len(set(keys)) and {"order", "raise_rounds", "kernel", "sliding"} <= set(keys)
+    for o in options:
+        assert set(o) == {"key", "type", "default", "doc"} and o["doc"]
+    assert "blending_factor" in [o["key"] for o in mm.curve_options()]
+    circle = {"wall": "circle:0,0,0.5"}
+    _, report = mm.curve_mesh(annulus(), geometry=circle, method="rbf", raise_rounds=1, midpoint="parameter",
+                              sliding=[], support_radius_factor=3.5)
+    assert list(report) == mm.report_fields("curve")
+    assert list(report["quality"]) == mm.report_fields("quality")
+    assert list(report["untangle"]) == mm.report_fields("untangle")
+    assert all(list(s) == mm.report_fields("mover_stats") for s in report["mover_steps"])
+    assert report["support_radius_limited"] is False and "wall" in report["curved_groups"]
+    assert report["layers"] and set(report["layers"][0]) >= {"group", "thickness"}
+    with pytest.raises(ValueError, match="unknown report"):
+        mm.report_fields("nothing")

@@ -1,0 +1,141 @@
+#pragma once
+// What every file of the Python module shares: numpy arrays without a copy, option values as
+// the library's text, reports as dicts, and the bind_* function of each file.
+//
+// Layout: a Mesh<Dim> stores its points Dim × n column-major, which is the memory of a C-order
+// (n, Dim) array: `points` is that array, a view on the mesh (no copy), kept alive by it.
+// Arrays from Python are taken without a copy when they are C-contiguous float64 of the right
+// shape; anything else is refused with the shape and dtype expected.
+
+#include "meshmotion/core/element.hpp"
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/fields.hpp"
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/types.hpp"
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <string>
+#include <type_traits>
+#include <utility>
+
+namespace meshmotion::python {
+
+namespace py = pybind11;
+
+// Python's repr of a float is its shortest round-trip text, which the library's parser reads
+// back exactly; sequences become comma-separated lists.
+inline std::string option_text(const std::string& key, const py::handle& value) {
+  if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
+  if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+  if (py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value)) return py::repr(value).cast<std::string>();
+  if (value.is_none()) return "none";
+  if (py::isinstance<py::sequence>(value) || py::isinstance<py::array>(value)) {
+    std::string out;
+    for (const py::handle item : value) {
+      if (!out.empty()) out += ',';
+      out += py::repr(py::float_(py::reinterpret_borrow<py::object>(item))).cast<std::string>();
+    }
+    return out;
+  }
+  throw InputError("option '" + key + "': expected a number, a string, a bool or a sequence of numbers (got " +
+                   py::repr(py::type::of(value)).cast<std::string>() + ")");
+}
+
+// A sequence of names as the parser's comma-separated text.
+inline std::string names_text(const py::handle& value) {
+  std::string out;
+  for (const py::handle item : value) {
+    if (!py::isinstance<py::str>(item))
+      throw InputError("expected a list of names (got " + py::repr(value).cast<std::string>() + ")");
+    if (!out.empty()) out += ',';
+    out += item.cast<std::string>();
+  }
+  return out;
+}
+
+// A C-contiguous float64 array of shape (rows, Dim), without a copy; refused otherwise.
+template <int Dim>
+Eigen::Map<const Points<Dim>> rows_of(const py::array& a, const char* what, Index rows = -1) {
+  const bool float64 = py::isinstance<py::array_t<double>>(a);
+  const bool contiguous = (a.flags() & py::array::c_style) != 0;
+  if (!float64 || !contiguous || a.ndim() != 2 || a.shape(1) != Dim || (rows >= 0 && a.shape(0) != rows)) {
+    std::string shape = "(";
+    for (py::ssize_t k = 0; k < a.ndim(); ++k) {
+      if (k > 0) shape += ", ";
+      shape += std::to_string(a.shape(k));
+    }
+    throw InputError(std::string(what) + ": expected a C-contiguous float64 array of shape (" +
+                     (rows >= 0 ? std::to_string(rows) : std::string("n")) + ", " + std::to_string(Dim) + ") (got " +
+                     py::str(a.dtype()).cast<std::string>() + ", shape " + shape + ")" +
+                     (contiguous ? "" : ", not C-contiguous") + ")");
+  }
+  return {static_cast<const double*>(a.data()), Dim, static_cast<Index>(a.shape(0))};
+}
+
+template <int Dim>
+py::array_t<double> to_rows(Points<Dim> p) {
+  auto* owner = new Points<Dim>(std::move(p));
+  py::capsule free_when_done(owner, [](void* q) { delete static_cast<Points<Dim>*>(q); });
+  return py::array_t<double>({static_cast<py::ssize_t>(owner->cols()), static_cast<py::ssize_t>(Dim)},
+                             {static_cast<py::ssize_t>(Dim * sizeof(double)), static_cast<py::ssize_t>(sizeof(double))},
+                             owner->data(), free_when_done);
+}
+
+// A described report as Python objects: reports as dicts, lists as lists, enums by name.
+template <class V>
+py::object to_py(const V& v) {
+  if constexpr (DescribedFields<V>) {
+    py::dict d;
+    visit_fields(v, [&](std::string_view key, const auto& x, std::string_view) { d[py::str(std::string(key))] = to_py(x); });
+    return d;
+  } else if constexpr (detail::is_field_list<V>::value) {
+    py::list items;
+    for (const auto& x : v) items.append(to_py(x));
+    return items;
+  } else if constexpr (std::is_enum_v<V>) {
+    return py::str(std::string(name(v)));
+  } else {
+    return py::cast(v);
+  }
+}
+
+inline ElementType element_type_named(const std::string& type_name) {
+  std::string known;
+  for (int t = 0; t < num_element_types; ++t) {
+    const auto type = static_cast<ElementType>(t);
+    if (name(type) == type_name) return type;
+    if (!known.empty()) known += ", ";
+    known += name(type);
+  }
+  throw InputError("unknown element type '" + type_name + "' (expected one of " + known + ")");
+}
+
+// The connectivity of a block as an (n_cells, nodes_per_cell) int64 view kept alive by `owner`.
+inline py::array_t<Index> connectivity_view(ElementBlock& b, const py::object& owner) {
+  const auto npc = static_cast<py::ssize_t>(b.nodes_per_element());
+  return py::array_t<Index>({static_cast<py::ssize_t>(b.size()), npc},
+                            {static_cast<py::ssize_t>(npc * sizeof(Index)), static_cast<py::ssize_t>(sizeof(Index))},
+                            b.connectivity.data(), owner);
+}
+
+/// Runs f.template operator()<Dim>() for Dim 2 and 3: each class and function is bound once
+/// per dimension, with the dimension in its Python name (Mesh2, Mesh3).
+template <class F>
+void for_each_dimension(F&& f) {
+  f.template operator()<2>();
+  f.template operator()<3>();
+}
+
+void bind_errors(py::module_& m);
+void bind_catalogue(py::module_& m);
+void bind_mesh(py::module_& m);
+void bind_io(py::module_& m);
+void bind_boundary(py::module_& m);
+void bind_movers(py::module_& m);
+void bind_quality(py::module_& m);
+void bind_curving(py::module_& m);
+
+}  // namespace meshmotion::python

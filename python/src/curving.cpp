@@ -1,0 +1,91 @@
+// curve_mesh with its keywords from the one description of its options, and its report as a dict.
+
+#include "bindings.hpp"
+
+#include "meshmotion/curving/curve_mesh.hpp"
+#include "meshmotion/curving/geometry_text.hpp"
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+namespace meshmotion::python {
+
+namespace {
+
+// curve_mesh's keywords: each through the library's one parser (set_curve_options), the
+// pipeline's own keys and the method's alike; `geometry` is a dict {group: geometry text}.
+template <int Dim>
+CurveOptions<Dim> curve_options(const py::kwargs& kwargs) {
+  CurveOptions<Dim> o;
+  KeyValues given;
+  const std::vector<OptionDoc> own = option_docs(o);
+  for (const auto& [key_handle, value] : kwargs) {
+    const auto key = py::cast<std::string>(key_handle);
+    if (key == "geometry") {
+      if (!py::isinstance<py::dict>(value))
+        throw InputError("curve_mesh: option 'geometry' expects a dict {group: geometry text} (got " +
+                         py::cast<std::string>(py::repr(value)) + ")");
+      for (const auto& [group, spec] : py::cast<py::dict>(value)) {
+        if (!py::isinstance<py::str>(group) || !py::isinstance<py::str>(spec))
+          throw InputError("curve_mesh: option 'geometry' expects group names and geometry texts (got " +
+                           py::cast<std::string>(py::repr(value)) + ")");
+        o.geometry.insert_or_assign(py::cast<std::string>(group), geometry_from_text<Dim>(py::cast<std::string>(spec)));
+      }
+      continue;
+    }
+    // A single string where a list of names is expected is a mistake, not a list of one.
+    const auto doc = std::find_if(own.begin(), own.end(), [&](const OptionDoc& d) { return d.key == key; });
+    const bool names = doc != own.end() && doc->type == "names";
+    if (names && (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value)))
+      throw InputError("curve_mesh: option '" + key + "' expects a list of group names (got " +
+                       py::cast<std::string>(py::repr(value)) + ")");
+    if (key == "method" && !py::isinstance<py::str>(value))
+      throw InputError("curve_mesh: option 'method' expects a string (got " + py::cast<std::string>(py::repr(value)) + ")");
+    given.emplace_back(key, names ? names_text(value) : option_text(key, value));
+  }
+  set_curve_options(o, given);
+  return o;
+}
+
+}  // namespace
+
+void bind_curving(py::module_& m) {
+  for_each_dimension([&]<int Dim>() {
+    using M = Mesh<Dim>;
+    m.def(
+        "curve_mesh",
+        [](const M& mesh, const py::kwargs& kwargs) {
+          const CurveOptions<Dim> options = curve_options<Dim>(kwargs);
+          CurveResult<Dim> result;
+          {
+            py::gil_scoped_release release;
+            result = curve_mesh(mesh, options);
+          }
+          py::object report = to_py(result);
+          return py::make_tuple(py::cast(std::move(result.curved)), report);
+        },
+        py::arg("mesh"));
+  });
+  m.def(
+      "curve_options",
+      [](const std::string& method) {
+        py::list out;
+        for (const OptionDoc& d : curve_option_docs<3>(method))
+          out.append(py::dict(py::arg("key") = d.key, py::arg("type") = d.type, py::arg("default") = d.value, py::arg("doc") = d.doc));
+        return out;
+      },
+      py::arg("method") = "blend", "curve_mesh's keywords with method `method`: key, type, default (as text) and doc");
+  m.def(
+      "report_fields",
+      [](const std::string& report) {
+        if (report == "curve") return field_keys(CurveResult<3>{});
+        if (report == "quality") return field_keys(QualityReport{});
+        if (report == "mover_stats") return field_keys(MoverStats{});
+        if (report == "untangle") return field_keys(UntangleReport{});
+        throw InputError("report_fields: unknown report '" + report + "' (expected curve, quality, mover_stats or untangle)");
+      },
+      py::arg("report"), "the keys of a report's dict, from its one description");
+}
+
+}  // namespace meshmotion::python
