@@ -24,19 +24,29 @@ TEST_CASE("JSON writer: strings escaped, numbers exact, non-finite as null", "[c
   CHECK(out.str() == R"({"file":"a\"b\\c\n.su2","x":4.9e-06,"nan":null,"n":3})");
 }
 
-TEST_CASE("thread count: set, read back, same results; negative refused", "[core]") {
+TEST_CASE("thread count: set, read back, same results; OpenMP's default follows; negative and huge refused", "[core]") {
   const Mesh<2> mesh = rectangle_mesh({});
   const QualityReport all = quality_report(mesh, Metric::shape);
+#ifdef _OPENMP
+  const int openmp_default = omp_get_max_threads();
+#endif
   set_num_threads(1);
 #ifdef _OPENMP
   CHECK(num_threads() == 1);
+  // What CHOLMOD's parallel regions open.
+  CHECK(omp_get_max_threads() == 1);
 #endif
   const QualityReport one = quality_report(mesh, Metric::shape);
   CHECK(one.min == all.min);
   CHECK(one.mean == all.mean);
   set_num_threads(0);
   CHECK(num_threads() >= 1);
+#ifdef _OPENMP
+  CHECK(omp_get_max_threads() == openmp_default);
+#endif
   CHECK_THROWS_AS(set_num_threads(-2), InputError);
+  CHECK_THROWS_WITH(set_num_threads(100000), Catch::Contains("got 100000"));
+  CHECK(num_threads() >= 1);
 }
 
 TEST_CASE("version: the macros agree with the string", "[core]") {

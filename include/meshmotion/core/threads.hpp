@@ -20,19 +20,41 @@
 
 namespace meshmotion {
 
+/// Most threads set_num_threads takes: the OpenMP runtime fails outright on tens of
+/// thousands, and no node has this many cores.
+inline constexpr int max_threads = 1024;
+
 namespace detail {
 // One setting per program: an inline function's static is shared by every translation unit.
 inline std::atomic<int>& thread_setting() {
   static std::atomic<int> n{0};
   return n;
 }
+
+#ifdef _OPENMP
+// OpenMP's default before the first set_num_threads, to give back on set_num_threads(0).
+inline int openmp_default_threads() {
+  static const int n = omp_get_max_threads();
+  return n;
+}
+#endif
 }  // namespace detail
 
-/// Threads of the library's parallel loops (and of Eigen's dense products) from now on;
-/// 0 gives back OpenMP's own default (OMP_NUM_THREADS, else the cores). Throws InputError for
-/// a negative count. Without OpenMP the library runs on one thread whatever is set.
+/// Threads of the library's parallel loops, of Eigen's dense products and of the libraries
+/// it calls that use OpenMP (CHOLMOD's supernodal factorization) from now on; 0 gives back
+/// OpenMP's own default (OMP_NUM_THREADS, else the cores). Throws InputError for a negative
+/// count or one above max_threads. Without OpenMP the library runs on one thread whatever is set.
+///
+/// OpenMP's default is set too, on the calling thread: CHOLMOD opens its parallel regions
+/// with it, and 16 MPI ranks each opening 16 threads there made the replicated RBF setup 17×
+/// slower on a 16-core node (docs/parallel.md).
 inline void set_num_threads(int n) {
-  if (n < 0) throw InputError("set_num_threads: expected 0 (OpenMP's default) or more threads (got " + std::to_string(n) + ")");
+  if (n < 0 || n > max_threads)
+    throw InputError("set_num_threads: expected 0 (OpenMP's default) to " + std::to_string(max_threads) + " threads (got " +
+                     std::to_string(n) + ")");
+#ifdef _OPENMP
+  omp_set_num_threads(n > 0 ? n : detail::openmp_default_threads());
+#endif
   detail::thread_setting().store(n);
   Eigen::setNbThreads(n);
 }
