@@ -28,6 +28,22 @@ def per_cell_growth(small, large):
     return value
 
 
+def distributed_setup_growth(ranks):
+    """The distributed RBF's setup on the box (automatic boundary solve) at `ranks` ranks over
+    one rank's, in the same run (1 = no growth with the ranks)."""
+    def value(rows, build):
+        def setup(r):
+            found = None
+            for row in rows:
+                if (row.get("build", "current") == build and row.get("method") == "rbf" and row.get("ranks") == r
+                        and str(row.get("case", "")).startswith("box") and "setup_seconds" in row):
+                    found = row["setup_seconds"]
+            return found
+        one, many = setup(1), setup(ranks)
+        return None if one is None or many is None else many / one
+    return value
+
+
 # (name, rows' fields to match or a function of (rows, build), field, "<=" or ">=", limit, unit)
 TARGETS = [
     ("P1->P2 30P30N quads (median)", {"bench": "conversion", "case": "30p30n-quads"}, "median_s", "<=", 0.015, "s"),
@@ -44,6 +60,8 @@ TARGETS = [
      "<=", 3.0, "s"),
     ("bump fine level, whole pipeline (thesis radius)", {"bench": "bump3d", "level": "fine", "case": "rbf thesis r"},
      "seconds", "<=", 4.0, "s"),
+    ("distributed RBF box setup, 2 ranks / 1 rank", distributed_setup_growth(2), None, "<=", 1.2, "x"),
+    ("distributed RBF box setup, 4 ranks (2 per core) / 1 rank", distributed_setup_growth(4), None, "<=", 1.2, "x"),
     ("PU RBF, 1M centres and 10M nodes: peak", {"bench": "pu_rbf", "mesh": "flat-707", "method": "pu"}, "peak_mb",
      "<=", 24576, "MB"),
 ]

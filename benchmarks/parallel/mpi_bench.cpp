@@ -9,7 +9,8 @@
 // (../shared/data, skipped when absent) with the RBF mover (wall rotated 2°) and the
 // stiffened elasticity mover (χ = 2.75; serial: direct Cholesky, distributed: CG + GAMG).
 // The serial mover runs first on rank 0 with every core's threads while the other ranks
-// sleep; then every rank runs the distributed mover with cores / ranks threads. Setup and move
+// sleep; then every rank runs the distributed mover with its share of the node's cores
+// (node_share_of_cores, what move_mesh_mpi sets). Setup and move
 // are the slowest rank's; memory is the heap each rank's mover keeps after setup (largest, and
 // rank 0's);
 // more ranks than cores is flagged "oversubscribed". A table and one JSON line per case.
@@ -103,7 +104,7 @@ void run_case(const std::string& name, const Mesh<Dim>& whole, const ResolvedBou
   }
   sleeping_barrier(comm);
 
-  set_num_threads(std::max(1, cores / ranks));
+  set_num_threads(node_share_of_cores(comm));
   const DistributedMesh<Dim> part = partition_mesh(comm, whole);
   const ResolvedBoundary<Dim> local = distribute_boundary(part, boundary);
   Figures mine;
@@ -131,10 +132,10 @@ void run_case(const std::string& name, const Mesh<Dim>& whole, const ResolvedBou
   std::printf("{\"case\":\"%s\",\"method\":\"%s\",\"boundary_solve\":\"%s\",\"ranks\":%d,\"cores\":%d,\"oversubscribed\":%s,\"nodes\":%ld,"
               "\"boundary_nodes\":%ld,\"serial_setup_seconds\":%.6f,\"setup_seconds\":%.6f,\"serial_move_seconds\":%.6f,"
               "\"move_seconds\":%.6f,\"setup_ratio\":%.3f,\"move_ratio\":%.3f,\"serial_setup_memory_mb\":%.1f,"
-              "\"setup_memory_mb_per_rank_max\":%.1f,\"rank0_setup_memory_mb\":%.1f}\n",
+              "\"setup_memory_mb_per_rank_max\":%.1f,\"rank0_setup_memory_mb\":%.1f,\"threads_per_rank\":%d}\n",
               name.c_str(), method == Method::rbf ? "rbf" : "sle", petsc ? "petsc" : "replicated", ranks, cores, oversubscribed ? "true" : "false",
               static_cast<long>(whole.num_nodes()), static_cast<long>(boundary.size()), serial.setup, worst[0], serial.move,
-              worst[1], setup_ratio, move_ratio, serial.memory, worst[2], mine.memory);
+              worst[1], setup_ratio, move_ratio, serial.memory, worst[2], mine.memory, num_threads());
   std::fflush(stdout);
 }
 

@@ -7,6 +7,9 @@
 //   mpiexec -n 4 move_mesh_mpi wing.msh -o moved.msh --group wall --rotate 30 --center 0.25,0 --fixed farfield
 //   mpiexec -n 2 move_mesh_mpi wing.su2 -o moved.su2 --group wall --translate 0,0.1 --method sle --petsc-solver cg_hypre
 //
+// Each rank runs --threads threads (default: OMP_NUM_THREADS when set, else the node's cores
+// shared among the ranks on it). With rbf, --boundary-solve says where the boundary system is
+// solved (automatic: through PETSc on several ranks once it is big enough, see docs/parallel.md).
 // PETSc options refine the elasticity solver through PETSC_OPTIONS with the prefix
 // meshmotion_ (e.g. PETSC_OPTIONS="-meshmotion_ksp_monitor"). Exit codes as move_mesh: 0
 // moved and valid, 1 error (nothing written), 2 written with invalid cells or refused by
@@ -26,6 +29,7 @@
 
 #include <petscsys.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -38,8 +42,9 @@ namespace {
 struct Arguments {
   std::string input, output;
   examples::MotionArguments motion;
-  std::string solver = "automatic";
+  std::string solver = "automatic", boundary_solve = "automatic";
   double tolerance = 1e-10;
+  int threads = 0;
   bool json = false, strict = false, overwrite = false, keep_orientation = false, rank_files = false;
   examples::MoverArguments mover;
 };
@@ -50,6 +55,20 @@ PetscSolverKind solver_kind(const std::string& name) {
   if (name == "cg_hypre") return PetscSolverKind::cg_hypre;
   if (name == "mumps") return PetscSolverKind::direct_mumps;
   throw InputError("move_mesh_mpi: --petsc-solver '" + name + "' is not one of automatic, cg_gamg, cg_hypre, mumps");
+}
+
+BoundarySolve boundary_solve_kind(const std::string& name) {
+  if (name == "automatic") return BoundarySolve::automatic;
+  if (name == "replicated") return BoundarySolve::replicated;
+  if (name == "petsc") return BoundarySolve::petsc;
+  throw InputError("move_mesh_mpi: --boundary-solve '" + name + "' is not one of automatic, replicated, petsc");
+}
+
+// Threads per rank: --threads, else OMP_NUM_THREADS, else the node's cores shared among its ranks.
+int threads_per_rank(MPI_Comm comm, int asked) {
+  const int share = node_share_of_cores(comm);
+  if (asked > 0) return asked;
+  return std::getenv("OMP_NUM_THREADS") != nullptr ? 0 : share;
 }
 
 // rank<R>.<ext> beside OUTPUT: each rank's part with its local numbering.
@@ -94,11 +113,13 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
   const ResolvedBoundary<Dim> local = distribute_boundary(part, boundary);
   Points<Dim> displacement;
   MoverStats stats;
+  bool petsc_boundary = false;
   if (auto* rbf = std::get_if<RbfOptions>(&config.options)) {
-    DistributedRbfMover<Dim> mover(*rbf);
+    DistributedRbfMover<Dim> mover(*rbf, {.kind = boundary_solve_kind(a.boundary_solve)});
     mover.setup(part.view(), local);
     displacement = mover.move(local.displacements);
     stats = mover.stats();
+    petsc_boundary = mover.petsc_solve();
   } else {
     DistributedElasticityOptions options;
     options.elasticity = std::get<ElasticityOptions>(config.options);
@@ -132,9 +153,11 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
     if (a.json) {
       JsonWriter w(std::cout);
       w.begin_object().key("input").value(a.input).key("output").value(a.output).key("method").value(config.method);
-      w.key("ranks").value(ranks);
-      if (std::holds_alternative<RbfOptions>(config.options)) w.key("support_radius").value(radius);
-      else w.key("solver").value(a.solver);
+      w.key("ranks").value(ranks).key("threads_per_rank").value(num_threads());
+      if (std::holds_alternative<RbfOptions>(config.options))
+        w.key("support_radius").value(radius).key("boundary_solve").value(petsc_boundary ? "petsc" : "replicated");
+      else
+        w.key("solver").value(a.solver);
       w.key("nodes").value(whole->num_nodes()).key("boundary_nodes").value(stats.boundary_nodes);
       w.key("setup_seconds").value(seconds[0]).key("move_seconds").value(seconds[1]);
       w.key("before").begin_object().key("min").value(before.min).key("mean").value(before.mean);
@@ -144,7 +167,10 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
       w.end_object();
       std::cout << "\n";
     } else {
-      std::cout << "moved " << whole->num_nodes() << " nodes with " << config.method << " on " << ranks << " rank(s)\n"
+      std::cout << "moved " << whole->num_nodes() << " nodes with " << config.method << " on " << ranks << " rank(s) of "
+                << num_threads() << " thread(s)"
+                << (std::holds_alternative<RbfOptions>(config.options) ? (petsc_boundary ? ", boundary system through PETSc" : ", boundary system on every rank") : "")
+                << "\n"
                 << "  setup " << seconds[0] << " s, move " << seconds[1] << " s (slowest rank)\n"
                 << "  skew before: min " << before.min << " mean " << before.mean << " invalid " << before.num_invalid << "\n"
                 << "  skew after:  min " << after.min << " mean " << after.mean << " invalid " << after.num_invalid << "\n";
@@ -172,6 +198,14 @@ int main_body(int argc, char** argv) {
   examples::add_mover_options(app, a.mover, known_methods<3>());
   app.add_option("--petsc-solver", a.solver, "le/sle: PETSc solver automatic (mumps in 2D, cg_gamg in 3D) | cg_gamg | cg_hypre | mumps")->capture_default_str();
   app.add_option("--petsc-tolerance", a.tolerance, "le/sle: relative residual of CG (displacement units)")->capture_default_str();
+  app.add_option("--boundary-solve", a.boundary_solve,
+                 "rbf: where the boundary system is solved: automatic (PETSc when the options allow it and it is big "
+                 "enough for the ranks per node) | replicated (on every rank; any option) | petsc (MUMPS across the ranks)")
+      ->capture_default_str();
+  app.add_option("--threads", a.threads,
+                 "threads per rank (0: OMP_NUM_THREADS if set, else the node's cores shared among its ranks)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, max_threads));
   app.add_flag("--rank-files", a.rank_files, "also write each rank's part as OUTPUT's stem + .rankR + extension");
   app.add_flag("--strict", a.strict, "write nothing when invalid cells remain (exit 2)");
   app.add_flag("--overwrite", a.overwrite, "allow the output to be the input file");
@@ -191,9 +225,11 @@ int main_body(int argc, char** argv) {
       if (examples::list_options<2>(a.mover)) return examples::exit_ok;
       int dim = 0;
       std::unique_ptr<AnyMesh> mesh;
+      set_num_threads(threads_per_rank(comm, a.threads));
       collective(comm, [&] {
         if (a.input.empty() || a.output.empty()) throw InputError("move_mesh_mpi: give an input mesh and -o OUTPUT (see --help)");
         examples::require_motion(a.motion, "move_mesh_mpi");
+        (void)boundary_solve_kind(a.boundary_solve);
         if (!root) return;
         examples::check_output(a.input, a.output, 1, a.overwrite);
         mesh = std::make_unique<AnyMesh>(read_mesh(a.input));

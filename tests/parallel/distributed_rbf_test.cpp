@@ -13,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <thread>
 
 using namespace meshmotion;
 using namespace meshmotion::parallel;
@@ -159,6 +160,35 @@ TEST_CASE("distributed RBF with the boundary system factorized across the ranks 
   DistributedRbfMover<2> automatic({.support_radius = 0.5}, {BoundarySolve::automatic, 1});
   automatic.setup(part.view(), b);
   CHECK_FALSE(automatic.petsc_solve());
+}
+
+TEST_CASE("automatic boundary solve: PETSc on several ranks once centres × ranks per node reach the threshold",
+          "[parallel][rbf][petsc]") {
+  // Every rank of a ctest run shares one node.
+  CHECK(ranks_on_node(world()) == size_of(world()));
+  const int share = node_share_of_cores(world());
+  CHECK(share >= 1);
+  CHECK(share <= std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / size_of(world())));
+
+  const Mesh<2> mesh = rectangle_mesh({.nx = 10, .ny = 10});
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Translation<2>{{0.0, 0.05}}).fixed("top");
+  const ResolvedBoundary<2> whole_b = spec.resolve(mesh);
+  const auto centres = static_cast<Index>(whole_b.size());
+  const DistributedMesh<2> part = partition_mesh(world(), mesh);
+  const ResolvedBoundary<2> b = distribute_boundary(part, whole_b);
+  const auto chooses_petsc = [&](Index node_centres) {
+    BoundarySolveOptions solve;
+    solve.petsc_min_node_centres = node_centres;
+    DistributedRbfMover<2> mover({.support_radius = 0.5}, solve);
+    mover.setup(part.view(), b);
+    return mover.petsc_solve();
+  };
+  const Index work = centres * ranks_on_node(world());
+  // One rank keeps the serial mover's own solve; several take PETSc from the threshold on.
+  CHECK(chooses_petsc(work) == (size_of(world()) > 1));
+  CHECK_FALSE(chooses_petsc(work + 1));
+  CHECK_FALSE(chooses_petsc(BoundarySolveOptions{}.petsc_min_node_centres));
 }
 
 TEST_CASE("distributed RBF keeps sliding nodes and per-node radii as serial does", "[parallel][rbf]") {

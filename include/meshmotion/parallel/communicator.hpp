@@ -13,11 +13,17 @@
 
 #include <mpi.h>
 
+#ifdef __linux__
+#include <sched.h>
+#endif
+
+#include <algorithm>
 #include <climits>
 #include <cstdint>
 #include <numeric>
 #include <span>
 #include <string>
+#include <thread>
 #include <type_traits>
 #include <vector>
 
@@ -64,6 +70,28 @@ template <class T>
 }
 
 }  // namespace detail
+
+/// Ranks of `comm` on this rank's node (those that can share memory with it). Collective.
+[[nodiscard]] inline int ranks_on_node(MPI_Comm comm) {
+  MPI_Comm node = MPI_COMM_NULL;
+  MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node);
+  const int n = size_of(node);
+  MPI_Comm_free(&node);
+  return n;
+}
+
+/// This rank's even share of its node's cores among the ranks of `comm` on it, at least 1 and
+/// at most the cores the process may run on (bound to one core: 1). Give it to
+/// set_num_threads when several ranks share a node: each rank's OpenMP loops and CHOLMOD
+/// otherwise open a thread per core, and the node runs ranks × cores threads. Collective.
+[[nodiscard]] inline int node_share_of_cores(MPI_Comm comm) {
+  int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+#ifdef __linux__
+  cpu_set_t mask;
+  if (sched_getaffinity(0, sizeof(mask), &mask) == 0) cores = std::min(cores, std::max(1, CPU_COUNT(&mask)));
+#endif
+  return std::max(1, cores / ranks_on_node(comm));
+}
 
 /// Every rank's `mine` concatenated in rank order, on every rank; `counts` (optional) receives
 /// each rank's count.

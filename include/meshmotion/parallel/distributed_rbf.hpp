@@ -10,7 +10,8 @@
 ///   displacements; any option), or once across the ranks by MUMPS through PETSc
 ///   (PetscRbfSystem: the factor's memory and the solves split between the ranks; compact
 ///   kernel, one radius, no sliding node, distinct centres). BoundarySolve::automatic takes
-///   PETSc from BoundarySolveOptions::petsc_min_centres centres on when the options allow it.
+///   PETSc when the options allow it, from BoundarySolveOptions::petsc_min_centres centres on,
+///   or on several ranks when centres × ranks per node reach petsc_min_node_centres.
 ///   Each rank then builds the evaluation operator of its own local nodes (owned and ghost)
 ///   with its own k-d tree over the centres.
 /// - move: one allgatherv of the owned entries' displacements (Dim doubles per boundary node),
@@ -46,16 +47,23 @@ namespace meshmotion::parallel {
 
 /// Where the distributed RBF mover solves its boundary system.
 enum class BoundarySolve {
-  automatic,   ///< PETSc from petsc_min_centres centres on when the options allow it, else replicated
+  automatic,   ///< PETSc when the options allow it and the system is big enough (BoundarySolveOptions), else replicated
   replicated,  ///< factorized on every rank (any option: sliding, radius per node, global kernels)
   petsc,       ///< factorized once across the ranks by MUMPS (compact kernel, one radius, no sliding, distinct centres)
 };
 
+/// How automatic chooses, from the figures of docs/parallel.md: replicated, every rank on a node
+/// factorizes the same system at once, which on a 16-core node made the 2.05M-node box's setup
+/// 5× slower at 8 ranks and 25× at 16 than at one (16,129 centres), while MUMPS's setup fell
+/// with the ranks and its moves were faster from 2 ranks on.
 struct BoundarySolveOptions {
   BoundarySolve kind = BoundarySolve::automatic;
-  /// Fewest centres for which automatic takes PETSc: below, the replicated solve moves faster on
-  /// the machines measured (docs/parallel.md); above, its factor on every rank costs too much memory.
+  /// Fewest centres for which automatic takes PETSc at any rank count: above, the factor on
+  /// every rank costs too much memory.
   Index petsc_min_centres = 50000;
+  /// Fewest centres × ranks sharing a node for which automatic takes PETSc on 2 ranks or more:
+  /// the replicated factorizations a node runs at once.
+  Index petsc_min_node_centres = 30000;
 };
 
 template <int Dim>
@@ -240,8 +248,10 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
   gathered_.resize(Dim, m);
   // Every rank decides alike: the inputs are the gathered arrays.
   // The obstacles (a k-d tree over the centres among them) are looked for only when PETSc is wanted.
+  const int sharing = ranks_on_node(comm_);
   const bool wanted = solve_.kind == BoundarySolve::petsc ||
-                      (solve_.kind == BoundarySolve::automatic && m >= solve_.petsc_min_centres);
+                      (solve_.kind == BoundarySolve::automatic &&
+                       (m >= solve_.petsc_min_centres || (size_of(comm_) > 1 && m * sharing >= solve_.petsc_min_node_centres)));
   const std::string obstacle = wanted ? petsc_obstacle(all_kinds, any_radius != 0, points.leftCols(m)) : std::string();
   if (solve_.kind == BoundarySolve::petsc && !obstacle.empty())
     throw InputError("DistributedRbfMover::setup: the boundary system cannot go through PETSc: " + obstacle +
