@@ -8,6 +8,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <string>
+#include <utility>
+
 using namespace meshmotion;
 using namespace meshmotion::parallel;
 using test::global_max;
@@ -95,4 +98,29 @@ TEST_CASE("distributed elasticity: a solver failure raises on every rank, or fal
   DistributedElasticityOptions unsupported;
   unsupported.elasticity.active_radius = 0.3;
   CHECK_THROWS_WITH(relative_error(mesh, spec, unsupported), Catch::Contains("not supported in parallel"));
+}
+
+TEST_CASE("PETSc plumbing: a failed call names the caller, the call and PETSc's own text; handles own", "[parallel][petsc]") {
+  using meshmotion::parallel::detail::OwnedVec;
+  using meshmotion::parallel::detail::petsc_check;
+  CHECK_NOTHROW(petsc_check(0, "here", "VecCreate"));
+  const char* text = nullptr;
+  PetscErrorMessage(PETSC_ERR_ARG_OUTOFRANGE, &text, nullptr);
+  REQUIRE(text != nullptr);
+  CHECK_THROWS_AS(petsc_check(PETSC_ERR_ARG_OUTOFRANGE, "here", "MatSetSizes"), SolverError);
+  CHECK_THROWS_WITH(petsc_check(PETSC_ERR_ARG_OUTOFRANGE, "DistributedElasticityMover::setup", "MatSetSizes"),
+                    Catch::Contains("DistributedElasticityMover::setup: PETSc's MatSetSizes failed") &&
+                        Catch::Contains(std::string(text)));
+  OwnedVec v;
+  CHECK_FALSE(v);
+  REQUIRE(VecCreateSeq(PETSC_COMM_SELF, 4, v.out()) == 0);
+  CHECK(v);
+  OwnedVec w = std::move(v);
+  CHECK(w);
+  CHECK_FALSE(v);  // NOLINT(bugprone-use-after-move): a moved-from handle is empty by contract
+  PetscInt size = 0;
+  REQUIRE(VecGetSize(w.get(), &size) == 0);
+  CHECK(size == 4);
+  w.reset();
+  CHECK_FALSE(w);
 }

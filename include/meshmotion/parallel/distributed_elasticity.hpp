@@ -35,6 +35,7 @@
 #include "meshmotion/movers/elasticity.hpp"
 #include "meshmotion/parallel/communicator.hpp"
 #include "meshmotion/parallel/distributed_mesh.hpp"
+#include "meshmotion/parallel/petsc.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 
 #include <petscksp.h>
@@ -73,14 +74,6 @@ struct DistributedElasticityOptions {
   std::string petsc_prefix = "meshmotion_";
 };
 
-namespace detail {
-
-inline void petsc_check(PetscErrorCode code, const char* call) {
-  if (code != 0) throw SolverError(std::string("DistributedElasticityMover: PETSc's ") + call + " failed (error " + std::to_string(code) + ")");
-}
-
-}  // namespace detail
-
 template <int Dim>
 class DistributedElasticityMover {
  public:
@@ -89,7 +82,6 @@ class DistributedElasticityMover {
   explicit DistributedElasticityMover(DistributedElasticityOptions options = {}) : options_(std::move(options)) {}
   DistributedElasticityMover(const DistributedElasticityMover&) = delete;
   DistributedElasticityMover& operator=(const DistributedElasticityMover&) = delete;
-  ~DistributedElasticityMover() { release(); }
 
   [[nodiscard]] const DistributedElasticityOptions& options() const noexcept { return options_; }
   [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
@@ -128,15 +120,18 @@ class DistributedElasticityMover {
   };
 
   void setup_mesh(const PartitionView<Dim>& part, const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary);
-  void build_solver(KSP& ksp, PetscSolverKind kind);
+  using OwnedKsp = detail::OwnedKsp;
+  using OwnedMat = detail::OwnedMat;
+  using OwnedVec = detail::OwnedVec;
+
+  void build_solver(OwnedKsp& ksp, PetscSolverKind kind, const char* where);
   void release() {
-    if (ksp_ != nullptr) KSPDestroy(&ksp_);
-    if (direct_ != nullptr) KSPDestroy(&direct_);
-    if (a_ != nullptr) MatDestroy(&a_);
-    if (k_ != nullptr) MatDestroy(&k_);
-    for (::Vec* v : {&scale_, &b_, &x_, &values_, &ghosts_})
-      if (*v != nullptr) VecDestroy(v);
-    if (scatter_ != nullptr) VecScatterDestroy(&scatter_);
+    ksp_.reset();
+    direct_.reset();
+    scatter_.reset();
+    for (OwnedVec* v : {&scale_, &b_, &x_, &values_, &ghosts_}) v->reset();
+    a_.reset();
+    k_.reset();
   }
 
   static NodeCondition condition_of(const ResolvedBoundary<Dim>& b, Index k) {
@@ -168,48 +163,42 @@ class DistributedElasticityMover {
   std::vector<PetscInt> dirichlet_;       ///< owned Dirichlet rows (global)
   Index boundary_size_ = 0;
   PetscInt first_row_ = 0;
-  Mat k_ = nullptr, a_ = nullptr;  ///< K in the rotated frames; the same with Dirichlet rows, scaled
-  KSP ksp_ = nullptr, direct_ = nullptr;
-  ::Vec scale_ = nullptr, b_ = nullptr, x_ = nullptr, values_ = nullptr, ghosts_ = nullptr;
-  VecScatter scatter_ = nullptr;
+  OwnedMat k_, a_;  ///< K in the rotated frames; the same with Dirichlet rows, scaled
+  OwnedVec scale_, b_, x_, values_, ghosts_;
+  detail::OwnedScatter scatter_;
+  OwnedKsp ksp_, direct_;
 };
 
 template <int Dim>
-void DistributedElasticityMover<Dim>::build_solver(KSP& ksp, PetscSolverKind kind) {
-  using meshmotion::parallel::detail::petsc_check;
-  petsc_check(KSPCreate(comm_, &ksp), "KSPCreate");
-  petsc_check(KSPSetOperators(ksp, a_, a_), "KSPSetOperators");
+void DistributedElasticityMover<Dim>::build_solver(OwnedKsp& ksp, PetscSolverKind kind, const char* where) {
+  using detail::petsc_check;
+  petsc_check(KSPCreate(comm_, ksp.out()), where, "KSPCreate");
+  petsc_check(KSPSetOperators(ksp.get(), a_.get(), a_.get()), where, "KSPSetOperators");
   PC pc = nullptr;
-  petsc_check(KSPGetPC(ksp, &pc), "KSPGetPC");
+  petsc_check(KSPGetPC(ksp.get(), &pc), where, "KSPGetPC");
   if (kind == PetscSolverKind::direct_mumps) {
-    petsc_check(KSPSetType(ksp, KSPPREONLY), "KSPSetType");
-    petsc_check(PCSetType(pc, PCCHOLESKY), "PCSetType");
-    petsc_check(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS), "PCFactorSetMatSolverType");
-    // METIS ordering: MUMPS's automatic choice fills twice as much on these meshes.
-    petsc_check(PCFactorSetUpMatSolverType(pc), "PCFactorSetUpMatSolverType");
-    Mat factor = nullptr;
-    petsc_check(PCFactorGetMatrix(pc, &factor), "PCFactorGetMatrix");
-    petsc_check(MatMumpsSetIcntl(factor, 7, 5), "MatMumpsSetIcntl");
+    detail::use_mumps_cholesky(ksp.get(), where);
   } else {
-    petsc_check(KSPSetType(ksp, KSPCG), "KSPSetType");
+    petsc_check(KSPSetType(ksp.get(), KSPCG), where, "KSPSetType");
     if (kind == PetscSolverKind::cg_hypre) {
-      petsc_check(PCSetType(pc, PCHYPRE), "PCSetType");
-      petsc_check(PCHYPRESetType(pc, "boomeramg"), "PCHYPRESetType");
+      petsc_check(PCSetType(pc, PCHYPRE), where, "PCSetType");
+      petsc_check(PCHYPRESetType(pc, "boomeramg"), where, "PCHYPRESetType");
     } else {
-      petsc_check(PCSetType(pc, PCGAMG), "PCSetType");
+      petsc_check(PCSetType(pc, PCGAMG), where, "PCSetType");
     }
-    petsc_check(KSPSetTolerances(ksp, options_.tolerance, 0.0, PETSC_DEFAULT, options_.max_iterations), "KSPSetTolerances");
-    petsc_check(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
+    petsc_check(KSPSetTolerances(ksp.get(), options_.tolerance, 0.0, PETSC_DEFAULT, options_.max_iterations), where, "KSPSetTolerances");
+    petsc_check(KSPSetNormType(ksp.get(), KSP_NORM_UNPRECONDITIONED), where, "KSPSetNormType");
   }
-  petsc_check(KSPSetOptionsPrefix(ksp, options_.petsc_prefix.c_str()), "KSPSetOptionsPrefix");
-  petsc_check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
-  petsc_check(KSPSetUp(ksp), "KSPSetUp");
+  petsc_check(KSPSetOptionsPrefix(ksp.get(), options_.petsc_prefix.c_str()), where, "KSPSetOptionsPrefix");
+  petsc_check(KSPSetFromOptions(ksp.get()), where, "KSPSetFromOptions");
+  petsc_check(KSPSetUp(ksp.get()), where, "KSPSetUp");
 }
 
 template <int Dim>
 void DistributedElasticityMover<Dim>::setup_mesh(const PartitionView<Dim>& part, const Mesh<Dim>& mesh,
                                                  const ResolvedBoundary<Dim>& boundary) {
-  using meshmotion::parallel::detail::petsc_check;
+  using detail::petsc_check;
+  constexpr const char* where = "DistributedElasticityMover::setup";
   const meshmotion::detail::Stopwatch watch;
   ready_ = false;
   release();
@@ -356,24 +345,24 @@ void DistributedElasticityMover<Dim>::setup_mesh(const PartitionView<Dim>& part,
       cv.push_back(it.value());
     }
   const PetscInt local_rows = n_owned * Dim;
-  petsc_check(MatCreate(comm_, &k_), "MatCreate");
-  petsc_check(MatSetSizes(k_, local_rows, local_rows, PETSC_DETERMINE, PETSC_DETERMINE), "MatSetSizes");
-  petsc_check(MatSetType(k_, MATAIJ), "MatSetType");
-  petsc_check(MatSetBlockSize(k_, Dim), "MatSetBlockSize");
-  petsc_check(MatSetPreallocationCOO(k_, static_cast<PetscCount>(ci.size()), ci.data(), cj.data()), "MatSetPreallocationCOO");
-  petsc_check(MatSetValuesCOO(k_, cv.data(), ADD_VALUES), "MatSetValuesCOO");
+  petsc_check(MatCreate(comm_, k_.out()), where, "MatCreate");
+  petsc_check(MatSetSizes(k_.get(), local_rows, local_rows, PETSC_DETERMINE, PETSC_DETERMINE), where, "MatSetSizes");
+  petsc_check(MatSetType(k_.get(), MATAIJ), where, "MatSetType");
+  petsc_check(MatSetBlockSize(k_.get(), Dim), where, "MatSetBlockSize");
+  petsc_check(MatSetPreallocationCOO(k_.get(), static_cast<PetscCount>(ci.size()), ci.data(), cj.data()), where, "MatSetPreallocationCOO");
+  petsc_check(MatSetValuesCOO(k_.get(), cv.data(), ADD_VALUES), where, "MatSetValuesCOO");
   ci = {}, cj = {}, cv = {};
 
   // Dirichlet dofs: prescribed and fixed nodes, the constrained directions of sliding ones,
   // and dofs without stiffness (a node in no cell).
-  petsc_check(MatCreateVecs(k_, &x_, &b_), "MatCreateVecs");
-  petsc_check(VecDuplicate(x_, &values_), "VecDuplicate");
-  petsc_check(VecDuplicate(x_, &scale_), "VecDuplicate");
-  petsc_check(MatGetDiagonal(k_, scale_), "MatGetDiagonal");
+  petsc_check(MatCreateVecs(k_.get(), x_.out(), b_.out()), where, "MatCreateVecs");
+  petsc_check(VecDuplicate(x_.get(), values_.out()), where, "VecDuplicate");
+  petsc_check(VecDuplicate(x_.get(), scale_.out()), where, "VecDuplicate");
+  petsc_check(MatGetDiagonal(k_.get(), scale_.get()), where, "MatGetDiagonal");
   dirichlet_.clear();
   {
     const PetscScalar* diag = nullptr;
-    petsc_check(VecGetArrayRead(scale_, &diag), "VecGetArrayRead");
+    petsc_check(VecGetArrayRead(scale_.get(), &diag), where, "VecGetArrayRead");
     for (PetscInt j = 0; j < n_owned; ++j) {
       const NodeCondition& c = conditions_[static_cast<std::size_t>(owned_nodes_[static_cast<std::size_t>(j)])];
       for (int a = 0; a < Dim; ++a) {
@@ -382,61 +371,57 @@ void DistributedElasticityMover<Dim>::setup_mesh(const PartitionView<Dim>& part,
         if (held) dirichlet_.push_back(first_row_ + j * Dim + a);
       }
     }
-    petsc_check(VecRestoreArrayRead(scale_, &diag), "VecRestoreArrayRead");
+    petsc_check(VecRestoreArrayRead(scale_.get(), &diag), where, "VecRestoreArrayRead");
   }
-  petsc_check(MatDuplicate(k_, MAT_COPY_VALUES, &a_), "MatDuplicate");
-  petsc_check(MatZeroRowsColumns(a_, static_cast<PetscInt>(dirichlet_.size()), dirichlet_.data(), 1.0, nullptr, nullptr),
-              "MatZeroRowsColumns");
+  petsc_check(MatDuplicate(k_.get(), MAT_COPY_VALUES, a_.out()), where, "MatDuplicate");
+  petsc_check(MatZeroRowsColumns(a_.get(), static_cast<PetscInt>(dirichlet_.size()), dirichlet_.data(), 1.0, nullptr, nullptr),
+              where, "MatZeroRowsColumns");
   // Symmetric diagonal scaling: s = diag^-1/2.
-  petsc_check(MatGetDiagonal(a_, scale_), "MatGetDiagonal");
+  petsc_check(MatGetDiagonal(a_.get(), scale_.get()), where, "MatGetDiagonal");
   double smallest = 0.0;
-  petsc_check(VecMin(scale_, nullptr, &smallest), "VecMin");
+  petsc_check(VecMin(scale_.get(), nullptr, &smallest), where, "VecMin");
   collective(comm_, [&] {
     if (!(smallest > 0.0))
       throw SolverError("DistributedElasticityMover::setup: the stiffness matrix has a non-positive diagonal entry "
                         "(an inverted cell, or a material that is not positive definite)");
   });
-  petsc_check(VecSqrtAbs(scale_), "VecSqrtAbs");
-  petsc_check(VecReciprocal(scale_), "VecReciprocal");
-  petsc_check(MatDiagonalScale(a_, scale_, scale_), "MatDiagonalScale");
-  petsc_check(MatSetOption(a_, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption");
-  petsc_check(MatSetOption(a_, MAT_SPD, PETSC_TRUE), "MatSetOption");
+  petsc_check(VecSqrtAbs(scale_.get()), where, "VecSqrtAbs");
+  petsc_check(VecReciprocal(scale_.get()), where, "VecReciprocal");
+  petsc_check(MatDiagonalScale(a_.get(), scale_.get(), scale_.get()), where, "MatDiagonalScale");
+  petsc_check(MatSetOption(a_.get(), MAT_SYMMETRIC, PETSC_TRUE), where, "MatSetOption");
+  petsc_check(MatSetOption(a_.get(), MAT_SPD, PETSC_TRUE), where, "MatSetOption");
   if (options_.solver == PetscSolverKind::cg_gamg || (options_.solver == PetscSolverKind::automatic && Dim == 3)) {
     // Rigid-body modes of the owned nodes (in the unrotated frame: near enough for the AMG).
-    ::Vec coordinates = nullptr;
-    petsc_check(VecCreateMPI(comm_, local_rows, PETSC_DETERMINE, &coordinates), "VecCreateMPI");
-    petsc_check(VecSetBlockSize(coordinates, Dim), "VecSetBlockSize");
+    OwnedVec coordinates;
+    petsc_check(VecCreateMPI(comm_, local_rows, PETSC_DETERMINE, coordinates.out()), where, "VecCreateMPI");
+    petsc_check(VecSetBlockSize(coordinates.get(), Dim), where, "VecSetBlockSize");
     PetscScalar* xyz = nullptr;
-    petsc_check(VecGetArray(coordinates, &xyz), "VecGetArray");
+    petsc_check(VecGetArray(coordinates.get(), &xyz), where, "VecGetArray");
     for (PetscInt j = 0; j < n_owned; ++j)
       for (int a = 0; a < Dim; ++a) xyz[j * Dim + a] = part.points(a, owned_nodes_[static_cast<std::size_t>(j)]);
-    petsc_check(VecRestoreArray(coordinates, &xyz), "VecRestoreArray");
-    MatNullSpace modes = nullptr;
-    petsc_check(MatNullSpaceCreateRigidBody(coordinates, &modes), "MatNullSpaceCreateRigidBody");
-    petsc_check(MatSetNearNullSpace(a_, modes), "MatSetNearNullSpace");
-    MatNullSpaceDestroy(&modes);
-    VecDestroy(&coordinates);
+    petsc_check(VecRestoreArray(coordinates.get(), &xyz), where, "VecRestoreArray");
+    detail::OwnedNullSpace modes;
+    petsc_check(MatNullSpaceCreateRigidBody(coordinates.get(), modes.out()), where, "MatNullSpaceCreateRigidBody");
+    petsc_check(MatSetNearNullSpace(a_.get(), modes.get()), where, "MatSetNearNullSpace");
   }
   const PetscSolverKind kind = options_.solver != PetscSolverKind::automatic ? options_.solver
                                : Dim == 2                                   ? PetscSolverKind::direct_mumps
                                                                             : PetscSolverKind::cg_gamg;
-  build_solver(ksp_, kind);
+  build_solver(ksp_, kind, where);
 
   // Ghost values come from their owners' rows.
   std::vector<PetscInt> from;
   from.reserve(ghost_nodes_.size() * Dim);
   for (const Index i : ghost_nodes_)
     for (int a = 0; a < Dim; ++a) from.push_back(row_of[static_cast<std::size_t>(i)] + a);
-  IS is_from = nullptr, is_to = nullptr;
-  petsc_check(ISCreateGeneral(PETSC_COMM_SELF, static_cast<PetscInt>(from.size()), from.data(), PETSC_COPY_VALUES, &is_from), "ISCreateGeneral");
-  petsc_check(ISCreateStride(PETSC_COMM_SELF, static_cast<PetscInt>(from.size()), 0, 1, &is_to), "ISCreateStride");
-  petsc_check(VecCreateSeq(PETSC_COMM_SELF, static_cast<PetscInt>(from.size()), &ghosts_), "VecCreateSeq");
-  petsc_check(VecScatterCreate(x_, is_from, ghosts_, is_to, &scatter_), "VecScatterCreate");
-  ISDestroy(&is_from);
-  ISDestroy(&is_to);
+  detail::OwnedIs is_from, is_to;
+  petsc_check(ISCreateGeneral(PETSC_COMM_SELF, static_cast<PetscInt>(from.size()), from.data(), PETSC_COPY_VALUES, is_from.out()), where, "ISCreateGeneral");
+  petsc_check(ISCreateStride(PETSC_COMM_SELF, static_cast<PetscInt>(from.size()), 0, 1, is_to.out()), where, "ISCreateStride");
+  petsc_check(VecCreateSeq(PETSC_COMM_SELF, static_cast<PetscInt>(from.size()), ghosts_.out()), where, "VecCreateSeq");
+  petsc_check(VecScatterCreate(x_.get(), is_from.get(), ghosts_.get(), is_to.get(), scatter_.out()), where, "VecScatterCreate");
 
   MatInfo info;
-  MatGetInfo(a_, MAT_LOCAL, &info);
+  MatGetInfo(a_.get(), MAT_LOCAL, &info);
   stats_ = MoverStats{};
   stats_.boundary_nodes = static_cast<Index>(owned_entries_.size());
   MPI_Allreduce(MPI_IN_PLACE, &stats_.boundary_nodes, 1, MPI_INT64_T, MPI_SUM, comm_);
@@ -449,7 +434,8 @@ void DistributedElasticityMover<Dim>::setup_mesh(const PartitionView<Dim>& part,
 
 template <int Dim>
 void DistributedElasticityMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& out) {
-  using meshmotion::parallel::detail::petsc_check;
+  using detail::petsc_check;
+  constexpr const char* where = "DistributedElasticityMover::move";
   const meshmotion::detail::Stopwatch watch;
   collective(comm_, [&] {
     if (!ready_) throw InputError("DistributedElasticityMover::move: setup() was not called");
@@ -461,9 +447,9 @@ void DistributedElasticityMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& 
         throw InputError("DistributedElasticityMover::move: boundary entry " + std::to_string(k) + " has a non-finite displacement");
   });
   // values_: the prescribed displacements on their owned rows, zero elsewhere.
-  petsc_check(VecSet(values_, 0.0), "VecSet");
+  petsc_check(VecSet(values_.get(), 0.0), where, "VecSet");
   PetscScalar* v = nullptr;
-  petsc_check(VecGetArray(values_, &v), "VecGetArray");
+  petsc_check(VecGetArray(values_.get(), &v), where, "VecGetArray");
   for (std::size_t e = 0; e < owned_entries_.size(); ++e) {
     const Index k = owned_entries_[e];
     if (conditions_[static_cast<std::size_t>(entry_nodes_[e])].kind != prescribed) continue;
@@ -471,23 +457,23 @@ void DistributedElasticityMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& 
   }
   std::vector<double> held(dirichlet_.size());
   for (std::size_t r = 0; r < held.size(); ++r) held[r] = v[dirichlet_[r] - first_row_];
-  petsc_check(VecRestoreArray(values_, &v), "VecRestoreArray");
+  petsc_check(VecRestoreArray(values_.get(), &v), where, "VecRestoreArray");
   // b = −K u_D on free rows, u_D on Dirichlet rows; then scaled like the matrix.
-  petsc_check(MatMult(k_, values_, b_), "MatMult");
-  petsc_check(VecScale(b_, -1.0), "VecScale");
+  petsc_check(MatMult(k_.get(), values_.get(), b_.get()), where, "MatMult");
+  petsc_check(VecScale(b_.get(), -1.0), where, "VecScale");
   PetscScalar* b = nullptr;
-  petsc_check(VecGetArray(b_, &b), "VecGetArray");
+  petsc_check(VecGetArray(b_.get(), &b), where, "VecGetArray");
   for (std::size_t r = 0; r < held.size(); ++r) b[dirichlet_[r] - first_row_] = held[r];
-  petsc_check(VecRestoreArray(b_, &b), "VecRestoreArray");
-  petsc_check(VecPointwiseMult(b_, b_, scale_), "VecPointwiseMult");
+  petsc_check(VecRestoreArray(b_.get(), &b), where, "VecRestoreArray");
+  petsc_check(VecPointwiseMult(b_.get(), b_.get(), scale_.get()), where, "VecPointwiseMult");
   PetscReal rhs_norm = 0.0;
-  petsc_check(VecNorm(b_, NORM_2, &rhs_norm), "VecNorm");
+  petsc_check(VecNorm(b_.get(), NORM_2, &rhs_norm), where, "VecNorm");
 
-  petsc_check(KSPSolve(ksp_, b_, x_), "KSPSolve");
+  petsc_check(KSPSolve(ksp_.get(), b_.get(), x_.get()), where, "KSPSolve");
   KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
-  petsc_check(KSPGetConvergedReason(ksp_, &reason), "KSPGetConvergedReason");
+  petsc_check(KSPGetConvergedReason(ksp_.get(), &reason), where, "KSPGetConvergedReason");
   PetscInt iterations = 0;
-  petsc_check(KSPGetIterationNumber(ksp_, &iterations), "KSPGetIterationNumber");
+  petsc_check(KSPGetIterationNumber(ksp_.get(), &iterations), where, "KSPGetIterationNumber");
   stats_.fell_back = false;
   // The reason is the same on every rank, so every rank raises or falls back alike.
   if (reason < 0) {
@@ -496,37 +482,36 @@ void DistributedElasticityMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& 
                         " after " + std::to_string(iterations) + " iterations; tolerance " + std::to_string(options_.tolerance) +
                         "); set fallback_to_direct or another solver");
     }
-    if (direct_ == nullptr) build_solver(direct_, PetscSolverKind::direct_mumps);
-    petsc_check(KSPSolve(direct_, b_, x_), "KSPSolve");
+    if (!direct_) build_solver(direct_, PetscSolverKind::direct_mumps, where);
+    petsc_check(KSPSolve(direct_.get(), b_.get(), x_.get()), where, "KSPSolve");
     stats_.fell_back = true;
   }
-  ::Vec residual = nullptr;
-  petsc_check(VecDuplicate(b_, &residual), "VecDuplicate");
-  petsc_check(MatMult(a_, x_, residual), "MatMult");
-  petsc_check(VecAYPX(residual, -1.0, b_), "VecAYPX");
+  OwnedVec residual;
+  petsc_check(VecDuplicate(b_.get(), residual.out()), where, "VecDuplicate");
+  petsc_check(MatMult(a_.get(), x_.get(), residual.get()), where, "MatMult");
+  petsc_check(VecAYPX(residual.get(), -1.0, b_.get()), where, "VecAYPX");
   PetscReal residual_norm = 0.0;
-  petsc_check(VecNorm(residual, NORM_2, &residual_norm), "VecNorm");
-  VecDestroy(&residual);
-  petsc_check(VecPointwiseMult(x_, x_, scale_), "VecPointwiseMult");
+  petsc_check(VecNorm(residual.get(), NORM_2, &residual_norm), where, "VecNorm");
+  petsc_check(VecPointwiseMult(x_.get(), x_.get(), scale_.get()), where, "VecPointwiseMult");
   // Dirichlet values exactly, whatever the Krylov iterate left there.
   PetscScalar* x = nullptr;
-  petsc_check(VecGetArray(x_, &x), "VecGetArray");
+  petsc_check(VecGetArray(x_.get(), &x), where, "VecGetArray");
   for (std::size_t r = 0; r < held.size(); ++r) x[dirichlet_[r] - first_row_] = held[r];
   out.resize(Dim, n_local_);
   for (std::size_t j = 0; j < owned_nodes_.size(); ++j) {
     const Index i = owned_nodes_[j];
     out.col(i) = conditions_[static_cast<std::size_t>(i)].frame * Eigen::Map<const Vec<Dim>>(x + j * Dim);
   }
-  petsc_check(VecRestoreArray(x_, &x), "VecRestoreArray");
-  petsc_check(VecScatterBegin(scatter_, x_, ghosts_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
-  petsc_check(VecScatterEnd(scatter_, x_, ghosts_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
+  petsc_check(VecRestoreArray(x_.get(), &x), where, "VecRestoreArray");
+  petsc_check(VecScatterBegin(scatter_.get(), x_.get(), ghosts_.get(), INSERT_VALUES, SCATTER_FORWARD), where, "VecScatterBegin");
+  petsc_check(VecScatterEnd(scatter_.get(), x_.get(), ghosts_.get(), INSERT_VALUES, SCATTER_FORWARD), where, "VecScatterEnd");
   const PetscScalar* g = nullptr;
-  petsc_check(VecGetArrayRead(ghosts_, &g), "VecGetArrayRead");
+  petsc_check(VecGetArrayRead(ghosts_.get(), &g), where, "VecGetArrayRead");
   for (std::size_t j = 0; j < ghost_nodes_.size(); ++j) {
     const Index i = ghost_nodes_[j];
     out.col(i) = conditions_[static_cast<std::size_t>(i)].frame * Eigen::Map<const Vec<Dim>>(g + j * Dim);
   }
-  petsc_check(VecRestoreArrayRead(ghosts_, &g), "VecRestoreArrayRead");
+  petsc_check(VecRestoreArrayRead(ghosts_.get(), &g), where, "VecRestoreArrayRead");
   ++stats_.moves;
   stats_.iterations = iterations;
   stats_.residual = rhs_norm > 0.0 ? residual_norm / rhs_norm : 0.0;

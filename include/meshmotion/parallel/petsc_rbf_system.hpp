@@ -18,9 +18,8 @@
 #include "meshmotion/movers/detail/rbf_system.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
 #include "meshmotion/parallel/communicator.hpp"
+#include "meshmotion/parallel/petsc.hpp"
 #include "meshmotion/spatial/kd_tree.hpp"
-
-#include <petscksp.h>
 
 #include <Eigen/LU>
 
@@ -30,10 +29,6 @@
 
 namespace meshmotion::parallel::detail {
 
-inline void petsc_ok(PetscErrorCode code, const char* call) {
-  if (code != 0) throw SolverError(std::string("PETSc's ") + call + " failed (error " + std::to_string(code) + ")");
-}
-
 template <int Dim>
 class PetscRbfSystem {
  public:
@@ -42,12 +37,13 @@ class PetscRbfSystem {
   PetscRbfSystem() = default;
   PetscRbfSystem(const PetscRbfSystem&) = delete;
   PetscRbfSystem& operator=(const PetscRbfSystem&) = delete;
-  ~PetscRbfSystem() { release(); }
 
   /// Collective. `centres` (Dim × m, the same on every rank, distinct), a compact kernel with
   /// one radius. Throws SolverError when MUMPS fails (on every rank).
   void setup(MPI_Comm comm, const Points<Dim>& centres, const meshmotion::detail::RbfKernelSettings& kernel) {
-    release();
+    constexpr const char* where = "DistributedRbfMover::setup";
+    ksp_.reset();
+    a_.reset();
     comm_ = comm;
     centres_ = centres;
     kernel_ = kernel;
@@ -71,27 +67,19 @@ class PetscRbfSystem {
     std::vector<PetscInt> inner(block.innerIndexPtr(), block.innerIndexPtr() + block.nonZeros());
     std::vector<PetscScalar> values(block.valuePtr(), block.valuePtr() + block.nonZeros());
     collective(comm_, [&] {
-      petsc_ok(MatCreateMPIAIJWithArrays(comm_, local, local, static_cast<PetscInt>(m), static_cast<PetscInt>(m), outer.data(),
-                                         inner.data(), values.data(), &a_),
-               "MatCreateMPIAIJWithArrays");
-      petsc_ok(MatSetOption(a_, MAT_SPD, PETSC_TRUE), "MatSetOption");
-      petsc_ok(KSPCreate(comm_, &ksp_), "KSPCreate");
-      petsc_ok(KSPSetOperators(ksp_, a_, a_), "KSPSetOperators");
-      petsc_ok(KSPSetType(ksp_, KSPPREONLY), "KSPSetType");
-      PC pc = nullptr;
-      petsc_ok(KSPGetPC(ksp_, &pc), "KSPGetPC");
-      petsc_ok(PCSetType(pc, PCCHOLESKY), "PCSetType");
-      petsc_ok(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS), "PCFactorSetMatSolverType");
-      petsc_ok(PCFactorSetUpMatSolverType(pc), "PCFactorSetUpMatSolverType");
-      Mat factor = nullptr;
-      petsc_ok(PCFactorGetMatrix(pc, &factor), "PCFactorGetMatrix");
-      petsc_ok(MatMumpsSetIcntl(factor, 7, 5), "MatMumpsSetIcntl");
-      petsc_ok(KSPSetOptionsPrefix(ksp_, "meshmotion_rbf_"), "KSPSetOptionsPrefix");
-      petsc_ok(KSPSetFromOptions(ksp_), "KSPSetFromOptions");
-      petsc_ok(KSPSetUp(ksp_), "KSPSetUp");
+      petsc_check(MatCreateMPIAIJWithArrays(comm_, local, local, static_cast<PetscInt>(m), static_cast<PetscInt>(m),
+                                            outer.data(), inner.data(), values.data(), a_.out()),
+                  where, "MatCreateMPIAIJWithArrays");
+      petsc_check(MatSetOption(a_.get(), MAT_SPD, PETSC_TRUE), where, "MatSetOption");
+      petsc_check(KSPCreate(comm_, ksp_.out()), where, "KSPCreate");
+      petsc_check(KSPSetOperators(ksp_.get(), a_.get(), a_.get()), where, "KSPSetOperators");
+      use_mumps_cholesky(ksp_.get(), where);
+      petsc_check(KSPSetOptionsPrefix(ksp_.get(), "meshmotion_rbf_"), where, "KSPSetOptionsPrefix");
+      petsc_check(KSPSetFromOptions(ksp_.get()), where, "KSPSetFromOptions");
+      petsc_check(KSPSetUp(ksp_.get()), where, "KSPSetUp");
     });
     PC pc = nullptr;
-    KSPGetPC(ksp_, &pc);
+    KSPGetPC(ksp_.get(), &pc);
     PCFailedReason failed = PC_NOERROR;
     PCGetFailedReason(pc, &failed);
     if (failed != PC_NOERROR)
@@ -144,30 +132,25 @@ class PetscRbfSystem {
   // one MUMPS call (one pass of communication for the Dim right-hand sides, not one each);
   // every rank gets the whole solution.
   void solve_a(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) {
+    constexpr const char* where = "DistributedRbfMover::move";
     const auto local = static_cast<PetscInt>(hi_ - lo_);
     const auto columns = static_cast<PetscInt>(b.cols());
-    Mat rhs = nullptr, solution = nullptr;
-    petsc_ok(MatCreateDense(comm_, local, PETSC_DECIDE, static_cast<PetscInt>(b.rows()), columns, nullptr, &rhs), "MatCreateDense");
-    petsc_ok(MatDuplicate(rhs, MAT_DO_NOT_COPY_VALUES, &solution), "MatDuplicate");
+    OwnedMat rhs, solution;
+    petsc_check(MatCreateDense(comm_, local, PETSC_DECIDE, static_cast<PetscInt>(b.rows()), columns, nullptr, rhs.out()), where,
+                "MatCreateDense");
+    petsc_check(MatDuplicate(rhs.get(), MAT_DO_NOT_COPY_VALUES, solution.out()), where, "MatDuplicate");
     PetscScalar* block = nullptr;
-    petsc_ok(MatDenseGetArrayWrite(rhs, &block), "MatDenseGetArrayWrite");
+    petsc_check(MatDenseGetArrayWrite(rhs.get(), &block), where, "MatDenseGetArrayWrite");
     Eigen::Map<Eigen::MatrixXd>(block, local, columns) = b.middleRows(lo_, local);
-    petsc_ok(MatDenseRestoreArrayWrite(rhs, &block), "MatDenseRestoreArrayWrite");
-    petsc_ok(KSPMatSolve(ksp_, rhs, solution), "KSPMatSolve");
+    petsc_check(MatDenseRestoreArrayWrite(rhs.get(), &block), where, "MatDenseRestoreArrayWrite");
+    petsc_check(KSPMatSolve(ksp_.get(), rhs.get(), solution.get()), where, "KSPMatSolve");
     const PetscScalar* solved = nullptr;
-    petsc_ok(MatDenseGetArrayRead(solution, &solved), "MatDenseGetArrayRead");
+    petsc_check(MatDenseGetArrayRead(solution.get(), &solved), where, "MatDenseGetArrayRead");
     // Row-major pieces, so that each rank's rows land contiguously in x's transpose.
     Eigen::MatrixXd mine = Eigen::Map<const Eigen::MatrixXd>(solved, local, columns).transpose();
-    petsc_ok(MatDenseRestoreArrayRead(solution, &solved), "MatDenseRestoreArrayRead");
-    MatDestroy(&rhs);
-    MatDestroy(&solution);
+    petsc_check(MatDenseRestoreArrayRead(solution.get(), &solved), where, "MatDenseRestoreArrayRead");
     const std::vector<double> all = all_gather(comm_, std::span<const double>(mine.data(), static_cast<std::size_t>(mine.size())));
     x = Eigen::Map<const Eigen::MatrixXd>(all.data(), columns, b.rows()).transpose();
-  }
-
-  void release() {
-    if (ksp_ != nullptr) KSPDestroy(&ksp_);
-    if (a_ != nullptr) MatDestroy(&a_);
   }
 
   MPI_Comm comm_ = MPI_COMM_NULL;
@@ -177,8 +160,8 @@ class PetscRbfSystem {
   Index lo_ = 0, hi_ = 0, nonzeros_ = 0;
   Vec<Dim> shift_ = Vec<Dim>::Zero();
   double scale_ = 1.0;
-  Mat a_ = nullptr;
-  KSP ksp_ = nullptr;
+  OwnedMat a_;
+  OwnedKsp ksp_;
   Eigen::MatrixXd p_, g_;
   Eigen::PartialPivLU<Eigen::Matrix<double, Dim + 1, Dim + 1>> schur_;
 };
