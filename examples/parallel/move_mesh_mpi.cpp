@@ -42,26 +42,24 @@ namespace {
 struct Arguments {
   std::string input, output;
   examples::MotionArguments motion;
-  std::string solver = "automatic", boundary_solve = "automatic";
-  double tolerance = 1e-10;
+  KeyValues parallel;  ///< the flags of BoundarySolveOptions and DistributedElasticityOptions given
   int threads = 0;
   bool json = false, strict = false, overwrite = false, keep_orientation = false, rank_files = false;
   examples::MoverArguments mover;
 };
 
-PetscSolverKind solver_kind(const std::string& name) {
-  if (name == "automatic") return PetscSolverKind::automatic;
-  if (name == "cg_gamg") return PetscSolverKind::cg_gamg;
-  if (name == "cg_hypre") return PetscSolverKind::cg_hypre;
-  if (name == "mumps") return PetscSolverKind::direct_mumps;
-  throw InputError("move_mesh_mpi: --petsc-solver '" + name + "' is not one of automatic, cg_gamg, cg_hypre, mumps");
-}
+// The distributed solves' options: the descriptions' defaults with the flags given set over them.
+struct ParallelOptions {
+  BoundarySolveOptions boundary;
+  DistributedElasticityOptions elasticity;
+};
 
-BoundarySolve boundary_solve_kind(const std::string& name) {
-  if (name == "automatic") return BoundarySolve::automatic;
-  if (name == "replicated") return BoundarySolve::replicated;
-  if (name == "petsc") return BoundarySolve::petsc;
-  throw InputError("move_mesh_mpi: --boundary-solve '" + name + "' is not one of automatic, replicated, petsc");
+ParallelOptions parallel_options(const KeyValues& given) {
+  ParallelOptions o;
+  for (const auto& [key, text] : given)
+    if (!set_option(o.boundary, key, text) && !set_option(o.elasticity, key, text))
+      throw InputError("move_mesh_mpi: unknown parallel option '" + key + "'");
+  return o;
 }
 
 // Threads per rank: --threads, else OMP_NUM_THREADS, else the node's cores shared among its ranks.
@@ -87,8 +85,10 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
   ResolvedBoundary<Dim> boundary;
   QualityReport before;
   MoverConfig<Dim> config;
+  ParallelOptions parallel;
   double radius = 0.0;
   collective(comm, [&] {
+    parallel = parallel_options(a.parallel);
     KeyValues given = examples::given_options(a.mover);
     config = mover_config<Dim>(a.mover.method, given);
     if (config.method != "rbf" && config.method != "le" && config.method != "sle")
@@ -115,16 +115,14 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
   MoverStats stats;
   bool petsc_boundary = false;
   if (auto* rbf = std::get_if<RbfOptions>(&config.options)) {
-    DistributedRbfMover<Dim> mover(*rbf, {.kind = boundary_solve_kind(a.boundary_solve)});
+    DistributedRbfMover<Dim> mover(*rbf, parallel.boundary);
     mover.setup(part.view(), local);
     displacement = mover.move(local.displacements);
     stats = mover.stats();
     petsc_boundary = mover.petsc_solve();
   } else {
-    DistributedElasticityOptions options;
+    DistributedElasticityOptions options = parallel.elasticity;
     options.elasticity = std::get<ElasticityOptions>(config.options);
-    options.solver = solver_kind(a.solver);
-    options.tolerance = a.tolerance;
     DistributedElasticityMover<Dim> mover(options);
     mover.setup(part, local);
     displacement = mover.move(local.displacements);
@@ -157,7 +155,7 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
       if (std::holds_alternative<RbfOptions>(config.options))
         w.key("support_radius").value(radius).key("boundary_solve").value(petsc_boundary ? "petsc" : "replicated");
       else
-        w.key("solver").value(a.solver);
+        w.key("solver").value(name(parallel.elasticity.solver));
       w.key("nodes").value(whole->num_nodes()).key("boundary_nodes").value(stats.boundary_nodes);
       w.key("setup_seconds").value(seconds[0]).key("move_seconds").value(seconds[1]);
       w.key("before").begin_object().key("min").value(before.min).key("mean").value(before.mean);
@@ -196,12 +194,8 @@ int main_body(int argc, char** argv) {
   app.add_option("-o,--output", a.output, "Output mesh (.msh, .su2, .vtu), written by rank 0");
   examples::add_motion_options(app, a.motion);
   examples::add_mover_options(app, a.mover, known_methods<3>());
-  app.add_option("--petsc-solver", a.solver, "le/sle: PETSc solver automatic (mumps in 2D, cg_gamg in 3D) | cg_gamg | cg_hypre | mumps")->capture_default_str();
-  app.add_option("--petsc-tolerance", a.tolerance, "le/sle: relative residual of CG (displacement units)")->capture_default_str();
-  app.add_option("--boundary-solve", a.boundary_solve,
-                 "rbf: where the boundary system is solved: automatic (PETSc when the options allow it and it is big "
-                 "enough for the ranks per node) | replicated (on every rank; any option) | petsc (MUMPS across the ranks)")
-      ->capture_default_str();
+  examples::add_option_flags(app, option_docs(BoundarySolveOptions{}), a.parallel, "Distributed RBF (rbf)");
+  examples::add_option_flags(app, option_docs(DistributedElasticityOptions{}), a.parallel, "Distributed elasticity (le, sle)");
   app.add_option("--threads", a.threads,
                  "threads per rank (0: OMP_NUM_THREADS if set, else the node's cores shared among its ranks)")
       ->capture_default_str()
@@ -229,7 +223,6 @@ int main_body(int argc, char** argv) {
       collective(comm, [&] {
         if (a.input.empty() || a.output.empty()) throw InputError("move_mesh_mpi: give an input mesh and -o OUTPUT (see --help)");
         examples::require_motion(a.motion, "move_mesh_mpi");
-        (void)boundary_solve_kind(a.boundary_solve);
         if (!root) return;
         examples::check_output(a.input, a.output, 1, a.overwrite);
         mesh = std::make_unique<AnyMesh>(read_mesh(a.input));

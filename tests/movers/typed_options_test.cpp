@@ -72,6 +72,22 @@ TEST_CASE("option text: key=value text", "[options]") {
   CHECK_THAT(message_of<InputError>([] { (void)parse_key_values("a=1 a=2"); }), Catch::Contains("'a'"));
 }
 
+TEST_CASE("option text: one field set by its key; other keys left alone", "[options]") {
+  RbfOptions o;
+  CHECK(set_option(o, "support_radius", "0.25"));
+  CHECK(o.support_radius == 0.25);
+  CHECK(set_option(o, "kernel", "wendland4"));
+  CHECK(o.kernel == RbfKernel::wendland4);
+  const RbfOptions before = o;
+  CHECK_FALSE(set_option(o, "no_such_key", "1"));
+  CHECK(o.support_radius == before.support_radius);
+  CHECK_THAT(message_of<InputError>([&] { (void)set_option(o, "support_radius", "wide"); }), Catch::Contains("support_radius"));
+  const std::vector<std::string> keys = option_keys(RbfOptions{});
+  REQUIRE_FALSE(keys.empty());
+  CHECK(keys.front() == "kernel");
+  CHECK(keys.size() == option_docs(RbfOptions{}).size());
+}
+
 TEST_CASE("mover options: every method's values read back to the same options", "[options]") {
   for (const auto& method : mover_methods<3>()) {
     INFO(method.name);

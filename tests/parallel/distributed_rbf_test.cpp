@@ -162,6 +162,22 @@ TEST_CASE("distributed RBF with the boundary system factorized across the ranks 
   CHECK_FALSE(automatic.petsc_solve());
 }
 
+TEST_CASE("parallel options: described once, set from text, bad values refused naming the key", "[parallel][options]") {
+  BoundarySolveOptions solve;
+  CHECK(set_option(solve, "boundary_solve", "petsc"));
+  CHECK(solve.kind == BoundarySolve::petsc);
+  CHECK(set_option(solve, "petsc_min_node_centres", "12"));
+  CHECK(solve.petsc_min_node_centres == 12);
+  CHECK_THROWS_WITH(set_option(solve, "boundary_solve", "mumps"), Catch::Contains("boundary_solve") && Catch::Contains("replicated"));
+  DistributedElasticityOptions elasticity;
+  CHECK(set_option(elasticity, "petsc_solver", "mumps"));
+  CHECK(elasticity.solver == PetscSolverKind::direct_mumps);
+  CHECK_FALSE(set_option(elasticity, "boundary_solve", "petsc"));
+  // The defaults the docs show are the structs' own.
+  for (const OptionDoc& d : option_docs(BoundarySolveOptions{}))
+    if (d.key == "petsc_min_node_centres") CHECK(d.value == std::to_string(BoundarySolveOptions{}.petsc_min_node_centres));
+}
+
 TEST_CASE("automatic boundary solve: PETSc on several ranks once centres × ranks per node reach the threshold",
           "[parallel][rbf][petsc]") {
   // Every rank of a ctest run shares one node.

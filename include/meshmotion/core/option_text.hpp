@@ -317,6 +317,27 @@ template <class Options>
   return out;
 }
 
+/// Sets the field of `o` named `key` from `text`; false when `o` has no such key. Throws
+/// InputError (naming the key) for a value the field cannot hold.
+template <class Options>
+bool set_option(Options& o, std::string_view key, std::string_view text) {
+  bool found = false;
+  visit_options(o, [&](const std::string& k, auto& field, std::string_view) {
+    if (found || k != key) return;
+    parse_option_value(key, text, field);
+    found = true;
+  });
+  return found;
+}
+
+/// Every key of `o`, in its order.
+template <class Options>
+[[nodiscard]] std::vector<std::string> option_keys(Options o) {
+  std::vector<std::string> out;
+  visit_options(o, [&](const std::string& key, auto&, std::string_view) { out.push_back(key); });
+  return out;
+}
+
 /// Splits "key=value key2=value2" (whitespace- or newline-separated; '#' starts a comment to
 /// the end of its line) into pairs. Throws InputError for a token without '=' or with an
 /// empty key, or a key given twice.

@@ -252,8 +252,7 @@ namespace detail {
 template <int Dim>
 void set_curve_options(CurveOptions<Dim>& options, const KeyValues& values) {
   CurveOptions<Dim> o = options;  // `options` changes only when every value is taken
-  std::vector<std::string> own;
-  visit_options(o, [&](const std::string& key, auto&, std::string_view) { own.push_back(key); });
+  const std::vector<std::string> own = option_keys(o);
   for (const auto& [key, text] : values)
     if (key == "method") parse_option_value(key, text, o.method);
   MoverConfig<Dim> config;
@@ -264,16 +263,9 @@ void set_curve_options(CurveOptions<Dim>& options, const KeyValues& values) {
   }
   if (o.mover_options && o.mover_options->index() == config.options.index()) config.options = *o.mover_options;
   KeyValues mover;
+  const std::vector<std::string> theirs = config.keys();
   for (const auto& [key, text] : values) {
-    if (key == "method") continue;
-    bool found = false;
-    visit_options(o, [&](const std::string& k, auto& field, std::string_view) {
-      if (k != key) return;
-      parse_option_value(key, text, field);
-      found = true;
-    });
-    if (found) continue;
-    const std::vector<std::string> theirs = config.keys();
+    if (key == "method" || set_option(o, key, text)) continue;
     if (std::find(theirs.begin(), theirs.end(), key) == theirs.end()) {
       std::vector<std::string> known = own;
       known.insert(known.end(), theirs.begin(), theirs.end());

@@ -348,27 +348,15 @@ struct MoverConfig {
   }
   /// Every key with its type, current value and line of help.
   [[nodiscard]] std::vector<OptionDoc> docs() const {
-    std::vector<OptionDoc> out;
-    for_each_field([&](const std::string& key, auto& value, std::string_view help) {
-      out.push_back({key, option_type_name(value), format_option_value(value), std::string(help)});
-    });
-    return out;
+    check();
+    return std::visit([](const auto& o) { return option_docs(o); }, options);
   }
   /// Sets one option from text. Throws InputError for a key this method does not take
   /// (listing the ones it does) or a value its field cannot hold.
   void set(std::string_view key, std::string_view text) {
     check();
-    bool found = false;
-    std::visit(
-        [&](auto& o) {
-          visit_options(o, [&](const std::string& k, auto& field, std::string_view) {
-            if (k != key) return;
-            parse_option_value(key, text, field);
-            found = true;
-          });
-        },
-        options);
-    if (!found) throw InputError(unknown_key_message("method '" + method + "'", key, keys()));
+    if (!std::visit([&](auto& o) { return set_option(o, key, text); }, options))
+      throw InputError(unknown_key_message("method '" + method + "'", key, keys()));
   }
   /// Sets every pair in order (see set()).
   void set(const KeyValues& values) {

@@ -28,6 +28,7 @@
 /// destroyed.
 
 #include "meshmotion/core/error.hpp"
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary.hpp"
@@ -39,6 +40,8 @@
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 
 #include <petscksp.h>
+
+#include <array>
 
 #include <cmath>
 #include <cstdint>
@@ -59,6 +62,19 @@ enum class PetscSolverKind {
   direct_mumps,  ///< Cholesky by MUMPS (distributed direct)
 };
 
+[[nodiscard]] constexpr const char* name(PetscSolverKind k) {
+  switch (k) {
+    case PetscSolverKind::automatic: return "automatic";
+    case PetscSolverKind::cg_gamg: return "cg_gamg";
+    case PetscSolverKind::cg_hypre: return "cg_hypre";
+    case PetscSolverKind::direct_mumps: return "mumps";
+  }
+  return "?";
+}
+[[nodiscard]] constexpr std::array<PetscSolverKind, 4> option_choices(PetscSolverKind) {
+  return {PetscSolverKind::automatic, PetscSolverKind::cg_gamg, PetscSolverKind::cg_hypre, PetscSolverKind::direct_mumps};
+}
+
 struct DistributedElasticityOptions {
   /// Material and Jacobian stiffening as in serial; `solver` there is not used (see below),
   /// distance_exponent and active_radius must be 0.
@@ -73,6 +89,17 @@ struct DistributedElasticityOptions {
   /// PETSC_OPTIONS (e.g. -meshmotion_ksp_monitor).
   std::string petsc_prefix = "meshmotion_";
 };
+
+/// The options of the distributed solve, as text may set them (the material is the serial
+/// mover's, ElasticityOptions).
+template <class F>
+void visit_options(DistributedElasticityOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "petsc_solver", o.solver, "PETSc solver (automatic: mumps in 2D, cg_gamg in 3D)");
+  f(prefix + "petsc_tolerance", o.tolerance, "relative residual of CG on the scaled system (displacement units)");
+  f(prefix + "petsc_max_iterations", o.max_iterations, "iteration cap of CG");
+  f(prefix + "petsc_fallback_to_direct", o.fallback_to_direct, "solve again with MUMPS when CG does not converge");
+  f(prefix + "petsc_prefix", o.petsc_prefix, "prefix of the PETSc options that refine the solver");
+}
 
 template <int Dim>
 class DistributedElasticityMover {

@@ -27,6 +27,7 @@
 /// plane and displacement come from its owner), so parts need not agree on ghosts.
 
 #include "meshmotion/core/error.hpp"
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/detail/mover_support.hpp"
@@ -37,6 +38,7 @@
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <numeric>
@@ -52,6 +54,18 @@ enum class BoundarySolve {
   petsc,       ///< factorized once across the ranks by MUMPS (compact kernel, one radius, no sliding, distinct centres)
 };
 
+[[nodiscard]] constexpr const char* name(BoundarySolve k) {
+  switch (k) {
+    case BoundarySolve::automatic: return "automatic";
+    case BoundarySolve::replicated: return "replicated";
+    case BoundarySolve::petsc: return "petsc";
+  }
+  return "?";
+}
+[[nodiscard]] constexpr std::array<BoundarySolve, 3> option_choices(BoundarySolve) {
+  return {BoundarySolve::automatic, BoundarySolve::replicated, BoundarySolve::petsc};
+}
+
 /// How automatic chooses, from the figures of docs/parallel.md: replicated, every rank on a node
 /// factorizes the same system at once, which on a 16-core node made the 2.05M-node box's setup
 /// 5× slower at 8 ranks and 25× at 16 than at one (16,129 centres), while MUMPS's setup fell
@@ -65,6 +79,14 @@ struct BoundarySolveOptions {
   /// the replicated factorizations a node runs at once.
   Index petsc_min_node_centres = 30000;
 };
+
+template <class F>
+void visit_options(BoundarySolveOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "boundary_solve", o.kind, "where the RBF boundary system is solved");
+  f(prefix + "petsc_min_centres", o.petsc_min_centres, "automatic: fewest centres for PETSc at any rank count");
+  f(prefix + "petsc_min_node_centres", o.petsc_min_node_centres,
+    "automatic: fewest centres x ranks per node for PETSc on several ranks");
+}
 
 template <int Dim>
 class DistributedRbfMover {
