@@ -11,15 +11,18 @@
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/fields.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/core/types.hpp"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 namespace meshmotion::python {
 
@@ -54,6 +57,36 @@ inline std::string names_text(const py::handle& value) {
     out += item.cast<std::string>();
   }
   return out;
+}
+
+// A keyword's value as option text, by the type its description gives (`docs`, the keys the
+// receiver takes): a list of names must be a sequence of str (a lone str is a mistake, not a
+// list of one), integers a sequence of int, a choice or a text a str; a key without a
+// description goes as it is and the parser names the known keys.
+inline std::string option_text(const std::vector<OptionDoc>& docs, const std::string& key, const py::handle& value) {
+  const auto doc = std::find_if(docs.begin(), docs.end(), [&](const OptionDoc& d) { return d.key == key; });
+  if (doc == docs.end()) return option_text(key, value);
+  const std::string& type = doc->type;
+  const auto refuse = [&](const std::string& expected) {
+    throw InputError("option '" + key + "': expected " + expected + " (got " + py::repr(value).cast<std::string>() + ")");
+  };
+  if (type == "names") {
+    if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value)) refuse("a list of names");
+    return names_text(value);
+  }
+  if (type == "integers") {
+    if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value)) refuse("a list of integers");
+    std::string out;
+    for (const py::handle item : value) {
+      if (!py::isinstance<py::int_>(item) || py::isinstance<py::bool_>(item)) refuse("a list of integers");
+      if (!out.empty()) out += ',';
+      out += py::repr(item).cast<std::string>();
+    }
+    return out;
+  }
+  if ((type == "text" || type.find('|') != std::string::npos) && !py::isinstance<py::str>(value))
+    refuse(type == "text" ? std::string("a string") : "one of " + type + " as a string");
+  return option_text(key, value);
 }
 
 // A C-contiguous float64 array of shape (rows, Dim), without a copy; refused otherwise.

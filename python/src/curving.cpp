@@ -34,15 +34,7 @@ CurveOptions<Dim> curve_options(const py::kwargs& kwargs) {
       }
       continue;
     }
-    // A single string where a list of names is expected is a mistake, not a list of one.
-    const auto doc = std::find_if(own.begin(), own.end(), [&](const OptionDoc& d) { return d.key == key; });
-    const bool names = doc != own.end() && doc->type == "names";
-    if (names && (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value)))
-      throw InputError("curve_mesh: option '" + key + "' expects a list of group names (got " +
-                       py::cast<std::string>(py::repr(value)) + ")");
-    if (key == "method" && !py::isinstance<py::str>(value))
-      throw InputError("curve_mesh: option 'method' expects a string (got " + py::cast<std::string>(py::repr(value)) + ")");
-    given.emplace_back(key, names ? names_text(value) : option_text(key, value));
+    given.emplace_back(key, option_text(own, key, value));
   }
   set_curve_options(o, given);
   return o;

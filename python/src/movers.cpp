@@ -18,9 +18,10 @@ void bind_movers(py::module_& m) {
     py::class_<A>(m, ("Mover" + suffix).c_str())
         .def(py::init([](const std::string& method, const py::kwargs& options) {
                MoverConfig<Dim> c = mover_config<Dim>(method);
+               const std::vector<OptionDoc> docs = c.docs();
                for (const auto& [key, value] : options) {
                  const std::string k = key.template cast<std::string>();
-                 c.set(k, option_text(k, value));
+                 c.set(k, option_text(docs, k, value));
                }
                return make_mover(c);
              }),

@@ -274,10 +274,13 @@ def test_curve_mesh_puts_the_high_order_nodes_on_the_circle():
         mm.curve_mesh(mesh, support_radius="big")
     with pytest.raises(ValueError, match="expected a finite number"):
         mm.curve_mesh(mesh, support_radius=True)
-    with pytest.raises(ValueError, match="expects a string"):
+    with pytest.raises(ValueError, match="'method': expected a string"):
         mm.curve_mesh(mesh, method=5)
-    with pytest.raises(ValueError, match="list of group names"):
+    with pytest.raises(ValueError, match="'sliding': expected a list of names"):
         mm.curve_mesh(mesh, sliding="wall")
+    # The movers' keywords go by the same descriptions.
+    with pytest.raises(ValueError, match="'kernel': expected one of .*wendland2.* as a string"):
+        mm.Mover("rbf", 2, kernel=2)
     with pytest.raises(ValueError, match="expects a dict"):
         mm.curve_mesh(mesh, geometry="circle:0,0,0.5")
     with pytest.raises(ValueError, match="unknown option 'kernel' for curve_mesh with method 'blend'"):
