@@ -296,8 +296,8 @@ smoke_test(NAME move_mesh.openfoam_in_place_needs_overwrite.json REQUIRES exampl
            COMMAND move_mesh "${smoke_dir}/foam_case" -o "${smoke_dir}/foam_case" --group top --translate 0.05,0,0
                    --fixed bottom --json)
 
-# move_mesh_mpi: the same mesh as move_mesh's, byte for byte, from 3 ranks (automatic keeps the
-# small boundary system on every rank); the boundary system through PETSc on request; elasticity
+# move_mesh_mpi: the same mesh as move_mesh's, byte for byte, from 3 ranks with the boundary
+# system replicated (the serial mover's factorization); through PETSc on request; elasticity
 # through PETSc; an unknown group or boundary solve refused by every rank with rank 0's message.
 if(TARGET move_mesh_mpi)
   smoke_test(NAME move_mesh_mpi.help KEYS "" EXPECT_RC 0 RANKS 1 COMMAND move_mesh_mpi --version)
@@ -309,7 +309,7 @@ if(TARGET move_mesh_mpi)
              KEYS ranks,threads_per_rank,setup_seconds,move_seconds,after/min
              VALUES ranks=3,threads_per_rank=1,boundary_solve=replicated,after/invalid=0
              COMMAND move_mesh_mpi "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_mpi.msh" --group wall --rotate 5
-                     --fixed farfield --json)
+                     --fixed farfield --boundary-solve replicated --json)
   smoke_test(NAME move_mesh_mpi.rbf_petsc.json REQUIRES examples_demo_mesh RANKS 2
              KEYS after/min VALUES boundary_solve=petsc,threads_per_rank=2,after/invalid=0
              COMMAND move_mesh_mpi "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_mpi_petsc.vtu" --group wall --rotate 5

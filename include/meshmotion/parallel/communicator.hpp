@@ -80,12 +80,15 @@ template <class T>
   return n;
 }
 
+/// The cores of this node (1 when unknown).
+[[nodiscard]] inline int cores_of_node() { return std::max(1, static_cast<int>(std::thread::hardware_concurrency())); }
+
 /// This rank's even share of its node's cores among the ranks of `comm` on it, at least 1 and
 /// at most the cores the process may run on (bound to one core: 1). Give it to
 /// set_num_threads when several ranks share a node: each rank's OpenMP loops and CHOLMOD
 /// otherwise open a thread per core, and the node runs ranks × cores threads. Collective.
 [[nodiscard]] inline int node_share_of_cores(MPI_Comm comm) {
-  int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  int cores = cores_of_node();
 #ifdef __linux__
   cpu_set_t mask;
   if (sched_getaffinity(0, sizeof(mask), &mask) == 0) cores = std::min(cores, std::max(1, CPU_COUNT(&mask)));

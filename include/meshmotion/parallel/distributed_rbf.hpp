@@ -11,7 +11,8 @@
 ///   (PetscRbfSystem: the factor's memory and the solves split between the ranks; compact
 ///   kernel, one radius, no sliding node, distinct centres). BoundarySolve::automatic takes
 ///   PETSc when the options allow it, from BoundarySolveOptions::petsc_min_centres centres on,
-///   or on several ranks when centres × ranks per node reach petsc_min_node_centres.
+///   or on several ranks when centres × ranks per node (× rounds of ranks per core) reach
+///   petsc_min_node_centres.
 ///   Each rank then builds the evaluation operator of its own local nodes (owned and ghost)
 ///   with its own k-d tree over the centres.
 /// - move: one allgatherv of the owned entries' displacements (Dim doubles per boundary node),
@@ -76,7 +77,8 @@ struct BoundarySolveOptions {
   /// every rank costs too much memory.
   Index petsc_min_centres = 50000;
   /// Fewest centres × ranks sharing a node for which automatic takes PETSc on 2 ranks or more:
-  /// the replicated factorizations a node runs at once.
+  /// the replicated factorizations a node runs at once, counted once more for each further
+  /// round when the node has more ranks than cores (they then run one after another).
   Index petsc_min_node_centres = 30000;
 };
 
@@ -271,9 +273,10 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
   // Every rank decides alike: the inputs are the gathered arrays.
   // The obstacles (a k-d tree over the centres among them) are looked for only when PETSc is wanted.
   const int sharing = ranks_on_node(comm_);
+  const int rounds = (sharing + cores_of_node() - 1) / cores_of_node();
+  const bool crowded = size_of(comm_) > 1 && m * sharing * rounds >= solve_.petsc_min_node_centres;
   const bool wanted = solve_.kind == BoundarySolve::petsc ||
-                      (solve_.kind == BoundarySolve::automatic &&
-                       (m >= solve_.petsc_min_centres || (size_of(comm_) > 1 && m * sharing >= solve_.petsc_min_node_centres)));
+                      (solve_.kind == BoundarySolve::automatic && (m >= solve_.petsc_min_centres || crowded));
   const std::string obstacle = wanted ? petsc_obstacle(all_kinds, any_radius != 0, points.leftCols(m)) : std::string();
   if (solve_.kind == BoundarySolve::petsc && !obstacle.empty())
     throw InputError("DistributedRbfMover::setup: the boundary system cannot go through PETSc: " + obstacle +
