@@ -64,7 +64,7 @@ ParallelOptions parallel_options(const KeyValues& given) {
 
 // Threads per rank: --threads, else OMP_NUM_THREADS, else the node's cores shared among its ranks.
 int threads_per_rank(MPI_Comm comm, int asked) {
-  const int share = node_share_of_cores(comm);
+  const int share = node_share_of_cores(comm);  // collective: every rank asks, whatever it was given
   if (asked > 0) return asked;
   return std::getenv("OMP_NUM_THREADS") != nullptr ? 0 : share;
 }
@@ -113,13 +113,13 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
   const ResolvedBoundary<Dim> local = distribute_boundary(part, boundary);
   Points<Dim> displacement;
   MoverStats stats;
-  bool petsc_boundary = false;
+  BoundarySolve boundary_solve = BoundarySolve::replicated;  ///< the one the RBF mover took
   if (auto* rbf = std::get_if<RbfOptions>(&config.options)) {
     DistributedRbfMover<Dim> mover(*rbf, parallel.boundary);
     mover.setup(part.view(), local);
     displacement = mover.move(local.displacements);
     stats = mover.stats();
-    petsc_boundary = mover.petsc_solve();
+    if (mover.petsc_solve()) boundary_solve = BoundarySolve::petsc;
   } else {
     DistributedElasticityOptions options = parallel.elasticity;
     options.elasticity = std::get<ElasticityOptions>(config.options);
@@ -153,7 +153,7 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
       w.begin_object().key("input").value(a.input).key("output").value(a.output).key("method").value(config.method);
       w.key("ranks").value(ranks).key("threads_per_rank").value(num_threads());
       if (std::holds_alternative<RbfOptions>(config.options))
-        w.key("support_radius").value(radius).key("boundary_solve").value(petsc_boundary ? "petsc" : "replicated");
+        w.key("support_radius").value(radius).key("boundary_solve").value(name(boundary_solve));
       else
         w.key("solver").value(name(parallel.elasticity.solver));
       w.key("nodes").value(whole->num_nodes()).key("boundary_nodes").value(stats.boundary_nodes);
@@ -167,7 +167,7 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
     } else {
       std::cout << "moved " << whole->num_nodes() << " nodes with " << config.method << " on " << ranks << " rank(s) of "
                 << num_threads() << " thread(s)"
-                << (std::holds_alternative<RbfOptions>(config.options) ? (petsc_boundary ? ", boundary system through PETSc" : ", boundary system on every rank") : "")
+                << (std::holds_alternative<RbfOptions>(config.options) ? std::string(", boundary solve ") + name(boundary_solve) : "")
                 << "\n"
                 << "  setup " << seconds[0] << " s, move " << seconds[1] << " s (slowest rank)\n"
                 << "  skew before: min " << before.min << " mean " << before.mean << " invalid " << before.num_invalid << "\n"
