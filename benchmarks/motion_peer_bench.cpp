@@ -20,7 +20,7 @@
 
 #include "bench_memory.hpp"
 #include "meshmotion/core/generators.hpp"
-#include "meshmotion/io/detail/atomic_file.hpp"
+#include "meshmotion/core/detail/atomic_file.hpp"
 #include "meshmotion/io/mesh_io.hpp"
 #include "meshmotion/movers.hpp"
 #include "meshmotion/quality.hpp"

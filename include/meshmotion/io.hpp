@@ -1,7 +1,7 @@
 #pragma once
 /// \file
-/// The io layer: Gmsh .msh, SU2 .su2, CGNS, VTK .vtu and OpenFOAM reading and writing,
-/// checkMesh measures of polyMesh cells, mesh summaries.
+/// The io layer: Gmsh .msh, SU2 .su2, CGNS, VTK .vtu and OpenFOAM reading and writing, mesh
+/// summaries.
 
 #include "meshmotion/io/any_mesh.hpp"
 #include "meshmotion/io/gmsh_reader.hpp"
@@ -9,7 +9,6 @@
 #include "meshmotion/io/mesh_summary.hpp"
 #include "meshmotion/io/mesh_io.hpp"
 #include "meshmotion/io/openfoam.hpp"
-#include "meshmotion/io/openfoam_quality.hpp"
 #include "meshmotion/io/su2_reader.hpp"
 #include "meshmotion/io/su2_writer.hpp"
 #include "meshmotion/io/vtu_reader.hpp"

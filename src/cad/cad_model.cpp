@@ -3,6 +3,7 @@
 #include "meshmotion/cad/cad_model.hpp"
 
 #include "meshmotion/core/error.hpp"
+#include "meshmotion/io/detail/read_file.hpp"
 
 #include <BRepAdaptor_Curve.hxx>
 #include <BRepAdaptor_Surface.hxx>
@@ -34,7 +35,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <functional>
@@ -64,12 +64,6 @@ struct CadModel::Impl {
 
 namespace {
 
-std::string lower_extension(const std::filesystem::path& file) {
-  std::string ext = file.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
 // OpenCASCADE's translators print their progress to stdout: a program's JSON output must stay
 // clean, and failures reach the caller as exceptions.
 void quiet_occt() {
@@ -82,7 +76,7 @@ void quiet_occt() {
 
 TopoDS_Shape read_shape(const std::filesystem::path& file) {
   quiet_occt();
-  const std::string ext = lower_extension(file);
+  const std::string ext = detail::lower_extension(file);
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) throw IoError(file.string() + ": no such file");
   if (ext == ".step" || ext == ".stp") {

@@ -24,6 +24,21 @@ TEST_CASE("JSON writer: strings escaped, numbers exact, non-finite as null", "[c
   CHECK(out.str() == R"({"file":"a\"b\\c\n.su2","x":4.9e-06,"nan":null,"n":3})");
 }
 
+TEST_CASE("JSON writer: UTF-8 passes as it is, any other byte is escaped so the output stays JSON", "[core]") {
+  const auto written = [](std::string_view text) {
+    std::ostringstream out;
+    JsonWriter(out).value(text);
+    return out.str();
+  };
+  CHECK(written("\xC3\xA9t\xC3\xA9 \xE2\x82\xAC \xF0\x9F\x98\x80") == "\"\xC3\xA9t\xC3\xA9 \xE2\x82\xAC \xF0\x9F\x98\x80\"");
+  // A Latin-1 path, a stray continuation byte, an overlong '/', a surrogate, a cut sequence.
+  CHECK(written("caf\xE9.msh") == R"("caf\u00e9.msh")");
+  CHECK(written("\x80") == R"("\u0080")");
+  CHECK(written("\xC0\xAF") == R"("\u00c0\u00af")");
+  CHECK(written("\xED\xA0\x80") == R"("\u00ed\u00a0\u0080")");
+  CHECK(written("\xE2\x82") == R"("\u00e2\u0082")");
+}
+
 TEST_CASE("thread count: set, read back, same results; OpenMP's default follows; negative and huge refused", "[core]") {
   const Mesh<2> mesh = rectangle_mesh({});
   const QualityReport all = quality_report(mesh, Metric::shape);

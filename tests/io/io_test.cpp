@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -511,6 +512,17 @@ TEST_CASE("VTU input: bad files are refused with the file, the line and the reas
   const std::string binary = format_vtu(square, {});
   refused(replace(binary, "Name=\"types\" format=\"binary\">\n          ", "Name=\"types\" format=\"binary\">\n          !"),
           "'!' is not a base64 character");
+  // Counts too large for the file are refused before they size anything.
+  const auto points_count = "NumberOfPoints=\"" + std::to_string(square.num_nodes()) + "\"";
+  refused(replace(ascii, points_count, "NumberOfPoints=\"99999999999999999999999\""), "NumberOfPoints '99999999999999999999999'");
+  refused(replace(ascii, points_count, "NumberOfPoints=\"4000000000\""), "NumberOfPoints '4000000000' (expected a count");
+  // Numbers in another notation than their type's are not read as something else.
+  const std::string first_node = "Name=\"connectivity\" format=\"ascii\">\n0";
+  for (const char* value : {"1.5", "0x10", "1e1"})
+    refused(replace(ascii, first_node, std::string("Name=\"connectivity\" format=\"ascii\">\n") + value),
+            std::string("'") + value + "' is not an integer");
+  refused(replace(ascii, "NumberOfComponents=\"3\" format=\"ascii\">\n0 0 0", "NumberOfComponents=\"3\" format=\"ascii\">\n0x10 0 0"),
+          "'0x10' is not a decimal number");
 }
 
 TEST_CASE("files written in chunks equal the formatted text, byte for byte", "[io]") {
@@ -667,6 +679,31 @@ TEST_CASE("bad paths, dimensions and meshes give clear errors", "[io]") {
   CHECK_NOTHROW((void)read_mesh_as<2>(tri));
 }
 
+TEST_CASE("every row of the format table is written and read back by its extension, in any case", "[io]") {
+  const auto mesh = all_types_mesh<3>(1);
+  for (const auto& format : mesh_file_formats) {
+    if (!format.available) {
+      WARN("skipped " << format.extension << ": this build lacks " << format.library);
+      continue;
+    }
+    std::string upper(format.extension);
+    for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    INFO(upper);
+    const auto file = test::scratch_path("format_table" + upper);
+    REQUIRE(mesh_format_of(file) == &format);
+    CHECK_NOTHROW(check_mesh_output(file, 2));
+    write_mesh(file, mesh);
+    const auto back = read_mesh_as<3>(file);
+    CHECK(back.num_nodes() == mesh.num_nodes());
+    CHECK(back.num_cells() == mesh.num_cells());
+    CHECK(back.points.isApprox(mesh.points));
+  }
+  CHECK(mesh_format_of(test::scratch_path("mesh.obj")) == nullptr);
+  CHECK_THROWS_WITH(check_mesh_output(test::scratch_path("mesh.obj")), Catch::Contains("one of .msh, .su2, .cgns, .vtu"));
+  CHECK_THROWS_WITH(check_mesh_output(test::scratch_path("p3.cgns"), 3), Catch::Contains("up to order 2 (expected one of .msh, .su2, .vtu for order 3)") ||
+                                                                         Catch::Contains("needs the CGNS library"));
+}
+
 TEST_CASE("a failing write leaves no output and no temporary file, and never touches the input", "[io]") {
   const auto dir = test::scratch_path("atomic");
   fs::remove_all(dir);
@@ -693,6 +730,25 @@ TEST_CASE("a failing write leaves no output and no temporary file, and never tou
   write_mesh(dir / "copy.msh", read_mesh_as<3>(input));
   CHECK(fs::last_write_time(input) == time_before);
   CHECK(fs::file_size(input) == size_before);
+}
+
+TEST_CASE("a killed run's temporaries are removed once an hour old; anyone else's never", "[io]") {
+  const auto dir = test::scratch_path("stale");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto touch = [&](const std::string& name, std::chrono::hours age) {
+    std::ofstream(dir / name) << "partial";
+    fs::last_write_time(dir / name, fs::file_time_type::clock::now() - age);
+  };
+  touch("out.msh.tmp123456_7", std::chrono::hours(2));  // a killed run's
+  touch("out.msh.tmp999_0", std::chrono::hours(0));     // a run writing now
+  touch("out.msh.tmp_notes", std::chrono::hours(5));    // not of our naming
+  touch("other.msh.tmp1_1", std::chrono::hours(5));     // another output's
+  write_mesh(dir / "out.msh", all_types_mesh<2>(1));
+  std::vector<std::string> names;
+  for (const auto& file : files_in(dir)) names.push_back(file.filename().string());
+  std::sort(names.begin(), names.end());
+  CHECK(names == std::vector<std::string>{"other.msh.tmp1_1", "out.msh", "out.msh.tmp999_0", "out.msh.tmp_notes"});
 }
 
 TEST_CASE("in-memory parsing entry points name the source in errors", "[io]") {

@@ -6,7 +6,7 @@
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/core/orientation.hpp"
 #include "meshmotion/io.hpp"
-#include "meshmotion/io/openfoam_quality.hpp"
+#include "meshmotion/quality/foam_quality.hpp"
 #include "meshmotion/movers.hpp"
 #include "meshmotion/quality.hpp"
 
@@ -275,24 +275,25 @@ TEST_CASE("OpenFOAM: each kind of bad case gets a clear error and nothing is wri
   {
     PolyMesh c = hanging_node_case();
     c.neighbour[1] = 0;
-    CHECK_THAT(message(c), Catch::Contains("internal face 1 has neighbour 0 (owner 0)"));
+    CHECK_THAT(message(c), Catch::Contains("internal face 1 has neighbour 0 (owner 0,"));
   }
   {
     // A truncated list: the file and line of the end.
     write_case(dir, hanging_node_case());
     const fs::path faces = dir / "constant" / "polyMesh" / "faces";
     std::string text = read_text(faces);
-    std::ofstream(faces, std::ios::binary) << text.substr(0, text.size() / 2);
+    std::ofstream(faces, std::ios::binary) << text.substr(0, text.rfind(')') - 3);
     const std::string m = test::message_of<ParseError>([&] { (void)read_openfoam(dir); });
     CHECK_THAT(m, Catch::Contains("faces:") && Catch::Contains("unexpected end of file"));
   }
   {
-    // A binary list shorter than its count says.
+    // A binary list shorter than its count says: refused by its count, before it is read.
     write_case(dir, hanging_node_case(), Format::binary);
     const fs::path owner = dir / "constant" / "polyMesh" / "owner";
     std::string text = read_text(owner);
     std::ofstream(owner, std::ios::binary) << text.substr(0, text.rfind(')') - 30);
-    CHECK_THAT(test::message_of<ParseError>([&] { (void)read_openfoam(dir); }), Catch::Contains("owner: byte") && Catch::Contains("binary owner ends"));
+    CHECK_THAT(test::message_of<ParseError>([&] { (void)read_openfoam(dir); }),
+               Catch::Contains("owner:") && Catch::Contains("owner count 16 is more than the 34 bytes left"));
   }
   CHECK_THAT(test::message_of<IoError>([&] { (void)read_mesh(test::scratch_path("")); }), Catch::Contains("not an OpenFOAM case"));
 
@@ -308,6 +309,44 @@ TEST_CASE("OpenFOAM: each kind of bad case gets a clear error and nothing is wri
   CHECK_THROWS_AS(check_mesh_output(dir, 2), InputError);
   CHECK_NOTHROW(check_mesh_output(dir, 1));
   CHECK_NOTHROW(check_mesh_output(dir / "0.25", 1));
+}
+
+TEST_CASE("OpenFOAM: corrupt counts, labels and classes are refused before anything is allocated for them", "[io][openfoam]") {
+  const fs::path dir = test::scratch_path("foam_hostile");
+  const fs::path mesh_dir = dir / "constant" / "polyMesh";
+  // Rewrites one file of a freshly written case; returns the message read_openfoam() throws.
+  const auto edited = [&](const std::string& file, Format format, const auto& edit) {
+    write_case(dir, hanging_node_case(), format);
+    std::string text = read_text(mesh_dir / file);
+    edit(text);
+    std::ofstream(mesh_dir / file, std::ios::binary) << text;
+    try {
+      (void)read_openfoam(dir);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  // One owner label of 2^31 - 1: it names the face instead of sizing a cell list by it.
+  CHECK_THAT(edited("owner", Format::ascii, [](std::string& t) { t.replace(t.find("\n(\n") + 3, 1, "2147483647"); }),
+             Catch::Contains("owner") && Catch::Contains("face 0 has owner 2147483647") && Catch::Contains("at most 8 cells"));
+  // A list count of 2^31 in a file of a few hundred bytes.
+  CHECK_THAT(edited("points", Format::ascii, [](std::string& t) { t.replace(t.find("\n16\n"), 4, "\n2147483648\n"); }),
+             Catch::Contains("points:") && Catch::Contains("point count 2147483648 is more than"));
+  CHECK_THAT(edited("owner", Format::ascii, [](std::string& t) { t.replace(t.find("\n16\n"), t.rfind(')') - t.find("\n16\n") + 1, "\n2147483648{0}"); }),
+             Catch::Contains("owner:") && Catch::Contains("uniform owner list of 2147483648 entries (at most 16 here)"));
+  // One flipped byte in a binary neighbour list: the last label's high byte.
+  CHECK_THAT(edited("neighbour", Format::binary, [](std::string& t) { t[t.rfind(')') - 1] = '\x40'; }),
+             Catch::Contains("neighbour") && Catch::Contains("internal face 2 has neighbour 1073741826"));
+  // A file declaring another class than its own, as OpenFOAM refuses it.
+  CHECK_THAT(edited("points", Format::ascii, [](std::string& t) { t.replace(t.find("vectorField"), 11, "faceList"); }),
+             Catch::Contains("points:") && Catch::Contains("FoamFile class 'faceList' (expected vectorField)"));
+  // A face through one vertex twice.
+  CHECK_THAT(edited("faces", Format::ascii, [](std::string& t) { t.replace(t.find("4(1 3 11 9)"), 11, "4(1 3 11 1)"); }),
+             Catch::Contains("face 0 lists vertex 1 twice"));
+  // A face relabelled to a cell of its own: a cell of one face.
+  CHECK_THAT(edited("owner", Format::ascii, [](std::string& t) { t.replace(t.rfind("\n2\n"), 3, "\n3\n"); }),
+             Catch::Contains("owner") && Catch::Contains("cell 3 is bounded by 1 face in the owner and neighbour lists"));
 }
 
 TEST_CASE("OpenFOAM: checkMesh's measures agree with checkMesh on the shared case, a moved one and a polyhedral one",
@@ -413,4 +452,27 @@ TEST_CASE("OpenFOAM: a mixed mesh written as a new case reads back cell by cell 
   CHECK_FALSE(is_new_openfoam_case(file));
   CHECK_THROWS_AS(write_mesh(file, box_mesh({})), InputError);
   CHECK(fs::exists(file / "keep.txt"));
+}
+
+TEST_CASE("OpenFOAM: a new case appears whole or not at all, and never over a folder that holds something", "[io][openfoam]") {
+  const fs::path parent = test::scratch_path("foam_atomic");
+  fs::remove_all(parent);
+  fs::create_directories(parent / "empty");
+  const Mesh<3> box = box_mesh({.nx = 2, .ny = 1, .nz = 1});
+  write_mesh(parent / "fresh", box);
+  write_mesh(parent / "empty/", box);  // an existing empty folder, named with a trailing slash
+  CHECK(read_openfoam(parent / "fresh").points == box.points);
+  CHECK(read_openfoam(parent / "empty").points == box.points);
+  // Nothing but the two cases: the temporary folders were renamed into place.
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(parent)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  CHECK(names == std::vector<std::string>{"empty", "fresh"});
+  // A folder that holds a file is not a place for a new case: refused, and left as it was.
+  fs::create_directories(parent / "busy");
+  std::ofstream(parent / "busy" / "notes.txt") << "keep";
+  CHECK_THAT(test::message_of<InputError>([&] { write_new_polymesh_case(parent / "busy", to_polymesh(box)); }),
+             Catch::Contains("not empty"));
+  CHECK(fs::exists(parent / "busy" / "notes.txt"));
+  CHECK(std::distance(fs::directory_iterator(parent), fs::directory_iterator{}) == 3);
 }

@@ -120,7 +120,7 @@ TEST_CASE("the worst cell is named by the id the written .msh gives it", "[io][q
       std::vector<std::int64_t> nodes(4);
       for (auto& n : nodes) s >> n;
       const auto cell = mesh.cells.front().element(q.worst[0].id);
-      for (int k = 0; k < 4; ++k) CHECK(nodes[static_cast<std::size_t>(k)] == mesh.node_id(cell[static_cast<std::size_t>(k)]));
+      for (int k = 0; k < 4; ++k) CHECK(nodes[static_cast<std::size_t>(k)] == msh_node_id(mesh, cell[static_cast<std::size_t>(k)]));
     }
   CHECK(found);
   CHECK(q.worst[0].file_id == static_cast<std::int64_t>(mesh.num_facets()) + q.worst[0].id + 1);
@@ -171,4 +171,49 @@ TEST_CASE("SU2 sections after the markers (periodic transformations, FFD boxes) 
   // A keyword line after the skipped data is still read: a marker section after an FFD box.
   write_file(file, "NDIME= 2\nFFD_NBOX= 1\nFFD_CORNER_POINTS= 1\n0 0\n" + square_su2(false).substr(9));
   CHECK(read_mesh_as<2>(file).num_cells() == 2);
+}
+
+TEST_CASE("SU2 lines that say something else than their element, and markers beyond NMARK, are refused", "[io]") {
+  const fs::path file = test::scratch_path("hostile.su2");
+  const auto parse_error = [&](const std::string& text) {
+    write_file(file, text);
+    return test::message_of<ParseError>([&] { (void)read_mesh(file); });
+  };
+  // A quadrilateral's line given the triangle's type code: four nodes and an index.
+  CHECK_THAT(parse_error("NDIME= 2\nNELEM= 1\n5 0 1 2 3 0\nNPOIN= 4\n0 0 0\n1 0 1\n1 1 2\n0 1 3\n"),
+             Catch::Contains("hostile.su2:3:") && Catch::Contains("tri3 element with more numbers than its 3 nodes"));
+  // One number after the nodes is SU2's element index, so the same line without its index
+  // reads as a triangle: the type code alone cannot tell.
+  write_file(file, "NDIME= 2\nNELEM= 1\n5 0 1 2 3\nNPOIN= 4\n0 0 0\n1 0 1\n1 1 2\n0 1 3\n");
+  CHECK(read_mesh_as<2>(file).num_cells() == 1);
+  CHECK_THAT(parse_error(square_su2(false) + "MARKER_TAG= far\nMARKER_ELEMS= 1\n3 1 2\n"),
+             Catch::Contains("MARKER_TAG= of a marker beyond NMARK="));
+}
+
+TEST_CASE("a group name given to two groups is refused where it is looked up, naming both", "[io]") {
+  const fs::path file = test::scratch_path("twice.su2");
+  write_file(file, "NDIME= 2\nNELEM= 2\n5 0 1 2 0\n5 0 2 3 1\nNPOIN= 4\n0 0 0\n1 0 1\n1 1 2\n0 1 3\nNMARK= 2\n"
+                   "MARKER_TAG= wall\nMARKER_ELEMS= 1\n3 0 1\nMARKER_TAG= wall\nMARKER_ELEMS= 1\n3 2 3\n");
+  const Mesh<2> mesh = read_mesh_as<2>(file);
+  CHECK_THAT(input_error_of([&] { (void)mesh.group("wall"); }),
+             Catch::Contains("'wall' names two groups (tag 1 of dimension 1 and tag 2 of dimension 1)"));
+}
+
+TEST_CASE("node ids are each format's own: from 0 in SU2 and VTU, from 1 in a written .msh", "[io]") {
+  const fs::path su2 = test::scratch_path("numbering.su2");
+  write_file(su2, square_su2(false));
+  const Mesh<2> from_su2 = read_mesh_as<2>(su2);
+  CHECK(from_su2.first_node_id == 0);
+  CHECK(from_su2.node_indices(std::vector<std::int64_t>{0, 3}) == std::vector<Index>{0, 3});
+  CHECK_THAT(input_error_of([&] { (void)from_su2.node_indices(std::vector<std::int64_t>{4}); }),
+             Catch::Contains("no node has id 4") && Catch::Contains("numbers its nodes 0 to 3"));
+  const fs::path vtu = test::scratch_path("numbering.vtu");
+  write_mesh(vtu, from_su2);
+  CHECK(read_mesh_as<2>(vtu).node_indices(std::vector<std::int64_t>{0}) == std::vector<Index>{0});
+  // Written as .msh, the same node is 1: Gmsh numbers from 1.
+  const fs::path msh = test::scratch_path("numbering.msh");
+  write_mesh(msh, from_su2);
+  const Mesh<2> from_msh = read_mesh_as<2>(msh);
+  CHECK(from_msh.node_indices(std::vector<std::int64_t>{1, 4}) == std::vector<Index>{0, 3});
+  CHECK_THROWS_AS(from_msh.node_indices(std::vector<std::int64_t>{0}), InputError);
 }

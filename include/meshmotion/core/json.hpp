@@ -98,10 +98,44 @@ class JsonWriter {
     if (!first_.back()) out_ << ',';
     first_.back() = false;
   }
+  // The length of the well-formed UTF-8 sequence starting at s[k] (1 to 4), or 0 when the
+  // bytes there are not one (a stray continuation byte, an overlong form, a surrogate, a
+  // truncated sequence).
+  [[nodiscard]] static std::size_t utf8_length(std::string_view s, std::size_t k) {
+    const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(s[i]); };
+    const unsigned char c = byte(k);
+    if (c < 0x80) return 1;
+    std::size_t n = 0;
+    unsigned char lo = 0x80, hi = 0xBF;  // the range of the second byte
+    if (c >= 0xC2 && c <= 0xDF) n = 2;
+    else if (c >= 0xE0 && c <= 0xEF) n = 3, lo = c == 0xE0 ? 0xA0 : 0x80, hi = c == 0xED ? 0x9F : 0xBF;
+    else if (c >= 0xF0 && c <= 0xF4) n = 4, lo = c == 0xF0 ? 0x90 : 0x80, hi = c == 0xF4 ? 0x8F : 0xBF;
+    else return 0;
+    if (k + n > s.size() || byte(k + 1) < lo || byte(k + 1) > hi) return 0;
+    for (std::size_t i = 2; i < n; ++i)
+      if ((byte(k + i) & 0xC0) != 0x80) return 0;
+    return n;
+  }
+
   void write_string(std::string_view s) {
     out_ << '"';
-    for (const char ch : s) {
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      const char ch = s[k];
       const auto c = static_cast<unsigned char>(ch);
+      if (c >= 0x80) {
+        // Well-formed UTF-8 passes; any other byte (a binary file's, a path's in another
+        // encoding) is written as the code point of its value, so the output stays JSON.
+        const std::size_t n = utf8_length(s, k);
+        if (n == 0) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", c);
+          out_ << buf;
+        } else {
+          out_ << s.substr(k, n);
+          k += n - 1;
+        }
+        continue;
+      }
       switch (ch) {
         case '"': out_ << "\\\""; break;
         case '\\': out_ << "\\\\"; break;

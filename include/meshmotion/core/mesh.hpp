@@ -89,7 +89,11 @@ struct Mesh {
   std::vector<ElementBlock> facets;                ///< dimension Dim - 1, tagged by group
   std::vector<ElementBlock> lower;                 ///< dimension < Dim - 1 (curves in 3D, points)
   std::vector<PhysicalGroup> groups;               ///< names of the tags
-  std::vector<std::int64_t> node_ids;              ///< node ids from the file; empty means 1..n
+  std::vector<std::int64_t> node_ids;              ///< node ids from the file; empty: see first_node_id
+  /// The file's id of node 0 when node_ids is empty (node i is then first_node_id + i): each
+  /// format's own numbering, 1 for Gmsh and CGNS, 0 for SU2, VTU and OpenFOAM (their point
+  /// indices) and for arrays given from Python.
+  std::int64_t first_node_id = 1;
   std::vector<NodeParametrization> node_params;    ///< empty, or one per node
   /// The last num_auxiliary_nodes nodes are construction nodes, not the file's: the cell and
   /// face centres of a polyhedral mesh cut into tetrahedra (io/openfoam.hpp). They move with
@@ -123,11 +127,20 @@ struct Mesh {
     return nullptr;
   }
 
-  /// The group of that name, or nullptr.
+  /// The group of that name, or nullptr. Two groups of one name (two SU2 markers, two
+  /// OpenFOAM patches, a Gmsh name on two dimensions) make the name ambiguous: InputError
+  /// naming both tags, rather than the first one taken in silence.
   [[nodiscard]] const PhysicalGroup* find_group(std::string_view group_name) const {
-    for (const auto& g : groups)
-      if (g.name == group_name) return &g;
-    return nullptr;
+    const PhysicalGroup* found = nullptr;
+    for (const auto& g : groups) {
+      if (g.name != group_name) continue;
+      if (found != nullptr)
+        throw InputError("Mesh::group: '" + std::string(group_name) + "' names two groups (tag " + std::to_string(found->tag) +
+                         " of dimension " + std::to_string(found->dim) + " and tag " + std::to_string(g.tag) + " of dimension " +
+                         std::to_string(g.dim) + "): rename one in the mesh file");
+      found = &g;
+    }
+    return found;
   }
   /// The group of that name; throws InputError listing the known names when absent.
   [[nodiscard]] const PhysicalGroup& group(std::string_view group_name) const {
@@ -159,7 +172,7 @@ struct Mesh {
 
   /// The file id of node i (1-based position when the file gave none).
   [[nodiscard]] std::int64_t node_id(Index i) const {
-    return node_ids.empty() ? static_cast<std::int64_t>(i) + 1 : node_ids[static_cast<std::size_t>(i)];
+    return node_ids.empty() ? static_cast<std::int64_t>(i) + first_node_id : node_ids[static_cast<std::size_t>(i)];
   }
 
   /// The node indices of file node ids (node_id()'s inverse), in the order given. Throws
@@ -169,10 +182,10 @@ struct Mesh {
     out.reserve(ids.size());
     if (node_ids.empty()) {
       for (const std::int64_t id : ids) {
-        if (id < 1 || id > num_nodes())
-          throw InputError("Mesh::node_indices: no node has id " + std::to_string(id) + " (ids are 1 to " +
-                           std::to_string(num_nodes()) + ")");
-        out.push_back(static_cast<Index>(id - 1));
+        if (id < first_node_id || id - first_node_id >= num_nodes())
+          throw InputError("Mesh::node_indices: no node has id " + std::to_string(id) + " (the file numbers its nodes " +
+                           std::to_string(first_node_id) + " to " + std::to_string(first_node_id + num_nodes() - 1) + ")");
+        out.push_back(static_cast<Index>(id - first_node_id));
       }
       return out;
     }
@@ -223,6 +236,13 @@ template <int Dim>
 
 }  // namespace detail
 
+/// The id a written .msh gives node `i`: the file's id when the mesh keeps them (node_ids),
+/// else i + 1, as Gmsh numbers from 1 whatever the format the mesh came from.
+template <int Dim>
+[[nodiscard]] std::int64_t msh_node_id(const Mesh<Dim>& mesh, Index i) {
+  return mesh.node_ids.empty() ? static_cast<std::int64_t>(i) + 1 : mesh.node_ids[static_cast<std::size_t>(i)];
+}
+
 /// The id element e of `block` (a block of `mesh`) has in a .msh file written from `mesh`:
 /// its stored id, else its 1-based position among all the elements the file lists (lower
 /// dimensions first), which is what a user sees in Gmsh.
@@ -246,8 +266,11 @@ void validate(const Mesh<Dim>& mesh) {
   for (Index i = 0; i < n; ++i)
     for (int d = 0; d < Dim; ++d)
       if (!std::isfinite(mesh.points(d, i)))
-        throw InputError("validate: node " + std::to_string(i) + " has a non-finite coordinate (" +
-                         std::to_string(mesh.points(d, i)) + ")");
+        throw InputError("validate: node " + std::to_string(i) +
+                         (static_cast<std::size_t>(i) < mesh.node_ids.size()
+                              ? " (id " + std::to_string(mesh.node_ids[static_cast<std::size_t>(i)]) + " in the file)"
+                              : std::string()) +
+                         " has a non-finite coordinate (" + std::to_string(mesh.points(d, i)) + ")");
   if (!mesh.node_ids.empty() && static_cast<Index>(mesh.node_ids.size()) != n)
     throw InputError("validate: " + std::to_string(mesh.node_ids.size()) + " node ids for " +
                      std::to_string(n) + " nodes");

@@ -9,8 +9,14 @@
 
 #include "meshmotion/core/error.hpp"
 
+#include <algorithm>
 #include <atomic>
+#include <charconv>
+#include <cstdlib>
+#include <cstring>
 #include <string>
+#include <string_view>
+#include <system_error>
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -32,9 +38,10 @@ inline std::atomic<int>& thread_setting() {
 }
 
 #ifdef _OPENMP
-// OpenMP's default before the first set_num_threads, to give back on set_num_threads(0).
+// OpenMP's default before the first set_num_threads, to give back on set_num_threads(0);
+// capped, as an OMP_NUM_THREADS of 100000 would crash the runtime.
 inline int openmp_default_threads() {
-  static const int n = omp_get_max_threads();
+  static const int n = std::min(omp_get_max_threads(), max_threads);
   return n;
 }
 #endif
@@ -53,20 +60,37 @@ inline void set_num_threads(int n) {
     throw InputError("set_num_threads: expected 0 (OpenMP's default) to " + std::to_string(max_threads) + " threads (got " +
                      std::to_string(n) + ")");
 #ifdef _OPENMP
-  omp_set_num_threads(n > 0 ? n : detail::openmp_default_threads());
+  // Read before the first change, so that 0 gives back the default as the program started.
+  const int fallback = detail::openmp_default_threads();
+  omp_set_num_threads(n > 0 ? n : fallback);
 #endif
   detail::thread_setting().store(n);
   Eigen::setNbThreads(n);
 }
 
-/// Threads the library's parallel loops use now (1 without OpenMP).
+/// Threads the library's parallel loops use now (1 without OpenMP; at most max_threads).
 [[nodiscard]] inline int num_threads() {
 #ifdef _OPENMP
   const int n = detail::thread_setting().load();
-  return n > 0 ? n : omp_get_max_threads();
+  return n > 0 ? n : std::min(omp_get_max_threads(), max_threads);
 #else
   return 1;
 #endif
+}
+
+/// Refuses an OMP_NUM_THREADS beyond max_threads (InputError naming it): the OpenMP runtime
+/// opens that many threads in the first parallel region of a library that takes its default
+/// (CHOLMOD, OpenBLAS), which crashes at tens of thousands. The programs call it first.
+inline void check_thread_environment() {
+  const char* text = std::getenv("OMP_NUM_THREADS");
+  if (text == nullptr) return;
+  // OpenMP reads the first number of a list ("8,2" nests).
+  const std::string_view first(text, std::strcspn(text, ","));
+  long long n = 0;
+  const auto [ptr, ec] = std::from_chars(first.data(), first.data() + first.size(), n);
+  if (ec == std::errc::result_out_of_range || (ec == std::errc() && n > max_threads))
+    throw InputError("OMP_NUM_THREADS=" + std::string(text).substr(0, 32) + ": more than " + std::to_string(max_threads) +
+                     " threads (the OpenMP runtime fails on that many; set it to the cores to use)");
 }
 
 }  // namespace meshmotion

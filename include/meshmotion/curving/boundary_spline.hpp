@@ -165,13 +165,13 @@ class BoundarySpline {
   /// Facets are numbered chain by chain in chain order (see chain_first_facet).
   /// Throws InputError for an out-of-range node index, a non-finite coordinate, an open chain
   /// of fewer than 2 or a closed one of fewer than 3 nodes, two consecutive nodes at the
-  /// same position, or a corner_angle that is NaN or negative.
+  /// same position, or a corner_angle that is NaN or outside 0 to 180 degrees.
   BoundarySpline(const Points<2>& points, std::span<const BoundaryChain> chains,
                  BoundarySplineOptions options = {})
       : options_(std::move(options)) {
-    if (!(options_.corner_angle >= 0.0))
-      throw InputError("BoundarySpline: invalid corner_angle (got " +
-                       std::to_string(options_.corner_angle) + ", expected degrees >= 0)");
+    if (!(options_.corner_angle >= 0.0 && options_.corner_angle <= 180.0))
+      throw InputError("BoundarySpline: invalid corner_angle (got " + std::to_string(options_.corner_angle) +
+                       ", expected 0 to 180 degrees)");
     std::sort(options_.corner_nodes.begin(), options_.corner_nodes.end());
     Index total = 0;
     for (const BoundaryChain& chain : chains)

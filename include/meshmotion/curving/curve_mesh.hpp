@@ -670,6 +670,9 @@ template <int Dim>
     throw InputError("curve_mesh: active_radius_factor must be non-negative (got " +
                      format_option_value(options.active_radius_factor) + ")");
   check_untangle_options(options.untangle);
+  // The angle between two facets' directions: 0 to 180 degrees (720 is a slip, not a corner).
+  if (!(options.snap.corner_angle >= 0.0 && options.snap.corner_angle <= 180.0))
+    throw InputError("curve_mesh: corner_angle must be 0 to 180 degrees (got " + format_option_value(options.snap.corner_angle) + ")");
   if (options.centre_reach < 0.0)
     throw InputError("curve_mesh: centre_reach must be non-negative (got " + format_option_value(options.centre_reach) + ")");
   CurveResult<Dim> result;

@@ -231,6 +231,7 @@ template <int Dim>
   mesh.points.resize(Dim, n_total);
   for (Index i = 0; i < out.num_kept_nodes; ++i) mesh.points.col(i) = input.points.col(out.kept[static_cast<std::size_t>(i)]);
   for (std::size_t i = 0; i < added.size(); ++i) mesh.points.col(out.num_kept_nodes + static_cast<Index>(i)) = added[i];
+  mesh.first_node_id = input.first_node_id;
   if (!input.node_ids.empty()) {
     for (const Index v : out.kept) mesh.node_ids.push_back(input.node_ids[static_cast<std::size_t>(v)]);
     std::int64_t next = *std::max_element(input.node_ids.begin(), input.node_ids.end()) + 1;

@@ -163,6 +163,7 @@ template <int Dim>
     mesh.points.col(n_linear + static_cast<Index>(i)) = p / n;
   }
 
+  mesh.first_node_id = linear.first_node_id;
   if (!linear.node_ids.empty()) {
     mesh.node_ids = linear.node_ids;
     std::int64_t next = *std::max_element(linear.node_ids.begin(), linear.node_ids.end()) + 1;

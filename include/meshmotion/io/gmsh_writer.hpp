@@ -9,7 +9,7 @@
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
-#include "meshmotion/io/detail/atomic_file.hpp"
+#include "meshmotion/core/detail/atomic_file.hpp"
 #include "meshmotion/io/detail/number_format.hpp"
 
 #include <algorithm>
@@ -67,8 +67,8 @@ template <int Dim>
 void check_int32_ids(const Mesh<Dim>& mesh, const std::vector<const ElementBlock*>& blocks) {
   const auto too_big = [](std::int64_t id) { return id < 0 || id > std::numeric_limits<std::int32_t>::max(); };
   for (Index i = 0; i < mesh.num_nodes(); ++i)
-    if (too_big(mesh.node_id(i)))
-      throw InputError("write_gmsh: node id " + std::to_string(mesh.node_id(i)) + " does not fit msh 2.2 binary (expected 0 to 2^31-1)");
+    if (too_big(msh_node_id(mesh, i)))
+      throw InputError("write_gmsh: node id " + std::to_string(msh_node_id(mesh, i)) + " does not fit msh 2.2 binary (expected 0 to 2^31-1)");
   for (const auto* b : blocks)
     for (const auto id : b->ids)
       if (too_big(id)) throw InputError("write_gmsh: element id " + std::to_string(id) + " does not fit msh 2.2 binary");
@@ -82,7 +82,7 @@ void format_gmsh_v2(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
   f.ascii(mesh.num_nodes());
   f.text("\n");
   for (Index i = 0; i < mesh.num_nodes(); ++i) {
-    f.value<std::int32_t>(mesh.node_id(i));
+    f.value<std::int32_t>(msh_node_id(mesh, i));
     for (int d = 0; d < 3; ++d) f.value<double>(d < Dim ? mesh.points(d, i) : 0.0);
     if (parametric) {
       const auto& p = mesh.node_params[static_cast<std::size_t>(i)];
@@ -117,7 +117,7 @@ void format_gmsh_v2(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
       }
       f.value<std::int32_t>(tag);
       f.value<std::int32_t>(tag);  // elementary entity: the mesh keeps none, the physical tag stands in
-      for (const Index v : b->element(e)) f.value<std::int32_t>(mesh.node_id(v));
+      for (const Index v : b->element(e)) f.value<std::int32_t>(msh_node_id(mesh, v));
       f.end_of_record();
     }
   }
@@ -159,8 +159,8 @@ void format_gmsh_v4(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
 
   std::int64_t min_id = std::numeric_limits<std::int64_t>::max(), max_id = 0;
   for (Index i = 0; i < mesh.num_nodes(); ++i) {
-    min_id = std::min(min_id, mesh.node_id(i));
-    max_id = std::max(max_id, mesh.node_id(i));
+    min_id = std::min(min_id, msh_node_id(mesh, i));
+    max_id = std::max(max_id, msh_node_id(mesh, i));
   }
   if (mesh.num_nodes() == 0) min_id = 0;
   f.text("$Nodes\n");
@@ -175,7 +175,7 @@ void format_gmsh_v4(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
     f.value<std::int32_t>(0);
     size(static_cast<std::uint64_t>(n), '\n');
     for (Index i = 0; i < n; ++i) {
-      size(static_cast<std::uint64_t>(mesh.node_id(i)), '\n');
+      size(static_cast<std::uint64_t>(msh_node_id(mesh, i)), '\n');
       f.end_of_record();
     }
     for (Index i = 0; i < n; ++i) {
@@ -224,7 +224,7 @@ void format_gmsh_v4(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
     size(static_cast<std::uint64_t>(run.last - run.first), '\n');
     for (Index e = run.first; e < run.last; ++e) {
       size(static_cast<std::uint64_t>(element_id(*run.block, e, block_start + e)));
-      for (const Index v : run.block->element(e)) size(static_cast<std::uint64_t>(mesh.node_id(v)));
+      for (const Index v : run.block->element(e)) size(static_cast<std::uint64_t>(msh_node_id(mesh, v)));
       f.end_of_record();
     }
     position = block_start + run.last;

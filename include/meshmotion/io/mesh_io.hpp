@@ -1,9 +1,9 @@
 #pragma once
 /// \file
-/// Reading and writing meshes by file extension: .msh (Gmsh 2.2/4.1, ASCII or binary, detected
-/// on reading), .su2 (SU2), .cgns (CGNS, when built with the CGNS library: io/cgns.hpp) and
-/// .vtu (VTK XML, io/vtu_reader.hpp and io/vtu_writer.hpp); a folder is an OpenFOAM case (io/openfoam.hpp): read as its
-/// polyMesh, written by replacing its points.
+/// Reading and writing meshes by file extension, from one table (mesh_file_formats): .msh
+/// (Gmsh 2.2/4.1, ASCII or binary, detected on reading), .su2 (SU2), .cgns (CGNS, when built
+/// with the CGNS library: io/cgns.hpp) and .vtu (VTK XML); a folder is an OpenFOAM case
+/// (io/openfoam.hpp): read as its polyMesh, written by replacing its points.
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
@@ -19,21 +19,68 @@
 #include "meshmotion/io/vtu_reader.hpp"
 #include "meshmotion/io/vtu_writer.hpp"
 
+#include "meshmotion/io/detail/read_file.hpp"
+
+#include <array>
 #include <concepts>
-#include <algorithm>
-#include <cctype>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <variant>
 
 namespace meshmotion {
 
-namespace detail {
-[[nodiscard]] inline std::string lower_extension(const std::filesystem::path& file) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
+/// The file formats read_mesh() and write_mesh() choose by extension.
+enum class MeshFormat { gmsh, su2, cgns, vtu };
+
+/// One row of the format table.
+struct MeshFormatEntry {
+  MeshFormat format;
+  std::string_view extension;  ///< lower case, with its dot
+  int max_write_order;         ///< the highest element order written; 0: any
+  std::string_view library;    ///< the library it needs, empty for none
+  bool available;              ///< false when the build lacks that library
+};
+
+/// Every format a file extension selects, in the order error messages list them. Adding a
+/// format is one row here and one case in read_mesh() and write_mesh().
+inline constexpr std::array<MeshFormatEntry, 4> mesh_file_formats{{
+    {MeshFormat::gmsh, ".msh", 0, "", true},
+    {MeshFormat::su2, ".su2", 0, "", true},
+    {MeshFormat::cgns, ".cgns", 2, "CGNS", have_cgns},
+    {MeshFormat::vtu, ".vtu", 0, "", true},
+}};
+
+/// The format row of `file`'s extension (any case); nullptr when none has it.
+[[nodiscard]] inline const MeshFormatEntry* mesh_format_of(const std::filesystem::path& file) {
+  const std::string ext = detail::lower_extension(file);
+  for (const auto& f : mesh_file_formats)
+    if (f.extension == ext) return &f;
+  return nullptr;
 }
+
+namespace detail {
+
+/// The extensions of the formats that write elements of `order` (of every format for order
+/// 0), as "one of .msh, .su2, ..." for messages.
+[[nodiscard]] inline std::string format_extensions(int order = 0) {
+  std::string list = "one of";
+  bool first = true;
+  for (const auto& f : mesh_file_formats)
+    if (order == 0 || f.max_write_order == 0 || order <= f.max_write_order) {
+      list += first ? " " : ", ";
+      list += f.extension;
+      first = false;
+    }
+  return list;
+}
+
+/// "unknown mesh format '.xyz' (expected one of .msh, ..." for messages, left open for the
+/// caller's alternatives and closing parenthesis.
+[[nodiscard]] inline std::string unknown_format(const std::filesystem::path& file) {
+  return "unknown mesh format '" + lower_extension(file) + "' (expected " + format_extensions();
+}
+
 }  // namespace detail
 
 /// What read_mesh() does with the orientation of the cells (core/orientation.hpp).
@@ -83,16 +130,19 @@ void apply_orientation(Mesh<Dim>& mesh, const std::filesystem::path& file, ReadO
 /// and line or byte offset) for malformed content, InputError for an invalid mesh (a 2D mesh
 /// with nonzero z names the first such node) or a negative cell under require_positive.
 [[nodiscard]] inline AnyMesh read_mesh(const std::filesystem::path& file, const ReadOptions& options = {}) {
-  const std::string ext = detail::lower_extension(file);
   AnyMesh mesh = [&]() -> AnyMesh {
     std::error_code ec;
     if (std::filesystem::is_directory(file, ec)) return read_openfoam(file);
-    if (ext == ".msh") return read_gmsh(file);
-    if (ext == ".su2") return read_su2(file);
-    if (ext == ".cgns") return read_cgns(file);
-    if (ext == ".vtu") return read_vtu(file);
-    throw InputError("read_mesh: " + file.string() + ": unknown mesh format '" + ext +
-                     "' (expected .msh, .su2, .cgns, .vtu or an OpenFOAM case folder)");
+    const MeshFormatEntry* format = mesh_format_of(file);
+    if (format == nullptr)
+      throw InputError("read_mesh: " + file.string() + ": " + detail::unknown_format(file) + ", or an OpenFOAM case folder)");
+    switch (format->format) {
+      case MeshFormat::gmsh: return read_gmsh(file);
+      case MeshFormat::su2: return read_su2(file);
+      case MeshFormat::cgns: return read_cgns(file);
+      case MeshFormat::vtu: return read_vtu(file);
+    }
+    throw InputError("read_mesh: " + file.string() + ": no reader for its format");
   }();
   std::visit([&](auto& m) { detail::apply_orientation(m, file, options.orientation); }, mesh);
   return mesh;
@@ -126,17 +176,28 @@ void write_mesh(const std::filesystem::path& file, const Mesh<Dim>& mesh, const 
   if (is_openfoam_target(file) || is_new_openfoam_case(file)) {
     if constexpr (Dim == 3) {
       if (is_openfoam_target(file)) return write_polymesh_points(file, mesh);
-      return write_polymesh(file, to_polymesh(mesh));
+      return write_new_polymesh_case(file, to_polymesh(mesh));
     } else {
       throw InputError("write_mesh: " + file.string() + ": an OpenFOAM case holds a 3D mesh (got a 2D one)");
     }
   }
-  const std::string ext = detail::lower_extension(file);
-  if (ext == ".msh") return write_gmsh(file, mesh, GmshWriteOptions{options.msh_version, options.binary});
-  if (ext == ".su2") return write_su2(file, mesh);
-  if (ext == ".vtu") return write_vtu(file, mesh, VtuFields{}, VtuOptions{options.vtu_facets});
-  if (ext == ".cgns") return write_cgns(file, mesh);
-  throw InputError("write_mesh: " + file.string() + ": unknown mesh format '" + ext + "' (expected .msh, .su2, .cgns or .vtu)");
+  const MeshFormatEntry* format = mesh_format_of(file);
+  if (format == nullptr) throw InputError("write_mesh: " + file.string() + ": " + detail::unknown_format(file) + ")");
+  switch (format->format) {
+    case MeshFormat::gmsh: return write_gmsh(file, mesh, GmshWriteOptions{options.msh_version, options.binary});
+    case MeshFormat::su2: return write_su2(file, mesh);
+    case MeshFormat::cgns: return write_cgns(file, mesh);
+    case MeshFormat::vtu: return write_vtu(file, mesh, VtuFields{}, VtuOptions{options.vtu_facets});
+  }
+}
+
+/// Checks, before any work, that the folder `file` is to be written into exists (an SVG
+/// picture, a report); InputError naming the folder otherwise.
+inline void check_output_folder(const std::filesystem::path& file) {
+  const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  std::error_code ec;
+  if (!std::filesystem::is_directory(folder, ec))
+    throw InputError("output " + file.string() + ": folder " + folder.string() + " does not exist");
 }
 
 /// Checks, before any work, that write_mesh() can write a mesh of element order `order` (1:
@@ -144,22 +205,21 @@ void write_mesh(const std::filesystem::path& file, const Mesh<Dim>& mesh, const 
 /// existing folder. Throws InputError saying which formats would do, or naming the folder.
 inline void check_mesh_output(const std::filesystem::path& file, int order = 1) {
   if (is_openfoam_target(file) || is_new_openfoam_case(file)) {
-    if (order > 1) throw InputError("output " + file.string() + ": an OpenFOAM case holds linear cells only (expected .msh, .cgns or .vtu for order " +
-                                    std::to_string(order) + ")");
+    if (order > 1)
+      throw InputError("output " + file.string() + ": an OpenFOAM case holds linear cells only (expected " +
+                       detail::format_extensions(order) + " for order " + std::to_string(order) + ")");
     return;
   }
-  const std::string ext = detail::lower_extension(file);
-  if (ext != ".msh" && ext != ".su2" && ext != ".vtu" && ext != ".cgns")
-    throw InputError("output " + file.string() + ": unknown mesh format '" + ext + "' (expected .msh, .su2, .cgns or .vtu)");
-  if (ext == ".cgns" && !have_cgns)
-    throw InputError("output " + file.string() + ": writing CGNS needs the CGNS library (meshmotion was built without it)");
-  if (ext == ".cgns" && order > 2)
-    throw InputError("output " + file.string() + ": CGNS files are written up to order 2 (expected .msh or .vtu for order " +
+  const MeshFormatEntry* format = mesh_format_of(file);
+  if (format == nullptr) throw InputError("output " + file.string() + ": " + detail::unknown_format(file) + ")");
+  if (!format->available)
+    throw InputError("output " + file.string() + ": writing " + std::string(format->extension) + " needs the " +
+                     std::string(format->library) + " library (meshmotion was built without it)");
+  if (format->max_write_order != 0 && order > format->max_write_order)
+    throw InputError("output " + file.string() + ": " + std::string(format->extension) + " files are written up to order " +
+                     std::to_string(format->max_write_order) + " (expected " + detail::format_extensions(order) + " for order " +
                      std::to_string(order) + ")");
-  const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
-  std::error_code ec;
-  if (!std::filesystem::is_directory(folder, ec))
-    throw InputError("output " + file.string() + ": folder " + folder.string() + " does not exist");
+  check_output_folder(file);
 }
 
 /// Writes a solver's own mesh type (any MeshLike): its nodes and cells, copied into a

@@ -52,6 +52,8 @@ class Su2Parser {
       } else if (key == "NMARK") {
         require_dim();
         read_markers(pending);
+      } else if (key == "MARKER_TAG" || key == "MARKER_ELEMS") {
+        text_.fail(std::string(key) + "= of a marker beyond NMARK= (the file lists more markers than NMARK= counts)");
       } else {
         skip_section();  // NZONE, IZONE, NPERIODIC/PERIODIC_INDEX, FFD_* boxes: not mesh data
       }
@@ -131,8 +133,7 @@ class Su2Parser {
       }
       text_.next_line();  // optional index (and, in some 2D files, a zero z) after the coordinates
     }
-    raw_.node_ids.resize(static_cast<std::size_t>(count));
-    for (std::int64_t i = 0; i < count; ++i) raw_.node_ids[static_cast<std::size_t>(i)] = i + 1;
+    raw_.first_node_id = 0;  // SU2's point index, which element lines and markers use
   }
 
   void skip_comments() {
@@ -178,9 +179,18 @@ class Su2Parser {
         const int local = order.empty() ? k : order[static_cast<std::size_t>(k)];
         block.connectivity[first + static_cast<std::size_t>(local)] = text_.integer<Index>("node index", 0);
       }
+      // SU2 lists the element's index after its nodes; more numbers mean that the type code
+      // and the nodes disagree (a prism listed as a tetrahedron), which must not pass as a
+      // smaller element.
+      if (!text_.at_line_end()) {
+        (void)text_.integer<std::int64_t>("element index");
+        if (!text_.at_line_end())
+          text_.fail(std::string(name(block.type)) + " element with more numbers than its " + std::to_string(nodes) +
+                     " nodes and an index (does its type code match its nodes?)");
+      }
       block.tags.push_back(tag);
       pending.push_back({index, first, line});
-      text_.next_line();  // optional element index
+      text_.next_line();
     }
   }
 

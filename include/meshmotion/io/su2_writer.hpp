@@ -10,7 +10,7 @@
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/shape_functions.hpp"
-#include "meshmotion/io/detail/atomic_file.hpp"
+#include "meshmotion/core/detail/atomic_file.hpp"
 #include "meshmotion/io/detail/number_format.hpp"
 
 #include <algorithm>

@@ -13,12 +13,14 @@
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/io/any_mesh.hpp"
+#include "meshmotion/io/detail/raw_mesh.hpp"
 #include "meshmotion/io/detail/read_file.hpp"
 #include "meshmotion/io/vtu_writer.hpp"
 
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <charconv>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -27,6 +29,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -177,19 +180,36 @@ inline std::vector<double> array_values(const VtuText& t, const VtuArray& a, con
   if (size == 0) t.fail(a.tag.at, "DataArray '" + a.name() + "' has type '" + type + "' (expected a VTK scalar type: Int8 .. Float64)");
   const std::string format = a.tag.attribute("format").value_or("ascii");
   std::vector<double> out;
-  out.reserve(expected);
+  // `expected` comes from the file's counts: reserve no more than the array's text can hold.
+  out.reserve(std::min(expected, a.end - a.begin));
   if (format == "ascii") {
+    // Values in the notation of their type: an integer array holds integers only (not 1.5,
+    // 1e1 or 0x10), a real array decimal numbers (not hexadecimal ones).
+    const bool integers = type.find("Int") != std::string::npos;
     const std::string& s = t.text();
+    const auto blank = [&](std::size_t k) { return s[k] == ' ' || s[k] == '\n' || s[k] == '\r' || s[k] == '\t'; };
     std::size_t p = a.begin;
     while (true) {
-      while (p < a.end && (s[p] == ' ' || s[p] == '\n' || s[p] == '\r' || s[p] == '\t')) ++p;
+      while (p < a.end && blank(p)) ++p;
       if (p >= a.end) break;
-      const char* first = s.c_str() + p;
-      char* last = nullptr;
-      const double v = std::strtod(first, &last);
-      if (last == first) t.fail(p, "DataArray '" + a.name() + "': '" + s.substr(p, std::min<std::size_t>(16, a.end - p)) + "' is not a number");
+      std::size_t q = p;
+      while (q < a.end && !blank(q)) ++q;
+      const char* first = s.data() + p;
+      const char* last = s.data() + q;
+      double v = 0.0;
+      std::from_chars_result r{};
+      if (integers) {
+        long long i = 0;
+        r = std::from_chars(first, last, i);
+        v = static_cast<double>(i);
+      } else {
+        r = std::from_chars(first + (*first == '+' ? 1 : 0), last, v);
+      }
+      if (r.ec != std::errc() || r.ptr != last)
+        t.fail(p, "DataArray '" + a.name() + "': '" + s.substr(p, std::min<std::size_t>(16, q - p)) + "' is not " +
+                      (integers ? "an integer (its type is " + type + ")" : std::string("a decimal number")));
       out.push_back(v);
-      p += static_cast<std::size_t>(last - first);
+      p = q;
     }
   } else if (format == "binary") {
     const auto decoded = decode_base64(t, a.begin, a.end);
@@ -245,14 +265,14 @@ inline std::optional<VtkReadCell> element_of_vtk(int vtk_type, int n) {
 
 }  // namespace detail
 
-/// Reads a .vtu file (see the file comment): a 3D mesh when it holds a 3D cell, else a 2D
-/// mesh, whose points must then lie in z = 0. Node numbering is the file's; element ids
-/// follow the file's order. Throws IoError when the file cannot be read, and ParseError (file
+/// Parses VTK XML content held in memory (see the file comment); `file` names it in messages.
+/// A 3D mesh when it holds a 3D cell, else a 2D mesh, whose points must then lie in z = 0.
+/// Node numbering is the file's; element ids follow the file's order. Throws ParseError (file
 /// and line) for malformed content: a missing section or array, an array of the wrong length,
 /// a node index out of range, a cell type the library lacks (naming it and its node count),
 /// compressed or appended data, a 2D mesh off z = 0.
-[[nodiscard]] inline AnyMesh read_vtu(const std::filesystem::path& file) {
-  const detail::VtuText t(file, detail::read_whole_file(file));
+[[nodiscard]] inline AnyMesh parse_vtu(std::string_view data, const std::filesystem::path& file) {
+  const detail::VtuText t(file, std::string(data));
   const detail::VtuTag root = detail::find_tag(t, "VTKFile", 0);
   if (!root.found()) t.fail(0, "no <VTKFile> element (expected a VTK XML file)");
   if (root.attribute("type").value_or("") != "UnstructuredGrid")
@@ -271,9 +291,20 @@ inline std::optional<VtkReadCell> element_of_vtk(int vtk_type, int n) {
   const detail::VtuTag piece = detail::find_tag(t, "Piece", root.end);
   if (!piece.found()) t.fail(root.end, "no <Piece> element");
   if (detail::find_tag(t, "Piece", piece.end).found()) t.fail(piece.end, "several <Piece> elements (expected one)");
-  const long long num_points = std::atoll(piece.attribute("NumberOfPoints").value_or("-1").c_str());
-  const long long num_cells = std::atoll(piece.attribute("NumberOfCells").value_or("-1").c_str());
-  if (num_points < 0 || num_cells < 0) t.fail(piece.at, "<Piece> without NumberOfPoints and NumberOfCells");
+  // A count is refused beyond what the file's bytes can hold (each value takes one at least),
+  // before it sizes anything.
+  const auto count = [&](const char* key) {
+    const std::optional<std::string> text = piece.attribute(key);
+    if (!text) t.fail(piece.at, std::string("<Piece> without ") + key);
+    long long n = -1;
+    const auto [ptr, ec] = std::from_chars(text->data(), text->data() + text->size(), n);
+    if (ec != std::errc() || ptr != text->data() + text->size() || n < 0 || static_cast<unsigned long long>(n) > t.text().size())
+      t.fail(piece.at, std::string(key) + " '" + text->substr(0, 32) + "' (expected a count the file's " +
+                           std::to_string(t.text().size()) + " bytes can hold)");
+    return n;
+  };
+  const long long num_points = count("NumberOfPoints");
+  const long long num_cells = count("NumberOfCells");
   const std::size_t piece_end = detail::find_end_tag(t, "Piece", piece.end);
 
   const auto section = [&](std::string_view name) -> std::pair<std::size_t, std::size_t> {
@@ -282,6 +313,7 @@ inline std::optional<VtkReadCell> element_of_vtk(int vtk_type, int n) {
     return {tag.end, detail::find_end_tag(t, name, tag.end)};
   };
   const auto [points_begin, points_end] = section("Points");
+  const std::size_t points_at = points_begin;  // for the lambda below (clang 14 captures no bindings)
   if (points_end == 0) t.fail(piece.end, "no <Points> section");
   const auto point_arrays = detail::data_arrays(t, points_begin, points_end);
   if (point_arrays.empty()) t.fail(points_begin, "<Points> holds no DataArray");
@@ -334,10 +366,11 @@ inline std::optional<VtkReadCell> element_of_vtk(int vtk_type, int n) {
 
   const auto build = [&]<int Dim>(Mesh<Dim>& mesh) {
     mesh.points.resize(Dim, static_cast<Index>(num_points));
+    mesh.first_node_id = 0;  // the file's point index, which its connectivity uses
     for (Index v = 0; v < static_cast<Index>(num_points); ++v) {
       for (int d = 0; d < Dim; ++d) mesh.points(d, v) = xyz[static_cast<std::size_t>(3 * v + d)];
       if (Dim == 2 && xyz[static_cast<std::size_t>(3 * v + 2)] != 0.0)
-        t.fail(points_begin, "point " + std::to_string(v) + " has z = " + std::to_string(xyz[static_cast<std::size_t>(3 * v + 2)]) +
+        t.fail(points_at, "point " + std::to_string(v) + " has z = " + std::to_string(xyz[static_cast<std::size_t>(3 * v + 2)]) +
                                  " in a mesh of 2D cells (expected z = 0)");
     }
     std::array<Index, max_element_nodes> local{};
@@ -366,7 +399,7 @@ inline std::optional<VtkReadCell> element_of_vtk(int vtk_type, int n) {
       blocks.back().add(std::span<const Index>(local.data(), static_cast<std::size_t>(num_nodes(et))), tag);
       blocks.back().ids.push_back(static_cast<std::int64_t>(e) + 1);
     }
-    validate(mesh);
+    detail::validate_read(mesh, file);
   };
   if (dim == 3) {
     Mesh<3> mesh;
@@ -377,5 +410,8 @@ inline std::optional<VtkReadCell> element_of_vtk(int vtk_type, int n) {
   build(mesh);
   return mesh;
 }
+
+/// Reads a .vtu file: as parse_vtu() on its content; IoError when it cannot be read.
+[[nodiscard]] inline AnyMesh read_vtu(const std::filesystem::path& file) { return parse_vtu(detail::read_whole_file(file), file); }
 
 }  // namespace meshmotion

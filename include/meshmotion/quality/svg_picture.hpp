@@ -8,6 +8,7 @@
 /// is narrower than a pixel.
 
 #include "meshmotion/core/element.hpp"
+#include "meshmotion/core/detail/atomic_file.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/types.hpp"
@@ -17,10 +18,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <optional>
 #include <string>
-#include <system_error>
 #include <vector>
 
 namespace meshmotion {
@@ -206,19 +205,7 @@ inline std::string colour(double t) {
 /// rename). Throws IoError when the file cannot be written, InputError as svg_picture().
 inline void write_svg(const std::filesystem::path& file, const Mesh<2>& mesh, const std::vector<double>& values,
                       const SvgOptions& options = {}) {
-  const std::string text = svg_picture(mesh, values, options);
-  const std::filesystem::path tmp = file.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    if (!out.flush()) throw IoError("write_svg: cannot write " + tmp.string());
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw IoError("write_svg: cannot rename " + tmp.string() + " to " + file.string());
-  }
+  detail::write_file_atomically(file, svg_picture(mesh, values, options));
 }
 
 }  // namespace meshmotion

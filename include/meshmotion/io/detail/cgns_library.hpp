@@ -47,6 +47,11 @@ inline const CgnsLibrary& cgns_api() {
       throw IoError(std::string("cannot load the CGNS library " MESHMOTION_CGNS_LIBRARY " (") +
                     (reason != nullptr ? reason : "unknown reason") + "; is libcgns installed?)");
     }
+    // HDF5 (loaded with libcgns) closes its open files at exit, and crashes there on a file
+    // whose write failed (a full disk, a file size limit): the program would end with a
+    // segmentation fault after reporting the error. Every file is closed by its owner
+    // (CgnsFile), so HDF5's exit handler is declined, before HDF5's first use.
+    if (auto* dont_atexit = reinterpret_cast<int (*)()>(dlsym(handle, "H5dont_atexit"))) dont_atexit();
     CgnsLibrary loaded;
 #define MESHMOTION_CGNS_LOAD(name)                                                                  \
   loaded.name = reinterpret_cast<decltype(&::name)>(dlsym(handle, #name));                         \

@@ -15,9 +15,20 @@
 
 namespace meshmotion::detail {
 
+/// validate(mesh) for a mesh read from `file`, whose name its message then carries.
+template <int Dim>
+void validate_read(const Mesh<Dim>& mesh, const std::filesystem::path& file) {
+  try {
+    validate(mesh);
+  } catch (const InputError& e) {
+    throw InputError(file.string() + ": invalid mesh after reading: " + e.what());
+  }
+}
+
 struct RawMesh {
   std::vector<double> coords;                    ///< x y z per node
-  std::vector<std::int64_t> node_ids;            ///< one per node
+  std::vector<std::int64_t> node_ids;            ///< one per node, or empty: first_node_id + i
+  std::int64_t first_node_id = 1;                ///< the format's numbering (Mesh::first_node_id)
   std::vector<NodeParametrization> node_params;  ///< empty or one per node
   std::vector<ElementBlock> blocks;              ///< one per type, in order of first appearance
   std::vector<PhysicalGroup> groups;
@@ -79,11 +90,12 @@ template <int Dim>
     const double* c = raw.coords.data() + 3 * i;
     for (int d = 0; d < Dim; ++d) mesh.points(d, i) = c[d];
     if (Dim == 2 && c[2] != 0.0)
-      throw InputError(file.string() + ": node " + std::to_string(raw.node_ids.empty() ? i + 1 : raw.node_ids[static_cast<std::size_t>(i)]) +
+      throw InputError(file.string() + ": node " + std::to_string(raw.node_ids.empty() ? i + raw.first_node_id : raw.node_ids[static_cast<std::size_t>(i)]) +
                        " has z = " + std::to_string(c[2]) + " in a 2D mesh (expected z = 0: a mesh is 3D only if it has 3D elements)");
   }
   std::vector<double>().swap(raw.coords);
   if (!is_identity_numbering(raw.node_ids)) mesh.node_ids = std::move(raw.node_ids);
+  mesh.first_node_id = raw.first_node_id;
   mesh.node_params = std::move(raw.node_params);
   for (auto& b : raw.blocks) {
     if (dimension(b.type) > Dim)
@@ -91,11 +103,7 @@ template <int Dim>
     mesh.blocks_of_dim(dimension(b.type)).push_back(std::move(b));
   }
   mesh.groups = std::move(raw.groups);
-  try {
-    validate(mesh);
-  } catch (const InputError& e) {
-    throw InputError(file.string() + ": invalid mesh after reading: " + e.what());
-  }
+  validate_read(mesh, file);
   return mesh;
 }
 

@@ -37,10 +37,32 @@ inline void rename_into_place(const std::filesystem::path& tmp, const std::files
   }
 }
 
+/// Removes what a killed run left of its temporaries for `file` (temporary_path_for()'s names,
+/// files or folders) once they are an hour old: a run still writing one is younger.
+inline void remove_stale_temporaries(const std::filesystem::path& file) {
+  const std::string prefix = file.filename().string() + ".tmp";
+  const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  const auto old = std::filesystem::file_time_type::clock::now() - std::chrono::hours(1);
+  std::error_code ec;
+  for (std::filesystem::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    // "<stamp>_<counter>", digits only: nothing else of this name is ours.
+    const std::string_view tail = std::string_view(name).substr(prefix.size());
+    const std::size_t cut = tail.find('_');
+    const auto digits = [](std::string_view t) { return !t.empty() && t.find_first_not_of("0123456789") == std::string_view::npos; };
+    if (cut == std::string_view::npos || !digits(tail.substr(0, cut)) || !digits(tail.substr(cut + 1))) continue;
+    std::error_code ignored;
+    if (std::filesystem::last_write_time(it->path(), ignored) < old && !ignored) std::filesystem::remove_all(it->path(), ignored);
+  }
+}
+
 /// Has `write(tmp)` write a whole file at a temporary path beside `file`, then renames it onto
-/// `file`; when `write` throws, the temporary is removed and `file` is left as it was.
+/// `file`; when `write` throws, the temporary is removed and `file` is left as it was. Stale
+/// temporaries of `file` from killed runs are removed first.
 template <class Write>
 void write_through_temporary(const std::filesystem::path& file, Write&& write) {
+  remove_stale_temporaries(file);
   const std::filesystem::path tmp = temporary_path_for(file);
   try {
     write(tmp);

@@ -15,10 +15,10 @@
 ///   absolute face areas, in the mesh's solution directions (`empty` patches remove theirs),
 ///   and in 3D at least the area-to-volume ratio of a cube; high above 1000;
 /// - cell volumes: smallest, largest, total, and the cells of zero or negative volume.
-/// Validated against checkMesh (Debian `openfoam`) in tests/io/openfoam_test.cpp.
+/// Validated against checkMesh (Debian `openfoam`) in tests/io/openfoam_test.cpp. Polyhedra: core/poly_mesh.hpp.
 
 #include "meshmotion/core/types.hpp"
-#include "meshmotion/io/openfoam.hpp"
+#include "meshmotion/core/poly_mesh.hpp"
 
 #include <Eigen/Geometry>
 

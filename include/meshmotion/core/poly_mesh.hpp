@@ -1,0 +1,40 @@
+#pragma once
+/// \file
+/// A polyhedral mesh stored by faces, as OpenFOAM's polyMesh files hold it. Read and written by
+/// io/openfoam_reader.hpp and io/openfoam_writer.hpp, converted by io/openfoam_polymesh.hpp,
+/// measured by quality/foam_quality.hpp.
+
+#include "meshmotion/core/types.hpp"
+
+#include <span>
+#include <string>
+#include <vector>
+
+namespace meshmotion {
+
+/// An OpenFOAM polyMesh as its files hold it: faces as vertex lists (outward from their owner
+/// cell), owner and neighbour cells per face (internal faces first), patches as face ranges.
+struct PolyMesh {
+  struct Patch {
+    std::string name;
+    std::string type;  ///< patch, wall, empty, symmetryPlane, ...
+    Index start = 0;   ///< first face
+    Index size = 0;    ///< number of faces
+  };
+  Points<3> points;
+  std::vector<Index> face_offsets{0};  ///< face f: face_nodes[face_offsets[f] .. face_offsets[f+1])
+  std::vector<Index> face_nodes;
+  std::vector<Index> owner;      ///< one per face
+  std::vector<Index> neighbour;  ///< one per internal face
+  std::vector<Patch> patches;
+  Index num_cells = 0;
+
+  [[nodiscard]] Index num_faces() const noexcept { return static_cast<Index>(face_offsets.size()) - 1; }
+  [[nodiscard]] Index num_internal_faces() const noexcept { return static_cast<Index>(neighbour.size()); }
+  [[nodiscard]] std::span<const Index> face(Index f) const {
+    return {face_nodes.data() + face_offsets[static_cast<std::size_t>(f)],
+            static_cast<std::size_t>(face_offsets[static_cast<std::size_t>(f) + 1] - face_offsets[static_cast<std::size_t>(f)])};
+  }
+};
+
+}  // namespace meshmotion

@@ -1,0 +1,513 @@
+#pragma once
+/// \file
+/// CGNS (.cgns) reading through the CGNS library (Debian libcgns-dev; see io/cgns.hpp for what
+/// is read and what is refused). Without the library read_cgns() throws InputError saying so.
+
+#include "meshmotion/core/element.hpp"
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/topology.hpp"
+#include "meshmotion/io/any_mesh.hpp"
+#include "meshmotion/io/detail/cgns_file.hpp"
+#include "meshmotion/io/detail/raw_mesh.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <iterator>
+#include <map>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+namespace meshmotion {
+
+#ifdef MESHMOTION_HAVE_CGNS
+
+namespace detail {
+
+/// Where each element number of a zone was read to: per section its number range and the
+/// block and first position of its elements (a one-type section fills one block in order), or
+/// each element's block and position (a MIXED section).
+class CgnsSections {
+ public:
+  struct Section {
+    std::string path;
+    std::int64_t start = 0, end = 0;
+    std::size_t block = 0;
+    Index first = 0;
+    std::vector<std::pair<std::size_t, Index>> each;  ///< MIXED sections only
+  };
+
+  void add(Section section) { sections_.push_back(std::move(section)); }
+
+  /// Sorts the sections by number; refuses two sections sharing a number.
+  void finish(const CgnsFile& cgns) {
+    std::sort(sections_.begin(), sections_.end(), [](const Section& a, const Section& b) { return a.start < b.start; });
+    for (std::size_t k = 1; k < sections_.size(); ++k)
+      if (sections_[k].start <= sections_[k - 1].end)
+        cgns.fail(sections_[k].path, "element numbers " + std::to_string(sections_[k].start) + ".." + std::to_string(sections_[k].end) +
+                                         " overlap those of " + sections_[k - 1].path);
+  }
+
+  /// The block and position of element `number`, or false.
+  [[nodiscard]] bool find(std::int64_t number, std::size_t& block, Index& local) const {
+    const auto it = std::upper_bound(sections_.begin(), sections_.end(), number,
+                                     [](std::int64_t v, const Section& sec) { return v < sec.start; });
+    if (it == sections_.begin()) return false;
+    const Section& sec = *std::prev(it);
+    if (number > sec.end) return false;
+    const auto k = number - sec.start;
+    if (sec.each.empty()) {
+      block = sec.block;
+      local = sec.first + k;
+    } else {
+      std::tie(block, local) = sec.each[static_cast<std::size_t>(k)];
+    }
+    return true;
+  }
+
+  /// Calls f(block, local) for every element of the zone.
+  template <class F>
+  void for_each(F&& f) const {
+    for (const Section& sec : sections_) {
+      if (!sec.each.empty()) {
+        for (const auto& [block, local] : sec.each) f(block, local);
+      } else {
+        for (std::int64_t k = 0; k <= sec.end - sec.start; ++k) f(sec.block, sec.first + k);
+      }
+    }
+  }
+
+ private:
+  std::vector<Section> sections_;
+};
+
+class CgnsReader {
+ public:
+  explicit CgnsReader(const std::filesystem::path& file) : file_(file), cgns_(file, CG_MODE_READ) {}
+
+  [[nodiscard]] RawMesh read() {
+    const int fn = cgns_.id();
+    int nbases = 0;
+    cgns_.check(cgns_api().cg_nbases(fn, &nbases), "/");
+    if (nbases == 0) cgns_.fail("/", "no CGNS base (expected one CGNSBase_t)");
+    char name[33] = {};
+    int cell_dim = 0, phys_dim = 0;
+    if (nbases > 1) {
+      std::string names;
+      for (int b = 1; b <= nbases; ++b) {
+        cgns_.check(cgns_api().cg_base_read(fn, b, name, &cell_dim, &phys_dim), "/");
+        names += (b > 1 ? ", " : "") + std::string(name);
+      }
+      cgns_.fail("/", std::to_string(nbases) + " bases (" + names + "): meshmotion reads files with one base");
+    }
+    cgns_.check(cgns_api().cg_base_read(fn, 1, name, &cell_dim, &phys_dim), "/");
+    base_ = "/" + std::string(name);
+    if (cell_dim != 2 && cell_dim != 3)
+      cgns_.fail(base_, "cell dimension " + std::to_string(cell_dim) + " (expected 2 or 3)");
+    if (phys_dim < cell_dim || phys_dim > 3)
+      cgns_.fail(base_, "physical dimension " + std::to_string(phys_dim) + " for cell dimension " + std::to_string(cell_dim));
+    cell_dim_ = cell_dim;
+    phys_dim_ = phys_dim;
+    raw_.dim = cell_dim;
+
+    int nzones = 0;
+    cgns_.check(cgns_api().cg_nzones(fn, 1, &nzones), base_);
+    std::vector<int> zones;
+    std::string structured;
+    for (int z = 1; z <= nzones; ++z) {
+      CGNS_ENUMT(ZoneType_t) type{};
+      cgns_.check(cgns_api().cg_zone_type(fn, 1, z, &type), base_);
+      if (type == CGNS_ENUMV(Unstructured)) {
+        zones.push_back(z);
+      } else {
+        cgsize_t size[9] = {};
+        cgns_.check(cgns_api().cg_zone_read(fn, 1, z, name, size), base_);
+        structured += (structured.empty() ? "" : ", ") + std::string(name);
+      }
+    }
+    if (zones.empty())
+      cgns_.fail(base_, "no unstructured zone" + (structured.empty() ? std::string() : " (structured zones: " + structured + ")"));
+    if (!structured.empty())
+      cgns_.fail(base_, "structured zones (" + structured + ") beside unstructured ones: meshmotion reads unstructured meshes");
+    multi_zone_ = zones.size() > 1;
+    for (const int z : zones) read_zone(z);
+    return std::move(raw_);
+  }
+
+ private:
+  void read_zone(int z) {
+    const int fn = cgns_.id();
+    char name[33] = {};
+    cgsize_t size[3] = {};
+    cgns_.check(cgns_api().cg_zone_read(fn, 1, z, name, size), base_);
+    zone_name_ = name;
+    zone_ = base_ + "/" + zone_name_;
+    const auto num_vertices = static_cast<std::int64_t>(size[0]);
+    const std::vector<Index> node_of_vertex = read_coordinates(z, num_vertices);
+
+    int nsections = 0;
+    cgns_.check(cgns_api().cg_nsections(fn, 1, z, &nsections), zone_);
+    CgnsSections sections;
+    bool has_facets = false;
+    std::int64_t largest = 0;
+    for (int s = 1; s <= nsections; ++s) {
+      const std::int64_t last = read_section(z, s, node_of_vertex, num_vertices, sections, has_facets);
+      largest = std::max(largest, last);
+    }
+    sections.finish(cgns_);
+    read_bocos(z, sections, node_of_vertex, has_facets);
+    // Facets no BC holds keep their section's group.
+    for (const auto& [block, local, tag] : section_tags_) {
+      int& t = raw_.blocks[block].tags[static_cast<std::size_t>(local)];
+      if (t == 0) t = tag;
+    }
+    section_tags_.clear();
+    // Boundary facets made for vertex BCs join the mesh (those a BC holds), numbered after
+    // the zone's elements.
+    for (ElementBlock& src : boundary_)
+      for (Index e = 0; e < src.size(); ++e)
+        if (const int t = src.tags[static_cast<std::size_t>(e)]; t != 0) {
+          ElementBlock& dst = raw_.block(src.type);
+          dst.add(src.element(e), t);
+          dst.ids.push_back(element_offset_ + ++largest);
+        }
+    boundary_.clear();
+    element_offset_ += largest;
+  }
+
+  /// Reads the zone's coordinates; returns the mesh node of each CGNS vertex (0-based).
+  [[nodiscard]] std::vector<Index> read_coordinates(int z, std::int64_t num_vertices) {
+    const int fn = cgns_.id();
+    const std::string path = zone_ + "/GridCoordinates";
+    int ncoords = 0;
+    cgns_.check(cgns_api().cg_ncoords(fn, 1, z, &ncoords), path);
+    static constexpr const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
+    std::vector<std::string> present;
+    for (int c = 1; c <= ncoords; ++c) {
+      CGNS_ENUMT(DataType_t) type{};
+      char cname[33] = {};
+      cgns_.check(cgns_api().cg_coord_info(fn, 1, z, c, &type, cname), path);
+      present.emplace_back(cname);
+    }
+    std::vector<double> xyz(static_cast<std::size_t>(3 * num_vertices), 0.0);
+    std::vector<double> column(static_cast<std::size_t>(num_vertices));
+    for (int d = 0; d < phys_dim_; ++d) {
+      if (std::find(present.begin(), present.end(), names[d]) == present.end()) {
+        std::string have;
+        for (const auto& p : present) have += (have.empty() ? "" : ", ") + p;
+        cgns_.fail(path, std::string("no ") + names[d] + " (has: " + (have.empty() ? "none" : have) +
+                             "; meshmotion reads Cartesian coordinates)");
+      }
+      cgsize_t lo = 1, hi = static_cast<cgsize_t>(num_vertices);
+      if (num_vertices > 0)
+        cgns_.check(cgns_api().cg_coord_read(fn, 1, z, names[d], CGNS_ENUMV(RealDouble), &lo, &hi, column.data()), path + "/" + names[d]);
+      for (std::int64_t i = 0; i < num_vertices; ++i) xyz[static_cast<std::size_t>(3 * i + d)] = column[static_cast<std::size_t>(i)];
+    }
+    std::vector<Index> node(static_cast<std::size_t>(num_vertices));
+    const Index first = raw_.num_nodes();
+    if (!multi_zone_) {
+      raw_.coords = std::move(xyz);
+      for (std::int64_t i = 0; i < num_vertices; ++i) node[static_cast<std::size_t>(i)] = first + i;
+      return node;
+    }
+    // Conforming zone interfaces: the same coordinates in an earlier zone are the same node
+    // (not within one zone: duplicated nodes there are the file's, kept apart).
+    std::vector<std::pair<Key, Index>> added;
+    for (std::int64_t i = 0; i < num_vertices; ++i) {
+      const Key key = key_of(&xyz[static_cast<std::size_t>(3 * i)]);
+      if (const auto it = node_at_.find(key); it != node_at_.end()) {
+        node[static_cast<std::size_t>(i)] = it->second;
+        continue;
+      }
+      node[static_cast<std::size_t>(i)] = raw_.num_nodes();
+      raw_.coords.insert(raw_.coords.end(), xyz.begin() + 3 * i, xyz.begin() + 3 * i + 3);
+      added.emplace_back(key, node[static_cast<std::size_t>(i)]);
+    }
+    for (const auto& [key, index] : added) node_at_.try_emplace(key, index);
+    return node;
+  }
+
+  /// Reads section s into the blocks; returns its last element number (zone numbering).
+  std::int64_t read_section(int z, int s, const std::vector<Index>& node_of_vertex, std::int64_t num_vertices,
+                            CgnsSections& sections, bool& has_facets) {
+    const int fn = cgns_.id();
+    char name[33] = {};
+    CGNS_ENUMT(ElementType_t) type{};
+    cgsize_t start = 0, end = 0;
+    int nbndry = 0, parent_flag = 0;
+    cgns_.check(cgns_api().cg_section_read(fn, 1, z, s, name, &type, &start, &end, &nbndry, &parent_flag), zone_);
+    const std::string path = zone_ + "/" + name;
+    if (end < start) cgns_.fail(path, "element range " + std::to_string(start) + ".." + std::to_string(end) + " is empty or reversed");
+    const std::int64_t count = static_cast<std::int64_t>(end) - start + 1;
+    if (type == CGNS_ENUMV(NGON_n) || type == CGNS_ENUMV(NFACE_n))
+      cgns_.fail(path, cgns_type_name(type) + " section: polyhedral cells are not supported (expected standard element types)");
+    cgsize_t data_size = 0;
+    cgns_.check(cgns_api().cg_ElementDataSize(fn, 1, z, s, &data_size), path);
+    std::vector<cgsize_t> data(static_cast<std::size_t>(data_size));
+    std::vector<cgsize_t> offsets;
+    const bool mixed = type == CGNS_ENUMV(MIXED);
+    if (mixed) {
+      offsets.resize(static_cast<std::size_t>(count + 1));
+      cgns_.check(cgns_api().cg_poly_elements_read(fn, 1, z, s, data.data(), offsets.data(), nullptr), path + "/ElementConnectivity");
+    } else {
+      cgns_.check(cgns_api().cg_elements_read(fn, 1, z, s, data.data(), nullptr), path + "/ElementConnectivity");
+    }
+    // The section's group per element dimension: none when the section is named after its
+    // element type (as write_cgns names elements without a group); the zone's for cells of
+    // a multi-zone file.
+    const bool unnamed = std::string(name) == cgns_type_name(type);
+    std::array<int, 4> tag_of_dim{-1, -1, -1, -1};
+    const auto tag_for = [&](int d) {
+      int& t = tag_of_dim[static_cast<std::size_t>(d)];
+      if (t < 0) t = multi_zone_ && d == cell_dim_ ? group_tag(zone_name_, d) : unnamed ? 0 : group_tag(name, d);
+      return t;
+    };
+    CgnsSections::Section section{path, start, end, 0, 0, {}};
+    ElementType current{};
+    ElementBlock* block = nullptr;
+    std::size_t block_index = 0;
+    const auto use_type = [&](CGNS_ENUMT(ElementType_t) t, std::int64_t number) {
+      const int ours = element_type_of_cgns(t);
+      if (ours < 0) {
+        const bool high_order = static_cast<int>(t) >= static_cast<int>(CGNS_ENUMV(BAR_4));  // BAR_4 and after: order 3 and 4
+        cgns_.fail(path, "element " + std::to_string(number) + " is " + cgns_type_name(t) +
+                             (high_order ? " (meshmotion reads elements up to order 2)" : " (not supported)"));
+      }
+      current = static_cast<ElementType>(ours);
+      block = &raw_.block(current);
+      block_index = static_cast<std::size_t>(block - raw_.blocks.data());
+    };
+    if (!mixed) {
+      use_type(type, start);
+      section.block = block_index;
+      section.first = block->size();
+      block->reserve(block->size() + count);
+      block->ids.reserve(block->ids.size() + static_cast<std::size_t>(count));
+    } else {
+      section.each.reserve(static_cast<std::size_t>(count));
+    }
+    std::size_t at = 0;
+    for (std::int64_t e = 0; e < count; ++e) {
+      const std::int64_t number = start + e;
+      if (mixed) {
+        at = static_cast<std::size_t>(offsets[static_cast<std::size_t>(e)]);
+        if (at >= data.size()) cgns_.fail(path, "element " + std::to_string(number) + ": offset past the connectivity");
+        const auto t = static_cast<CGNS_ENUMT(ElementType_t)>(data[at++]);
+        if (block == nullptr || cgns_type(current) != t) use_type(t, number);
+      }
+      const int n = num_nodes(current);
+      if (at + static_cast<std::size_t>(n) > data.size())
+        cgns_.fail(path, "element " + std::to_string(number) + ": connectivity ends inside it");
+      const std::vector<int>& order = cgns_order_of(current);
+      const Index local = block->size();
+      block->connectivity.resize(block->connectivity.size() + static_cast<std::size_t>(n));
+      Index* nodes = block->connectivity.data() + local * n;
+      for (int k = 0; k < n; ++k) {
+        const auto v = static_cast<std::int64_t>(data[at + static_cast<std::size_t>(k)]);
+        if (v < 1 || v > num_vertices)
+          cgns_.fail(path, "element " + std::to_string(number) + " has node " + std::to_string(v) + " (the zone has " +
+                               std::to_string(num_vertices) + " nodes, numbered from 1)");
+        nodes[order[static_cast<std::size_t>(k)]] = node_of_vertex[static_cast<std::size_t>(v - 1)];
+      }
+      at += static_cast<std::size_t>(n);
+      block->ids.push_back(number + element_offset_);
+      const int d = dimension(current);
+      if (d == cell_dim_ - 1) {
+        has_facets = true;
+        block->tags.push_back(0);  // a BC may claim it; else its section's group
+        section_tags_.push_back({block_index, local, tag_for(d)});
+      } else {
+        block->tags.push_back(tag_for(d));
+      }
+      if (mixed) section.each.emplace_back(block_index, local);
+    }
+    sections.add(std::move(section));
+    return end;
+  }
+
+  void read_bocos(int z, const CgnsSections& sections, const std::vector<Index>& node_of_vertex, bool has_facets) {
+    const int fn = cgns_.id();
+    int nbocos = 0;
+    cgns_.check(cgns_api().cg_nbocos(fn, 1, z, &nbocos), zone_ + "/ZoneBC");
+    for (int bc = 1; bc <= nbocos; ++bc) {
+      char name[33] = {};
+      CGNS_ENUMT(BCType_t) bctype{};
+      CGNS_ENUMT(PointSetType_t) ptset{};
+      cgsize_t npnts = 0, normal_size = 0;
+      int normal_index[3] = {};
+      CGNS_ENUMT(DataType_t) normal_type{};
+      int ndataset = 0;
+      cgns_.check(cgns_api().cg_boco_info(fn, 1, z, bc, name, &bctype, &ptset, &npnts, normal_index, &normal_size, &normal_type, &ndataset),
+                  zone_ + "/ZoneBC");
+      const std::string path = zone_ + "/ZoneBC/" + name;
+      CGNS_ENUMT(GridLocation_t) location = CGNS_ENUMV(Vertex);
+      cgns_.check(cgns_api().cg_boco_gridlocation_read(fn, 1, z, bc, &location), path);
+      std::vector<cgsize_t> points(static_cast<std::size_t>(std::max<cgsize_t>(npnts, 0)));
+      if (npnts > 0) cgns_.check(cgns_api().cg_boco_read(fn, 1, z, bc, points.data(), nullptr), path);
+      std::string group = name;
+      char family[33] = {};
+      if (cgns_api().cg_goto(fn, 1, "Zone_t", z, "ZoneBC_t", 1, "BC_t", bc, "end") == CG_OK && cgns_api().cg_famname_read(family) == CG_OK)
+        group = family;
+      const int tag = group_tag(group, cell_dim_ - 1);
+
+      const bool range = ptset == CGNS_ENUMV(PointRange) || ptset == CGNS_ENUMV(ElementRange);
+      const bool list = ptset == CGNS_ENUMV(PointList) || ptset == CGNS_ENUMV(ElementList);
+      if (!range && !list) cgns_.fail(path, "point set type " + std::to_string(static_cast<int>(ptset)) +
+                                                " (expected PointList, PointRange, ElementList or ElementRange)");
+      if (range && points.size() != 2) cgns_.fail(path, "a range needs 2 numbers (got " + std::to_string(points.size()) + ")");
+      const bool elements = ptset == CGNS_ENUMV(ElementRange) || ptset == CGNS_ENUMV(ElementList) ||
+                            location != CGNS_ENUMV(Vertex);
+      const auto for_each_number = [&](auto&& f) {
+        if (range)
+          for (std::int64_t k = points[0]; k <= points[1]; ++k) f(k);
+        else
+          for (const cgsize_t k : points) f(static_cast<std::int64_t>(k));
+      };
+      if (elements) {
+        for_each_number([&](std::int64_t number) {
+          std::size_t block = 0;
+          Index local = 0;
+          if (!sections.find(number, block, local)) cgns_.fail(path, "element " + std::to_string(number) + " is in no section of the zone");
+          claim(block, local, tag, path);
+        });
+      } else {
+        std::vector<char> in_bc(node_of_vertex.size(), 0);
+        for_each_number([&](std::int64_t v) {
+          if (v < 1 || v > static_cast<std::int64_t>(node_of_vertex.size()))
+            cgns_.fail(path, "node " + std::to_string(v) + " is out of range (the zone has " +
+                                 std::to_string(node_of_vertex.size()) + " nodes, numbered from 1)");
+          in_bc[static_cast<std::size_t>(v - 1)] = 1;
+        });
+        tag_facets_on_vertices(in_bc, node_of_vertex, tag, path, has_facets, sections);
+      }
+    }
+  }
+
+  /// A vertex BC: the zone's facets whose vertices the BC all holds; its boundary facets when
+  /// the zone has no facet section.
+  void tag_facets_on_vertices(const std::vector<char>& in_bc, const std::vector<Index>& node_of_vertex, int tag,
+                              const std::string& path, bool has_facets, const CgnsSections& sections) {
+    std::vector<char> marked(static_cast<std::size_t>(raw_.num_nodes()), 0);
+    for (std::size_t v = 0; v < in_bc.size(); ++v)
+      if (in_bc[v]) marked[static_cast<std::size_t>(node_of_vertex[v])] = 1;
+    const auto all_marked = [&](std::span<const Index> nodes, ElementType t) {
+      for (int k = 0; k < num_vertices(t); ++k)
+        if (!marked[static_cast<std::size_t>(nodes[static_cast<std::size_t>(k)])]) return false;
+      return true;
+    };
+    if (has_facets) {
+      for (const auto& [block, local, section_tag] : section_tags_) {
+        const ElementBlock& b = raw_.blocks[block];
+        if (all_marked(b.element(local), b.type)) claim(block, local, tag, path);
+      }
+      return;
+    }
+    if (boundary_.empty()) boundary_ = cell_dim_ == 3 ? zone_boundary<3>(sections) : zone_boundary<2>(sections);
+    for (std::size_t k = 0; k < boundary_.size(); ++k) {
+      ElementBlock& src = boundary_[k];
+      for (Index e = 0; e < src.size(); ++e) {
+        if (!all_marked(src.element(e), src.type)) continue;
+        int& t = src.tags[static_cast<std::size_t>(e)];
+        if (t != 0 && t != tag) cgns_.fail(path, "a boundary facet lies in two vertex BCs (the groups of tags " + std::to_string(t) +
+                                                     " and " + std::to_string(tag) + ")");
+        t = tag;
+      }
+    }
+  }
+
+  /// The boundary facets of this zone's cells (topology only: the coordinates are not used).
+  template <int Dim>
+  [[nodiscard]] std::vector<ElementBlock> zone_boundary(const CgnsSections& sections) const {
+    Mesh<Dim> cells;
+    cells.points = Points<Dim>::Zero(Dim, raw_.num_nodes());
+    sections.for_each([&](std::size_t block, Index local) {
+      const ElementBlock& b = raw_.blocks[block];
+      if (dimension(b.type) == Dim) cells.block(b.type).add(b.element(local));
+    });
+    return boundary_facets(cells);
+  }
+
+  /// Gives element (block, local) the BC tag; refuses an element two BCs claim.
+  void claim(std::size_t block, Index local, int tag, const std::string& path) {
+    int& t = raw_.blocks[block].tags[static_cast<std::size_t>(local)];
+    const bool facet = dimension(raw_.blocks[block].type) == cell_dim_ - 1;
+    if (facet && t != 0 && t != tag) {
+      std::string other;
+      for (const auto& g : raw_.groups)
+        if (g.tag == t) other = g.name;
+      cgns_.fail(path, "element " + std::to_string(raw_.blocks[block].ids[static_cast<std::size_t>(local)] - element_offset_) +
+                           " is also in BC '" + other + "'");
+    }
+    t = tag;
+  }
+
+  /// The tag of group (name, dim), created on first use.
+  int group_tag(const std::string& name, int dim) {
+    const auto key = std::make_pair(dim, name);
+    const auto it = tags_.find(key);
+    if (it != tags_.end()) return it->second;
+    const int tag = static_cast<int>(tags_.size()) + 1;
+    tags_.emplace(key, tag);
+    raw_.groups.push_back(PhysicalGroup{dim, tag, name});
+    return tag;
+  }
+
+  using Key = std::array<std::uint64_t, 3>;
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const noexcept {
+      return static_cast<std::size_t>((k[0] * 0x9E3779B97F4A7C15ull) ^ (k[1] * 0xC2B2AE3D27D4EB4Full) ^ (k[2] * 0x165667B19E3779F9ull));
+    }
+  };
+  [[nodiscard]] static Key key_of(const double* c) {
+    Key k{};
+    for (int d = 0; d < 3; ++d) {
+      const double v = c[d] == 0.0 ? 0.0 : c[d];  // -0 and +0 are one place
+      std::memcpy(&k[static_cast<std::size_t>(d)], &v, sizeof v);
+    }
+    return k;
+  }
+
+  struct SectionTag {
+    std::size_t block;
+    Index local;
+    int tag;
+  };
+
+  std::filesystem::path file_;
+  CgnsFile cgns_;
+  RawMesh raw_;
+  std::string base_, zone_, zone_name_;
+  int cell_dim_ = 3, phys_dim_ = 3;
+  bool multi_zone_ = false;
+  std::int64_t element_offset_ = 0;
+  std::map<std::pair<int, std::string>, int> tags_;
+  std::vector<SectionTag> section_tags_;
+  std::unordered_map<Key, Index, KeyHash> node_at_;
+  std::vector<ElementBlock> boundary_;
+};
+
+}  // namespace detail
+
+#endif  // MESHMOTION_HAVE_CGNS
+
+/// Reads a .cgns file (see the file comment for what is read and what is refused). Throws
+/// IoError for a file the CGNS library cannot open or read, InputError naming the CGNS node
+/// path for content meshmotion does not take, and InputError when built without CGNS.
+[[nodiscard]] inline AnyMesh read_cgns(const std::filesystem::path& file) {
+#ifdef MESHMOTION_HAVE_CGNS
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw IoError(file.string() + ": no such file");
+  return detail::to_any_mesh(detail::CgnsReader(file).read(), file);
+#else
+  throw InputError(file.string() + ": reading CGNS needs the CGNS library (meshmotion was built without it: install "
+                   "libcgns-dev and reconfigure)");
+#endif
+}
+
+}  // namespace meshmotion

@@ -1,0 +1,229 @@
+#pragma once
+/// \file
+/// OpenFOAM polyMesh reading (`constant/polyMesh/`: points, faces, owner, neighbour, boundary):
+/// ASCII and binary files (FoamFile header; `arch` label and scalar sizes), `faceList` and
+/// `faceCompactList` faces, gzip-compressed files (`points.gz`, ...) when built with zlib.
+/// read_polymesh() gives the face-based mesh as the files hold it, read_openfoam() the Mesh<3>
+/// (io/openfoam_polymesh.hpp's to_mesh()). Malformed files give the file, the line (ASCII) or
+/// byte offset (binary) and the entry; inconsistent lists (an owner list shorter than the
+/// faces, a face index out of range, patches that do not cover the boundary faces) name the list.
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/io/detail/foam_files.hpp"
+#include "meshmotion/io/detail/raw_mesh.hpp"
+#include "meshmotion/io/openfoam_polymesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace meshmotion {
+namespace detail {
+
+/// Reads the points file: "N ( (x y z) ... )" or its binary form.
+[[nodiscard]] inline Points<3> read_foam_points(const std::filesystem::path& file) {
+  const std::string text = read_foam_file(file);
+  FoamCursor in(text, file);
+  const FoamHeader h = read_foam_header(in);
+  check_foam_class(in, h, {"vectorField"});
+  const auto n = in.integer<Index>("point count", 0, std::numeric_limits<Index>::max());
+  in.expect("(");
+  // "(x y z)" takes seven bytes at least in ASCII.
+  in.check_count(n, "point", h.binary ? static_cast<std::size_t>(3 * h.scalar_bytes) : 7);
+  Points<3> points(3, n);
+  if (h.binary && n > 0) {
+    in.use_byte_offsets();
+    const std::string_view bytes = in.raw(static_cast<std::size_t>(3 * n) * static_cast<std::size_t>(h.scalar_bytes), "points");
+    for (Index k = 0; k < 3 * n; ++k) {
+      double v = 0;
+      if (h.scalar_bytes == 8) {
+        std::memcpy(&v, bytes.data() + 8 * k, 8);
+      } else {
+        float f = 0;
+        std::memcpy(&f, bytes.data() + 4 * k, 4);
+        v = f;
+      }
+      if (!std::isfinite(v)) in.fail("point " + std::to_string(k / 3) + " has a non-finite coordinate");
+      points.data()[k] = v;
+    }
+  } else {
+    for (Index i = 0; i < n; ++i) {
+      in.expect("(");
+      for (int d = 0; d < 3; ++d) points(d, i) = in.real("a point coordinate");
+      in.expect(")");
+    }
+  }
+  in.expect(")");
+  return points;
+}
+
+/// Reads the faces: faceList "N ( k(a b ...) ... )" or faceCompactList (offsets, then labels).
+inline void read_foam_faces(const std::filesystem::path& file, PolyMesh& mesh) {
+  const std::string text = read_foam_file(file);
+  FoamCursor in(text, file);
+  const FoamHeader h = read_foam_header(in);
+  check_foam_class(in, h, {"faceList", "faceCompactList"});
+  const auto cls = h.entries.find("class");
+  if (h.binary || (cls != h.entries.end() && cls->second == "faceCompactList")) {
+    // A uniform offset list cannot be increasing, nor a uniform vertex list name a face.
+    std::vector<Index> offsets = read_label_list(in, h, "face offsets", 1);
+    std::vector<Index> nodes = read_label_list(in, h, "face vertices", 3);
+    if (offsets.empty() || offsets.front() != 0 || offsets.back() != static_cast<Index>(nodes.size()))
+      in.fail("faceCompactList offsets do not span the vertex list (first " + std::to_string(offsets.empty() ? -1 : offsets.front()) +
+              ", last " + std::to_string(offsets.empty() ? -1 : offsets.back()) + ", vertices " + std::to_string(nodes.size()) + ")");
+    for (std::size_t k = 1; k < offsets.size(); ++k)
+      if (offsets[k] < offsets[k - 1] + 3) in.fail("face " + std::to_string(k - 1) + " has fewer than 3 vertices");
+    mesh.face_offsets = std::move(offsets);
+    mesh.face_nodes = std::move(nodes);
+    return;
+  }
+  const auto n = in.integer<Index>("face count", 0, std::numeric_limits<Index>::max());
+  in.expect("(");
+  in.check_count(n, "face", 8);  // "3(a b c)"
+  mesh.face_offsets.assign(1, 0);
+  mesh.face_offsets.reserve(static_cast<std::size_t>(n) + 1);
+  mesh.face_nodes.reserve(static_cast<std::size_t>(4 * n));
+  for (Index f = 0; f < n; ++f) {
+    const auto k = in.integer<Index>("a face's vertex count", 3, 1 << 20);
+    in.expect("(");
+    for (Index j = 0; j < k; ++j) mesh.face_nodes.push_back(in.integer<Index>("a face vertex", 0, std::numeric_limits<Index>::max()));
+    in.expect(")");
+    mesh.face_offsets.push_back(static_cast<Index>(mesh.face_nodes.size()));
+  }
+  in.expect(")");
+}
+
+/// Reads the boundary dictionary list: "N ( name { type T; nFaces N; startFace S; ... } ... )".
+[[nodiscard]] inline std::vector<PolyMesh::Patch> read_foam_boundary(const std::filesystem::path& file) {
+  const std::string text = read_foam_file(file);
+  FoamCursor in(text, file);
+  check_foam_class(in, read_foam_header(in), {"polyBoundaryMesh"});
+  const auto n = in.integer<Index>("patch count", 0, 1 << 20);
+  in.expect("(");
+  std::vector<PolyMesh::Patch> patches;
+  for (Index p = 0; p < n; ++p) {
+    PolyMesh::Patch patch;
+    patch.name = std::string(in.token("a patch name"));
+    in.expect("{");
+    bool have_faces = false, have_start = false;
+    for (;;) {
+      const std::string key(in.token("a patch entry or '}'"));
+      if (key == "}") break;
+      if (key == "nFaces") {
+        patch.size = in.integer<Index>("nFaces", 0, std::numeric_limits<Index>::max());
+        have_faces = true;
+        in.expect(";");
+      } else if (key == "startFace") {
+        patch.start = in.integer<Index>("startFace", 0, std::numeric_limits<Index>::max());
+        have_start = true;
+        in.expect(";");
+      } else {
+        int depth = 0;
+        std::string value;
+        for (std::string_view t = in.token("';'"); depth > 0 || t != ";"; t = in.token("';'")) {
+          if (t == "(" || t == "{") ++depth;
+          if (t == ")" || t == "}") --depth;
+          if (key == "type") value += std::string(t);
+        }
+        if (key == "type") patch.type = value;
+      }
+    }
+    if (!have_faces || !have_start) in.fail("patch '" + patch.name + "' lacks " + (have_faces ? "startFace" : "nFaces"));
+    patches.push_back(std::move(patch));
+  }
+  in.expect(")");
+  return patches;
+}
+
+/// The label list of a polyMesh file (owner, neighbour).
+[[nodiscard]] inline std::vector<Index> read_foam_labels(const std::filesystem::path& file, std::string_view what, Index max_uniform) {
+  const std::string text = read_foam_file(file);
+  FoamCursor in(text, file);
+  const FoamHeader h = read_foam_header(in);
+  check_foam_class(in, h, {"labelList"});
+  return read_label_list(in, h, what, max_uniform);
+}
+
+}  // namespace detail
+
+/// Reads an OpenFOAM polyMesh from a case folder (its constant/polyMesh) or a polyMesh folder.
+/// Throws IoError for a missing file, ParseError for malformed content (file and line or byte
+/// offset), InputError for lists that do not fit together (naming the list and the entry).
+[[nodiscard]] inline PolyMesh read_polymesh(const std::filesystem::path& path) {
+  const std::filesystem::path dir = detail::polymesh_folder(path);
+  if (dir.empty())
+    throw IoError(path.string() + ": not an OpenFOAM case or polyMesh folder (no constant/polyMesh/faces nor faces in it)");
+  PolyMesh mesh;
+  mesh.points = detail::read_foam_points(dir / "points");
+  detail::read_foam_faces(dir / "faces", mesh);
+  // Uniform lists hold at most one entry per face.
+  mesh.owner = detail::read_foam_labels(dir / "owner", "owner", mesh.num_faces());
+  mesh.neighbour = detail::read_foam_labels(dir / "neighbour", "neighbour", mesh.num_faces());
+  mesh.patches = detail::read_foam_boundary(dir / "boundary");
+
+  const Index nf = mesh.num_faces(), np = mesh.points.cols();
+  const auto fail = [&](const std::string& file, const std::string& what) { throw InputError((dir / file).string() + ": " + what); };
+  std::vector<Index> sorted;
+  for (Index f = 0; f < nf; ++f) {
+    const auto face = mesh.face(f);
+    for (const Index v : face)
+      if (v < 0 || v >= np)
+        fail("faces", "face " + std::to_string(f) + " has vertex " + std::to_string(v) + " (the mesh has " + std::to_string(np) +
+                          " points, numbered from 0)");
+    sorted.assign(face.begin(), face.end());
+    std::sort(sorted.begin(), sorted.end());
+    if (const auto twice = std::adjacent_find(sorted.begin(), sorted.end()); twice != sorted.end())
+      fail("faces", "face " + std::to_string(f) + " lists vertex " + std::to_string(*twice) + " twice");
+  }
+  if (static_cast<Index>(mesh.owner.size()) != nf)
+    fail("owner", "the owner list has " + std::to_string(mesh.owner.size()) + " entries for " + std::to_string(nf) + " faces");
+  if (static_cast<Index>(mesh.neighbour.size()) > nf)
+    fail("neighbour", "the neighbour list has " + std::to_string(mesh.neighbour.size()) + " entries for " + std::to_string(nf) + " faces");
+  // A cell has four faces at least and a face two cells at most: no label reaches nf / 2, and
+  // a corrupt one is refused here, before anything is allocated per cell.
+  const Index max_cells = nf / 2;
+  for (std::size_t f = 0; f < mesh.owner.size(); ++f)
+    if (mesh.owner[f] < 0 || mesh.owner[f] >= max_cells)
+      fail("owner", "face " + std::to_string(f) + " has owner " + std::to_string(mesh.owner[f]) + " (" + std::to_string(nf) +
+                        " faces bound at most " + std::to_string(max_cells) + " cells, numbered from 0)");
+  for (std::size_t f = 0; f < mesh.neighbour.size(); ++f)
+    if (mesh.neighbour[f] < 0 || mesh.neighbour[f] >= max_cells || mesh.neighbour[f] == mesh.owner[f])
+      fail("neighbour", "internal face " + std::to_string(f) + " has neighbour " + std::to_string(mesh.neighbour[f]) + " (owner " +
+                            std::to_string(mesh.owner[f]) + ", at most " + std::to_string(max_cells) + " cells)");
+  Index cells = 0;
+  for (const Index c : mesh.owner) cells = std::max(cells, c + 1);
+  for (const Index c : mesh.neighbour) cells = std::max(cells, c + 1);
+  std::vector<Index> faces_of(static_cast<std::size_t>(cells), 0);
+  for (const Index c : mesh.owner) ++faces_of[static_cast<std::size_t>(c)];
+  for (const Index c : mesh.neighbour) ++faces_of[static_cast<std::size_t>(c)];
+  for (Index c = 0; c < cells; ++c)
+    if (faces_of[static_cast<std::size_t>(c)] < 4)
+      fail("owner", "cell " + std::to_string(c) + " is bounded by " + std::to_string(faces_of[static_cast<std::size_t>(c)]) +
+                        (faces_of[static_cast<std::size_t>(c)] == 1 ? " face" : " faces") +
+                        " in the owner and neighbour lists (a cell has 4 at least)");
+  mesh.num_cells = cells;
+  Index next = mesh.num_internal_faces();
+  for (const auto& p : mesh.patches) {
+    if (p.start != next || p.start + p.size > nf)
+      fail("boundary", "patch '" + p.name + "' covers faces " + std::to_string(p.start) + ".." + std::to_string(p.start + p.size - 1) +
+                           " (expected to start at face " + std::to_string(next) + " of " + std::to_string(nf) + ")");
+    next = p.start + p.size;
+  }
+  if (next != nf)
+    fail("boundary", "the patches end at face " + std::to_string(next) + " (the boundary faces run to " + std::to_string(nf) + ")");
+  return mesh;
+}
+
+/// Reads an OpenFOAM case or polyMesh folder as a Mesh<3> (read_polymesh, then to_mesh).
+[[nodiscard]] inline Mesh<3> read_openfoam(const std::filesystem::path& path) {
+  Mesh<3> mesh = to_mesh(read_polymesh(path));
+  detail::validate_read(mesh, path);
+  return mesh;
+}
+
+}  // namespace meshmotion

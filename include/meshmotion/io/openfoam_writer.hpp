@@ -1,0 +1,298 @@
+#pragma once
+/// \file
+/// OpenFOAM polyMesh writing. write_polymesh_points() replaces the `points` of a case,
+/// atomically, keeping the case's own header, format (ASCII or binary) and compression; the
+/// faces and the rest of the case are not touched. It writes the nodes before the auxiliary
+/// ones and refuses a mesh whose node count differs from the case's. Targets: a case folder
+/// (its constant/polyMesh), a polyMesh folder, or a time folder of a case (`case/0.001`: its
+/// polyMesh/points, created, which is where OpenFOAM looks for moved points).
+/// write_polymesh() writes a whole new case's polyMesh.
+
+#include "meshmotion/core/element.hpp"
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/detail/atomic_file.hpp"
+#include "meshmotion/io/detail/foam_files.hpp"
+#include "meshmotion/io/detail/number_format.hpp"
+#include "meshmotion/io/openfoam_polymesh.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <system_error>
+
+namespace meshmotion {
+namespace detail {
+
+/// Appends a points list ("N ( (x y z) ... )" or its binary form) to `out`.
+inline void append_foam_points(std::string& out, const Eigen::Ref<const Points<3>>& points, const FoamHeader& h) {
+  const Index n = points.cols();
+  out += "\n\n\n";
+  append_number(out, n);
+  out += "\n(";
+  if (h.binary) {
+    const std::size_t at = out.size();
+    out.resize(at + static_cast<std::size_t>(3 * n) * static_cast<std::size_t>(h.scalar_bytes));
+    for (Index i = 0; i < n; ++i)
+      for (int d = 0; d < 3; ++d) {
+        const double v = points(d, i);
+        char* dst = out.data() + at + static_cast<std::size_t>(3 * i + d) * static_cast<std::size_t>(h.scalar_bytes);
+        if (h.scalar_bytes == 8) {
+          std::memcpy(dst, &v, 8);
+        } else {
+          const auto f = static_cast<float>(v);
+          std::memcpy(dst, &f, 4);
+        }
+      }
+    out += ")\n";
+    return;
+  }
+  out += '\n';
+  for (Index i = 0; i < n; ++i) {
+    out += '(';
+    for (int d = 0; d < 3; ++d) {
+      if (d > 0) out += ' ';
+      append_number(out, points(d, i));
+    }
+    out += ")\n";
+  }
+  out += ")\n";
+}
+
+/// Writes `text` to `file` (or `file`.gz, compressed) through a temporary file and a rename.
+inline void write_foam_file(const std::filesystem::path& file, const std::string& text, bool compressed) {
+  if (!compressed) {
+    write_file_atomically(file, text);
+    return;
+  }
+#ifdef MESHMOTION_HAVE_ZLIB
+  std::filesystem::path gz = file;
+  gz += ".gz";
+  write_through_temporary(gz, [&](const std::filesystem::path& tmp) {
+    gzFile out = gzopen(tmp.c_str(), "wb");
+    if (out == nullptr) throw IoError(gz.string() + ": cannot create the temporary file " + tmp.string());
+    std::size_t done = 0;
+    bool ok = true;
+    while (ok && done < text.size()) {
+      const auto chunk = static_cast<unsigned>(std::min<std::size_t>(text.size() - done, std::size_t{1} << 30));
+      ok = gzwrite(out, text.data() + done, chunk) == static_cast<int>(chunk);
+      done += chunk;
+    }
+    if (gzclose(out) != Z_OK || !ok) throw IoError(gz.string() + ": compressed write failed");
+  });
+#else
+  throw InputError(file.string() + ".gz: compressed OpenFOAM files need zlib (meshmotion was built without it)");
+#endif
+}
+
+
+/// Where write_polymesh_points() writes for `target` (see the file comment), and the points
+/// file whose header and node count it follows; empty when `target` is no OpenFOAM folder.
+struct FoamPointsTarget {
+  std::filesystem::path points;     ///< the file to write (without .gz)
+  std::filesystem::path reference;  ///< the case's existing points file (without .gz)
+};
+
+[[nodiscard]] inline FoamPointsTarget foam_points_target(const std::filesystem::path& target) {
+  std::filesystem::path dir = polymesh_folder(target);
+  if (!dir.empty()) return {dir / "points", dir / "points"};
+  // A time folder of a case: "<case>/<number>".
+  const std::filesystem::path case_dir = target.has_filename() ? target.parent_path() : target.parent_path().parent_path();
+  const std::string time = (target.has_filename() ? target : target.parent_path()).filename().string();
+  double t = 0;
+  const auto [ptr, ec] = std::from_chars(time.data(), time.data() + time.size(), t);
+  const std::filesystem::path constant = polymesh_folder(case_dir.empty() ? std::filesystem::path(".") : case_dir);
+  if (ec == std::errc() && ptr == time.data() + time.size() && !constant.empty())
+    return {(case_dir.empty() ? std::filesystem::path(".") : case_dir) / time / "polyMesh" / "points", constant / "points"};
+  return {};
+}
+
+}  // namespace detail
+
+/// Whether write_mesh() treats `path` as an OpenFOAM output whose points it replaces (a case,
+/// polyMesh or time folder).
+[[nodiscard]] inline bool is_openfoam_target(const std::filesystem::path& path) {
+  return !detail::foam_points_target(path).points.empty();
+}
+
+/// Whether write_mesh() writes a whole new OpenFOAM case at `path`: a path without extension
+/// that does not exist or is an empty folder.
+[[nodiscard]] inline bool is_new_openfoam_case(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (path.empty() || !path.extension().empty() || is_openfoam_target(path)) return false;
+  if (!std::filesystem::exists(path, ec)) return true;
+  return std::filesystem::is_directory(path, ec) && std::filesystem::is_empty(path, ec);
+}
+
+/// Replaces the points of the OpenFOAM case at `target` by the mesh's nodes (those before the
+/// auxiliary ones), atomically, with the case's header, format and compression. Throws
+/// InputError when `target` is not an OpenFOAM folder, when the mesh has high-order elements or
+/// a node count other than the case's, IoError when writing fails.
+inline void write_polymesh_points(const std::filesystem::path& target, const Mesh<3>& mesh) {
+  validate(mesh);
+  const detail::FoamPointsTarget where = detail::foam_points_target(target);
+  if (where.points.empty())
+    throw InputError(target.string() + ": not an OpenFOAM case, polyMesh folder or time folder of a case (nowhere to write points)");
+  for (const auto* list : {&mesh.cells, &mesh.facets})
+    for (const auto& b : *list)
+      if (order(b.type) > 1) throw InputError(target.string() + ": OpenFOAM meshes are linear (the mesh has " + std::string(name(b.type)) + ")");
+  const Index n = mesh.num_nodes() - mesh.num_auxiliary_nodes;
+  const bool compressed = detail::foam_file_is_compressed(where.reference);
+  const std::string reference_text = detail::read_foam_file(where.reference);
+  detail::FoamCursor in(reference_text, where.reference);
+  const detail::FoamHeader h = detail::read_foam_header(in);
+  const auto expected = in.integer<Index>("point count", 0, Index{1} << 40);
+  if (n != expected)
+    throw InputError(target.string() + ": the mesh has " + std::to_string(n) + " points, the case " + std::to_string(expected) +
+                     " (" + where.reference.string() + "): not this case's mesh");
+  std::string header(reference_text.substr(0, h.data_offset));
+  if (where.points != where.reference) {
+    // A time folder: the header's location names it.
+    const std::size_t at = header.find("location");
+    if (at != std::string::npos) {
+      const std::size_t end = header.find(';', at);
+      const std::string time = where.points.parent_path().parent_path().filename().string();
+      header.replace(at, end - at, "location    \"" + time + "/polyMesh\"");
+    }
+  }
+  std::string out = header;
+  detail::append_foam_points(out, mesh.points.leftCols(n), h);
+  out += "\n\n// ************************************************************************* //\n";
+  std::error_code ec;
+  std::filesystem::create_directories(where.points.parent_path(), ec);
+  if (ec) throw IoError(where.points.parent_path().string() + ": cannot create the folder (" + ec.message() + ")");
+  detail::write_foam_file(where.points, out, compressed);
+}
+
+/// Options of write_polymesh().
+struct PolyMeshWriteOptions {
+  bool binary = false;      ///< binary lists (faces as faceCompactList), else ASCII
+  bool compressed = false;  ///< gzip every file (needs zlib)
+};
+
+/// Writes a whole polyMesh (points, faces, owner, neighbour, boundary) into `case_dir`'s
+/// constant/polyMesh, each file through a temporary file and a rename. The faces must be
+/// ordered as OpenFOAM requires (internal faces first, then each patch's); InputError otherwise.
+inline void write_polymesh(const std::filesystem::path& case_dir, const PolyMesh& mesh, const PolyMeshWriteOptions& options = {}) {
+  const Index nf = mesh.num_faces();
+  if (static_cast<Index>(mesh.owner.size()) != nf || mesh.num_internal_faces() > nf)
+    throw InputError("write_polymesh: " + std::to_string(mesh.owner.size()) + " owners and " + std::to_string(mesh.neighbour.size()) +
+                     " neighbours for " + std::to_string(nf) + " faces");
+  Index next = mesh.num_internal_faces();
+  for (const auto& p : mesh.patches) {
+    if (p.start != next) throw InputError("write_polymesh: patch '" + p.name + "' starts at face " + std::to_string(p.start) +
+                                          " (expected " + std::to_string(next) + ")");
+    next += p.size;
+  }
+  if (next != nf) throw InputError("write_polymesh: the patches end at face " + std::to_string(next) + " of " + std::to_string(nf));
+  for (const auto& p : mesh.patches)
+    if (p.name.empty() || p.name.find_first_of(" \t\n\"';{}()/\\") != std::string::npos)
+      throw InputError("write_polymesh: patch name '" + p.name + "' is not an OpenFOAM word (no blanks, quotes, ;, braces, parentheses or slashes)");
+#ifndef MESHMOTION_HAVE_ZLIB
+  if (options.compressed) throw InputError("write_polymesh: compressed files need zlib (meshmotion was built without it)");
+#endif
+  const std::filesystem::path dir = case_dir / "constant" / "polyMesh";
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw IoError(dir.string() + ": cannot create the folder (" + ec.message() + ")");
+  detail::FoamHeader h;
+  h.binary = options.binary;
+  h.label_bytes = 4;
+  if (mesh.points.cols() > std::numeric_limits<std::int32_t>::max() || static_cast<Index>(mesh.face_nodes.size()) > std::numeric_limits<std::int32_t>::max())
+    h.label_bytes = 8;
+  const auto header = [&](const char* cls, const char* object, bool binary) {
+    return std::string("FoamFile\n{\n    version     2.0;\n    format      ") + (binary ? "binary" : "ascii") +
+           ";\n    arch        \"LSB;label=" + std::to_string(8 * h.label_bytes) + ";scalar=64\";\n    class       " + cls +
+           ";\n    location    \"constant/polyMesh\";\n    object      " + object + ";\n}\n";
+  };
+  const auto end = std::string("\n\n// ************************************************************************* //\n");
+  const auto labels = [&](std::string& out, std::span<const Index> v) {
+    out += "\n";
+    detail::append_number(out, static_cast<Index>(v.size()));
+    out += "\n(";
+    if (h.binary) {
+      for (const Index x : v) {
+        if (h.label_bytes == 4) {
+          const auto i = static_cast<std::int32_t>(x);
+          out.append(reinterpret_cast<const char*>(&i), 4);
+        } else {
+          const auto i = static_cast<std::int64_t>(x);
+          out.append(reinterpret_cast<const char*>(&i), 8);
+        }
+      }
+      out += ")\n";
+    } else {
+      out += '\n';
+      for (const Index x : v) {
+        detail::append_number(out, x);
+        out += '\n';
+      }
+      out += ")\n";
+    }
+  };
+  std::string points = header("vectorField", "points", h.binary);
+  detail::append_foam_points(points, mesh.points, h);
+  detail::write_foam_file(dir / "points", points + end, options.compressed);
+
+  std::string faces = header(h.binary ? "faceCompactList" : "faceList", "faces", h.binary);
+  if (h.binary) {
+    labels(faces, mesh.face_offsets);
+    labels(faces, mesh.face_nodes);
+  } else {
+    faces += "\n";
+    detail::append_number(faces, nf);
+    faces += "\n(\n";
+    for (Index f = 0; f < nf; ++f) {
+      const auto v = mesh.face(f);
+      detail::append_number(faces, static_cast<Index>(v.size()));
+      faces += '(';
+      for (std::size_t k = 0; k < v.size(); ++k) {
+        if (k > 0) faces += ' ';
+        detail::append_number(faces, v[k]);
+      }
+      faces += ")\n";
+    }
+    faces += ")\n";
+  }
+  detail::write_foam_file(dir / "faces", faces + end, options.compressed);
+  std::string owner = header("labelList", "owner", h.binary);
+  labels(owner, mesh.owner);
+  detail::write_foam_file(dir / "owner", owner + end, options.compressed);
+  std::string neighbour = header("labelList", "neighbour", h.binary);
+  labels(neighbour, mesh.neighbour);
+  detail::write_foam_file(dir / "neighbour", neighbour + end, options.compressed);
+  std::string boundary = header("polyBoundaryMesh", "boundary", false) + "\n" + std::to_string(mesh.patches.size()) + "\n(\n";
+  for (const auto& p : mesh.patches)
+    boundary += "    " + p.name + "\n    {\n        type            " + (p.type.empty() ? std::string("patch") : p.type) +
+                ";\n        nFaces          " + std::to_string(p.size) + ";\n        startFace       " + std::to_string(p.start) +
+                ";\n    }\n";
+  detail::write_foam_file(dir / "boundary", boundary + ")\n" + end, options.compressed);
+}
+
+/// Writes a whole new case at `case_dir`, a path that does not exist or an empty folder, as
+/// one step: write_polymesh() into a temporary folder beside it, renamed into place once
+/// complete, so a full disk or a killed run leaves no half case (points and faces without
+/// owner). InputError when `case_dir` holds something, IoError when writing fails.
+inline void write_new_polymesh_case(const std::filesystem::path& case_dir, const PolyMesh& mesh,
+                                    const PolyMeshWriteOptions& options = {}) {
+  // "out/" names the folder "out": its temporary goes beside it, not into it.
+  const std::filesystem::path target = case_dir.has_filename() ? case_dir : case_dir.parent_path();
+  std::error_code ec;
+  if (std::filesystem::exists(target, ec) && !(std::filesystem::is_directory(target, ec) && std::filesystem::is_empty(target, ec)))
+    throw InputError(target.string() + ": not empty (a new OpenFOAM case is written into a new or empty folder)");
+  detail::remove_stale_temporaries(target);
+  const std::filesystem::path tmp = detail::temporary_path_for(target);
+  try {
+    write_polymesh(tmp, mesh, options);
+    std::filesystem::remove(target, ec);  // the empty folder, if any
+    std::filesystem::rename(tmp, target, ec);
+    if (ec) throw IoError(target.string() + ": cannot rename the case written at " + tmp.string() + " into place (" + ec.message() + ")");
+  } catch (...) {
+    std::filesystem::remove_all(tmp, ec);
+    throw;
+  }
+}
+
+}  // namespace meshmotion
