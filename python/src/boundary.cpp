@@ -22,10 +22,7 @@ void bind_boundary(py::module_& m) {
         .def_property_readonly("kinds",
                                [](const B& b) {
                                  std::vector<std::string> out;
-                                 for (const auto k : b.kinds)
-                                   out.emplace_back(k == BoundaryKind::prescribed ? "prescribed"
-                                                    : k == BoundaryKind::fixed    ? "fixed"
-                                                                                  : "sliding");
+                                 for (const auto k : b.kinds) out.emplace_back(name(k));
                                  return out;
                                })
         .def_property_readonly("displacements", [](const B& b) { return to_rows<Dim>(b.displacements); })

@@ -99,6 +99,35 @@ TEST_CASE("displacements by node: bad node lists are refused, naming the node", 
   CHECK_THAT(input_error_of([&] { resolve(ramp.nodes, nan); }), Catch::Contains("non-finite"));
 }
 
+TEST_CASE("a group given two conditions is refused; groups sharing nodes say which condition wins", "[movers][boundary]") {
+  const Mesh<2> mesh = rectangle_mesh({});
+  BoundarySpec<2> twice;
+  twice.moving("bottom", Translation<2>{Vec<2>(0.0, 0.1)}).fixed("top").fixed("bottom");
+  CHECK_THAT(input_error_of([&] { (void)twice.resolve(mesh); }),
+             Catch::Contains("group 'bottom' is given twice (prescribed and fixed)"));
+
+  // The bottom moves, the left and top sides are fixed, the right side slides: each corner
+  // is in two groups, and the strongest condition wins (prescribed, fixed, sliding).
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Translation<2>{Vec<2>(0.0, 0.1)}).fixed("left").sliding("right").fixed("top");
+  const auto overlaps = spec.overlaps(mesh);
+  const auto find = [&](const std::string& winner, const std::string& other) {
+    for (const auto& o : overlaps)
+      if (o.winner == winner && o.other == other) return o.nodes;
+    return Index{-1};
+  };
+  CHECK(overlaps.size() == 3);  // left and top are both fixed: no conflict to report
+  CHECK(find("bottom", "left") == 1);
+  CHECK(find("bottom", "right") == 1);
+  CHECK(find("top", "right") == 1);
+  const ResolvedBoundary<2> b = spec.resolve(mesh);
+  const std::vector<Index> left = mesh.group_nodes("left");
+  const Index corner = mesh.group_nodes("bottom").front();
+  REQUIRE(std::binary_search(left.begin(), left.end(), corner));
+  CHECK(b.kinds[static_cast<std::size_t>(b.column(corner))] == BoundaryKind::prescribed);
+  CHECK(b.displacements.col(b.column(corner)).isApprox(Vec<2>(0.0, 0.1)));
+}
+
 TEST_CASE("prescribed group: displacements given to move() by node", "[movers][boundary]") {
   const Mesh<2> mesh = rectangle_mesh({});
   const Ramp ramp = shuffled_ramp(mesh);

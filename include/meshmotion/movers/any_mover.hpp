@@ -8,12 +8,19 @@
 #include "meshmotion/movers/detail/mover_support.hpp"
 #include "meshmotion/movers/mover.hpp"
 
+#include <atomic>
 #include <concepts>
 #include <memory>
+#include <string>
 
 namespace meshmotion {
 
 /// A type-erased MeshMover over Mesh<Dim>.
+///
+/// One mover serves one thread at a time: setup, move and the derivatives use the mover's own
+/// scratch (factorizations, buffers), and copies of an AnyMover share one mover. A call made
+/// while another thread is inside one of them throws SolverError instead of returning a wrong
+/// mesh. Give each thread its own mover (make_mover() again, and setup) to move concurrently.
 template <int Dim>
 class AnyMover {
  public:
@@ -23,24 +30,33 @@ class AnyMover {
     requires(M::dim == Dim)
   explicit AnyMover(M mover) : self_(std::make_shared<Model<M>>(std::move(mover))) {}
 
-  void setup(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) { self_->setup(mesh, boundary); }
+  void setup(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) {
+    const Exclusive use(*self_, "setup");
+    self_->setup(mesh, boundary);
+  }
   /// A solver's own mesh type: copied into a Mesh<Dim> for the mover, which keeps what it
   /// needs of it anyway.
   template <MeshLike M>
     requires(mesh_dim<M> == Dim && !std::same_as<M, Mesh<Dim>>)
   void setup(const M& mesh, const ResolvedBoundary<Dim>& boundary) {
-    self_->setup(to_mesh(mesh), boundary);
+    setup(to_mesh(mesh), boundary);
   }
   [[nodiscard]] Points<Dim> move(PointsView<Dim> d) {
     Points<Dim> out;
-    self_->move_into(d, out);
+    move_into(d, out);
     return out;
   }
-  void move_into(PointsView<Dim> d, Points<Dim>& out) { self_->move_into(d, out); }
+  void move_into(PointsView<Dim> d, Points<Dim>& out) {
+    const Exclusive use(*self_, "move");
+    self_->move_into(d, out);
+  }
   /// Into the caller's own storage (an Eigen::Map over a solver's array of Dim × n_nodes
   /// doubles): the RBF mover writes there directly, the others through a buffer of their own
   /// (no allocation after the first move). Throws InputError when its shape is not Dim × n_nodes.
-  void move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) { self_->move_into_storage(d, out); }
+  void move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) {
+    const Exclusive use(*self_, "move");
+    self_->move_into_storage(d, out);
+  }
   [[nodiscard]] MoverStats stats() const { return self_->stats(); }
 
   /// True when the mover offers derivative_forward and derivative_reverse (the movers linear
@@ -50,10 +66,16 @@ class AnyMover {
   /// displacements (RBF, springs, torsion springs, linear and stiffened elasticity, DGM,
   /// improved DGM, DGRBF).
   /// Throws InputError when the mover has no derivatives.
-  [[nodiscard]] Points<Dim> derivative_forward(PointsView<Dim> w) { return self_->derivative_forward(w); }
+  [[nodiscard]] Points<Dim> derivative_forward(PointsView<Dim> w) {
+    const Exclusive use(*self_, "derivative_forward");
+    return self_->derivative_forward(w);
+  }
   /// Jᵀ v for v (Dim × n_nodes): the gradient of ⟨v, move(d)⟩ with respect to d.
   /// Throws InputError when the mover has no derivatives.
-  [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) { return self_->derivative_reverse(v); }
+  [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) {
+    const Exclusive use(*self_, "derivative_reverse");
+    return self_->derivative_reverse(v);
+  }
 
  private:
   struct Concept {
@@ -65,6 +87,22 @@ class AnyMover {
     [[nodiscard]] virtual bool has_derivatives() const = 0;
     [[nodiscard]] virtual Points<Dim> derivative_forward(PointsView<Dim>) = 0;
     [[nodiscard]] virtual Points<Dim> derivative_reverse(PointsView<Dim>) = 0;
+    std::atomic<bool> busy{false};
+  };
+  // Holds the mover for one call; throws SolverError when another thread holds it.
+  class Exclusive {
+   public:
+    Exclusive(Concept& c, const char* call) : c_(c) {
+      if (c_.busy.exchange(true, std::memory_order_acquire))
+        throw SolverError(std::string("AnyMover::") + call + ": the mover is in use by another thread (one mover serves "
+                          "one thread at a time: give each thread its own)");
+    }
+    Exclusive(const Exclusive&) = delete;
+    Exclusive& operator=(const Exclusive&) = delete;
+    ~Exclusive() { c_.busy.store(false, std::memory_order_release); }
+
+   private:
+    Concept& c_;
   };
   template <class M>
   struct Model final : Concept {

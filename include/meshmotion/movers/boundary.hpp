@@ -22,9 +22,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -36,6 +38,10 @@ enum class BoundaryKind {
   fixed,       ///< zero displacement
   sliding,     ///< free to move in a plane, zero displacement along its normal
 };
+
+[[nodiscard]] inline std::string_view name(BoundaryKind k) {
+  return k == BoundaryKind::prescribed ? "prescribed" : k == BoundaryKind::fixed ? "fixed" : "sliding";
+}
 
 /// An orthonormal basis of the plane normal to the unit vector n (Dim × (Dim − 1)).
 template <int Dim>
@@ -256,6 +262,30 @@ class BoundarySpec {
 
   [[nodiscard]] bool empty() const noexcept { return groups_.empty(); }
 
+  /// Nodes that two groups of different kinds share, and which condition they take (the
+  /// strongest: prescribed over fixed over sliding; see ResolvedBoundary). A flap touching a
+  /// fixed wing moves its shared nodes with the flap: this says how many, so a program can
+  /// tell its user.
+  struct Overlap {
+    std::string winner, other;            ///< group names
+    BoundaryKind winner_kind, other_kind;
+    Index nodes = 0;                      ///< shared nodes
+  };
+  [[nodiscard]] std::vector<Overlap> overlaps(const Mesh<Dim>& mesh) const {
+    std::vector<Overlap> out;
+    for (std::size_t i = 0; i < groups_.size(); ++i)
+      for (std::size_t j = i + 1; j < groups_.size(); ++j) {
+        const Group *a = &groups_[i], *b = &groups_[j];
+        if (a->kind == b->kind) continue;
+        if (static_cast<int>(b->kind) < static_cast<int>(a->kind)) std::swap(a, b);
+        const std::vector<Index> na = mesh.group_nodes(a->name), nb = mesh.group_nodes(b->name);
+        std::vector<Index> shared;
+        std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(shared));
+        if (!shared.empty()) out.push_back({a->name, b->name, a->kind, b->kind, static_cast<Index>(shared.size())});
+      }
+    return out;
+  }
+
   /// Resolves against a Mesh<Dim> (groups by name, reference positions mesh.points).
   /// Displacements are those between fractions `from` and `to` of the motions (arrays scale
   /// linearly), so a driver can split the motion into steps. Throws InputError for an unknown
@@ -273,6 +303,11 @@ class BoundarySpec {
   [[nodiscard]] ResolvedBoundary<Dim> resolve(const Points<Dim>& points, const GroupNodes& group_nodes,
                                               double to = 1.0, double from = 0.0) const {
     BoundaryCollector<Dim> entries(points.cols());
+    for (auto g = groups_.begin(); g != groups_.end(); ++g)
+      for (auto h = groups_.begin(); h != g; ++h)
+        if (h->name == g->name)
+          throw InputError("BoundarySpec::resolve: group '" + g->name + "' is given twice (" + std::string(name(h->kind)) + " and " +
+                           std::string(name(g->kind)) + "): give each group one condition");
     for (const auto& g : groups_) {
       const auto found = group_nodes.find(g.name);
       if (found == group_nodes.end()) {
