@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
   app.add_option("--ny", ny, "cells across the channel")->check(CLI::PositiveNumber);
   app.add_option("--length", length, "channel length")->check(CLI::PositiveNumber);
   app.add_flag("--json", json, "print one JSON object");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv)) return *rc;
 
   return meshmotion::examples::guarded(json, [&] {
     const solver::FlowMesh flow = solver::channel(nx, ny, length);

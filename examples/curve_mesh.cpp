@@ -29,7 +29,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include <cctype>
 #include <cstdint>
 #include <chrono>
 #include <cstdio>
@@ -64,8 +63,7 @@ struct Arguments {
 
 // A --geometry naming a STEP, IGES or BREP file (any case) rather than an analytic shape.
 bool is_cad_file(const std::string& text) {
-  std::string ext = std::filesystem::path(text).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = detail::lower_extension(text);
   return ext == ".step" || ext == ".stp" || ext == ".iges" || ext == ".igs" || ext == ".brep";
 }
 
@@ -246,10 +244,10 @@ int main(int argc, char** argv) {
   meshmotion::tune_process_memory(argc, argv);  // may restart the program once (core/process_memory.hpp)
   CLI::App app{"Curve a linear mesh into a certified P2 (P3, P4) mesh (spline or CAD boundary, RBF or blending interior)"};
   Arguments args;
-  app.add_option("input", args.input, "linear mesh (.msh, .su2, .cgns, .vtu); none: the built-in demo");
+  auto* input = app.add_option("input", args.input, "linear mesh (.msh, .su2, .cgns, .vtu); none: the built-in demo");
   app.add_option("-o,--output", args.output, "curved mesh to write (.msh, .cgns; .su2 for linear); a .vtu is written beside it");
   examples::add_version_flag(app);
-  app.add_flag("--demo", args.demo, "curve the built-in boundary-layer mesh around a cylinder");
+  app.add_flag("--demo", args.demo, "curve the built-in boundary-layer mesh around a cylinder")->excludes(input);
   // Every key of curve_mesh() and of the movers is a flag (--list-options: those of --method).
   examples::add_option_flags(app, option_docs(CurveOptions<3>{}), args.options.given, "Curving options");
   // The flags of earlier versions, kept for their users' scripts.
@@ -288,7 +286,7 @@ int main(int argc, char** argv) {
   app.add_flag("--svg-no-markers", args.svg_no_markers,
                "SVG: do not ring invalid cells (by default each cell with scaled Jacobian <= 0 gets a red ring, "
                "the legend counts them and the colour scale spans [0, 1]); the scale then reaches down to the minimum");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv)) return *rc;
 
   args.demo = args.demo || args.input.empty();
   return examples::guarded(args.json, [&] {
@@ -312,6 +310,7 @@ int main(int argc, char** argv) {
         args.geometry = {"circle:0,0,0.5"};
       }
       examples::check_output({}, args.output, given_curve_options<3>(args).order, args.overwrite);
+      check_output_folder(args.svg);
       return run(o_mesh({}), args);  // 128 x 64 quads, first cell 1e-5 for a 0.025 wall spacing
     }
     if (args.output.empty()) throw InputError("curve_mesh: no output file (expected -o OUTPUT)");
@@ -319,6 +318,7 @@ int main(int argc, char** argv) {
     const int order = given_curve_options<3>(args).order;
     examples::check_output(args.input, args.output, order, args.overwrite);
     examples::check_output(args.input, with_extension(args.output, ".vtu"), order, args.overwrite);
+    if (!args.svg.empty()) check_output_folder(args.svg);
     AnyMesh mesh = read_mesh(args.input);
     return std::visit([&](auto& m) { return run(std::move(m), args); }, mesh);
   });

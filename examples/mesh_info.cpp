@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
   bool json = false;
   app.add_option("file", file, "mesh file (.msh Gmsh 2.2/4.1, .su2, .cgns) or OpenFOAM case folder")->required();
   app.add_flag("--json", json, "print one JSON object instead of text");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv)) return *rc;
   return examples::guarded(json, [&] {
     const AnyMesh mesh = read_mesh(file);
     const auto summary = std::visit([](const auto& m) { return summarize(m); }, mesh);

@@ -132,7 +132,7 @@ int main(int argc, char** argv) {
   app.add_option("--worst", s.worst, "how many worst cells to list per metric");
   app.add_flag("--keep-orientation", s.keep_orientation,
                "refuse a mesh whose cells are all negatively oriented instead of reorienting it");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv)) return *rc;
   return examples::guarded(s.json, [&] {
     if (!s.vtu.empty()) examples::check_output(s.file, s.vtu, 2, false);
     AnyMesh mesh = read_mesh(s.file);

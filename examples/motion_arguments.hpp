@@ -4,13 +4,14 @@
 // radius of the methods that take one (a heuristic from the boundary when not given).
 
 #include "meshmotion/core/option_text.hpp"
+#include "meshmotion/io/detail/read_file.hpp"
 #include "meshmotion/movers.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cstdint>
-#include <fstream>
+#include <iostream>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -35,8 +36,9 @@ inline void add_motion_options(CLI::App& app, MotionArguments& a) {
   app.add_option("--axis", a.axis, "Rotation axis AX,AY,AZ (3D, default z)")->delimiter(',');
   auto* translate = app.add_option("--translate", a.translate, "Translation DX,DY[,DZ]")->delimiter(',');
   auto* file = app.add_option("--displacements", a.displacements_file,
-                              "Text file: lines 'node dx dy [dz]', node = the node's id in the mesh file, any order; "
-                              "every node of --group once");
+                              "Text file: lines 'node dx dy [dz]', node = the node's id as the mesh file numbers it (from 0 in "
+                              ".su2, .vtu and OpenFOAM cases, the file's ids in .msh, from 1 in .cgns), any order; every node of "
+                              "--group once");
   rotate->excludes(translate)->excludes(file);
   translate->excludes(file);
   app.add_option("--fixed", a.fixed, "Fixed groups");
@@ -65,8 +67,8 @@ Vec<Dim> vec(const std::vector<double>& v, const char* what) {
 // comment. The nodes may come in any order; resolve() checks them against the group.
 template <int Dim>
 std::pair<std::vector<std::int64_t>, Points<Dim>> read_displacements(const std::string& file) {
-  std::ifstream in(file);
-  if (!in) throw IoError("cannot open " + file);
+  // Read whole and bounded by the file's size: a device or pipe given by mistake is refused.
+  std::istringstream in(detail::read_whole_file(file));
   std::vector<std::int64_t> ids;
   std::vector<double> values;
   std::string line;
@@ -105,6 +107,7 @@ Motion<Dim> motion(const MotionArguments& a) {
   const double angle = radians(*a.rotate);
   const Vec<Dim> c = a.center.empty() ? Vec<Dim>::Zero() : vec<Dim>(a.center, "center");
   if constexpr (Dim == 2) {
+    if (!a.axis.empty()) throw InputError("--axis: a 2D mesh rotates in its plane (give --axis with a 3D mesh only)");
     return Rotation2D{c, angle};
   } else {
     return Rotation3D{c, a.axis.empty() ? Vec<3>::UnitZ() : vec<3>(a.axis, "axis"), angle};
@@ -123,6 +126,10 @@ BoundarySpec<Dim> boundary_spec(const MotionArguments& a, const Mesh<Dim>& mesh)
   }
   for (const auto& g : a.fixed) spec.fixed(g);
   for (const auto& g : a.sliding) spec.sliding(g);
+  for (const auto& o : spec.overlaps(mesh))
+    std::cerr << "note: " << o.nodes << " node" << (o.nodes == 1 ? "" : "s") << " of '" << o.winner << "' (" << name(o.winner_kind)
+              << ") " << (o.nodes == 1 ? "is" : "are") << " also in '" << o.other << "' (" << name(o.other_kind) << "): "
+              << name(o.winner_kind) << " wins (prescribed over fixed over sliding)\n";
   return spec;
 }
 

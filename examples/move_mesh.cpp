@@ -96,13 +96,14 @@ int main(int argc, char** argv) {
   app.add_option("-o,--output", a.output, "Output mesh (.msh, .su2, .cgns, .vtu), or an OpenFOAM case (its points replaced; give --overwrite when it is the input) or a time folder of it (case/0.001: its polyMesh/points)");
   examples::add_motion_options(app, a.motion);
   examples::add_mover_options(app, a.mover, known_methods<3>());
-  app.add_option("--steps", a.steps, "Number of steps")->check(CLI::PositiveNumber);
+  // More steps than this is a typing slip, not a motion: it would run for days.
+  app.add_option("--steps", a.steps, "Number of steps (1 to 100000)")->check(CLI::Range(1, 100000));
   app.add_flag("--strict", a.strict, "write nothing when invalid cells remain (exit 2)");
   app.add_flag("--overwrite", a.overwrite, "allow the output to be the input file");
   app.add_flag("--keep-orientation", a.keep_orientation,
                "refuse a mesh whose cells are all negatively oriented instead of reorienting it");
   app.add_flag("--json", a.json, "Print one JSON object");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv)) return *rc;
   return examples::guarded(a.json, [&] {
     if (examples::list_options<2>(a.mover)) return examples::exit_ok;
     if (a.input.empty() || a.output.empty()) throw InputError("move_mesh: give an input mesh and -o OUTPUT (see --help)");

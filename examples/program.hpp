@@ -9,15 +9,18 @@
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/orientation.hpp"
 #include "meshmotion/core/process_memory.hpp"
+#include "meshmotion/core/threads.hpp"
 #include "meshmotion/io/mesh_io.hpp"
 #include "meshmotion/version.hpp"
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <exception>
 #include <filesystem>
 #include <iostream>
 #include <new>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -35,6 +38,31 @@ inline void print_error_json(std::string_view message, std::string_view kind, in
   JsonWriter w(std::cout);
   w.begin_object().key("error").value(message).key("kind").value(kind).key("exit_code").value(exit_code).end_object();
   std::cout << "\n";
+}
+
+/// Parses the command line. --help and --version print and give exit 0; every other parse
+/// error (an unknown option, a value out of range, a missing file) is an input error like any
+/// other: exit 1, the message on stderr and, under --json, the error object on stdout. `print`
+/// is false on the ranks of a parallel program that stay silent.
+[[nodiscard]] inline std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv, bool print = true) {
+  const auto refuse = [&](const char* what, std::string_view kind, std::string_view hint) {
+    if (!print) return exit_error;
+    // --json may come after the word that failed: look for it in the words themselves.
+    if (std::any_of(argv + 1, argv + argc, [](const char* word) { return std::string_view(word) == "--json"; }))
+      print_error_json(what, kind, exit_error);
+    std::cerr << app.get_name() << ": " << what << "\n" << hint;
+    return exit_error;
+  };
+  try {
+    app.parse(argc, argv);
+    check_thread_environment();
+    return std::nullopt;
+  } catch (const InputError& e) {
+    return refuse(e.what(), "input", "");
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return print ? app.exit(e) : 0;
+    return refuse(e.what(), "usage", "Run with --help for more information.\n");
+  }
 }
 
 /// Runs body() (which returns the exit code) and turns what it throws into a message on
@@ -61,7 +89,15 @@ int guarded(bool json, Body&& body) {
   } catch (const Error& e) {
     return fail(e.what(), "error", exit_error);
   } catch (const std::bad_alloc&) {
-    return fail("out of memory", "memory", exit_error);
+    return fail("out of memory: the case needs more than this process may allocate (see ulimit -v, or a larger machine)",
+                "memory", exit_error);
+  } catch (const std::exception& e) {
+    // Not one of the library's errors (a standard library length or range error): still one
+    // message and the error object, never an abort.
+    const std::string what = std::string("internal error: ") + e.what();
+    return fail(what.c_str(), "internal", exit_error);
+  } catch (...) {
+    return fail("internal error: an exception of unknown type", "internal", exit_error);
   }
 }
 

@@ -239,7 +239,41 @@ smoke_test(NAME move_mesh.displacements_outside_group.json REQUIRES examples_dem
            COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_outside.msh" --group farfield
                    --displacements "${smoke_dir}/outside_node.txt" --fixed wall --json)
 
+# A command line the parser refuses is an input error like any other (exit 1, the error object),
+# absurd counts included; a device given as a file is refused, never read without end.
+smoke_test(NAME mesh_info.unknown_flag.json EXPECT_RC 1 KEYS error VALUES kind=usage
+           COMMAND mesh_info --no-such-flag --json)
+smoke_test(NAME move_mesh.absurd_steps.json REQUIRES examples_demo_mesh EXPECT_RC 1 KEYS error VALUES kind=usage
+           COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_steps.msh" --group wall --rotate 1
+                   --fixed farfield --steps 1000000000 --json)
+smoke_test(NAME mesh_info.huge_omp_num_threads.json REQUIRES examples_demo_mesh EXPECT_RC 1 KEYS error VALUES kind=input
+           COMMAND mesh_info "${smoke_dir}/demo.msh" --json)
+set_tests_properties(examples.mesh_info.huge_omp_num_threads.json PROPERTIES ENVIRONMENT "OMP_NUM_THREADS=100000")
+if(EXISTS /dev/zero)
+  smoke_test(NAME move_mesh.displacements_device.json REQUIRES examples_demo_mesh EXPECT_RC 1 KEYS error VALUES kind=io
+             COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_zero.msh" --group wall
+                     --displacements /dev/zero --fixed farfield --json)
+  smoke_test(NAME move_mesh.options_file_device.json REQUIRES examples_demo_mesh EXPECT_RC 1 KEYS error VALUES kind=io
+             COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_zero.msh" --group wall --rotate 1
+                     --options-file /dev/zero --fixed farfield --json)
+endif()
+
+# A CGNS write that fails (here a file size limit: a full disk alike) is an io error and the
+# program exits 1: HDF5 used to crash at exit over the file it could not close.
+if(MESHMOTION_HAVE_CGNS)
+  add_test(NAME examples.curve_mesh.cgns_write_fails.json
+           COMMAND "${CMAKE_COMMAND}" -DKEYS=error -DVALUES=kind=io -DEXPECT_RC=1 -P "${smoke_checker}"
+                   -- sh -c "ulimit -f 20 && trap '' XFSZ && exec \"$0\" \"$@\"" $<TARGET_FILE:curve_mesh> --demo
+                   -o "${smoke_dir}/size_limit.cgns" --json
+           WORKING_DIRECTORY "${smoke_dir}")
+  set_tests_properties(examples.curve_mesh.cgns_write_fails.json PROPERTIES LABELS examples)
+endif()
+
 # Outputs are checked before any work, and an input is never overwritten unasked.
+smoke_test(NAME curve_mesh.svg_in_missing_folder.json EXPECT_RC 1 KEYS error VALUES kind=input
+           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_svg_folder.msh" --svg "${smoke_dir}/no_such_folder/demo.svg" --json)
+smoke_test(NAME curve_mesh.demo_with_input.json EXPECT_RC 1 KEYS error VALUES kind=usage
+           COMMAND curve_mesh "${smoke_dir}/demo.msh" --demo -o "${smoke_dir}/demo_and_input.msh" --json)
 smoke_test(NAME curve_mesh.cgns_order3_output.json EXPECT_RC 1 KEYS error
            COMMAND curve_mesh --demo --order 3 -o "${smoke_dir}/demo_curved_p3.cgns" --json)
 smoke_test(NAME move_mesh.unknown_output.json REQUIRES examples_demo_mesh EXPECT_RC 1 KEYS error

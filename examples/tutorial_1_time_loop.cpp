@@ -277,6 +277,6 @@ int main(int argc, char** argv) {
                  "set up again when some cell's skew falls below this fraction of its skew at the last setup")->check(CLI::Range(0.0, 1.0))->capture_default_str();
   app.add_option("--print-every", s.print_every, "print a table line every N steps")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_flag("--json", s.json, "print one JSON object instead of the table");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv)) return *rc;
   return meshmotion::examples::guarded(s.json, [&] { return run(s); });
 }

@@ -277,7 +277,7 @@ int main(int argc, char** argv) {
   app.add_option("--fd-step", s.fd_step, "finite-difference step")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--tolerance", s.tolerance, "largest accepted relative difference reverse vs FD")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_flag("--json", s.json, "print one JSON object instead of the tables");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv)) return *rc;
   return meshmotion::examples::guarded(s.json, [&] {
     s.start = {start[0], start[1]};
     s.target = {target[0], target[1]};

@@ -206,13 +206,8 @@ int main_body(int argc, char** argv) {
   app.add_flag("--keep-orientation", a.keep_orientation,
                "refuse a mesh whose cells are all negatively oriented instead of reorienting it");
   app.add_flag("--json", a.json, "Print one JSON object (rank 0)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // Every rank parses the same words; rank 0 alone prints help or the complaint.
-    if (root) return app.exit(e);
-    return e.get_exit_code();
-  }
+  // Every rank parses the same words; rank 0 alone prints help or the complaint.
+  if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv, root)) return *rc;
   // Rank 0 reports; every rank gets the same exception from the collective calls.
   return examples::guarded(a.json && root, [&] {
     try {
