@@ -25,6 +25,7 @@ from ._core import (  # noqa: F401  (re-exported)
     vtk_order,
 )
 from . import _core
+from ._arrays import index_array, real_array
 from .warp import Warp  # noqa: F401
 
 import numpy as _np
@@ -37,20 +38,24 @@ def _dim_of(mesh):
 def from_arrays(points, cells, groups=None):
     """A mesh from a solver's arrays.
 
-    points: (n, dim) float64; cells: {type name: (n_cells, nodes_per_cell) ints} or a list of
+    The arrays are copied into the mesh, converted exactly: points of any float (up to 64 bits) or
+    integer dtype and any layout; cells and groups of any integer dtype (a float index is refused).
+
+    points: (n, dim) reals; cells: {type name: (n_cells, nodes_per_cell) ints} or a list of
     (type name, array) pairs ("tri3", "quad4", "tet4", "hex8", "prism6", "pyramid5", P2 types);
     groups: {name: (facet type name, (n_facets, nodes_per_facet) ints)}, or a list of such
     pairs for a group of several facet types (a 3D wall of triangles and quadrilaterals).
     """
-    points = _np.ascontiguousarray(points, dtype=_np.float64)
+    points = real_array(points, "from_arrays: points")
     if points.ndim != 2 or points.shape[1] not in (2, 3):
         raise InputError(f"from_arrays: points must have shape (n, 2) or (n, 3) (got {points.shape})")
-    cell_list = list(cells.items()) if isinstance(cells, dict) else list(cells)
+    cell_list = [(t, index_array(a, f"from_arrays: cells {t}"))
+                 for t, a in (cells.items() if isinstance(cells, dict) else cells)]
     group_list = []
     for name, value in (groups or {}).items():
         # One facet block per group, or several: [(facet type, facets), ...].
         for facet_type, facets in ([value] if isinstance(value[0], str) else value):
-            group_list.append((name, facet_type, facets))
+            group_list.append((name, facet_type, index_array(facets, f"from_arrays: group {name}")))
     build = _core._from_arrays2 if points.shape[1] == 2 else _core._from_arrays3
     return build(points, cell_list, group_list)
 

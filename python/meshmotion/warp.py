@@ -15,6 +15,7 @@ their plane, nodes of fixed groups stay; neither appears in the design surface.
 import numpy as _np
 
 from . import _core
+from ._arrays import index_array, real_array
 
 
 class Warp:
@@ -63,7 +64,7 @@ class Warp:
 
     def set_surface_order(self, nodes):
         """Use the solver's own order of the design nodes (each design node exactly once)."""
-        nodes = _np.asarray(nodes, dtype=_np.int64)
+        nodes = index_array(nodes, "set_surface_order")
         position = {int(v): k for k, v in enumerate(self._design)}
         if len(nodes) != len(self._design) or len(set(nodes.tolist())) != len(nodes):
             raise _core.InputError(
@@ -79,7 +80,7 @@ class Warp:
 
     def set_surface_coordinates(self, X):
         """New absolute coordinates of the design surface, (n_design, dim), finite."""
-        X = _np.asarray(X, dtype=_np.float64)
+        X = real_array(X, "set_surface_coordinates")
         if X.shape != (len(self._design), self._dim):
             raise _core.InputError(
                 f"set_surface_coordinates: expected shape ({len(self._design)}, {self._dim}) (got {X.shape})")
@@ -102,7 +103,7 @@ class Warp:
         """dI/dXs for dI/dXv (n_nodes, dim): one row per design node, in surface order."""
         if self._derivative_note:
             raise _core.InputError("warp_derivative: " + self._derivative_note)
-        v = _np.ascontiguousarray(dI_dXv, dtype=_np.float64)
+        v = real_array(dI_dXv, "warp_derivative")
         if v.shape != self._reference.shape:
             raise _core.InputError(f"warp_derivative: expected shape {self._reference.shape} (got {v.shape})")
         g = self._mover.derivative_reverse(v)

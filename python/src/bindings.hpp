@@ -149,9 +149,13 @@ inline ElementType element_type_named(const std::string& type_name) {
 // The connectivity of a block as an (n_cells, nodes_per_cell) int64 view kept alive by `owner`.
 inline py::array_t<Index> connectivity_view(ElementBlock& b, const py::object& owner) {
   const auto npc = static_cast<py::ssize_t>(b.nodes_per_element());
-  return py::array_t<Index>({static_cast<py::ssize_t>(b.size()), npc},
-                            {static_cast<py::ssize_t>(npc * sizeof(Index)), static_cast<py::ssize_t>(sizeof(Index))},
-                            b.connectivity.data(), owner);
+  py::array_t<Index> view({static_cast<py::ssize_t>(b.size()), npc},
+                          {static_cast<py::ssize_t>(npc * sizeof(Index)), static_cast<py::ssize_t>(sizeof(Index))},
+                          b.connectivity.data(), owner);
+  // Read-only: an index written here would reach the library's loops unchecked (a node out
+  // of range crashed quality_report). A new connectivity goes through from_arrays().
+  view.attr("setflags")(py::arg("write") = false);
+  return view;
 }
 
 /// Runs f.template operator()<Dim>() for Dim 2 and 3: each class and function is bound once

@@ -80,6 +80,7 @@ void bind_mesh(py::module_& m) {
              const std::vector<std::tuple<std::string, std::string, py::array_t<Index, py::array::c_style | py::array::forcecast>>>& groups) {
             M mesh;
             mesh.points = rows_of<Dim>(points, "from_arrays: points");
+            mesh.first_node_id = 0;  // numpy's indices: node_indices() takes them as they are
             const auto add = [&](const std::string& type_name, const py::array_t<Index, py::array::c_style | py::array::forcecast>& a,
                                  int tag, const char* what) {
               const ElementType type = element_type_named(type_name);

@@ -110,6 +110,30 @@ def test_bad_arrays_are_refused():
         mover.move_into(np.zeros((b.size, 2)), np.zeros((3, 2)))
 
 
+def test_copied_arrays_convert_exactly_or_are_refused_and_views_are_read_only():
+    mesh = grid()
+    points = mesh.points.copy()
+    quads = mesh.cells[0][1].copy()
+    # Copied arrays: float32 coordinates and int32 indices, in Fortran order, convert exactly.
+    p32 = np.asfortranarray(points.astype(np.float32))
+    again = mm.from_arrays(p32, {"quad4": np.asfortranarray(quads.astype(np.int32))})
+    assert np.array_equal(again.points, p32.astype(np.float64))
+    assert np.array_equal(again.cells[0][1], quads)
+    # What would lose something is refused: a float index, a complex coordinate.
+    with pytest.raises(mm.InputError, match="float index is not rounded"):
+        mm.from_arrays(points, {"quad4": quads + 0.7})
+    with pytest.raises(mm.InputError, match="expected real numbers"):
+        mm.from_arrays(points + 0j, {"quad4": quads})
+    with pytest.raises(mm.InputError, match="beyond 2\\*\\*53"):
+        mm.from_arrays(np.full((4, 2), 2**60, dtype=np.int64), {"quad4": np.array([[0, 1, 2, 3]])})
+    # The connectivity views cannot be written: an index out of range never reaches a loop.
+    view = mesh.cells[0][1]
+    assert not view.flags.writeable
+    with pytest.raises(ValueError):
+        view[0, 0] = 10**9
+    assert not mesh.facets[0][1].flags.writeable
+
+
 LINEAR_METHODS = ["rbf", "spring", "torsion", "le", "sle", "dgm", "idgm", "dgrbf"]
 
 
@@ -184,6 +208,11 @@ def test_errors_map_to_python_exceptions():
         mm.read_mesh(str(bad))
     assert issubclass(mm.InputError, ValueError) and issubclass(mm.IoError, OSError)
     assert issubclass(mm.SolverError, RuntimeError)
+    # Error is the base of every one of them, as docs/python.md says.
+    for kind in (mm.InputError, mm.IoError, mm.SolverError, mm.InvalidMeshError):
+        assert issubclass(kind, mm.Error), kind
+    with pytest.raises(mm.Error):
+        mm.read_mesh("/no/such/mesh.msh")
 
 
 def test_reversed_mesh_is_reoriented_at_read_time():
