@@ -20,7 +20,12 @@
 
 #include "bench_memory.hpp"
 #include "meshmotion/core/generators.hpp"
+// Where atomic writing lives moved (io/detail before issue 32); the baseline build has the old path.
+#if __has_include("meshmotion/core/detail/atomic_file.hpp")
 #include "meshmotion/core/detail/atomic_file.hpp"
+#else
+#include "meshmotion/io/detail/atomic_file.hpp"
+#endif
 #include "meshmotion/io/mesh_io.hpp"
 #include "meshmotion/movers.hpp"
 #include "meshmotion/quality.hpp"
