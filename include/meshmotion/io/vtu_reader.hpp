@@ -21,6 +21,7 @@
 #include <array>
 #include <bit>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -333,13 +334,27 @@ inline std::optional<VtkReadCell> element_of_vtk(int vtk_type, int n) {
     if (!*array) t.fail(cells_begin, std::string("<Cells> has no '") + name + "' array");
   const std::vector<double> offset = detail::array_values(t, *offsets, format, static_cast<std::size_t>(num_cells));
   const std::vector<double> type = detail::array_values(t, *types, format, static_cast<std::size_t>(num_cells));
+  // Each value checked before it is converted: a binary array may hold any double (a NaN, a
+  // negative or huge value), whose conversion to an index would be undefined.
+  const auto check_integers = [&](const std::vector<double>& values, const detail::VtuArray& a, double lo, double hi) {
+    for (std::size_t k = 0; k < values.size(); ++k)
+      if (!(values[k] >= lo && values[k] <= hi && values[k] == std::floor(values[k])))
+        t.fail(a.tag.at, "DataArray '" + a.name() + "': value " + std::to_string(values[k]) + " of cell " + std::to_string(k) +
+                             " (expected an integer from " + std::to_string(static_cast<long long>(lo)) + " to " +
+                             std::to_string(static_cast<long long>(hi)) + ")");
+  };
+  check_integers(offset, *offsets, 0.0, static_cast<double>(t.text().size()));
+  check_integers(type, *types, 0.0, 255.0);  // VTK's cell types are UInt8
   const std::size_t num_entries = offset.empty() ? 0 : static_cast<std::size_t>(offset.back());
   const std::vector<double> nodes = detail::array_values(t, *connectivity, format, num_entries);
 
   std::vector<double> facet_tag;
   if (const auto [data_begin, data_end] = section("CellData"); data_end != 0)
     for (const auto& a : detail::data_arrays(t, data_begin, data_end))
-      if (a.name() == "facet_tag") facet_tag = detail::array_values(t, a, format, static_cast<std::size_t>(num_cells));
+      if (a.name() == "facet_tag") {
+        facet_tag = detail::array_values(t, a, format, static_cast<std::size_t>(num_cells));
+        check_integers(facet_tag, a, -2147483647.0, 2147483647.0);
+      }
 
   // The elements, in file order, with our node order.
   struct Element {
