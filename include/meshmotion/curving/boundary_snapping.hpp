@@ -83,9 +83,7 @@ struct SnapOptions {
   std::vector<Index> corner_nodes;  ///< spline corners whatever their angle
   /// Where a spline facet's nodes go: at fractions of its arc length (default), or of its
   /// parameter (the thesis). The parameter need not be arc length, and the tangential offset
-  /// it gives a wall node is carried into a thin layer: gmsh's NACA0012 boundary-layer
-  /// triangles reach 0.912 with the parameter and 0.9927 with the arc length at P2 (the
-  /// analytic section: 0.9924), the 30P30N quadrilaterals 0.637 and 0.708 (docs/curving.md,
+  /// it gives a wall node is carried into a thin layer (the measurements: docs/curving.md,
   /// "Spline midpoints").
   SplineMidpoint midpoint = SplineMidpoint::arc_length;
   /// A vertex whose projection is closer than this (relative to the mesh's bounding-box
