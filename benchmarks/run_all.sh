@@ -202,7 +202,8 @@ fi
 # each against the serial mover in the same process.
 if [[ -x "$build_dir/benchmarks/mpi_bench" && ( -z "$only" || "$only" == *",mpi_bench,"* ) ]]; then
   mpi_flags=()
-  mpiexec --version 2>&1 | grep -q "Open MPI" && mpi_flags=(--oversubscribe --allow-run-as-root)
+  # Open MPI's mpiexec says "OpenRTE" or "Open MPI" depending on its version.
+  mpiexec --version 2>&1 | grep -qiE "open ?mpi|openrte" && mpi_flags=(--oversubscribe --allow-run-as-root)
   for ranks in 1 2 4; do
     run "mpi_bench_$ranks" mpiexec "${mpi_flags[@]}" -n "$ranks" "$build_dir/benchmarks/mpi_bench" \
       "$([[ $full == 1 ]] && echo 126 || echo 64)"
