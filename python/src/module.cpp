@@ -5,12 +5,16 @@
 
 #include "bindings.hpp"
 
+#include "meshmotion/core/threads.hpp"
 #include "meshmotion/version.hpp"
 
 PYBIND11_MODULE(_core, m) {
   using namespace meshmotion::python;
   m.doc() = "meshmotion's compiled core (use the meshmotion package)";
   m.attr("__version__") = MESHMOTION_VERSION_STRING;
+  // As the programs do: an OMP_NUM_THREADS the OpenMP runtime would crash on is refused
+  // (ImportError with the reason) before any parallel region opens.
+  meshmotion::check_thread_environment();
   bind_errors(m);
   bind_catalogue(m);
   bind_mesh(m);

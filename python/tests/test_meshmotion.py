@@ -215,6 +215,16 @@ def test_errors_map_to_python_exceptions():
         mm.read_mesh("/no/such/mesh.msh")
 
 
+def test_an_absurd_omp_num_threads_is_refused_at_import():
+    import subprocess
+    import sys
+
+    env = dict(os.environ, OMP_NUM_THREADS="100000")
+    run = subprocess.run([sys.executable, "-c", "import meshmotion"], env=env, capture_output=True, text=True)
+    assert run.returncode != 0
+    assert "OMP_NUM_THREADS=100000: more than 1024 threads" in run.stderr
+
+
 def test_reversed_mesh_is_reoriented_at_read_time():
     file = scratch("python_clockwise.su2")
     file.write_text("NDIME= 2\nNELEM= 2\n5 0 2 1 0\n5 0 3 2 1\nNPOIN= 4\n0 0 0\n1 0 1\n1 1 2\n0 1 3\n"
