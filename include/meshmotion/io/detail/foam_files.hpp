@@ -107,13 +107,8 @@ class FoamCursor {
     return real_token(token(what), what, [this](const std::string& m) { fail(m); });
   }
 
-  /// A list count read as "what count", refused when the rest of the file cannot hold that many
-  /// entries of at least `entry_bytes` bytes each: a corrupt count must not allocate gigabytes.
-  [[nodiscard]] Index count(std::string_view what, std::size_t entry_bytes) {
-    const auto n = integer<Index>(std::string(what) + " count", 0, std::numeric_limits<Index>::max());
-    check_count(n, what, entry_bytes);
-    return n;
-  }
+  /// Refuses a list count `n` when the rest of the file cannot hold that many entries of at
+  /// least `entry_bytes` bytes each: a corrupt count must not allocate gigabytes.
   void check_count(Index n, std::string_view what, std::size_t entry_bytes) {
     const std::size_t left = text_.size() - std::min(pos_, text_.size());
     if (static_cast<std::size_t>(n) > left / entry_bytes + 1)
