@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <type_traits>
 #include <utility>
@@ -45,6 +46,11 @@ void check_against_brute_force(Index n) {
     REQUIRE(knn.size() == 7);
     for (std::size_t k = 0; k < 7; ++k) CHECK(knn[k].second == Approx(all[k].first));
     CHECK(tree.nearest(query).first == all[0].second);
+    // The nearest point strictly within the radius, or none.
+    const auto within = tree.nearest_within(query, radius);
+    REQUIRE(within.has_value() == (all[0].first < radius * radius));
+    if (within) CHECK(within->first == all[0].second);
+    if (within) CHECK(within->second == Approx(all[0].first));
   }
 }
 
@@ -80,6 +86,14 @@ TEST_CASE("k-d tree reads the matrix in place and handles edge cases", "[spatial
   CHECK(empty.radius_search(Vec<2>(0.0, 0.0), 1.0).empty());
   CHECK(empty.nearest(Vec<2>(0.0, 0.0), 3).empty());
   CHECK_THROWS_AS(empty.nearest(Vec<2>(0.0, 0.0)), InputError);
+  CHECK_FALSE(empty.nearest_within(Vec<2>(0.0, 0.0), 1.0).has_value());
+  // From the centre of points on a circle every point is at one distance: a radius below it
+  // finds none, one above finds the nearest.
+  Points<2> circle(2, 64);
+  for (Index i = 0; i < 64; ++i) circle.col(i) = Vec<2>(std::cos(0.1 * static_cast<double>(i)), std::sin(0.1 * static_cast<double>(i)));
+  const KdTree<2> ring(circle);
+  CHECK_FALSE(ring.nearest_within(Vec<2>(0.0, 0.0), 0.99).has_value());
+  CHECK(ring.nearest_within(Vec<2>(0.9, 0.0), 0.2)->first == 0);
   CHECK(tree.nearest(Vec<2>(5.0, 0.0), 10).size() == 3);
   points(0, 1) = std::numeric_limits<double>::quiet_NaN();
   CHECK_THROWS_AS(KdTree<2>(points), InputError);

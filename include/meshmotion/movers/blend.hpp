@@ -19,12 +19,14 @@
 ///
 /// Linear in the displacements: setup stores the sparse operator (per node, the weights of
 /// the wall nodes of its closest facets), move is one sparse product. Setup: a k-d tree per
-/// wall and a closest-facet query per node within reach, O(n log m); move: O(nonzeros).
+/// wall and a closest-facet query per node within reach, O(n log m), over the threads
+/// (core/threads.hpp); move: O(nonzeros).
 
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/shape_functions.hpp"
+#include "meshmotion/core/threads.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary_layer.hpp"
 #include "meshmotion/movers/detail/wall_distance.hpp"
@@ -34,6 +36,10 @@
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 
 #include <Eigen/SparseCore>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include <algorithm>
 #include <array>
@@ -97,58 +103,78 @@ class BlendMover {
     const std::vector<std::vector<detail::WallFacet>> walls = split_walls(mesh);
     lengths_ = wall_lengths(mesh, walls);
 
+    // A wall whose every facet has length 0 (all bulge away from their cells: a farfield
+    // circle) gives no node a weight; querying it for each node of the mesh cost the 30P30N's
+    // curving half its time.
     std::vector<detail::WallDistance<Dim>> distance;
-    distance.reserve(walls.size());
     std::vector<double> reach;  // beyond this nearest-vertex distance no facet is within L
+    std::vector<std::size_t> active;
+    distance.reserve(walls.size());
     for (std::size_t b = 0; b < walls.size(); ++b) {
       reach.push_back(lengths_[b] + largest_facet(mesh.points, walls[b]));
       distance.emplace_back(mesh.points, walls[b]);
+      if (lengths_[b] > 0.0) active.push_back(b);
     }
     const auto length_at = [&](std::size_t b, Index facet) {
       return facet_lengths_[b].empty() ? lengths_[b] : facet_lengths_[b][static_cast<std::size_t>(facet)];
     };
-    std::vector<Eigen::Triplet<double, Index>> triplets;
-    std::array<double, max_facet_nodes> shape{};
-    std::vector<detail::WallPoint<Dim>> closest(walls.size());
-    std::vector<double> phi(walls.size());
-    evaluated_ = 0;
-    for (Index v = 0; v < n; ++v) {
-      const Index k = slot_[static_cast<std::size_t>(v)];
-      if (k >= 0 && boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed) {
-        triplets.emplace_back(k, v, 1.0);
-        continue;
-      }
-      if (k >= 0 && boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::fixed) continue;
-      const Vec<Dim> x = mesh.points.col(v);
-      bool any = false;
-      for (std::size_t b = 0; b < walls.size(); ++b) {
-        phi[b] = 0.0;
-        if (distance[b].nearest_vertex(x).second >= reach[b]) continue;
-        closest[b] = distance[b].closest(x);
-        const double length = length_at(b, closest[b].facet);
-        phi[b] = length > 0.0 ? rbf_value(RbfKernel::wendland2, closest[b].distance, length) : 0.0;
-        any = any || phi[b] > 0.0;
-      }
-      if (!any) continue;
-      ++evaluated_;
-      for (std::size_t b = 0; b < walls.size(); ++b) {
-        if (phi[b] == 0.0) continue;
-        // Another wall c within reach damps b's share to zero on c. In a gap narrower than
-        // L_c the damping runs over the gap's width d_b + d_c instead: over L_c it would
-        // suppress b's share already at b's own first cells (the 30P30N flap gap folded).
-        double weight = phi[b];
-        for (std::size_t c = 0; c < walls.size(); ++c)
-          if (c != b && phi[c] > 0.0)
-            weight *= 1.0 - rbf_value(RbfKernel::wendland2, closest[c].distance,
-                                      std::min(length_at(c, closest[c].facet), closest[b].distance + closest[c].distance));
-        const detail::WallFacet& f = distance[b].facets()[static_cast<std::size_t>(closest[b].facet)];
-        shape_functions(f.type, closest[b].xi, std::span<double>(shape.data(), static_cast<std::size_t>(num_nodes(f.type))));
-        for (int j = 0; j < num_nodes(f.type); ++j)
-          if (weight * shape[static_cast<std::size_t>(j)] != 0.0)
-            triplets.emplace_back(slot_[static_cast<std::size_t>(f.nodes[static_cast<std::size_t>(j)])], v,
-                                  weight * shape[static_cast<std::size_t>(j)]);
+    // Nodes in chunks over the threads, each thread its own triplets: no two walls share a
+    // node and no node is written twice, so the operator does not depend on the order.
+    std::vector<std::vector<Eigen::Triplet<double, Index>>> lists(static_cast<std::size_t>(num_threads()));
+    Index evaluated = 0;
+#pragma omp parallel num_threads(static_cast<int>(lists.size())) reduction(+ : evaluated)
+    {
+#ifdef _OPENMP
+      std::vector<Eigen::Triplet<double, Index>>& triplets = lists[static_cast<std::size_t>(omp_get_thread_num())];
+#else
+      std::vector<Eigen::Triplet<double, Index>>& triplets = lists[0];
+#endif
+      std::array<double, max_facet_nodes> shape{};
+      std::vector<detail::WallPoint<Dim>> closest(walls.size());
+      std::vector<double> phi(walls.size(), 0.0);
+      // Nodes near a wall cost a closest-facet search, the others a pruned search per wall.
+#pragma omp for schedule(dynamic, 1024)
+      for (Index v = 0; v < n; ++v) {
+        const Index k = slot_[static_cast<std::size_t>(v)];
+        if (k >= 0 && boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed) {
+          triplets.emplace_back(k, v, 1.0);
+          continue;
+        }
+        if (k >= 0 && boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::fixed) continue;
+        const Vec<Dim> x = mesh.points.col(v);
+        bool any = false;
+        for (const std::size_t b : active) {
+          phi[b] = 0.0;
+          if (!distance[b].vertex_within(x, reach[b])) continue;
+          closest[b] = distance[b].closest(x);
+          const double length = length_at(b, closest[b].facet);
+          phi[b] = length > 0.0 ? rbf_value(RbfKernel::wendland2, closest[b].distance, length) : 0.0;
+          any = any || phi[b] > 0.0;
+        }
+        if (!any) continue;
+        ++evaluated;
+        for (const std::size_t b : active) {
+          if (phi[b] == 0.0) continue;
+          // Another wall c within reach damps b's share to zero on c. In a gap narrower than
+          // L_c the damping runs over the gap's width d_b + d_c instead: over L_c it would
+          // suppress b's share already at b's own first cells (the 30P30N flap gap folded).
+          double weight = phi[b];
+          for (const std::size_t c : active)
+            if (c != b && phi[c] > 0.0)
+              weight *= 1.0 - rbf_value(RbfKernel::wendland2, closest[c].distance,
+                                        std::min(length_at(c, closest[c].facet), closest[b].distance + closest[c].distance));
+          const detail::WallFacet& f = distance[b].facets()[static_cast<std::size_t>(closest[b].facet)];
+          shape_functions(f.type, closest[b].xi, std::span<double>(shape.data(), static_cast<std::size_t>(num_nodes(f.type))));
+          for (int j = 0; j < num_nodes(f.type); ++j)
+            if (weight * shape[static_cast<std::size_t>(j)] != 0.0)
+              triplets.emplace_back(slot_[static_cast<std::size_t>(f.nodes[static_cast<std::size_t>(j)])], v,
+                                    weight * shape[static_cast<std::size_t>(j)]);
+        }
       }
     }
+    evaluated_ = evaluated;
+    std::vector<Eigen::Triplet<double, Index>> triplets;
+    for (const auto& list : lists) triplets.insert(triplets.end(), list.begin(), list.end());
     operator_.resize(m, n);
     operator_.setFromTriplets(triplets.begin(), triplets.end());
     stats_ = MoverStats{};

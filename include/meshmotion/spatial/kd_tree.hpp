@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -138,6 +139,21 @@ class KdTree {
     out.reserve(found);
     for (std::size_t i = 0; i < found; ++i) out.emplace_back(indices[i], distances[i]);
     return out;
+  }
+
+  /// The nearest point strictly closer than `radius` to `query`, or none: the search is pruned
+  /// by the radius from its start. Points at about one distance all around the query (a
+  /// farfield circle seen from inside it) make nearest() visit nearly every one of them.
+  [[nodiscard]] std::optional<Neighbor> nearest_within(const Vec<Dim>& query, double radius) const {
+    if (size() == 0 || box_squared_distance(query) >= radius * radius) return std::nullopt;
+    std::size_t index = 0;
+    double distance = 0.0;
+    nanoflann::KNNResultSet<double, std::size_t, std::size_t> result(1);
+    result.init(&index, &distance);
+    distance = radius * radius;  // the worst distance the search accepts
+    tree_->findNeighbors(result, query.data(), detail::RadiusSearchParameters{});
+    if (result.size() == 0) return std::nullopt;
+    return Neighbor{index, distance};
   }
 
   /// The nearest point to `query` as (index, squared distance). Throws InputError on an empty tree.

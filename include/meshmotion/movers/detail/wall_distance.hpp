@@ -165,6 +165,10 @@ class WallDistance {
   /// Sorted unique wall vertices.
   [[nodiscard]] const std::vector<Index>& vertices() const noexcept { return vertices_; }
 
+  /// Whether a wall vertex lies strictly closer than `radius` to p: far from the wall much
+  /// cheaper than nearest_vertex() (KdTree::nearest_within()).
+  [[nodiscard]] bool vertex_within(const Vec<Dim>& p, double radius) const { return tree_.nearest_within(p, radius).has_value(); }
+
   /// The wall vertex nearest to p (a mesh node index) and its distance.
   [[nodiscard]] std::pair<Index, double> nearest_vertex(const Vec<Dim>& p) const {
     const Neighbor n = tree_.nearest(p);
