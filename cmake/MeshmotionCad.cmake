@@ -1,7 +1,7 @@
 # The optional CAD component (include/meshmotion/cad/, src/cad/): STEP, IGES and BREP models on
 # OpenCASCADE (Debian libocct-modeling-algorithms-dev libocct-data-exchange-dev). Defines
-# meshmotion::cad, a compiled library whose header holds no OpenCASCADE type, and says what is
-# missing otherwise; the core does not depend on it.
+# meshmotion::cad, a compiled library whose header holds no OpenCASCADE type, and the module it
+# loads, and says what is missing otherwise; the core does not depend on it.
 set(MESHMOTION_HAVE_CAD OFF)
 if(NOT MESHMOTION_WITH_CAD)
   return()
@@ -30,15 +30,24 @@ set(_exclude)
 if(NOT MESHMOTION_TOP_LEVEL)
   set(_exclude EXCLUDE_FROM_ALL)
 endif()
+# The toolkits live in a module of their own that meshmotion::cad loads when a model is first
+# read (src/cad/cad_shape.hpp): linked into a program, Debian's toolkits cost 0.12 s at every
+# start. It installs beside the libraries; MESHMOTION_CAD_MODULE overrides where it is looked for.
+add_library(meshmotion_cad_occt MODULE ${_exclude} src/cad/occt_shape.cpp)
+target_include_directories(meshmotion_cad_occt SYSTEM PRIVATE ${OpenCASCADE_INCLUDE_DIR})
+target_link_libraries(meshmotion_cad_occt PRIVATE meshmotion::meshmotion ${MESHMOTION_OCCT_LIBRARIES})
 add_library(meshmotion_cad STATIC ${_exclude} src/cad/cad_model.cpp)
 add_library(meshmotion::cad ALIAS meshmotion_cad)
 set_target_properties(meshmotion_cad PROPERTIES EXPORT_NAME cad POSITION_INDEPENDENT_CODE ON)
-target_include_directories(meshmotion_cad SYSTEM PRIVATE ${OpenCASCADE_INCLUDE_DIR})
+add_dependencies(meshmotion_cad meshmotion_cad_occt)
 # The header-only core, not meshmotion::compiled: linking the component must not build the
 # whole compiled library (a consumer links meshmotion::compiled beside it for fast builds).
-target_link_libraries(meshmotion_cad PUBLIC meshmotion::meshmotion PRIVATE ${MESHMOTION_OCCT_LIBRARIES})
-target_compile_definitions(meshmotion_cad PUBLIC MESHMOTION_HAVE_CAD)
+target_link_libraries(meshmotion_cad PUBLIC meshmotion::meshmotion ${CMAKE_DL_LIBS})
+target_compile_definitions(meshmotion_cad PUBLIC MESHMOTION_HAVE_CAD PRIVATE
+  MESHMOTION_CAD_MODULE_BUILD="$<TARGET_FILE:meshmotion_cad_occt>"
+  MESHMOTION_CAD_MODULE_INSTALL="${CMAKE_INSTALL_FULL_LIBDIR}/$<TARGET_FILE_NAME:meshmotion_cad_occt>")
 if(TARGET meshmotion_warnings)
   target_link_libraries(meshmotion_cad PRIVATE $<BUILD_INTERFACE:meshmotion_warnings>)
+  target_link_libraries(meshmotion_cad_occt PRIVATE meshmotion_warnings)
 endif()
 message(STATUS "meshmotion: CAD component on OpenCASCADE ${OpenCASCADE_VERSION}: STEP, IGES and BREP geometry for curving")

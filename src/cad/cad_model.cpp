@@ -1,46 +1,24 @@
-// The CAD component (meshmotion::cad) on OpenCASCADE; see include/meshmotion/cad/cad_model.hpp.
+// The CAD component (meshmotion::cad); see include/meshmotion/cad/cad_model.hpp. The
+// OpenCASCADE side is a module loaded on first use (cad_shape.hpp).
 
 #include "meshmotion/cad/cad_model.hpp"
 
+#include "cad_shape.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/io/detail/read_file.hpp"
 
-#include <BRepAdaptor_Curve.hxx>
-#include <BRepAdaptor_Surface.hxx>
-#include <BRepBndLib.hxx>
-#include <BRepBuilderAPI_MakeVertex.hxx>
-#include <BRepExtrema_DistShapeShape.hxx>
-#include <BRepTools.hxx>
-#include <BRepTopAdaptor_FClass2d.hxx>
-#include <BRep_Builder.hxx>
-#include <BRep_Tool.hxx>
-#include <Bnd_Box.hxx>
-#include <GeomAPI_ProjectPointOnCurve.hxx>
-#include <Geom_Curve.hxx>
-#include <IFSelect_ReturnStatus.hxx>
-#include <IGESControl_Reader.hxx>
-#include <Message.hxx>
-#include <Message_Messenger.hxx>
-#include <STEPControl_Reader.hxx>
-#include <ShapeAnalysis_Surface.hxx>
-#include <Standard_Failure.hxx>
-#include <TopExp.hxx>
-#include <TopExp_Explorer.hxx>
-#include <TopTools_IndexedMapOfShape.hxx>
-#include <TopoDS.hxx>
-#include <TopoDS_Edge.hxx>
-#include <TopoDS_Face.hxx>
-#include <TopoDS_Shape.hxx>
-#include <TopoDS_Vertex.hxx>
+#include <dlfcn.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <functional>
 #include <limits>
 #include <map>
-#include <mutex>
+#include <memory>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -51,126 +29,43 @@ namespace meshmotion {
 
 struct CadModel::Impl {
   std::filesystem::path file;
-  TopoDS_Shape shape;
-  TopTools_IndexedMapOfShape faces, edges;
-  std::vector<Bnd_Box> face_boxes, edge_boxes;
-  std::vector<std::vector<int>> face_edges;
-  double diagonal = 0.0;
-  // Each face's classifier of parameter points (inside, on or outside its boundary), built on
-  // first use; the mutex keeps the model's const methods safe to call from several threads.
-  std::vector<std::unique_ptr<BRepTopAdaptor_FClass2d>> classifiers;
-  std::mutex classifiers_mutex;
+  std::unique_ptr<detail::CadShape> shape;
 };
 
 namespace {
 
-// OpenCASCADE's translators print their progress to stdout: a program's JSON output must stay
-// clean, and failures reach the caller as exceptions.
-void quiet_occt() {
-  static const bool done = [] {
-    Message::DefaultMessenger()->ChangePrinters().Clear();
-    return true;
-  }();
-  (void)done;
-}
+using ReadShape = detail::CadShape* (*)(const std::filesystem::path*);
 
-TopoDS_Shape read_shape(const std::filesystem::path& file) {
-  quiet_occt();
-  const std::string ext = detail::lower_extension(file);
+// $MESHMOTION_CAD_MODULE, else the build tree's module while it exists, else the installed one
+// (CMake passes both paths).
+std::string cad_module_path() {
+  if (const char* given = std::getenv("MESHMOTION_CAD_MODULE"); given != nullptr && *given != '\0') return given;
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw IoError(file.string() + ": no such file");
-  if (ext == ".step" || ext == ".stp") {
-    STEPControl_Reader reader;
-    if (reader.ReadFile(file.c_str()) != IFSelect_RetDone) throw IoError(file.string() + ": OpenCASCADE cannot read this STEP file");
-    reader.TransferRoots();
-    return reader.OneShape();
-  }
-  if (ext == ".iges" || ext == ".igs") {
-    IGESControl_Reader reader;
-    if (reader.ReadFile(file.c_str()) != IFSelect_RetDone) throw IoError(file.string() + ": OpenCASCADE cannot read this IGES file");
-    reader.TransferRoots();
-    return reader.OneShape();
-  }
-  if (ext == ".brep") {
-    TopoDS_Shape shape;
-    BRep_Builder builder;
-    if (!BRepTools::Read(shape, file.c_str(), builder)) throw IoError(file.string() + ": OpenCASCADE cannot read this BREP file");
-    return shape;
-  }
-  throw InputError(file.string() + ": unknown CAD format '" + ext + "' (expected .step, .stp, .iges, .igs or .brep)");
+  return std::filesystem::is_regular_file(MESHMOTION_CAD_MODULE_BUILD, ec) ? MESHMOTION_CAD_MODULE_BUILD
+                                                                           : MESHMOTION_CAD_MODULE_INSTALL;
 }
 
-gp_Pnt to_gp(const Vec<3>& x) { return gp_Pnt(x[0], x[1], x[2]); }
-Vec<3> from_gp(const gp_Pnt& p) { return Vec<3>(p.X(), p.Y(), p.Z()); }
-
-double box_distance(const Bnd_Box& box, const gp_Pnt& p) {
-  if (box.IsVoid()) return std::numeric_limits<double>::infinity();
-  double x0, y0, z0, x1, y1, z1;
-  box.Get(x0, y0, z0, x1, y1, z1);
-  const double dx = std::max({x0 - p.X(), 0.0, p.X() - x1});
-  const double dy = std::max({y0 - p.Y(), 0.0, p.Y() - y1});
-  const double dz = std::max({z0 - p.Z(), 0.0, p.Z() - z1});
-  return std::sqrt(dx * dx + dy * dy + dz * dz);
+// The module's reader, loaded once and kept for the life of the process.
+ReadShape cad_reader() {
+  static const ReadShape reader = [] {
+    const std::string path = cad_module_path();
+    void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (handle == nullptr) {
+      const char* reason = dlerror();
+      throw IoError("cannot load the CAD module " + path + " (" + (reason != nullptr ? reason : "unknown reason") +
+                    "; set MESHMOTION_CAD_MODULE to the installed libmeshmotion_cad_occt.so, and check that "
+                    "OpenCASCADE's libraries are installed)");
+    }
+    const auto version = reinterpret_cast<int (*)()>(dlsym(handle, "meshmotion_cad_module_version"));
+    const auto read = reinterpret_cast<ReadShape>(dlsym(handle, "meshmotion_cad_read"));
+    if (version == nullptr || read == nullptr || version() != detail::cad_module_version)
+      throw IoError("the CAD module " + path + " is not the one this program was built with (version " +
+                    (version != nullptr ? std::to_string(version()) : std::string("none")) + ", expected " +
+                    std::to_string(detail::cad_module_version) + ")");
+    return read;
+  }();
+  return reader;
 }
-
-}  // namespace
-
-CadModel::CadModel(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
-CadModel::CadModel(CadModel&&) noexcept = default;
-CadModel& CadModel::operator=(CadModel&&) noexcept = default;
-CadModel::~CadModel() = default;
-
-CadModel CadModel::read(const std::filesystem::path& file) {
-  auto impl = std::make_unique<Impl>();
-  impl->file = file;
-  try {
-    impl->shape = read_shape(file);
-  } catch (const Standard_Failure& e) {
-    throw IoError(file.string() + ": OpenCASCADE failed reading it (" + std::string(e.GetMessageString()) + ")");
-  }
-  if (impl->shape.IsNull()) throw InputError(file.string() + ": the file holds no shape");
-  TopExp::MapShapes(impl->shape, TopAbs_FACE, impl->faces);
-  TopExp::MapShapes(impl->shape, TopAbs_EDGE, impl->edges);
-  if (impl->faces.Extent() == 0 && impl->edges.Extent() == 0)
-    throw InputError(file.string() + ": the shape has no faces or edges to curve a mesh onto");
-  for (int f = 1; f <= impl->faces.Extent(); ++f) {
-    Bnd_Box box;
-    BRepBndLib::Add(impl->faces(f), box);
-    impl->face_boxes.push_back(box);
-    TopTools_IndexedMapOfShape bounding;
-    TopExp::MapShapes(impl->faces(f), TopAbs_EDGE, bounding);
-    std::vector<int> ids;
-    for (int e = 1; e <= bounding.Extent(); ++e) ids.push_back(impl->edges.FindIndex(bounding(e)));
-    impl->face_edges.push_back(std::move(ids));
-  }
-  impl->classifiers.resize(static_cast<std::size_t>(impl->faces.Extent()));
-  for (int e = 1; e <= impl->edges.Extent(); ++e) {
-    Bnd_Box box;
-    BRepBndLib::Add(impl->edges(e), box);
-    impl->edge_boxes.push_back(box);
-  }
-  Bnd_Box all;
-  BRepBndLib::Add(impl->shape, all);
-  if (!all.IsVoid()) {
-    double x0, y0, z0, x1, y1, z1;
-    all.Get(x0, y0, z0, x1, y1, z1);
-    impl->diagonal = std::sqrt((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0) + (z1 - z0) * (z1 - z0));
-  }
-  return CadModel(std::move(impl));
-}
-
-const std::filesystem::path& CadModel::file() const { return impl_->file; }
-int CadModel::num_faces() const { return impl_->faces.Extent(); }
-int CadModel::num_edges() const { return impl_->edges.Extent(); }
-double CadModel::diagonal() const { return impl_->diagonal; }
-
-std::vector<int> CadModel::face_edges(int index) const {
-  if (index < 1 || index > num_faces())
-    throw InputError("CadModel: no face " + std::to_string(index) + " (the model has " + std::to_string(num_faces()) + ")");
-  return impl_->face_edges[static_cast<std::size_t>(index - 1)];
-}
-
-namespace {
 
 void check_entity(const CadModel& m, int dim, int index) {
   const int count = dim == 2 ? m.num_faces() : dim == 1 ? m.num_edges() : 0;
@@ -181,116 +76,55 @@ void check_entity(const CadModel& m, int dim, int index) {
 
 }  // namespace
 
+CadModel::CadModel(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+CadModel::CadModel(CadModel&&) noexcept = default;
+CadModel& CadModel::operator=(CadModel&&) noexcept = default;
+CadModel::~CadModel() = default;
+
+CadModel CadModel::read(const std::filesystem::path& file) {
+  // What needs no OpenCASCADE is checked before loading it.
+  const std::string ext = detail::lower_extension(file);
+  if (ext != ".step" && ext != ".stp" && ext != ".iges" && ext != ".igs" && ext != ".brep")
+    throw InputError(file.string() + ": unknown CAD format '" + ext + "' (expected .step, .stp, .iges, .igs or .brep)");
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw IoError(file.string() + ": no such file");
+  auto impl = std::make_unique<Impl>();
+  impl->file = file;
+  impl->shape.reset(cad_reader()(&file));
+  return CadModel(std::move(impl));
+}
+
+const std::filesystem::path& CadModel::file() const { return impl_->file; }
+int CadModel::num_faces() const { return impl_->shape->num_faces(); }
+int CadModel::num_edges() const { return impl_->shape->num_edges(); }
+double CadModel::diagonal() const { return impl_->shape->diagonal(); }
+
+std::vector<int> CadModel::face_edges(int index) const {
+  if (index < 1 || index > num_faces())
+    throw InputError("CadModel: no face " + std::to_string(index) + " (the model has " + std::to_string(num_faces()) + ")");
+  return impl_->shape->face_edges(index);
+}
+
 CadPoint CadModel::closest_point(int dim, int index, const Vec<3>& x) const {
   check_entity(*this, dim, index);
-  CadPoint out;
-  out.dim = dim;
-  out.index = index;
-  const gp_Pnt p = to_gp(x);
-  if (dim == 1) {
-    // The edge's own curve on its parameter range, and its ends.
-    const TopoDS_Edge& edge = TopoDS::Edge(impl_->edges(index));
-    double first = 0, last = 0;
-    const Handle(Geom_Curve) curve = BRep_Tool::Curve(edge, first, last);
-    if (curve.IsNull()) {  // a degenerate edge (a sphere's pole): its one point
-      const gp_Pnt q = BRep_Tool::Pnt(TopExp::FirstVertex(edge));
-      out.u = first;
-      out.point = from_gp(q);
-      out.distance = q.Distance(p);
-      return out;
-    }
-    double best = std::numeric_limits<double>::infinity(), t_best = first;
-    for (const double t : {first, last}) {
-      const double d = curve->Value(t).Distance(p);
-      if (d < best) best = d, t_best = t;
-    }
-    GeomAPI_ProjectPointOnCurve projection(p, curve, first, last);
-    if (projection.NbPoints() > 0 && projection.LowerDistance() < best) best = projection.LowerDistance(), t_best = projection.LowerDistanceParameter();
-    out.u = t_best;
-    out.point = from_gp(curve->Value(t_best));
-    out.distance = best;
-    return out;
-  }
-  const TopoDS_Face& face = TopoDS::Face(impl_->faces(index));
-  const TopoDS_Vertex vertex = BRepBuilderAPI_MakeVertex(p).Vertex();
-  BRepExtrema_DistShapeShape extrema(vertex, face);
-  if (!extrema.IsDone() || extrema.NbSolution() == 0)
-    throw InputError(impl_->file.string() + ": no closest point on face " + std::to_string(index));
-  out.distance = extrema.Value();
-  out.point = from_gp(extrema.PointOnShape2(1));
-  if (extrema.SupportTypeShape2(1) == BRepExtrema_IsInFace) {
-    extrema.ParOnFaceS2(1, out.u, out.v);
-  } else {
-    // On the face's boundary: its surface parameters there.
-    ShapeAnalysis_Surface surface(BRep_Tool::Surface(face));
-    const gp_Pnt2d uv = surface.ValueOfUV(extrema.PointOnShape2(1), 1e-9 * std::max(impl_->diagonal, 1e-300));
-    out.u = uv.X();
-    out.v = uv.Y();
-  }
-  return out;
+  return impl_->shape->closest_point(dim, index, x);
 }
 
 CadPoint CadModel::closest_point_near(int dim, int index, const Vec<3>& x, double u0, double v0) const {
   check_entity(*this, dim, index);
-  if (dim != 2) return closest_point(dim, index, x);
-  const TopoDS_Face& face = TopoDS::Face(impl_->faces(index));
-  const BRepAdaptor_Surface surface(face);
-  // Newton's method on the squared distance, to round-off: from a start next to the answer it
-  // converges in a few steps (OpenCASCADE's local extremum stops at its parameter tolerance,
-  // 1e-9, which moved a sphere's edge nodes 5e-7 off their great circles).
-  const gp_Pnt p = to_gp(x);
-  double u = u0, v = v0;
-  bool converged = false;
-  for (int iteration = 0; iteration < 30 && !converged; ++iteration) {
-    gp_Pnt s;
-    gp_Vec su, sv, suu, svv, suv;
-    surface.D2(u, v, s, su, sv, suu, svv, suv);
-    const gp_Vec r(p, s);
-    const double gu = r.Dot(su), gv = r.Dot(sv);
-    const double huu = su.Dot(su) + r.Dot(suu), hvv = sv.Dot(sv) + r.Dot(svv), huv = su.Dot(sv) + r.Dot(suv);
-    const double det = huu * hvv - huv * huv;
-    if (!(det > 1e-14 * (su.SquareMagnitude() * sv.SquareMagnitude())) || !(huu > 0.0)) break;  // not a minimum, or degenerate
-    const double du = (hvv * gu - huv * gv) / det, dv = (huu * gv - huv * gu) / det;
-    u -= du;
-    v -= dv;
-    converged = std::abs(du) * su.Magnitude() + std::abs(dv) * sv.Magnitude() < 1e-14 * std::max(impl_->diagonal, 1e-300);
-  }
-  if (converged) {
-    CadPoint out;
-    out.dim = 2;
-    out.index = index;
-    out.u = u;
-    out.v = v;
-    TopAbs_State state;
-    {
-      const std::lock_guard<std::mutex> lock(impl_->classifiers_mutex);
-      auto& classifier = impl_->classifiers[static_cast<std::size_t>(index - 1)];
-      if (!classifier) classifier = std::make_unique<BRepTopAdaptor_FClass2d>(face, 1e-9 * std::max(impl_->diagonal, 1e-300));
-      state = classifier->Perform(gp_Pnt2d(out.u, out.v));
-    }
-    if (state == TopAbs_IN || state == TopAbs_ON) {
-      out.point = from_gp(surface.Value(u, v));
-      out.distance = (out.point - x).norm();
-      return out;
-    }
-  }
-  return closest_point(dim, index, x);
+  if (dim == 2)
+    if (const std::optional<CadPoint> found = impl_->shape->closest_point_near(index, x, u0, v0)) return *found;
+  return impl_->shape->closest_point(dim, index, x);
 }
 
 Vec<3> CadModel::point_at(int dim, int index, double u, double v) const {
   check_entity(*this, dim, index);
-  if (dim == 1) return from_gp(BRepAdaptor_Curve(TopoDS::Edge(impl_->edges(index))).Value(u));
-  return from_gp(BRepAdaptor_Surface(TopoDS::Face(impl_->faces(index))).Value(u, v));
+  return impl_->shape->point_at(dim, index, u, v);
 }
 
 std::array<double, 2> CadModel::periods(int dim, int index) const {
   check_entity(*this, dim, index);
-  if (dim == 1) {
-    const BRepAdaptor_Curve c(TopoDS::Edge(impl_->edges(index)));
-    return {c.IsPeriodic() ? c.Period() : 0.0, 0.0};
-  }
-  const BRepAdaptor_Surface s(TopoDS::Face(impl_->faces(index)));
-  return {s.IsUPeriodic() ? s.UPeriod() : 0.0, s.IsVPeriodic() ? s.VPeriod() : 0.0};
+  return impl_->shape->periods(dim, index);
 }
 
 double default_cad_tolerance(const CadModel& model) { return 1e-6 * model.diagonal(); }
@@ -307,11 +141,10 @@ std::vector<int> all_entities(int count) {
 
 std::vector<CadPoint> CadModel::entities_within(int dim, const std::vector<int>& candidates, const Vec<3>& x, double distance) const {
   const std::vector<int> all = candidates.empty() ? all_entities(dim == 2 ? num_faces() : num_edges()) : std::vector<int>{};
-  const auto& boxes = dim == 2 ? impl_->face_boxes : impl_->edge_boxes;
   std::vector<CadPoint> out;
   for (const int e : candidates.empty() ? all : candidates) {
     check_entity(*this, dim, e);
-    if (box_distance(boxes[static_cast<std::size_t>(e - 1)], to_gp(x)) > distance) continue;
+    if (impl_->shape->box_distance(dim, e, x) > distance) continue;
     const CadPoint c = closest_point(dim, e, x);
     if (c.distance <= distance) out.push_back(c);
   }
@@ -321,11 +154,10 @@ std::vector<CadPoint> CadModel::entities_within(int dim, const std::vector<int>&
 
 CadPoint CadModel::nearest(int dim, const std::vector<int>& candidates, const Vec<3>& x) const {
   const std::vector<int> all = candidates.empty() ? all_entities(dim == 2 ? num_faces() : num_edges()) : std::vector<int>{};
-  const auto& boxes = dim == 2 ? impl_->face_boxes : impl_->edge_boxes;
   std::vector<std::pair<double, int>> order;
   for (const int e : candidates.empty() ? all : candidates) {
     check_entity(*this, dim, e);
-    order.emplace_back(box_distance(boxes[static_cast<std::size_t>(e - 1)], to_gp(x)), e);
+    order.emplace_back(impl_->shape->box_distance(dim, e, x), e);
   }
   std::sort(order.begin(), order.end());
   CadPoint best;

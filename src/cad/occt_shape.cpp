@@ -1,0 +1,278 @@
+// The OpenCASCADE module of the CAD component: the toolkits behind detail::CadShape, loaded by
+// CadModel::read() on first use (src/cad/cad_shape.hpp says why).
+
+#include "cad_shape.hpp"
+
+#include "meshmotion/core/error.hpp"
+#include "meshmotion/io/detail/read_file.hpp"
+
+#include <BRepAdaptor_Curve.hxx>
+#include <BRepAdaptor_Surface.hxx>
+#include <BRepBndLib.hxx>
+#include <BRepBuilderAPI_MakeVertex.hxx>
+#include <BRepExtrema_DistShapeShape.hxx>
+#include <BRepTools.hxx>
+#include <BRepTopAdaptor_FClass2d.hxx>
+#include <BRep_Builder.hxx>
+#include <BRep_Tool.hxx>
+#include <Bnd_Box.hxx>
+#include <GeomAPI_ProjectPointOnCurve.hxx>
+#include <Geom_Curve.hxx>
+#include <IFSelect_ReturnStatus.hxx>
+#include <IGESControl_Reader.hxx>
+#include <Message.hxx>
+#include <Message_Messenger.hxx>
+#include <STEPControl_Reader.hxx>
+#include <ShapeAnalysis_Surface.hxx>
+#include <Standard_Failure.hxx>
+#include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Edge.hxx>
+#include <TopoDS_Face.hxx>
+#include <TopoDS_Shape.hxx>
+#include <TopoDS_Vertex.hxx>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <string>
+
+namespace meshmotion::detail {
+namespace {
+
+// OpenCASCADE's translators print their progress to stdout: a program's JSON output must stay
+// clean, and failures reach the caller as exceptions.
+void quiet_occt() {
+  static const bool done = [] {
+    Message::DefaultMessenger()->ChangePrinters().Clear();
+    return true;
+  }();
+  (void)done;
+}
+
+TopoDS_Shape read_shape(const std::filesystem::path& file) {
+  quiet_occt();
+  const std::string ext = detail::lower_extension(file);
+  if (ext == ".step" || ext == ".stp") {
+    STEPControl_Reader reader;
+    if (reader.ReadFile(file.c_str()) != IFSelect_RetDone) throw IoError(file.string() + ": OpenCASCADE cannot read this STEP file");
+    reader.TransferRoots();
+    return reader.OneShape();
+  }
+  if (ext == ".iges" || ext == ".igs") {
+    IGESControl_Reader reader;
+    if (reader.ReadFile(file.c_str()) != IFSelect_RetDone) throw IoError(file.string() + ": OpenCASCADE cannot read this IGES file");
+    reader.TransferRoots();
+    return reader.OneShape();
+  }
+  if (ext == ".brep") {
+    TopoDS_Shape shape;
+    BRep_Builder builder;
+    if (!BRepTools::Read(shape, file.c_str(), builder)) throw IoError(file.string() + ": OpenCASCADE cannot read this BREP file");
+    return shape;
+  }
+  throw InputError(file.string() + ": unknown CAD format '" + ext + "' (expected .step, .stp, .iges, .igs or .brep)");
+}
+
+gp_Pnt to_gp(const Vec<3>& x) { return gp_Pnt(x[0], x[1], x[2]); }
+Vec<3> from_gp(const gp_Pnt& p) { return Vec<3>(p.X(), p.Y(), p.Z()); }
+
+double distance_to_box(const Bnd_Box& box, const gp_Pnt& p) {
+  if (box.IsVoid()) return std::numeric_limits<double>::infinity();
+  double x0, y0, z0, x1, y1, z1;
+  box.Get(x0, y0, z0, x1, y1, z1);
+  const double dx = std::max({x0 - p.X(), 0.0, p.X() - x1});
+  const double dy = std::max({y0 - p.Y(), 0.0, p.Y() - y1});
+  const double dz = std::max({z0 - p.Z(), 0.0, p.Z() - z1});
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+class OcctShape final : public CadShape {
+ public:
+  explicit OcctShape(const std::filesystem::path& file);
+
+  int num_faces() const override { return faces_.Extent(); }
+  int num_edges() const override { return edges_.Extent(); }
+  double diagonal() const override { return diagonal_; }
+  std::vector<int> face_edges(int face) const override { return face_edges_[static_cast<std::size_t>(face - 1)]; }
+  double box_distance(int dim, int index, const Vec<3>& x) const override {
+    return distance_to_box((dim == 2 ? face_boxes_ : edge_boxes_)[static_cast<std::size_t>(index - 1)], to_gp(x));
+  }
+  CadPoint closest_point(int dim, int index, const Vec<3>& x) const override;
+  std::optional<CadPoint> closest_point_near(int face, const Vec<3>& x, double u0, double v0) const override;
+  Vec<3> point_at(int dim, int index, double u, double v) const override;
+  std::array<double, 2> periods(int dim, int index) const override;
+
+ private:
+  std::filesystem::path file_;
+  TopoDS_Shape shape_;
+  TopTools_IndexedMapOfShape faces_, edges_;
+  std::vector<Bnd_Box> face_boxes_, edge_boxes_;
+  std::vector<std::vector<int>> face_edges_;
+  double diagonal_ = 0.0;
+  // Each face's classifier of parameter points (inside, on or outside its boundary), built on
+  // first use; the mutex keeps the model's const methods safe to call from several threads.
+  mutable std::vector<std::unique_ptr<BRepTopAdaptor_FClass2d>> classifiers_;
+  mutable std::mutex classifiers_mutex_;
+};
+
+OcctShape::OcctShape(const std::filesystem::path& file) : file_(file) {
+  shape_ = read_shape(file);
+  if (shape_.IsNull()) throw InputError(file.string() + ": the file holds no shape");
+  TopExp::MapShapes(shape_, TopAbs_FACE, faces_);
+  TopExp::MapShapes(shape_, TopAbs_EDGE, edges_);
+  if (faces_.Extent() == 0 && edges_.Extent() == 0)
+    throw InputError(file.string() + ": the shape has no faces or edges to curve a mesh onto");
+  for (int f = 1; f <= faces_.Extent(); ++f) {
+    Bnd_Box box;
+    BRepBndLib::Add(faces_(f), box);
+    face_boxes_.push_back(box);
+    TopTools_IndexedMapOfShape bounding;
+    TopExp::MapShapes(faces_(f), TopAbs_EDGE, bounding);
+    std::vector<int> ids;
+    for (int e = 1; e <= bounding.Extent(); ++e) ids.push_back(edges_.FindIndex(bounding(e)));
+    face_edges_.push_back(std::move(ids));
+  }
+  classifiers_.resize(static_cast<std::size_t>(faces_.Extent()));
+  for (int e = 1; e <= edges_.Extent(); ++e) {
+    Bnd_Box box;
+    BRepBndLib::Add(edges_(e), box);
+    edge_boxes_.push_back(box);
+  }
+  Bnd_Box all;
+  BRepBndLib::Add(shape_, all);
+  if (!all.IsVoid()) {
+    double x0, y0, z0, x1, y1, z1;
+    all.Get(x0, y0, z0, x1, y1, z1);
+    diagonal_ = std::sqrt((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0) + (z1 - z0) * (z1 - z0));
+  }
+}
+
+CadPoint OcctShape::closest_point(int dim, int index, const Vec<3>& x) const {
+  CadPoint out;
+  out.dim = dim;
+  out.index = index;
+  const gp_Pnt p = to_gp(x);
+  if (dim == 1) {
+    // The edge's own curve on its parameter range, and its ends.
+    const TopoDS_Edge& edge = TopoDS::Edge(edges_(index));
+    double first = 0, last = 0;
+    const Handle(Geom_Curve) curve = BRep_Tool::Curve(edge, first, last);
+    if (curve.IsNull()) {  // a degenerate edge (a sphere's pole): its one point
+      const gp_Pnt q = BRep_Tool::Pnt(TopExp::FirstVertex(edge));
+      out.u = first;
+      out.point = from_gp(q);
+      out.distance = q.Distance(p);
+      return out;
+    }
+    double best = std::numeric_limits<double>::infinity(), t_best = first;
+    for (const double t : {first, last}) {
+      const double d = curve->Value(t).Distance(p);
+      if (d < best) best = d, t_best = t;
+    }
+    GeomAPI_ProjectPointOnCurve projection(p, curve, first, last);
+    if (projection.NbPoints() > 0 && projection.LowerDistance() < best) best = projection.LowerDistance(), t_best = projection.LowerDistanceParameter();
+    out.u = t_best;
+    out.point = from_gp(curve->Value(t_best));
+    out.distance = best;
+    return out;
+  }
+  const TopoDS_Face& face = TopoDS::Face(faces_(index));
+  const TopoDS_Vertex vertex = BRepBuilderAPI_MakeVertex(p).Vertex();
+  BRepExtrema_DistShapeShape extrema(vertex, face);
+  if (!extrema.IsDone() || extrema.NbSolution() == 0)
+    throw InputError(file_.string() + ": no closest point on face " + std::to_string(index));
+  out.distance = extrema.Value();
+  out.point = from_gp(extrema.PointOnShape2(1));
+  if (extrema.SupportTypeShape2(1) == BRepExtrema_IsInFace) {
+    extrema.ParOnFaceS2(1, out.u, out.v);
+  } else {
+    // On the face's boundary: its surface parameters there.
+    ShapeAnalysis_Surface surface(BRep_Tool::Surface(face));
+    const gp_Pnt2d uv = surface.ValueOfUV(extrema.PointOnShape2(1), 1e-9 * std::max(diagonal_, 1e-300));
+    out.u = uv.X();
+    out.v = uv.Y();
+  }
+  return out;
+}
+
+std::optional<CadPoint> OcctShape::closest_point_near(int index, const Vec<3>& x, double u0, double v0) const {
+  const TopoDS_Face& face = TopoDS::Face(faces_(index));
+  const BRepAdaptor_Surface surface(face);
+  // Newton's method on the squared distance, to round-off: from a start next to the answer it
+  // converges in a few steps (OpenCASCADE's local extremum stops at its parameter tolerance,
+  // 1e-9, which moved a sphere's edge nodes 5e-7 off their great circles).
+  const gp_Pnt p = to_gp(x);
+  double u = u0, v = v0;
+  bool converged = false;
+  for (int iteration = 0; iteration < 30 && !converged; ++iteration) {
+    gp_Pnt s;
+    gp_Vec su, sv, suu, svv, suv;
+    surface.D2(u, v, s, su, sv, suu, svv, suv);
+    const gp_Vec r(p, s);
+    const double gu = r.Dot(su), gv = r.Dot(sv);
+    const double huu = su.Dot(su) + r.Dot(suu), hvv = sv.Dot(sv) + r.Dot(svv), huv = su.Dot(sv) + r.Dot(suv);
+    const double det = huu * hvv - huv * huv;
+    if (!(det > 1e-14 * (su.SquareMagnitude() * sv.SquareMagnitude())) || !(huu > 0.0)) break;  // not a minimum, or degenerate
+    const double du = (hvv * gu - huv * gv) / det, dv = (huu * gv - huv * gu) / det;
+    u -= du;
+    v -= dv;
+    converged = std::abs(du) * su.Magnitude() + std::abs(dv) * sv.Magnitude() < 1e-14 * std::max(diagonal_, 1e-300);
+  }
+  if (converged) {
+    CadPoint out;
+    out.dim = 2;
+    out.index = index;
+    out.u = u;
+    out.v = v;
+    TopAbs_State state;
+    {
+      const std::lock_guard<std::mutex> lock(classifiers_mutex_);
+      auto& classifier = classifiers_[static_cast<std::size_t>(index - 1)];
+      if (!classifier) classifier = std::make_unique<BRepTopAdaptor_FClass2d>(face, 1e-9 * std::max(diagonal_, 1e-300));
+      state = classifier->Perform(gp_Pnt2d(out.u, out.v));
+    }
+    if (state == TopAbs_IN || state == TopAbs_ON) {
+      out.point = from_gp(surface.Value(u, v));
+      out.distance = (out.point - x).norm();
+      return out;
+    }
+  }
+  return std::nullopt;
+}
+
+Vec<3> OcctShape::point_at(int dim, int index, double u, double v) const {
+  if (dim == 1) return from_gp(BRepAdaptor_Curve(TopoDS::Edge(edges_(index))).Value(u));
+  return from_gp(BRepAdaptor_Surface(TopoDS::Face(faces_(index))).Value(u, v));
+}
+
+std::array<double, 2> OcctShape::periods(int dim, int index) const {
+  if (dim == 1) {
+    const BRepAdaptor_Curve c(TopoDS::Edge(edges_(index)));
+    return {c.IsPeriodic() ? c.Period() : 0.0, 0.0};
+  }
+  const BRepAdaptor_Surface s(TopoDS::Face(faces_(index)));
+  return {s.IsUPeriodic() ? s.UPeriod() : 0.0, s.IsVPeriodic() ? s.VPeriod() : 0.0};
+}
+
+}  // namespace
+}  // namespace meshmotion::detail
+
+extern "C" {
+
+int meshmotion_cad_module_version() { return meshmotion::detail::cad_module_version; }
+
+meshmotion::detail::CadShape* meshmotion_cad_read(const std::filesystem::path* file) {
+  // OpenCASCADE's own exceptions stay in the module: the caller knows meshmotion's.
+  try {
+    return new meshmotion::detail::OcctShape(*file);
+  } catch (const Standard_Failure& e) {
+    throw meshmotion::IoError(file->string() + ": OpenCASCADE failed reading it (" + std::string(e.GetMessageString()) + ")");
+  }
+}
+
+}
