@@ -182,6 +182,34 @@ TEST_CASE("affine motions are reproduced exactly with polynomial augmentation", 
   }
 }
 
+TEST_CASE("conditionally positive definite kernels always get the polynomial", "[movers]") {
+  // Without it tps is ill-posed: a rotation of the whole boundary gave garbage with no error.
+  const Grid<2> g = grid<2>(12);
+  const GroupNodes groups = with_outer<2>(g.groups);
+  BoundarySpec<2> spec;
+  spec.moving("outer", Rotation2D{Vec<2>(0.5, 0.5), 0.3});
+  const auto boundary = spec.resolve(g.mesh.points, groups);
+  const Eigen::Rotation2Dd turn(0.3);
+  for (const RbfKernel kernel : {RbfKernel::thin_plate_spline, RbfKernel::multiquadric}) {
+    CAPTURE(name(kernel));
+    CHECK(needs_polynomial(kernel));
+    RbfOptions options;
+    options.kernel = kernel;
+    options.support_radius = kernel == RbfKernel::thin_plate_spline ? 1.0 : 0.15;
+    options.polynomial = false;
+    RbfMover<2> mover(options);
+    CHECK(mover.options().polynomial);
+    mover.setup(g.mesh, boundary);
+    const Points<2> u = mover.move(boundary.displacements);
+    for (Index i = 0; i < g.mesh.num_nodes(); ++i) {
+      const Vec<2> x = g.mesh.points.col(i), c(0.5, 0.5);
+      CHECK((u.col(i) - (turn * (x - c) + c - x)).norm() < 1e-9);
+    }
+  }
+  for (const RbfKernel kernel : {RbfKernel::wendland2, RbfKernel::gaussian, RbfKernel::inverse_multiquadric})
+    CHECK_FALSE(needs_polynomial(kernel));
+}
+
 TEST_CASE("a support radius per boundary entry: interpolation, reach of each centre, affine reproduction", "[movers]") {
   const Grid<2> g = grid<2>(20);
   BoundarySpec<2> spec;

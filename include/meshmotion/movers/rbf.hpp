@@ -51,6 +51,7 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace meshmotion {
@@ -67,7 +68,9 @@ struct RbfOptions {
   /// Differing radii make the interpolation matrix nonsymmetric: it is factorized by sparse LU
   /// whatever `solver` says (BiCGSTAB is kept).
   std::vector<double> support_radii{};
-  /// Add a linear polynomial (reproduces affine motions exactly; needed by the thin plate spline).
+  /// Add a linear polynomial (reproduces affine motions exactly). Always on for the kernels
+  /// that need it (needs_polynomial(): tps, multiquadric; without it a rotation moved by tps
+  /// gave a scaled Jacobian of -230): see effective_options().
   bool polynomial = false;
   /// Solver of the sparse system of compact kernels.
   SolverOptions solver = {};
@@ -96,6 +99,13 @@ struct RbfOptions {
   double patch_overlap = 0.25;
 };
 
+/// The options an RBF mover runs with: `options` with the polynomial on where the kernel needs
+/// it (needs_polynomial()).
+[[nodiscard]] inline RbfOptions effective_options(RbfOptions options) {
+  options.polynomial = options.polynomial || needs_polynomial(options.kernel);
+  return options;
+}
+
 /// The RBF mover in Dim dimensions; models MeshMover.
 template <int Dim>
 class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
@@ -103,7 +113,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   static constexpr int dim = Dim;
   using Coefficients = Eigen::MatrixXd;
 
-  explicit RbfMover(RbfOptions options = {}) : options_(options) {}
+  explicit RbfMover(RbfOptions options = {}) : options_(effective_options(std::move(options))) {}
 
   [[nodiscard]] const RbfOptions& options() const noexcept { return options_; }
   [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }

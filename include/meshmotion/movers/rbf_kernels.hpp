@@ -29,6 +29,13 @@ inline constexpr std::array<RbfKernel, 8> all_rbf_kernels{
     RbfKernel::wendland0,         RbfKernel::wendland2, RbfKernel::wendland4,    RbfKernel::wendland6,
     RbfKernel::thin_plate_spline, RbfKernel::gaussian,  RbfKernel::multiquadric, RbfKernel::inverse_multiquadric};
 
+/// Whether the kernel is only conditionally positive definite (the thin plate spline of order
+/// 2, the multiquadric of order 1): its interpolation system is well posed only with the
+/// polynomial, which RbfMover therefore always adds for it.
+[[nodiscard]] constexpr bool needs_polynomial(RbfKernel kernel) {
+  return kernel == RbfKernel::thin_plate_spline || kernel == RbfKernel::multiquadric;
+}
+
 /// Name used on command lines: "wendland0", ..., "tps", "gaussian", "multiquadric", "inverse_multiquadric".
 [[nodiscard]] constexpr std::string_view name(RbfKernel kernel) {
   switch (kernel) {

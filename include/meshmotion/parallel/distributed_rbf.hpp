@@ -96,7 +96,7 @@ class DistributedRbfMover {
   static constexpr int dim = Dim;
 
   explicit DistributedRbfMover(RbfOptions options = {}, BoundarySolveOptions solve = {})
-      : inner_(options), options_(std::move(options)), solve_(solve) {}
+      : inner_(options), options_(effective_options(std::move(options))), solve_(solve) {}
 
   /// True when the last setup solves the boundary system through PETSc.
   [[nodiscard]] bool petsc_solve() const noexcept { return petsc_; }
