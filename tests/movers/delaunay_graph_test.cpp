@@ -250,6 +250,40 @@ TEST_CASE("Delaunay-graph movers: sliding nodes stay on their plane", "[movers]"
   check(DgrbfMover<2>());
 }
 
+TEST_CASE("Delaunay-graph movers: two tilted symmetry planes give finite coordinates", "[movers]") {
+  // A sector of a cylinder around a body, between planes at 10 and 50 degrees: the nodes of
+  // each plane are coplanar only to rounding, and the graph of the other boundary nodes closes
+  // its hull over them with slivers that thin. Points located in one got NaN coordinates (49
+  // nodes of a sphere slice, for a zero displacement), or moved so that the graph folded.
+  BoxOptions box;
+  box.nx = 6;
+  box.ny = 5;
+  box.nz = 4;
+  box.cells = BoxCells::tet4;
+  Mesh<3> mesh = box_mesh(box);
+  for (Index v = 0; v < mesh.num_nodes(); ++v) {
+    const double r = 0.5 + 4.5 * mesh.points(0, v), angle = radians(10.0 + 40.0 * mesh.points(1, v));
+    mesh.points.col(v) = Vec<3>(r * std::cos(angle), r * std::sin(angle), 4.0 * mesh.points(2, v));
+  }
+  BoundarySpec<3> spec;
+  spec.fixed("left").fixed("right").fixed("bottom").fixed("top").sliding("front").sliding("back");
+  const auto still = spec.resolve(mesh);
+  spec = BoundarySpec<3>{};
+  spec.moving("left", Translation<3>{Vec<3>(0.0, 0.0, 0.05)}).fixed("right").fixed("bottom").fixed("top").sliding("front").sliding("back");
+  const auto lifted = spec.resolve(mesh);
+  for (const char* method : {"dgm", "idgm", "dgrbf", "dgrbf2"}) {
+    CAPTURE(method);
+    AnyMover<3> mover = make_mover(MoverConfig<3>{method, mover_method<3>(method).defaults()});
+    mover.setup(mesh, still);
+    const Points<3> zero = mover.move(still.displacements);
+    CHECK(zero.cwiseAbs().maxCoeff() == 0.0);
+    mover.setup(mesh, lifted);
+    const Points<3> u = mover.move(lifted.displacements);
+    REQUIRE(u.allFinite());
+    CHECK(u.cwiseAbs().maxCoeff() == Approx(0.05));
+  }
+}
+
 TEST_CASE("Improved DGM: a wall-hugging layer in the graph, moved by RBF", "[movers]") {
   const Mesh<2> mesh = ellipse();
   BoundarySpec<2> spec;

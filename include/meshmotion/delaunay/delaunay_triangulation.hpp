@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -172,6 +173,7 @@ class DelaunayTriangulation {
       }
     }
     if (!found) s = locate_exhaustively(q, result.outside);
+    if (flat(s)) s = solid_simplex_near(s, q);
     result.simplex = s;
     result.barycentric = barycentric_coordinates<Dim>(corner_points(s), q);
     return result;
@@ -194,6 +196,44 @@ class DelaunayTriangulation {
     }
     outside = true;
     return nearest_hull_simplex(q);
+  }
+
+  /// Whether simplex s is flat to rounding: Dim! × its volume below 1e-8 × its longest edge to
+  /// the power Dim. Nodes on a plane that is not aligned with the axes are coplanar only to
+  /// rounding, and the exact predicates close the hull over them with slivers that thin: the
+  /// barycentric coordinates of a point in one are rounding noise, or 0/0 (a tilted symmetry
+  /// plane gave NaN coordinates for a zero displacement).
+  [[nodiscard]] bool flat(Index s) const {
+    const Eigen::Matrix<double, Dim, Dim + 1> c = corner_points(s);
+    Eigen::Matrix<double, Dim, Dim> edges;
+    double longest = 0.0;
+    for (int k = 0; k < Dim; ++k) edges.col(k) = c.col(k + 1) - c.col(0);
+    for (int a = 0; a < corners; ++a)
+      for (int b = a + 1; b < corners; ++b) longest = std::max(longest, (c.col(a) - c.col(b)).norm());
+    return !(std::abs(detail::small_determinant<Dim>(edges)) > 1e-8 * std::pow(longest, Dim));
+  }
+
+  /// From the flat simplex s, the simplex that is not flat, among the 256 nearest to s through
+  /// their neighbours, in which q's smallest barycentric coordinate is largest (q inside it
+  /// when it lies inside any of them); s when all are flat.
+  [[nodiscard]] Index solid_simplex_near(Index s, const Vec<Dim>& q) const {
+    std::vector<Index> seen{s};
+    Index best = s;
+    double best_lowest = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < seen.size() && seen.size() < 256; ++i) {
+      for (int j = 0; j < corners; ++j) {
+        const Index next = neighbours_(j, seen[i]);
+        if (next < 0 || std::find(seen.begin(), seen.end(), next) != seen.end()) continue;
+        seen.push_back(next);
+        if (flat(next)) continue;
+        const double lowest = barycentric_coordinates<Dim>(corner_points(next), q).minCoeff();
+        if (lowest > best_lowest) {
+          best_lowest = lowest;
+          best = next;
+        }
+      }
+    }
+    return best;
   }
 
   /// Distance from q to the hull facet opposite vertex j of s.

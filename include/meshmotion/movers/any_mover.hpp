@@ -46,9 +46,12 @@ class AnyMover {
     move_into(d, out);
     return out;
   }
+  /// Throws SolverError when the mover returns a non-finite displacement (a defect of the
+  /// mover, refused rather than written into a mesh).
   void move_into(PointsView<Dim> d, Points<Dim>& out) {
     const Exclusive use(*self_, "move");
     self_->move_into(d, out);
+    check_finite(out);
   }
   /// Into the caller's own storage (an Eigen::Map over a solver's array of Dim × n_nodes
   /// doubles): the RBF mover writes there directly, the others through a buffer of their own
@@ -56,6 +59,7 @@ class AnyMover {
   void move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) {
     const Exclusive use(*self_, "move");
     self_->move_into_storage(d, out);
+    check_finite(out);
   }
   [[nodiscard]] MoverStats stats() const { return self_->stats(); }
 
@@ -78,6 +82,15 @@ class AnyMover {
   }
 
  private:
+  template <class Out>
+  static void check_finite(const Out& out) {
+    if (out.allFinite()) return;
+    Index node = 0;
+    while (node < out.cols() && out.col(node).allFinite()) ++node;
+    throw SolverError("AnyMover::move: the mover returned a non-finite displacement at node " + std::to_string(node) +
+                      " (a defect of the mover for this mesh and boundary: please report it)");
+  }
+
   struct Concept {
     virtual ~Concept() = default;
     virtual void setup(const Mesh<Dim>&, const ResolvedBoundary<Dim>&) = 0;
