@@ -245,18 +245,40 @@ std::optional<CadPoint> OcctShape::closest_point_near(int index, const Vec<3>& x
   return std::nullopt;
 }
 
+// A curve or surface that closes on itself without being periodic (IGES stores a circle or an
+// ellipse as a closed, non-periodic B-spline; OpenCASCADE's STEP reader makes it a periodic
+// circle) still has a seam, and its parameter range is one period: the placement unwraps
+// across it as across a periodic one's (else the node between the seam vertex and its
+// neighbour went the long way round, to the far side of the body), and a parameter beyond the
+// range is wrapped back before evaluating, where a non-periodic curve would extrapolate.
+double period_of(bool periodic, double period, bool closed, double first, double last) {
+  return periodic ? period : closed ? last - first : 0.0;
+}
+
+double wrap(double t, bool periodic, bool closed, double first, double last) {
+  if (periodic || !closed || !(last > first)) return t;
+  t = first + std::fmod(t - first, last - first);
+  return t < first ? t + (last - first) : t;
+}
+
 Vec<3> OcctShape::point_at(int dim, int index, double u, double v) const {
-  if (dim == 1) return from_gp(BRepAdaptor_Curve(TopoDS::Edge(edges_(index))).Value(u));
-  return from_gp(BRepAdaptor_Surface(TopoDS::Face(faces_(index))).Value(u, v));
+  if (dim == 1) {
+    const BRepAdaptor_Curve c(TopoDS::Edge(edges_(index)));
+    return from_gp(c.Value(wrap(u, c.IsPeriodic(), c.IsClosed(), c.FirstParameter(), c.LastParameter())));
+  }
+  const BRepAdaptor_Surface s(TopoDS::Face(faces_(index)));
+  return from_gp(s.Value(wrap(u, s.IsUPeriodic(), s.IsUClosed(), s.FirstUParameter(), s.LastUParameter()),
+                         wrap(v, s.IsVPeriodic(), s.IsVClosed(), s.FirstVParameter(), s.LastVParameter())));
 }
 
 std::array<double, 2> OcctShape::periods(int dim, int index) const {
   if (dim == 1) {
     const BRepAdaptor_Curve c(TopoDS::Edge(edges_(index)));
-    return {c.IsPeriodic() ? c.Period() : 0.0, 0.0};
+    return {period_of(c.IsPeriodic(), c.IsPeriodic() ? c.Period() : 0.0, c.IsClosed(), c.FirstParameter(), c.LastParameter()), 0.0};
   }
   const BRepAdaptor_Surface s(TopoDS::Face(faces_(index)));
-  return {s.IsUPeriodic() ? s.UPeriod() : 0.0, s.IsVPeriodic() ? s.VPeriod() : 0.0};
+  return {period_of(s.IsUPeriodic(), s.IsUPeriodic() ? s.UPeriod() : 0.0, s.IsUClosed(), s.FirstUParameter(), s.LastUParameter()),
+          period_of(s.IsVPeriodic(), s.IsVPeriodic() ? s.VPeriod() : 0.0, s.IsVClosed(), s.FirstVParameter(), s.LastVParameter())};
 }
 
 }  // namespace

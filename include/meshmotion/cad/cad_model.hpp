@@ -10,7 +10,8 @@
 /// within a tolerance; cad_boundary() turns a match into the BoundaryGeometry curve_mesh()
 /// takes. Its placement puts a node between two vertices on a common CAD edge (an edge of a
 /// 2D model, a seam or ridge of a 3D one) along that edge at its fraction of the arc length
-/// between them (periodic parameters unwrapped across the seam), as Gmsh does; any other edge
+/// between them (the parameters of a periodic or closed curve unwrapped across its seam, the
+/// short way round), as Gmsh does; any other edge
 /// node goes to the closest point of the group's entities to its straight place (a curve of
 /// the surface close to the geodesic, where a parameter line need not be), and the nodes
 /// inside a facet to the closest point of their place on the facet curved by its edges.
@@ -64,9 +65,11 @@ class CadModel {
   /// search). Falls back to closest_point() when the search fails or ends outside the face's
   /// boundary. Edges (dim 1) take closest_point().
   [[nodiscard]] CadPoint closest_point_near(int dim, int index, const Vec<3>& x, double u0, double v0) const;
-  /// The point of entity (dim, index) at parameters (u, v) (v unused on edges).
+  /// The point of entity (dim, index) at parameters (u, v) (v unused on edges); on a closed
+  /// entity a parameter is taken modulo its period.
   [[nodiscard]] Vec<3> point_at(int dim, int index, double u, double v = 0.0) const;
-  /// The period of each parameter of entity (dim, index); 0 where not periodic.
+  /// The period of each parameter of entity (dim, index): a periodic one's, the parameter range
+  /// of one that closes without being periodic (IGES's closed B-splines), 0 elsewhere.
   [[nodiscard]] std::array<double, 2> periods(int dim, int index) const;
   /// The edges bounding face `index`.
   [[nodiscard]] std::vector<int> face_edges(int index) const;
