@@ -39,7 +39,7 @@ TEST_CASE("JSON writer: UTF-8 passes as it is, any other byte is escaped so the 
   CHECK(written("\xE2\x82") == R"("\u00e2\u0082")");
 }
 
-TEST_CASE("thread count: set, read back, same results; OpenMP's default follows; negative and huge refused", "[core]") {
+TEST_CASE("thread count: set, read back, same results, OpenMP's default follows, negative and huge refused", "[core]") {
   const Mesh<2> mesh = rectangle_mesh({});
   const QualityReport all = quality_report(mesh, Metric::shape);
 #ifdef _OPENMP

@@ -85,7 +85,7 @@ TEST_CASE("untangling never leaves a mesh worse than it found it", "[curving]") 
     }
 }
 
-TEST_CASE("untangling: nothing below the threshold, nothing moves; switched off, nothing moves", "[curving]") {
+TEST_CASE("untangling: nothing below the threshold, nothing moves, switched off, nothing moves", "[curving]") {
   std::vector<char> fixed;
   Mesh<2> m = shaken_mesh(RectangleCells::tri3, 2, fixed);
   const Mesh<2> before = m;

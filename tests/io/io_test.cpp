@@ -732,7 +732,7 @@ TEST_CASE("a failing write leaves no output and no temporary file, and never tou
   CHECK(fs::file_size(input) == size_before);
 }
 
-TEST_CASE("a killed run's temporaries are removed once an hour old; anyone else's never", "[io]") {
+TEST_CASE("a killed run's temporaries are removed once an hour old, anyone else's never", "[io]") {
   const auto dir = test::scratch_path("stale");
   fs::remove_all(dir);
   fs::create_directories(dir);

@@ -99,7 +99,7 @@ TEST_CASE("displacements by node: bad node lists are refused, naming the node", 
   CHECK_THAT(input_error_of([&] { resolve(ramp.nodes, nan); }), Catch::Contains("non-finite"));
 }
 
-TEST_CASE("a group given two conditions is refused; groups sharing nodes say which condition wins", "[movers][boundary]") {
+TEST_CASE("a group given two conditions is refused, groups sharing nodes say which condition wins", "[movers][boundary]") {
   const Mesh<2> mesh = rectangle_mesh({});
   BoundarySpec<2> twice;
   twice.moving("bottom", Translation<2>{Vec<2>(0.0, 0.1)}).fixed("top").fixed("bottom");

@@ -202,7 +202,7 @@ TEST_CASE("Delaunay-graph movers: repeated move equals a fresh setup", "[movers]
   check(ImprovedDgmMover<2>());
 }
 
-TEST_CASE("DGM refuses an inverted graph; run_steps rebuilds it each step", "[movers]") {
+TEST_CASE("DGM refuses an inverted graph, run_steps rebuilds it each step", "[movers]") {
   const Mesh<2> mesh = ellipse();
   BoundarySpec<2> spec;
   spec.moving("wall", Rotation2D{Vec<2>::Zero(), radians(120.0)}).fixed("farfield");

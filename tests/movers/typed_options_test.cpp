@@ -72,7 +72,7 @@ TEST_CASE("option text: key=value text", "[options]") {
   CHECK_THAT(message_of<InputError>([] { (void)parse_key_values("a=1 a=2"); }), Catch::Contains("'a'"));
 }
 
-TEST_CASE("option text: one field set by its key; other keys left alone", "[options]") {
+TEST_CASE("option text: one field set by its key, other keys left alone", "[options]") {
   RbfOptions o;
   CHECK(set_option(o, "support_radius", "0.25"));
   CHECK(o.support_radius == 0.25);

@@ -100,7 +100,7 @@ TEST_CASE("distributed elasticity: a solver failure raises on every rank, or fal
   CHECK_THROWS_WITH(relative_error(mesh, spec, unsupported), Catch::Contains("not supported in parallel"));
 }
 
-TEST_CASE("PETSc plumbing: a failed call names the caller, the call and PETSc's own text; handles own", "[parallel][petsc]") {
+TEST_CASE("PETSc plumbing: a failed call names the caller, the call and PETSc's own text, handles own", "[parallel][petsc]") {
   using meshmotion::parallel::detail::OwnedVec;
   using meshmotion::parallel::detail::petsc_check;
   CHECK_NOTHROW(petsc_check(0, "here", "VecCreate"));
