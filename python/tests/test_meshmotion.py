@@ -68,7 +68,7 @@ def test_typed_options_refused_like_the_cpp_parser():
         mm.Mover("rbf", 2, kernel="wendland3")
     with pytest.raises(ValueError, match="unknown mover method"):
         mm.Mover("rfb", 2)
-    assert ("support_radius", "1") in mm.mover_options("rbf")
+    assert ("support_radius", "0") in mm.mover_options("rbf")  # 0: from the boundary at setup
     mm.Mover("sle", 3, poisson_ratio=0.4, solver="cg_jacobi", tolerance=1e-9)
 
 
@@ -89,6 +89,21 @@ def test_rbf_moves_the_boundary_exactly_and_into_a_callers_array():
     mover.move_into(d, out)
     np.testing.assert_array_equal(out, u)
     assert mover.stats["moves"] == 2
+
+
+def test_the_default_radius_follows_the_mesh_scale():
+    # The same mesh in metres and in millimetres, moved with the defaults, moves alike.
+    moved = []
+    for size in (1.0, 1000.0):
+        mesh = grid(size=size)
+        b = mm.Boundary(2).prescribed("bottom").fixed("top").sliding("left").sliding("right").resolve(mesh)
+        bottom = mesh.groups["bottom"]
+        d = np.zeros((b.size, 2))
+        b.scatter(list(bottom), np.column_stack([np.zeros(len(bottom)), 0.2 * mesh.points[bottom, 0]]), d)
+        mover = mm.Mover("rbf", 2)
+        mover.setup(mesh, b)
+        moved.append(mover.move(d) / size)
+    np.testing.assert_allclose(moved[1], moved[0], rtol=0, atol=1e-12)
 
 
 def test_tps_gets_the_polynomial_it_needs():

@@ -182,6 +182,30 @@ TEST_CASE("affine motions are reproduced exactly with polynomial augmentation", 
   }
 }
 
+TEST_CASE("the default support radius follows the mesh: a mesh 1000 times larger moves 1000 times more", "[movers]") {
+  const Grid<2> g = grid<2>(16);
+  BoundarySpec<2> spec;
+  spec.moving("x0", Rotation2D{Vec<2>(0.0, 0.5), 0.2}).fixed("x1").sliding("y0").sliding("y1");
+  const auto boundary = spec.resolve(g.mesh.points, g.groups);
+  RbfMover<2> unit;
+  unit.setup(g.mesh, boundary);
+  const Points<2> u = unit.move(boundary.displacements);
+  Mesh<2> large = g.mesh;
+  large.points *= 1000.0;
+  ResolvedBoundary<2> large_boundary = boundary;
+  large_boundary.displacements *= 1000.0;
+  RbfMover<2> scaled;
+  scaled.setup(large, large_boundary);
+  const Points<2> v = scaled.move(large_boundary.displacements);
+  CHECK(scaled.support_radius() == Approx(1000.0 * unit.support_radius()).epsilon(1e-12));
+  CHECK((v - 1000.0 * u).cwiseAbs().maxCoeff() <= 1e-9 * v.cwiseAbs().maxCoeff());
+  // The radius the boundary proposes: max(5 × the largest displacement, 10 × the spacing).
+  Points<2> at(2, boundary.size());
+  for (Index k = 0; k < boundary.size(); ++k) at.col(k) = g.mesh.points.col(boundary.nodes[static_cast<std::size_t>(k)]);
+  CHECK(unit.support_radius() == suggest_support_radius(at, boundary.displacements));
+  CHECK(unit.options().support_radius == 0.0);
+}
+
 TEST_CASE("conditionally positive definite kernels always get the polynomial", "[movers]") {
   // Without it tps is ill-posed: a rotation of the whole boundary gave garbage with no error.
   const Grid<2> g = grid<2>(12);
@@ -354,7 +378,7 @@ TEST_CASE("sliding channel walls: nodes stay on their walls exactly", "[movers]"
   CHECK(mover.stats().factorizations == 2);
 }
 
-TEST_CASE("coincident boundary nodes are merged; conflicting displacements are named", "[movers]") {
+TEST_CASE("coincident boundary nodes are merged, conflicting displacements are named", "[movers]") {
   // Two nodes at the same place (a seam): node 4 duplicates node 0.
   Mesh<2> mesh;
   mesh.points.resize(2, 6);

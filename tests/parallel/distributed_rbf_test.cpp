@@ -112,6 +112,16 @@ TEST_CASE("distributed RBF equals serial on a 2D mesh partitioned by METIS", "[p
   }
 }
 
+TEST_CASE("distributed RBF takes the serial default radius, from the whole boundary", "[parallel][rbf][petsc]") {
+  const Mesh<2> mesh = rectangle_mesh({.nx = 24, .ny = 18, .cells = RectangleCells::tri_quad});
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Rotation2D{{0.5, 0.0}, radians(20.0)}).fixed("top").fixed("left");
+  for (const BoundarySolve solve : {BoundarySolve::replicated, BoundarySolve::petsc}) {
+    const Outcome r = compare_with_serial(mesh, spec.resolve(mesh), RbfOptions{}, {}, false, {solve});
+    CHECK(r.error <= 1e-12);
+  }
+}
+
 TEST_CASE("distributed RBF with the boundary system factorized across the ranks by MUMPS", "[parallel][rbf][petsc]") {
   const BoundarySolveOptions petsc{BoundarySolve::petsc};
   {

@@ -65,7 +65,7 @@ void visit_options(SolverOptions& o, F&& f, const std::string& prefix = {}) {
 template <class F>
 void visit_options(RbfOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "kernel", o.kernel, "radial function");
-  f(prefix + "support_radius", o.support_radius, "support radius (scale of global kernels), mesh units");
+  f(prefix + "support_radius", o.support_radius, "support radius (scale of global kernels), mesh units; 0: from the boundary");
   f(prefix + "support_radii", o.support_radii, "a radius per boundary entry (comma-separated), replacing support_radius");
   f(prefix + "polynomial", o.polynomial, "add a linear polynomial (affine motions exact)");
   visit_options(o.solver, f, prefix);

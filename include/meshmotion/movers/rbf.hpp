@@ -42,6 +42,7 @@
 #include "meshmotion/movers/detail/rbf_system.hpp"
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
+#include "meshmotion/movers/support_radius.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 #include "meshmotion/solvers/solver_options.hpp"
 
@@ -59,9 +60,11 @@ namespace meshmotion {
 /// Options of RbfMover.
 struct RbfOptions {
   RbfKernel kernel = RbfKernel::wendland2;
-  /// Support radius of compact kernels (shape scale of global ones), in mesh units; must be > 0.
-  /// See suggest_support_radius() for a heuristic.
-  double support_radius = 1.0;
+  /// Support radius of compact kernels (shape scale of global ones), in mesh units; 0
+  /// (default): suggest_support_radius() of the boundary each setup is given (its nodes and
+  /// displacements), so that the same mesh in millimetres and in metres moves alike;
+  /// RbfMover::support_radius() says what setup took.
+  double support_radius = 0.0;
   /// A radius per boundary entry (in the order of the boundary given to setup), replacing
   /// support_radius; empty: support_radius everywhere. Coincident nodes share the radius of
   /// the one that gives their value. Lets each wall's support follow its own boundary layer.
@@ -116,6 +119,9 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   explicit RbfMover(RbfOptions options = {}) : options_(effective_options(std::move(options))) {}
 
   [[nodiscard]] const RbfOptions& options() const noexcept { return options_; }
+  /// The support radius of the last setup: RbfOptions::support_radius, or the default it
+  /// proposed (the largest of support_radii when they are given).
+  [[nodiscard]] double support_radius() const noexcept { return radius_; }
   [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
   /// True when the last setup stored a dense evaluation matrix: a global kernel, or a compact
   /// one whose support covers most centres (see RbfOptions::max_evaluation_cache_bytes).
@@ -364,14 +370,27 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   Eigen::MatrixXd values_, alpha_, evaluated_values_;
   Eigen::MatrixXd seed_rows_;               ///< a reverse product's seed, gathered by rows
   Poly beta_ = Poly::Zero();
+  double radius_ = 0.0;  ///< the last setup's support radius
 };
 
 template <int Dim>
 void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<Dim>& boundary) {
   const detail::Stopwatch watch;
-  if (options_.support_radii.empty() && (!(options_.support_radius > 0.0) || !std::isfinite(options_.support_radius)))
-    throw InputError("RbfMover::setup: support radius must be positive (got " +
+  if (!(options_.support_radius >= 0.0) || !std::isfinite(options_.support_radius))
+    throw InputError("RbfMover::setup: support radius must be positive, or 0 for the default (got " +
                      std::to_string(options_.support_radius) + ")");
+  radius_ = options_.support_radius;
+  if (options_.support_radii.empty() && radius_ == 0.0) {
+    Points<Dim> at(Dim, boundary.size());
+    for (Index k = 0; k < boundary.size(); ++k) {
+      const Index v = boundary.nodes[static_cast<std::size_t>(k)];
+      if (v < 0 || v >= points.cols())
+        throw InputError("RbfMover::setup: boundary node " + std::to_string(v) + " out of range (expected 0 to " +
+                         std::to_string(points.cols() - 1) + ")");
+      at.col(k) = points.col(v);
+    }
+    radius_ = suggest_support_radius(at, boundary.displacements);
+  }
   if (!options_.support_radii.empty()) {
     if (static_cast<Index>(options_.support_radii.size()) != boundary.size())
       throw InputError("RbfMover::setup: " + std::to_string(options_.support_radii.size()) +
@@ -448,12 +467,13 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
     projectors_.push_back(p);
   }
 
-  detail::RbfKernelSettings kernel{options_.kernel, options_.support_radius, options_.polynomial};
+  detail::RbfKernelSettings kernel{options_.kernel, radius_, options_.polynomial};
   if (!options_.support_radii.empty()) {
     kernel.radii.resize(static_cast<std::size_t>(k));
     for (Index c = 0; c < k; ++c)
       kernel.radii[static_cast<std::size_t>(c)] = options_.support_radii[static_cast<std::size_t>(source_[static_cast<std::size_t>(c)])];
-    kernel.radius = k > 0 ? *std::max_element(kernel.radii.begin(), kernel.radii.end()) : options_.support_radius;
+    kernel.radius = k > 0 ? *std::max_element(kernel.radii.begin(), kernel.radii.end()) : radius_;
+    radius_ = kernel.radius;
   }
   n_centres_ = k;
   patched_all_.reset();

@@ -2,7 +2,8 @@
 /// \file
 /// A heuristic support radius for compactly supported RBF kernels, which the thesis asks for
 /// (section 2.2.2: "big enough to accommodate the expected deformation of the boundary, but
-/// small enough that the linear system is sparse").
+/// small enough that the linear system is sparse"). It is the default of RbfOptions and of the
+/// programs: made of the mesh's own lengths, it moves a mesh in millimetres as in metres.
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/types.hpp"
@@ -21,19 +22,14 @@ struct SupportRadiusOptions {
   double spacing_factor = 10.0;      ///< radius ≥ this × the median boundary node spacing
 };
 
-/// A support radius proposed from the boundary: max(displacement_factor × largest
-/// displacement, spacing_factor × median nearest-neighbour spacing of the boundary nodes).
-/// A HEURISTIC, not a guarantee: a larger radius spreads the deformation over more cells
-/// (better for large rotations, thesis fig. 4.11) and makes the system denser.
-/// `boundary_points` and `displacements` are Dim × m; throws InputError when m < 2 or the
-/// shapes differ, or when no positive radius follows (coincident nodes, no motion).
+/// suggest_support_radius() given the largest boundary displacement instead of every one (a
+/// distributed boundary reduces it over the ranks). Throws InputError when m < 2 or no
+/// positive radius follows.
 template <int Dim>
-[[nodiscard]] double suggest_support_radius(const Points<Dim>& boundary_points, const Points<Dim>& displacements,
+[[nodiscard]] double suggest_support_radius(const Points<Dim>& boundary_points, double largest,
                                             const SupportRadiusOptions& options = {}) {
   const Index m = boundary_points.cols();
-  if (m < 2 || displacements.cols() != m)
-    throw InputError("suggest_support_radius: needs at least 2 boundary nodes and one displacement each (got " +
-                     std::to_string(m) + " nodes, " + std::to_string(displacements.cols()) + " displacements)");
+  if (m < 2) throw InputError("suggest_support_radius: needs at least 2 boundary nodes (got " + std::to_string(m) + ")");
   const KdTree<Dim> tree(boundary_points);
   std::vector<double> spacing;
   spacing.reserve(static_cast<std::size_t>(m));
@@ -47,12 +43,27 @@ template <int Dim>
     std::nth_element(spacing.begin(), mid, spacing.end());
     median = *mid;
   }
-  const double largest = displacements.colwise().norm().maxCoeff();
   const double radius = std::max(options.displacement_factor * largest, options.spacing_factor * median);
   if (!(radius > 0.0) || !std::isfinite(radius))
     throw InputError("suggest_support_radius: cannot propose a radius (got " + std::to_string(radius) +
                      "; all boundary nodes coincide and do not move?)");
   return radius;
+}
+
+/// A support radius proposed from the boundary: max(displacement_factor × largest
+/// displacement, spacing_factor × median nearest-neighbour spacing of the boundary nodes).
+/// A HEURISTIC, not a guarantee: a larger radius spreads the deformation over more cells
+/// (better for large rotations, thesis fig. 4.11) and makes the system denser.
+/// `boundary_points` and `displacements` are Dim × m; throws InputError when m < 2 or the
+/// shapes differ, or when no positive radius follows (coincident nodes, no motion).
+template <int Dim>
+[[nodiscard]] double suggest_support_radius(const Points<Dim>& boundary_points, const Points<Dim>& displacements,
+                                            const SupportRadiusOptions& options = {}) {
+  const Index m = boundary_points.cols();
+  if (m < 2 || displacements.cols() != m)
+    throw InputError("suggest_support_radius: needs at least 2 boundary nodes and one displacement each (got " +
+                     std::to_string(m) + " nodes, " + std::to_string(displacements.cols()) + " displacements)");
+  return suggest_support_radius(boundary_points, displacements.colwise().norm().maxCoeff(), options);
 }
 
 }  // namespace meshmotion

@@ -102,6 +102,9 @@ class DistributedRbfMover {
   [[nodiscard]] bool petsc_solve() const noexcept { return petsc_; }
 
   [[nodiscard]] const RbfOptions& options() const noexcept { return options_; }
+  /// The support radius of the last setup (RbfMover::support_radius(): the default one is
+  /// proposed from the gathered boundary, as the serial mover does).
+  [[nodiscard]] double support_radius() const noexcept { return radius_; }
   /// This rank's figures; boundary_nodes counts the whole boundary's centres.
   [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
   /// Entries of the whole boundary (before merging coincident nodes).
@@ -147,6 +150,7 @@ class DistributedRbfMover {
   MPI_Comm comm_ = MPI_COMM_NULL;
   RbfMover<Dim> inner_;      ///< replicated: over the gathered centres followed by the local interior nodes
   RbfOptions options_;
+  double radius_ = 0.0;  ///< the last setup's support radius (options_'s, or the default's)
   BoundarySolveOptions solve_;
   bool petsc_ = false;
   std::unique_ptr<detail::PetscRbfSystem<Dim>> system_;  ///< PETSc: the boundary system
@@ -269,6 +273,15 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
   for (Index i = 0; i < n; ++i)
     if (column_[static_cast<std::size_t>(i)] >= m) points.col(column_[static_cast<std::size_t>(i)]) = part.points.col(i);
 
+  // The default radius from the whole boundary, as the serial mover takes it: the gathered
+  // nodes and the largest displacement over the ranks.
+  radius_ = options_.support_radius;
+  if (radius_ == 0.0 && any_radius == 0) {
+    double largest = 0.0, global_largest = 0.0;
+    for (const Index k : owned_entries_) largest = std::max(largest, boundary.displacements.col(k).norm());
+    MPI_Allreduce(&largest, &global_largest, 1, MPI_DOUBLE, MPI_MAX, comm_);
+    radius_ = suggest_support_radius(Points<Dim>(points.leftCols(m)), global_largest);
+  }
   gathered_.resize(Dim, m);
   // Every rank decides alike: the inputs are the gathered arrays.
   // The obstacles (a k-d tree over the centres among them) are looked for only when PETSc is wanted.
@@ -287,6 +300,7 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
   } else {
     system_.reset();
     RbfOptions options = options_;
+    options.support_radius = radius_;
     options.support_radii = std::move(radii);
     inner_ = RbfMover<Dim>(std::move(options));
     collective(comm_, [&] { inner_.setup_reference(std::move(points), centres); });
@@ -374,9 +388,9 @@ template <int Dim>
 void DistributedRbfMover<Dim>::setup_petsc(const PartitionView<Dim>& part, Points<Dim> centres) {
   const Index m = centres.cols();
   local_points_ = part.points;
-  if (!(options_.support_radius > 0.0) || !std::isfinite(options_.support_radius))
-    throw InputError("DistributedRbfMover::setup: support radius must be positive (got " + std::to_string(options_.support_radius) + ")");
-  const meshmotion::detail::RbfKernelSettings kernel{options_.kernel, options_.support_radius, options_.polynomial};
+  if (!(radius_ > 0.0) || !std::isfinite(radius_))
+    throw InputError("DistributedRbfMover::setup: support radius must be positive (got " + std::to_string(radius_) + ")");
+  const meshmotion::detail::RbfKernelSettings kernel{options_.kernel, radius_, options_.polynomial};
   system_ = std::make_unique<detail::PetscRbfSystem<Dim>>();
   system_->setup(comm_, centres, kernel);
   interior_.clear();
