@@ -112,6 +112,7 @@ int run(Mesh<Dim> linear, const Arguments& args) {
     static std::optional<CadModel> model;
     model.emplace(CadModel::read(args.geometry.front()));
     const std::vector<CadGroupMatch> matches = match_cad_groups(linear, *model, args.cad_tolerance, args.groups);
+    require_cad_fit(linear, *model, matches);
     for (const CadGroupMatch& m : matches)
       if (m.matched()) options.geometry.insert_or_assign(m.group, cad_boundary<Dim>(*model, m, args.cad_tolerance));
     cad_report = describe_cad_matches(matches);

@@ -459,6 +459,26 @@ BoundaryGeometry<Dim> cad_boundary(const CadModel& model, const CadGroupMatch& m
   return BoundaryGeometry<Dim>::project(project, place);
 }
 
+template <int Dim>
+void require_cad_fit(const Mesh<Dim>& mesh, const CadModel& model, const std::vector<CadGroupMatch>& matches) {
+  if (std::any_of(matches.begin(), matches.end(), [](const CadGroupMatch& m) { return m.matched(); })) return;
+  std::ostringstream msg;
+  msg << model.file().string() << " fits no group of the mesh";
+  const CadGroupMatch* closest = nullptr;
+  for (const CadGroupMatch& m : matches)
+    if (m.farthest_node >= 0 && (closest == nullptr || m.max_distance < closest->max_distance)) closest = &m;
+  if (closest != nullptr)
+    msg << " (closest: group '" << closest->group << "', whose node " << closest->farthest_node << " (file id "
+        << mesh.node_id(closest->farthest_node) << ") is " << closest->max_distance << " from it)";
+  if (mesh.num_nodes() > 0 && model.diagonal() > 0.0) {
+    const double size = (mesh.points.rowwise().maxCoeff() - mesh.points.rowwise().minCoeff()).norm() / model.diagonal();
+    msg << "; the mesh is " << size << " times the model's size";
+    if (size > 10.0 || size < 0.1) msg << " (another unit of length?)";
+  }
+  msg << "; expected the vertices of at least one group on the model";
+  throw InputError(msg.str());
+}
+
 std::string describe_cad_matches(const std::vector<CadGroupMatch>& matches) {
   std::ostringstream out;
   for (const CadGroupMatch& m : matches) {
@@ -480,6 +500,8 @@ std::string describe_cad_matches(const std::vector<CadGroupMatch>& matches) {
   return out.str();
 }
 
+template void require_cad_fit<2>(const Mesh<2>&, const CadModel&, const std::vector<CadGroupMatch>&);
+template void require_cad_fit<3>(const Mesh<3>&, const CadModel&, const std::vector<CadGroupMatch>&);
 template std::vector<CadGroupMatch> match_cad_groups<2>(const Mesh<2>&, const CadModel&, double, const std::vector<std::string>&);
 template std::vector<CadGroupMatch> match_cad_groups<3>(const Mesh<3>&, const CadModel&, double, const std::vector<std::string>&);
 template BoundaryGeometry<2> cad_boundary<2>(const CadModel&, const CadGroupMatch&, double);

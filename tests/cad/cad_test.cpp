@@ -23,6 +23,7 @@
 #include <gp_Circ.hxx>
 #include <gp_Elips.hxx>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <fstream>
@@ -136,6 +137,18 @@ TEST_CASE("CAD: groups match the model's edges, and a model that does not fit is
   CHECK(loose[0].max_distance == Approx(0.1));
   CHECK_THROWS_WITH(match_cad_groups(mesh, wrong, 0.0, {"wall"}),
                     Catch::Contains("does not fit group 'wall'") && Catch::Contains("node ") && Catch::Contains("from the model"));
+}
+
+TEST_CASE("CAD: a model that fits no group is refused, with the size ratio of another unit", "[cad]") {
+  const CadModel model = CadModel::read(circles_brep(0.5, 4.0));
+  Mesh<2> mesh = o_mesh(small_o_mesh());
+  require_cad_fit(mesh, model, match_cad_groups(mesh, model));  // fits: nothing thrown
+  mesh.points *= 1000.0;  // the same mesh in millimetres
+  const auto matches = match_cad_groups(mesh, model);
+  CHECK(std::none_of(matches.begin(), matches.end(), [](const CadGroupMatch& m) { return m.matched(); }));
+  CHECK_THROWS_WITH(require_cad_fit(mesh, model, matches),
+                    Catch::Contains("fits no group") && Catch::Contains("1000 times the model's size") &&
+                        Catch::Contains("another unit of length"));
 }
 
 TEST_CASE("CAD: bad files are refused with the reason", "[cad]") {

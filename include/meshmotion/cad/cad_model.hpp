@@ -127,6 +127,13 @@ template <int Dim>
 template <int Dim>
 [[nodiscard]] BoundaryGeometry<Dim> cad_boundary(const CadModel& model, const CadGroupMatch& match, double tolerance = 0.0);
 
+/// Throws InputError when `matches` (match_cad_groups() of `mesh`) matched no group: a user who
+/// gives a model wants it used, not a silent fallback. The message names the group that came
+/// closest and how far its farthest vertex is, and the ratio of the mesh's size to the
+/// model's (1000: a mesh in millimetres on a model in metres).
+template <int Dim>
+void require_cad_fit(const Mesh<Dim>& mesh, const CadModel& model, const std::vector<CadGroupMatch>& matches);
+
 /// One line per group: what it matched (or why not), for the programs' reports.
 [[nodiscard]] std::string describe_cad_matches(const std::vector<CadGroupMatch>& matches);
 
