@@ -29,6 +29,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <chrono>
 #include <cstdio>
@@ -38,6 +39,7 @@
 #include <optional>
 #include <string>
 #include <variant>
+#include <vector>
 #include <vector>
 
 namespace {
@@ -106,6 +108,7 @@ int run(Mesh<Dim> linear, const Arguments& args) {
   if (!args.demo) examples::handle_orientation(linear, args.input, args.keep_orientation);
   CurveOptions<Dim> options = curve_options<Dim>(args);
   std::string cad_report;
+  std::vector<std::string> on_model;  // the groups curved on the CAD file
   if (cad_geometry(args)) {
 #ifdef MESHMOTION_HAVE_CAD
     // Kept for the whole run: the groups' geometry refers to it.
@@ -114,7 +117,10 @@ int run(Mesh<Dim> linear, const Arguments& args) {
     const std::vector<CadGroupMatch> matches = match_cad_groups(linear, *model, args.cad_tolerance, args.groups);
     require_cad_fit(linear, *model, matches);
     for (const CadGroupMatch& m : matches)
-      if (m.matched()) options.geometry.insert_or_assign(m.group, cad_boundary<Dim>(*model, m, args.cad_tolerance));
+      if (m.matched()) {
+        options.geometry.insert_or_assign(m.group, cad_boundary<Dim>(*model, m, args.cad_tolerance));
+        on_model.push_back(m.group);
+      }
     cad_report = describe_cad_matches(matches);
     if (!args.json) std::fprintf(stderr, "CAD model %s:\n%s", args.geometry.front().c_str(), cad_report.c_str());
 #else
@@ -168,9 +174,24 @@ int run(Mesh<Dim> linear, const Arguments& args) {
                 static_cast<long long>(result.num_linear_nodes), result.order, result.method.c_str());
     write_text(std::cout, result, 2);
     std::cout.flush();
+    // The last line says what each curved group was curved onto: a CAD file that fits only
+    // some groups leaves the others to the reconstruction.
+    std::string curved_on;
+    for (const std::string& g : result.curved_groups) {
+      if (!curved_on.empty()) curved_on += ", ";
+      curved_on += "'";
+      curved_on += g;
+      curved_on += "' ";
+      if (std::find(on_model.begin(), on_model.end(), g) != on_model.end())
+        curved_on += "on " + std::filesystem::path(args.geometry.front()).filename().string();
+      else if (options.geometry.count(g) > 0)
+        curved_on += "on the given --geometry";
+      else
+        curved_on += Dim == 2 ? "by spline" : "by surface reconstruction";
+    }
     if (q.num_invalid == 0)
-      std::printf("wrote %s, %s%s%s\n", args.output.c_str(), vtu.string().c_str(), args.svg.empty() ? "" : ", ",
-                  args.svg.c_str());
+      std::printf("wrote %s, %s%s%s (curved: %s)\n", args.output.c_str(), vtu.string().c_str(), args.svg.empty() ? "" : ", ",
+                  args.svg.c_str(), curved_on.empty() ? "none" : curved_on.c_str());
   }
   if (q.num_invalid > 0) {
     std::fflush(stdout);

@@ -120,6 +120,11 @@ smoke_test(NAME adapt_solver_mesh.json
 smoke_test(NAME curve_mesh.demo.json SETUP examples_demo_mesh
            KEYS output,nodes,cells,min_scaled_jacobian,invalid,seconds/total
            COMMAND curve_mesh --demo -o "${smoke_dir}/demo.msh" --json)
+# The last line says what each group was curved onto.
+add_test(NAME examples.curve_mesh.demo.curved_on COMMAND curve_mesh --demo -o "${smoke_dir}/demo_text.msh"
+         WORKING_DIRECTORY "${smoke_dir}")
+set_tests_properties(examples.curve_mesh.demo.curved_on PROPERTIES LABELS examples
+                     PASS_REGULAR_EXPRESSION "wrote [^\n]*demo_text.msh[^\n]*\\(curved: 'wall' on the given --geometry, 'farfield' by spline\\)")
 smoke_test(NAME mesh_info.json REQUIRES examples_demo_mesh
            KEYS file,mesh/nodes,mesh/cells,mesh/groups
            COMMAND mesh_info "${smoke_dir}/demo.msh" --json)
