@@ -37,9 +37,9 @@
 #include <filesystem>
 #include <iostream>
 #include <optional>
+#include <set>
 #include <string>
 #include <variant>
-#include <vector>
 #include <vector>
 
 namespace {
@@ -114,10 +114,15 @@ int run(Mesh<Dim> linear, const Arguments& args) {
     // Kept for the whole run: the groups' geometry refers to it.
     static std::optional<CadModel> model;
     model.emplace(CadModel::read(args.geometry.front()));
+    name_unnamed_facet_groups(linear);  // as curve_mesh() does: the matches name groups by their tags
     const std::vector<CadGroupMatch> matches = match_cad_groups(linear, *model, args.cad_tolerance, args.groups);
     require_cad_fit(linear, *model, matches);
+    // Unless named, a planar group is left to curve_mesh(), which keeps it straight and lets it
+    // slide where it meets a curved group (a symmetry plane): snapping onto a plane moves nothing.
+    const std::set<int> planar =
+        args.groups.empty() && options.slide_planar_groups ? planar_group_tags(linear) : std::set<int>{};
     for (const CadGroupMatch& m : matches)
-      if (m.matched()) {
+      if (m.matched() && !planar.count(linear.group(m.group).tag)) {
         options.geometry.insert_or_assign(m.group, cad_boundary<Dim>(*model, m, args.cad_tolerance));
         on_model.push_back(m.group);
       }
@@ -189,9 +194,11 @@ int run(Mesh<Dim> linear, const Arguments& args) {
       else
         curved_on += Dim == 2 ? "by spline" : "by surface reconstruction";
     }
+    std::string sliding;
+    for (const std::string& g : result.sliding_groups) sliding.append(sliding.empty() ? "; sliding: '" : ", '").append(g).append("'");
     if (q.num_invalid == 0)
-      std::printf("wrote %s, %s%s%s (curved: %s)\n", args.output.c_str(), vtu.string().c_str(), args.svg.empty() ? "" : ", ",
-                  args.svg.c_str(), curved_on.empty() ? "none" : curved_on.c_str());
+      std::printf("wrote %s, %s%s%s (curved: %s%s)\n", args.output.c_str(), vtu.string().c_str(), args.svg.empty() ? "" : ", ",
+                  args.svg.c_str(), curved_on.empty() ? "none" : curved_on.c_str(), sliding.c_str());
   }
   if (q.num_invalid > 0) {
     std::fflush(stdout);

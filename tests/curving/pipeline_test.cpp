@@ -540,6 +540,49 @@ TEST_CASE("pipeline: in 3D the groups named like walls are reconstructed by defa
   CHECK(error < 0.01);
 }
 
+TEST_CASE("pipeline: planar groups meeting a curved wall slide in their planes by default", "[curving]") {
+  // A box whose bottom is a bowl z = h(x, y): each side meets it along a curve in its plane; the
+  // top meets no curved group.
+  Mesh<3> box = box_mesh({.nx = 4, .ny = 4, .nz = 4, .cells = BoxCells::tet4});
+  const auto bowl = [](double x, double y) { return 0.3 * ((x - 0.3) * (x - 0.3) + (y - 0.4) * (y - 0.4)); };
+  for (Index v = 0; v < box.num_nodes(); ++v) {
+    auto p = box.points.col(v);
+    p.z() += bowl(p.x(), p.y()) * (1.0 - p.z());
+  }
+  CurveOptions<3> options;
+  options.geometry.emplace("bottom", BoundaryGeometry<3>::project([&](const Vec<3>& x) {
+    return Vec<3>(x.x(), x.y(), bowl(x.x(), x.y()));
+  }));
+  // The top, given a geometry it already lies on: snapping moves nothing, so it is a fixed
+  // boundary and no wall to estimate a layer for.
+  options.geometry.emplace("top", BoundaryGeometry<3>::project([](const Vec<3>& x) { return x; }));
+  const CurveResult<3> curved = curve_mesh(box, options);
+  CHECK(curved.invalid() == 0);
+  CHECK(curved.curved_groups == std::vector<std::string>{"bottom", "top"});
+  CHECK(curved.sliding_groups == std::vector<std::string>{"left", "right", "front", "back"});
+  REQUIRE(curved.layers.size() == 1);
+  CHECK(curved.layers.front().group == "bottom");
+  const Mesh<3> straight = convert_to_quadratic(box).mesh;
+  const std::array<std::pair<const char*, int>, 4> sides{{{"left", 0}, {"right", 0}, {"front", 1}, {"back", 1}}};
+  double slid = 0.0;
+  for (const auto& [side, axis] : sides)
+    for (const Index v : curved.curved.group_nodes(std::string_view(side))) {
+      CHECK(curved.curved.points(axis, v) == straight.points(axis, v));
+      slid = std::max(slid, (curved.curved.points.col(v) - straight.points.col(v)).norm());
+    }
+  CHECK(slid > 1e-3);  // the sides' nodes by the wall followed it
+  for (const Index v : curved.curved.group_nodes("top")) CHECK(curved.curved.points.col(v) == straight.points.col(v));
+
+  CurveOptions<3> fixed_sides = options;
+  fixed_sides.slide_planar_groups = false;
+  const CurveResult<3> fixed = curve_mesh(box, fixed_sides);
+  CHECK(fixed.sliding_groups.empty());
+  const std::vector<Index> wall = fixed.curved.group_nodes("bottom");  // sorted
+  for (const auto& [side, axis] : sides)
+    for (const Index v : fixed.curved.group_nodes(std::string_view(side)))
+      if (!std::binary_search(wall.begin(), wall.end(), v)) CHECK(fixed.curved.points.col(v) == straight.points.col(v));
+}
+
 TEST_CASE("pipeline: 3D sphere with a symmetry plane curves onto the sphere", "[curving]") {
   MESHMOTION_REQUIRE_DATA(file, "meshopt_sphere_symmetry_linear_tet.msh");
   const Mesh<3> linear = read_mesh_as<3>(file);
@@ -722,8 +765,11 @@ TEST_CASE("pipeline: the coarse 3D bump-in-channel curves onto the analytic bump
   CHECK(curved.quality.min == Approx(thesis.quality.min).margin(1e-3));
   CHECK((curved.curved.points - thesis.curved.points).cwiseAbs().maxCoeff() < 0.02 * curved.max_boundary_displacement);
   const Mesh<3> straight = convert_to_quadratic(linear).mesh;
-  for (const char* group : {"top", "inflow", "outflow", "symmetry_lower"})
+  for (const char* group : {"top", "inflow", "outflow"})
     for (const Index v : curved.curved.group_nodes(group)) CHECK(curved.curved.points.col(v) == straight.points.col(v));
+  // The flat wall around the bump meets it: it slides in its plane (z = 0).
+  CHECK(curved.sliding_groups == std::vector<std::string>{"side_y0", "side_y1", "symmetry_lower"});
+  for (const Index v : curved.curved.group_nodes("symmetry_lower")) CHECK(curved.curved.points(2, v) == 0.0);
 }
 
 TEST_CASE("pipeline: the default support radius is limited to a budget of boundary nodes", "[curving][slow]") {

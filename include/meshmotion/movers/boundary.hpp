@@ -25,6 +25,7 @@
 #include <iterator>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -143,6 +144,37 @@ struct ResolvedBoundary {
     return u - n.dot(u) * n;
   }
 };
+
+/// The least-squares plane (a line in 2D) through some nodes, and how far they are from it.
+template <int Dim>
+struct PlaneFit {
+  Vec<Dim> normal = Vec<Dim>::Zero();    ///< unit normal
+  Vec<Dim> centroid = Vec<Dim>::Zero();
+  double off_plane = 0.0;  ///< largest distance of a node to the plane
+  double extent = 0.0;     ///< largest distance of a node to the centroid
+  /// The nodes lie in the plane to round-off: 1e-8 of their extent, the tolerance a sliding
+  /// group is held to (a mesh generator's planar faces are within 1e-15 of it).
+  [[nodiscard]] bool planar() const noexcept { return off_plane <= 1e-8 * std::max(extent, 1e-300); }
+};
+
+/// The plane through `points` of the nodes `list` (at least one): the eigenvector of the
+/// smallest eigenvalue of their scatter matrix is the normal.
+template <int Dim>
+[[nodiscard]] PlaneFit<Dim> fit_plane(const Points<Dim>& points, std::span<const Index> list) {
+  PlaneFit<Dim> fit;
+  for (const Index v : list) fit.centroid += points.col(v);
+  fit.centroid /= static_cast<double>(std::max<std::size_t>(list.size(), 1));
+  Eigen::Matrix<double, Dim, Dim> scatter = Eigen::Matrix<double, Dim, Dim>::Zero();
+  for (const Index v : list) {
+    const Vec<Dim> r = points.col(v) - fit.centroid;
+    scatter += r * r.transpose();
+    fit.extent = std::max(fit.extent, r.norm());
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Dim, Dim>> eig(scatter);
+  fit.normal = eig.eigenvectors().col(0);
+  for (const Index v : list) fit.off_plane = std::max(fit.off_plane, std::abs(fit.normal.dot(points.col(v) - fit.centroid)));
+  return fit;
+}
 
 /// One node's condition, as BoundarySpec (and other builders of a ResolvedBoundary) collect them.
 template <int Dim>
@@ -370,25 +402,11 @@ class BoundarySpec {
     if (static_cast<Index>(list.size()) < Dim)
       throw InputError("BoundarySpec::resolve: sliding group '" + g.name + "' has " + std::to_string(list.size()) +
                        " nodes, too few to fit a plane (give the normal)");
-    Vec<Dim> centroid = Vec<Dim>::Zero();
-    for (const Index v : list) centroid += points.col(v);
-    centroid /= static_cast<double>(list.size());
-    Eigen::Matrix<double, Dim, Dim> scatter = Eigen::Matrix<double, Dim, Dim>::Zero();
-    double extent = 0.0;
-    for (const Index v : list) {
-      const Vec<Dim> r = points.col(v) - centroid;
-      scatter += r * r.transpose();
-      extent = std::max(extent, r.norm());
-    }
-    // The eigenvector of the smallest scatter eigenvalue is the least-squares plane normal.
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, Dim, Dim>> eig(scatter);
-    const Vec<Dim> normal = eig.eigenvectors().col(0);
-    double off_plane = 0.0;
-    for (const Index v : list) off_plane = std::max(off_plane, std::abs(normal.dot(points.col(v) - centroid)));
-    if (off_plane > 1e-8 * std::max(extent, 1e-300))
+    const PlaneFit<Dim> fit = fit_plane(points, list);
+    if (!fit.planar())
       throw InputError("BoundarySpec::resolve: sliding group '" + g.name + "' is not planar (a node lies " +
-                       std::to_string(off_plane) + " off the fitted plane, expected 0; give the normal)");
-    return normal;
+                       std::to_string(fit.off_plane) + " off the fitted plane, expected 0; give the normal)");
+    return fit.normal;
   }
 
   // The displacements of a group given with their nodes, in the order of the sorted `list`.
