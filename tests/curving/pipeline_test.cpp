@@ -583,6 +583,32 @@ TEST_CASE("pipeline: planar groups meeting a curved wall slide in their planes b
       if (!std::binary_search(wall.begin(), wall.end(), v)) CHECK(fixed.curved.points.col(v) == straight.points.col(v));
 }
 
+TEST_CASE("pipeline: a reconstructed wall meeting the inlet and the symmetry plane curves valid by default", "[curving]") {
+  // A tetrahedral channel whose bottom wall has a bump reaching the inlet (x = 0) and the
+  // symmetry plane (y = 0), curved with the defaults (the wall reconstructed from the mesh
+  // alone). The wall's border turns at the domain's corners: fitted as one smooth curve there
+  // it left 5 invalid cells at P2 and 6 at P3 (minimum -0.16 / -0.77).
+  Mesh<3> channel = box_mesh({.nx = 8, .ny = 4, .nz = 4, .x_max = 2.0, .cells = BoxCells::tet4});
+  const auto bump = [](double x, double y) { return 0.2 * std::exp(-((x - 0.3) * (x - 0.3) + (y - 0.2) * (y - 0.2)) / 0.3); };
+  for (Index v = 0; v < channel.num_nodes(); ++v) {
+    auto p = channel.points.col(v);
+    p.z() += bump(p.x(), p.y()) * (1.0 - p.z());
+  }
+  for (auto& g : channel.groups)
+    g.name = g.name == "bottom" ? "wall" : g.name == "left" ? "inlet" : g.name == "front" ? "symmetry" : g.name;
+  for (const int order : {2, 3}) {
+    INFO("order " << order);
+    CurveOptions<3> options;
+    options.order = order;
+    const CurveResult<3> curved = curve_mesh(channel, options);
+    CHECK(curved.curved_groups == std::vector<std::string>{"wall"});
+    CHECK(curved.invalid() == 0);
+    CHECK(curved.quality.min > 0.8);
+    for (const Index v : curved.curved.group_nodes("inlet")) CHECK(curved.curved.points(0, v) == 0.0);
+    for (const Index v : curved.curved.group_nodes("symmetry")) CHECK(curved.curved.points(1, v) == 0.0);
+  }
+}
+
 TEST_CASE("pipeline: 3D sphere with a symmetry plane curves onto the sphere", "[curving]") {
   MESHMOTION_REQUIRE_DATA(file, "meshopt_sphere_symmetry_linear_tet.msh");
   const Mesh<3> linear = read_mesh_as<3>(file);

@@ -19,6 +19,7 @@
 #include <map>
 #include <numbers>
 #include <utility>
+#include <tuple>
 #include <vector>
 
 using namespace meshmotion;
@@ -668,6 +669,37 @@ TEST_CASE("surface reconstruction keeps the edges and corners of a cube sharp", 
   no_ridges.ridge_angle = 180.0;
   const SurfaceReconstruction rounded(s.points, s.triangles, no_ridges);
   CHECK(max_reconstruction_error(s, rounded, cube_distance) > 1e-3);
+}
+
+TEST_CASE("surface reconstruction keeps an open surface's border corners sharp", "[curving]") {
+  // A curved open patch z = 0.2 x^2 over [0, 1]^2 (a wall cut by four sides of the domain):
+  // its border turns by 90 degrees at each corner, and each side of the border is a curve in
+  // its own plane. Fitted as one smooth curve through a corner, the border bulged across the
+  // corner (the WALF drift that left invalid cells where a curved wall met two planes).
+  std::vector<Vec<3>> v;
+  std::vector<Index> t;
+  const int n = 4;
+  add_grid(v, t, n, n, [&](int i, int j) {
+    const double x = static_cast<double>(i) / n, y = static_cast<double>(j) / n;
+    return Vec<3>(x, y, 0.2 * x * x);
+  }, false);
+  const TriangleSurface s = from_vectors(v, t);
+  const SurfaceReconstruction r(s.points, s.triangles);
+  const auto id = [&](int i, int j) { return static_cast<Index>(j * (n + 1) + i); };
+  double off_side = 0.0, off_parabola = 0.0;
+  for (int k = 0; k < n; ++k)
+    for (const auto& [a, b, axis, value] : {std::tuple{id(k, 0), id(k + 1, 0), 1, 0.0}, std::tuple{id(k, n), id(k + 1, n), 1, 1.0},
+                                            std::tuple{id(0, k), id(0, k + 1), 0, 0.0}, std::tuple{id(n, k), id(n, k + 1), 0, 1.0}}) {
+      REQUIRE(r.is_ridge(a, b));
+      for (const double f : {0.25, 0.5, 0.75}) {
+        const Vec<3> p = r.edge_point(a, b, f);
+        off_side = std::max(off_side, std::abs(p[axis] - value));
+        off_parabola = std::max(off_parabola, std::abs(p.z() - 0.2 * p.x() * p.x()));
+      }
+    }
+  INFO("off the side's plane " << off_side << ", off the patch " << off_parabola);
+  CHECK(off_side < 1e-12);
+  CHECK(off_parabola < 1e-3);
 }
 
 TEST_CASE("surface reconstruction follows a curved ridge: the rim of a cylinder", "[curving]") {

@@ -16,7 +16,8 @@
 /// across a ridge: a vertex on a ridge gets one fitting per side ("sector"), so the surfaces
 /// on either side stay sharp. Ridge edges themselves are rebuilt as curves: each ridge
 /// vertex fits a space curve to the ridge polyline through it (one branch per ridge edge at
-/// a corner, where three or more ridges meet or a ridge ends), blended the same way.
+/// a corner, where three or more ridges meet, a ridge ends, or it turns by more than
+/// `ridge_angle`: an open wall's border at a corner of the domain), blended the same way.
 /// Setup is O(n) small dense least-squares problems; queries are O(1).
 
 #include "meshmotion/core/error.hpp"
@@ -357,8 +358,20 @@ class BasicSurfaceReconstruction {
       }
   }
 
-  /// Curve fits along ridges: at a regular ridge vertex (two ridge edges) one fit through
-  /// both branches, at a corner one fit per ridge edge along that branch only.
+  /// Whether v's ridge edges `ridges` continue each other: two of them, turning by no more than
+  /// the ridge angle. A border turning at a corner of the face it bounds (an open wall's
+  /// border where two sides of the domain meet) is a corner, not a point of one smooth curve.
+  [[nodiscard]] bool smooth_ridge_point(Index v, const std::vector<std::size_t>& ridges) const {
+    if (ridges.size() != 2) return false;
+    const auto other = [&](std::size_t e) { return edges_[e].a == v ? edges_[e].b : edges_[e].a; };
+    const Vec<3> in = points_.col(v) - points_.col(other(ridges[0]));
+    const Vec<3> out = points_.col(other(ridges[1])) - points_.col(v);
+    return in.dot(out) >= std::cos(options_.ridge_angle * std::numbers::pi / 180.0) * in.norm() * out.norm();
+  }
+
+  /// Curve fits along ridges: at a regular ridge vertex (two ridge edges continuing each
+  /// other) one fit through both branches, at a corner one fit per ridge edge along that
+  /// branch only.
   void fit_ridges() {
     std::vector<std::size_t> ridges, walk_ridges;
     std::vector<Index> samples;
@@ -368,7 +381,7 @@ class BasicSurfaceReconstruction {
         if (edges_[e].curve[static_cast<std::size_t>(end)] >= 0) continue;
         const Index v = end == 0 ? edges_[e].a : edges_[e].b;
         ridge_edges_at(v, ridges);
-        const bool regular = ridges.size() == 2;
+        const bool regular = smooth_ridge_point(v, ridges);
         samples.clear();
         const std::size_t branches = regular ? 2 : 1;
         std::array<Index, 2> nearest{v, v};  // first ridge neighbour of each branch
@@ -382,7 +395,7 @@ class BasicSurfaceReconstruction {
             if (step == 0) nearest[branch] = other;
             samples.push_back(other);
             ridge_edges_at(other, walk_ridges);
-            if (walk_ridges.size() != 2) break;
+            if (!smooth_ridge_point(other, walk_ridges)) break;
             edge = walk_ridges[0] == edge ? walk_ridges[1] : walk_ridges[0];
             current = other;
           }
