@@ -44,6 +44,16 @@ def distributed_setup_growth(ranks):
     return value
 
 
+def defaults_against_tuned(field, worst):
+    """The worst over the defaults_bench cases of the defaults' figure over the hand-set one
+    (`worst`: min or max)."""
+    def value(rows, build):
+        ratios = [row[field] for row in rows
+                  if row.get("build", "current") == build and row.get("bench") == "defaults" and row.get(field) is not None]
+        return worst(ratios) if ratios else None
+    return value
+
+
 # (name, rows' fields to match or a function of (rows, build), field, "<=" or ">=", limit, unit)
 TARGETS = [
     ("P1->P2 30P30N quads (median)", {"bench": "conversion", "case": "30p30n-quads"}, "median_s", "<=", 0.015, "s"),
@@ -62,6 +72,8 @@ TARGETS = [
      "seconds", "<=", 4.0, "s"),
     ("distributed RBF box setup, 2 ranks / 1 rank", distributed_setup_growth(2), None, "<=", 1.2, "x"),
     ("distributed RBF box setup, 4 ranks (2 per core) / 1 rank", distributed_setup_growth(4), None, "<=", 1.2, "x"),
+    ("defaults' minimum / hand-set's, worst case", defaults_against_tuned("quality_ratio", min), None, ">=", 0.98, "x"),
+    ("defaults' time / hand-set's, worst case", defaults_against_tuned("time_ratio", max), None, "<=", 1.5, "x"),
     ("PU RBF, 1M centres and 10M nodes: peak", {"bench": "pu_rbf", "mesh": "flat-707", "method": "pu"}, "peak_mb",
      "<=", 24576, "MB"),
 ]
