@@ -7,8 +7,8 @@
 /// assembles the rows of A of its block of centres [m r / P, m (r + 1) / P) with k-d tree radius
 /// queries, and MUMPS's Cholesky (METIS ordering) holds the factor distributed. A solve takes
 /// right-hand sides every rank holds and gives every rank the whole solution (α is needed by
-/// every rank's evaluation). The polynomial is eliminated through the Schur complement
-/// S = Pᵀ A⁻¹ P, as the serial RbfSystem does, with A⁻¹ P kept on every rank.
+/// every rank's evaluation). The polynomial is eliminated as the serial RbfSystem does
+/// (detail::RbfPolynomial), with A⁻¹ P kept on every rank.
 ///
 /// For a single radius only (A symmetric positive definite) and distinct centres: the
 /// distributed mover chooses it under those conditions.
@@ -32,7 +32,7 @@ namespace meshmotion::parallel::detail {
 template <int Dim>
 class PetscRbfSystem {
  public:
-  using PolyCoefficients = Eigen::Matrix<double, Dim + 1, Dim>;
+  using PolyCoefficients = typename meshmotion::detail::RbfPolynomial<Dim>::Coefficients;
 
   PetscRbfSystem() = default;
   PetscRbfSystem(const PetscRbfSystem&) = delete;
@@ -52,10 +52,6 @@ class PetscRbfSystem {
     lo_ = m * r / p;
     hi_ = m * (r + 1) / p;
     tree_.build(centres_);
-    // The serial RbfSystem's scaling of the polynomial basis, computed once: every node's
-    // evaluation asks for its polynomial.
-    shift_ = m > 0 ? Vec<Dim>(centres_.rowwise().mean()) : Vec<Dim>::Zero();
-    scale_ = m > 0 ? std::max((centres_.colwise() - shift_).colwise().norm().maxCoeff(), 1e-300) : 1.0;
     std::vector<Index> rows;
     for (Index i = lo_; i < hi_; ++i) rows.push_back(i);
     // Sorted columns per row: the storage-order round trip sorts them.
@@ -85,16 +81,8 @@ class PetscRbfSystem {
     if (failed != PC_NOERROR)
       throw SolverError("DistributedRbfMover::setup: MUMPS could not factorize the boundary system (PETSc reason " +
                         std::to_string(static_cast<int>(failed)) + ")");
-    if (kernel_.polynomial && m > 0) {
-      p_.resize(m, Dim + 1);
-      for (Index i = 0; i < m; ++i) p_.row(i) = polynomial(centres_.col(i)).transpose();
-      solve_a(p_, g_);
-      const Eigen::Matrix<double, Dim + 1, Dim + 1> s = p_.transpose() * g_;
-      schur_.compute(s);
-      if (!(std::abs(schur_.determinant()) > 1e-14 * std::max(1.0, s.norm())))
-        throw InputError("DistributedRbfMover::setup: linear polynomial augmentation needs boundary nodes that span the space "
-                         "(got them all on a line or plane)");
-    }
+    polynomial_.setup(centres_, kernel_.polynomial, [this](const Eigen::MatrixXd& b, Eigen::MatrixXd& x) { solve_a(b, x); },
+                      where);
   }
 
   [[nodiscard]] Index size() const noexcept { return centres_.cols(); }
@@ -102,28 +90,18 @@ class PetscRbfSystem {
   [[nodiscard]] auto within() const {
     return [this](const Vec<Dim>& x, std::vector<Neighbor>& out) { tree_.radius_search(x, kernel_.radius, out); };
   }
-  /// The polynomial basis [1, (x − shift)/scale], the serial RbfSystem's.
-  [[nodiscard]] Vec<Dim + 1> polynomial(const Vec<Dim>& x) const {
-    Vec<Dim + 1> q;
-    q[0] = 1.0;
-    q.template tail<Dim>() = (x - shift_) / scale_;
-    return q;
-  }
+  /// The polynomial basis, the serial RbfSystem's.
+  [[nodiscard]] Vec<Dim + 1> polynomial(const Vec<Dim>& x) const { return polynomial_(x); }
 
   /// Collective. Coefficients (m × Dim, on every rank) interpolating `values` (m × Dim, the
   /// same on every rank).
   void solve(const Eigen::MatrixXd& values, Eigen::MatrixXd& alpha, PolyCoefficients& beta) {
     solve_a(values, alpha);
-    beta.setZero();
-    if (!kernel_.polynomial || size() == 0) return;
-    beta = schur_.solve(p_.transpose() * alpha);
-    alpha.noalias() -= g_ * beta;
+    polynomial_.eliminate(alpha, beta);
   }
   /// Collective. The transpose of solve() (A is symmetric): A⁻¹ (ᾱ + P S⁻ᵀ (β̄ − Gᵀ ᾱ)).
   void solve_transpose(const Eigen::MatrixXd& alpha_bar, const PolyCoefficients& beta_bar, Eigen::MatrixXd& values_bar) {
-    Eigen::MatrixXd rhs = alpha_bar;
-    if (kernel_.polynomial && size() > 0) rhs.noalias() += p_ * schur_.transpose().solve(beta_bar - g_.transpose() * alpha_bar);
-    solve_a(rhs, values_bar);
+    solve_a(polynomial_.transpose_rhs(alpha_bar, beta_bar), values_bar);
   }
 
  private:
@@ -158,12 +136,9 @@ class PetscRbfSystem {
   meshmotion::detail::RbfKernelSettings kernel_;
   KdTree<Dim> tree_;
   Index lo_ = 0, hi_ = 0, nonzeros_ = 0;
-  Vec<Dim> shift_ = Vec<Dim>::Zero();
-  double scale_ = 1.0;
   OwnedMat a_;
   OwnedKsp ksp_;
-  Eigen::MatrixXd p_, g_;
-  Eigen::PartialPivLU<Eigen::Matrix<double, Dim + 1, Dim + 1>> schur_;
+  meshmotion::detail::RbfPolynomial<Dim> polynomial_;
 };
 
 }  // namespace meshmotion::parallel::detail

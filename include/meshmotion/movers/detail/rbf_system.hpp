@@ -128,11 +128,75 @@ template <int Dim, class Within>
   return m;
 }
 
+/// The linear polynomial part of an augmented system over its centres, eliminated through the
+/// Schur complement S = Pᵀ A⁻¹ P: with α₀ = A⁻¹ d, β = S⁻¹ Pᵀ α₀ and α = α₀ - G β (G = A⁻¹ P).
+/// The basis [1, (x - shift)/scale] is scaled to the centres for conditioning. Shared by the
+/// serial system and the distributed one (parallel/petsc_rbf_system.hpp), which differ only in
+/// how they solve with A.
+template <int Dim>
+class RbfPolynomial {
+ public:
+  using Coefficients = Eigen::Matrix<double, Dim + 1, Dim>;  ///< β, (Dim + 1) × Dim
+
+  /// Scales the basis to `centres` and, when `augmented`, factorizes S with `solve_a(b, x)`
+  /// solving A x = b. Throws InputError (naming `where`) when the centres lie on a line or a
+  /// plane, where S is singular.
+  template <class SolveA>
+  void setup(const Points<Dim>& centres, bool augmented, SolveA&& solve_a, const char* where) {
+    const Index k = centres.cols();
+    shift_ = k > 0 ? Vec<Dim>(centres.rowwise().mean()) : Vec<Dim>::Zero();
+    scale_ = k > 0 ? std::max((centres.colwise() - shift_).colwise().norm().maxCoeff(), 1e-300) : 1.0;
+    p_.resize(0, 0);
+    g_.resize(0, 0);
+    if (!augmented || k == 0) return;
+    p_.resize(k, Dim + 1);
+    for (Index i = 0; i < k; ++i) p_.row(i) = (*this)(centres.col(i)).transpose();
+    solve_a(p_, g_);
+    const Eigen::Matrix<double, Dim + 1, Dim + 1> s = p_.transpose() * g_;
+    schur_.compute(s);
+    if (!(std::abs(schur_.determinant()) > 1e-14 * std::max(1.0, s.norm())))
+      throw InputError(std::string(where) +
+                       ": linear polynomial augmentation needs boundary nodes that span the space "
+                       "(got them all on a line or plane)");
+  }
+
+  /// The basis at x.
+  [[nodiscard]] Vec<Dim + 1> operator()(const Vec<Dim>& x) const {
+    Vec<Dim + 1> q;
+    q[0] = 1.0;
+    q.template tail<Dim>() = (x - shift_) / scale_;
+    return q;
+  }
+
+  /// α₀ = A⁻¹ d in, α out, and β (zero without augmentation).
+  void eliminate(Eigen::MatrixXd& alpha, Coefficients& beta) const {
+    beta.setZero();
+    if (p_.rows() == 0) return;
+    beta = schur_.solve(p_.transpose() * alpha);
+    alpha.noalias() -= g_ * beta;
+  }
+
+  /// The transpose of eliminate(): ᾱ + P S⁻ᵀ (β̄ - Gᵀ ᾱ), the right-hand side that Aᵀ
+  /// turns into the gradient with respect to d.
+  [[nodiscard]] Eigen::MatrixXd transpose_rhs(const Eigen::MatrixXd& alpha_bar, const Coefficients& beta_bar) const {
+    Eigen::MatrixXd rhs = alpha_bar;
+    if (p_.rows() > 0) rhs.noalias() += p_ * schur_.transpose().solve(beta_bar - g_.transpose() * alpha_bar);
+    return rhs;
+  }
+
+ private:
+  Vec<Dim> shift_ = Vec<Dim>::Zero();
+  double scale_ = 1.0;
+  Eigen::MatrixXd p_;  ///< P, k × (Dim + 1); empty without augmentation
+  Eigen::MatrixXd g_;  ///< A⁻¹ P, k × (Dim + 1)
+  Eigen::PartialPivLU<Eigen::Matrix<double, Dim + 1, Dim + 1>> schur_;
+};
+
 template <int Dim>
 class RbfSystem {
  public:
   using Coefficients = Eigen::Matrix<double, Eigen::Dynamic, Dim>;       ///< n_centres × Dim
-  using PolyCoefficients = Eigen::Matrix<double, Dim + 1, Dim>;        ///< (Dim + 1) × Dim
+  using PolyCoefficients = typename RbfPolynomial<Dim>::Coefficients;
 
   /// Assembles and factorizes the system over `centres` (Dim × k, distinct points; with
   /// kernel.radii, one radius each). Throws InputError when a global kernel has more than
@@ -142,10 +206,6 @@ class RbfSystem {
     centres_ = centres;
     kernel_ = kernel;
     const Index k = centres_.cols();
-    if (k > 0) {
-      shift_ = centres_.rowwise().mean();
-      scale_ = std::max((centres_.colwise() - shift_).colwise().norm().maxCoeff(), 1e-300);
-    }
     compact_ = is_compact(kernel.kernel);
     symmetric_ = !kernel.varying();
     transposed_.reset();
@@ -185,16 +245,8 @@ class RbfSystem {
       dense_.compute(dense_matrix_);
       if (symmetric_) dense_matrix_.resize(0, 0);
     }
-    if (kernel.polynomial && k > 0) {
-      p_.resize(k, Dim + 1);
-      for (Index i = 0; i < k; ++i) p_.row(i) = polynomial(centres_.col(i)).transpose();
-      solve_a(p_, g_);
-      const Eigen::Matrix<double, Dim + 1, Dim + 1> s = p_.transpose() * g_;
-      schur_.compute(s);
-      if (!(std::abs(schur_.determinant()) > 1e-14 * std::max(1.0, s.norm())))
-        throw InputError("RbfMover::setup: linear polynomial augmentation needs boundary nodes that span the space "
-                         "(got them all on a line or plane)");
-    }
+    polynomial_.setup(centres_, kernel.polynomial, [this](const Eigen::MatrixXd& b, Eigen::MatrixXd& x) { solve_a(b, x); },
+                      "RbfMover::setup");
   }
 
   [[nodiscard]] Index size() const noexcept { return centres_.cols(); }
@@ -228,32 +280,19 @@ class RbfSystem {
   [[nodiscard]] const SolverReport& report() const noexcept { return compact_ ? sparse_.report() : dense_.report(); }
 
   /// The polynomial basis [1, (x - shift)/scale] (scaled for conditioning).
-  [[nodiscard]] Vec<Dim + 1> polynomial(const Vec<Dim>& x) const {
-    Vec<Dim + 1> q;
-    q[0] = 1.0;
-    q.template tail<Dim>() = (x - shift_) / scale_;
-    return q;
-  }
+  [[nodiscard]] Vec<Dim + 1> polynomial(const Vec<Dim>& x) const { return polynomial_(x); }
 
   /// Coefficients interpolating `values` (k × Dim) at the centres. β is zero without
   /// augmentation.
   void solve(const Eigen::MatrixXd& values, Eigen::MatrixXd& alpha, PolyCoefficients& beta) {
     solve_a(values, alpha);
-    beta.setZero();
-    if (!kernel_.polynomial || size() == 0) return;
-    // With α₀ = A⁻¹ d: β = S⁻¹ Pᵀ α₀, α = α₀ - G β (G = A⁻¹ P).
-    beta = schur_.solve(p_.transpose() * alpha);
-    alpha.noalias() -= g_ * beta;
+    polynomial_.eliminate(alpha, beta);
   }
 
   /// Transpose of solve(): the gradient with respect to `values` of ⟨ᾱ, α⟩ + ⟨β̄, β⟩,
   /// A⁻ᵀ (ᾱ + P S⁻ᵀ (β̄ - Gᵀ ᾱ)).
   void solve_transpose(const Eigen::MatrixXd& alpha_bar, const PolyCoefficients& beta_bar, Eigen::MatrixXd& values_bar) {
-    Eigen::MatrixXd rhs = alpha_bar;
-    if (kernel_.polynomial && size() > 0) {
-      const PolyCoefficients t = schur_.transpose().solve(beta_bar - g_.transpose() * alpha_bar);
-      rhs.noalias() += p_ * t;
-    }
+    const Eigen::MatrixXd rhs = polynomial_.transpose_rhs(alpha_bar, beta_bar);
     if (symmetric_) {
       solve_a(rhs, values_bar);
     } else if (compact_) {
@@ -328,11 +367,7 @@ class RbfSystem {
   LinearSolver sparse_;
   DenseSolver dense_;
   Index nonzeros_ = 0;
-  Vec<Dim> shift_ = Vec<Dim>::Zero();
-  double scale_ = 1.0;
-  Eigen::MatrixXd p_;  ///< P, k × (Dim + 1)
-  Eigen::MatrixXd g_;  ///< A⁻¹ P, k × (Dim + 1)
-  Eigen::PartialPivLU<Eigen::Matrix<double, Dim + 1, Dim + 1>> schur_;
+  RbfPolynomial<Dim> polynomial_;
 };
 
 }  // namespace meshmotion::detail
