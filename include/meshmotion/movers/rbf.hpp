@@ -172,6 +172,19 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
 
   [[nodiscard]] const Points<Dim>& all_centres() const { return all_.centres(); }
 
+  // setup_reference()'s stages, in order.
+  /// Refuses options the boundary cannot take; radius_ from support_radius.
+  void check_options(const ResolvedBoundary<Dim>& boundary);
+  /// The default support radius, from the boundary's extent and displacements.
+  [[nodiscard]] static double default_radius(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary);
+  /// Merges coincident boundary nodes into centres, constrained ones first and sliding ones
+  /// after (centre_of_, source_, n_constrained_, projectors_); returns the centres.
+  [[nodiscard]] Points<Dim> merge_centres(const ResolvedBoundary<Dim>& boundary);
+  /// Factorizes the systems over every centre and over the constrained ones.
+  void factorize(const Points<Dim>& centres, const detail::RbfKernelSettings& kernel);
+  /// The operator evaluating the interpolant at the non-boundary nodes.
+  void build_evaluation(const detail::RbfKernelSettings& kernel);
+
   /// f(the system over every centre), global or patched; likewise over the constrained ones.
   template <class F>
   decltype(auto) with_all(F&& f) {
@@ -376,21 +389,38 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
 template <int Dim>
 void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<Dim>& boundary) {
   const detail::Stopwatch watch;
+  check_options(boundary);
+  if (options_.support_radii.empty() && radius_ == 0.0) radius_ = default_radius(points, boundary);
+  points_ = std::move(points);
+  if (!points_.allFinite()) throw InputError("RbfMover::setup: mesh has a non-finite coordinate");
+  detail::check_boundary<Dim>("RbfMover::setup", boundary, points_.cols(), false);
+  boundary_nodes_ = boundary.nodes;
+  kinds_ = boundary.kinds;
+  const Points<Dim> centres = merge_centres(boundary);
+  detail::RbfKernelSettings kernel{options_.kernel, radius_, options_.polynomial};
+  if (!options_.support_radii.empty()) {
+    kernel.radii.resize(static_cast<std::size_t>(n_centres_));
+    for (Index c = 0; c < n_centres_; ++c)
+      kernel.radii[static_cast<std::size_t>(c)] = options_.support_radii[static_cast<std::size_t>(source_[static_cast<std::size_t>(c)])];
+    kernel.radius = n_centres_ > 0 ? *std::max_element(kernel.radii.begin(), kernel.radii.end()) : radius_;
+    radius_ = kernel.radius;
+  }
+  stats_ = MoverStats{};
+  stats_.boundary_nodes = n_centres_;
+  factorize(centres, kernel);
+  build_evaluation(kernel);
+  stats_.factorizations = with_all([](auto& system) { return system.report().factorizations; }) +
+                          (n_centres_ > n_constrained_ ? with_constrained([](auto& system) { return system.report().factorizations; }) : 0);
+  ready_ = true;
+  stats_.setup_seconds = watch.seconds();
+}
+
+template <int Dim>
+void RbfMover<Dim>::check_options(const ResolvedBoundary<Dim>& boundary) {
   if (!(options_.support_radius >= 0.0) || !std::isfinite(options_.support_radius))
     throw InputError("RbfMover::setup: support radius must be positive, or 0 for the default (got " +
                      std::to_string(options_.support_radius) + ")");
   radius_ = options_.support_radius;
-  if (options_.support_radii.empty() && radius_ == 0.0) {
-    Points<Dim> at(Dim, boundary.size());
-    for (Index k = 0; k < boundary.size(); ++k) {
-      const Index v = boundary.nodes[static_cast<std::size_t>(k)];
-      if (v < 0 || v >= points.cols())
-        throw InputError("RbfMover::setup: boundary node " + std::to_string(v) + " out of range (expected 0 to " +
-                         std::to_string(points.cols() - 1) + ")");
-      at.col(k) = points.col(v);
-    }
-    radius_ = suggest_support_radius(at, boundary.displacements);
-  }
   if (!options_.support_radii.empty()) {
     if (static_cast<Index>(options_.support_radii.size()) != boundary.size())
       throw InputError("RbfMover::setup: " + std::to_string(options_.support_radii.size()) +
@@ -402,30 +432,33 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
                          std::to_string(boundary.nodes[b]) + ") must be positive (got " +
                          std::to_string(options_.support_radii[b]) + ")");
   }
-  if (options_.partition_of_unity) {
-    const auto refuse = [](const std::string& why) {
-      throw InputError("RbfMover::setup: partition_of_unity " + why);
-    };
-    if (!is_compact(options_.kernel))
-      refuse("needs a compact kernel such as wendland2 (got " + std::string(name(options_.kernel)) + ")");
-    if (!options_.support_radii.empty()) refuse("needs one support_radius (got support_radii)");
-    if (options_.polynomial)
-      refuse("does not take a polynomial (nodes beyond every patch would lose its affine part)");
-    if (options_.patch_centres < 1)
-      refuse("needs patch_centres >= 1 (got " + std::to_string(options_.patch_centres) + ")");
-    if (!(options_.patch_overlap >= 0.0) || !std::isfinite(options_.patch_overlap))
-      refuse("needs a finite patch_overlap >= 0 (got " + std::to_string(options_.patch_overlap) + ")");
-  }
-  points_ = std::move(points);
-  const Index n = points_.cols();
-  if (!points_.allFinite()) throw InputError("RbfMover::setup: mesh has a non-finite coordinate");
-  detail::check_boundary<Dim>("RbfMover::setup", boundary, n, false);
-  boundary_nodes_ = boundary.nodes;
-  kinds_ = boundary.kinds;
-  dense_operator_.resize(0, 0);
-  const Index m = boundary.size();
+  if (!options_.partition_of_unity) return;
+  const auto refuse = [](const std::string& why) { throw InputError("RbfMover::setup: partition_of_unity " + why); };
+  if (!is_compact(options_.kernel))
+    refuse("needs a compact kernel such as wendland2 (got " + std::string(name(options_.kernel)) + ")");
+  if (!options_.support_radii.empty()) refuse("needs one support_radius (got support_radii)");
+  if (options_.polynomial) refuse("does not take a polynomial (nodes beyond every patch would lose its affine part)");
+  if (options_.patch_centres < 1) refuse("needs patch_centres >= 1 (got " + std::to_string(options_.patch_centres) + ")");
+  if (!(options_.patch_overlap >= 0.0) || !std::isfinite(options_.patch_overlap))
+    refuse("needs a finite patch_overlap >= 0 (got " + std::to_string(options_.patch_overlap) + ")");
+}
 
-  // Merge coincident boundary nodes into centres; constrained centres first, sliding after.
+template <int Dim>
+double RbfMover<Dim>::default_radius(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary) {
+  Points<Dim> at(Dim, boundary.size());
+  for (Index k = 0; k < boundary.size(); ++k) {
+    const Index v = boundary.nodes[static_cast<std::size_t>(k)];
+    if (v < 0 || v >= points.cols())
+      throw InputError("RbfMover::setup: boundary node " + std::to_string(v) + " out of range (expected 0 to " +
+                       std::to_string(points.cols() - 1) + ")");
+    at.col(k) = points.col(v);
+  }
+  return suggest_support_radius(at, boundary.displacements);
+}
+
+template <int Dim>
+Points<Dim> RbfMover<Dim>::merge_centres(const ResolvedBoundary<Dim>& boundary) {
+  const Index m = boundary.size();
   Points<Dim> positions(Dim, m);
   for (Index b = 0; b < m; ++b) positions.col(b) = points_.col(boundary_nodes_[static_cast<std::size_t>(b)]);
   const double diagonal = m > 0 ? (positions.rowwise().maxCoeff() - positions.rowwise().minCoeff()).norm() : 0.0;
@@ -455,10 +488,10 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   for (Index b = m - 1; b >= 0; --b)
     if (kinds_[static_cast<std::size_t>(b)] != BoundaryKind::sliding && centre_of_[static_cast<std::size_t>(b)] < n_constrained_)
       source_[static_cast<std::size_t>(centre_of_[static_cast<std::size_t>(b)])] = b;
-  const auto k = static_cast<Index>(source_.size());
-  Points<Dim> centres(Dim, k);
+  n_centres_ = static_cast<Index>(source_.size());
+  Points<Dim> centres(Dim, n_centres_);
   projectors_.clear();
-  for (Index c = 0; c < k; ++c) {
+  for (Index c = 0; c < n_centres_; ++c) {
     const Index b = source_[static_cast<std::size_t>(c)];
     centres.col(c) = positions.col(b);
     if (c < n_constrained_) continue;
@@ -466,16 +499,12 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
     for (int a = 0; a < Dim; ++a) p.col(a) = boundary.project(b, Vec<Dim>::Unit(a));
     projectors_.push_back(p);
   }
+  return centres;
+}
 
-  detail::RbfKernelSettings kernel{options_.kernel, radius_, options_.polynomial};
-  if (!options_.support_radii.empty()) {
-    kernel.radii.resize(static_cast<std::size_t>(k));
-    for (Index c = 0; c < k; ++c)
-      kernel.radii[static_cast<std::size_t>(c)] = options_.support_radii[static_cast<std::size_t>(source_[static_cast<std::size_t>(c)])];
-    kernel.radius = k > 0 ? *std::max_element(kernel.radii.begin(), kernel.radii.end()) : radius_;
-    radius_ = kernel.radius;
-  }
-  n_centres_ = k;
+template <int Dim>
+void RbfMover<Dim>::factorize(const Points<Dim>& centres, const detail::RbfKernelSettings& kernel) {
+  const Index k = n_centres_;
   patched_all_.reset();
   patched_constrained_.reset();
   const auto patched = [&](const Points<Dim>& at, const detail::RbfKernelSettings& settings) {
@@ -489,51 +518,52 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   } else {
     all_.setup(centres, kernel, options_.solver, options_.dense_solver, options_.max_dense_centres);
   }
-  stats_ = MoverStats{};
-  stats_.boundary_nodes = k;
   stats_.nonzeros = with_all([](auto& system) { return system.nonzeros(); });
-  if (k > n_constrained_) {
-    const Points<Dim> constrained_centres = centres.leftCols(n_constrained_);
-    sliding_rows_.resize(static_cast<std::size_t>(k - n_constrained_));
-    for (Index c = n_constrained_; c < k; ++c) sliding_rows_[static_cast<std::size_t>(c - n_constrained_)] = c;
-    if (options_.partition_of_unity) {
-      patched_constrained_ = patched(constrained_centres, kernel.leading(n_constrained_));
-      sliding_operator_ = patched_constrained_->evaluation_rows(centres, sliding_rows_);
-    } else {
-      constrained_.setup(constrained_centres, kernel.leading(n_constrained_), options_.solver, options_.dense_solver,
-                         options_.max_dense_centres);
-      sliding_operator_ = build_operator(centres, sliding_rows_, constrained_);
-    }
-    stats_.nonzeros += with_constrained([](auto& system) { return system.nonzeros(); }) + sliding_operator_.nonZeros();
+  if (k == n_constrained_) return;
+  const Points<Dim> constrained_centres = centres.leftCols(n_constrained_);
+  sliding_rows_.resize(static_cast<std::size_t>(k - n_constrained_));
+  for (Index c = n_constrained_; c < k; ++c) sliding_rows_[static_cast<std::size_t>(c - n_constrained_)] = c;
+  if (options_.partition_of_unity) {
+    patched_constrained_ = patched(constrained_centres, kernel.leading(n_constrained_));
+    sliding_operator_ = patched_constrained_->evaluation_rows(centres, sliding_rows_);
+  } else {
+    constrained_.setup(constrained_centres, kernel.leading(n_constrained_), options_.solver, options_.dense_solver,
+                       options_.max_dense_centres);
+    sliding_operator_ = build_operator(centres, sliding_rows_, constrained_);
   }
+  stats_.nonzeros += with_constrained([](auto& system) { return system.nonzeros(); }) + sliding_operator_.nonZeros();
+}
 
+template <int Dim>
+void RbfMover<Dim>::build_evaluation(const detail::RbfKernelSettings& kernel) {
   // Nodes evaluated: every non-boundary node inside some support (all of them for global
   // kernels); the polynomial part reaches every non-boundary node.
+  const Index n = points_.cols(), k = n_centres_;
   std::vector<bool> is_boundary(static_cast<std::size_t>(n), false);
   for (const Index v : boundary_nodes_) is_boundary[static_cast<std::size_t>(v)] = true;
   interior_.clear();
   for (Index i = 0; i < n; ++i)
     if (!is_boundary[static_cast<std::size_t>(i)]) interior_.push_back(i);
   evaluated_.clear();
+  dense_operator_.resize(0, 0);
   const bool fits = !interior_.empty() && static_cast<double>(interior_.size()) * static_cast<double>(k) * sizeof(double) <=
                                               static_cast<double>(options_.max_evaluation_cache_bytes);
   // A compact support that reaches most centres from most nodes (a radius far larger than the
   // moving body, as rotations want) makes the sparse operator a full one stored with indices:
   // building it dense is several times cheaper and so is every move.
   const bool dense = !patched_all_ && fits && (!is_compact(options_.kernel) || covered_fraction() > 0.5);
-  if (patched_all_) {
-    std::vector<Index> kept;
-    operator_ = patched_all_->evaluation_rows(points_, interior_, &kept);
+  const auto keep_rows = [&](Operator rows, const std::vector<Index>& kept) {
+    operator_ = std::move(rows);
     evaluated_.reserve(kept.size());
     for (const Index r : kept) evaluated_.push_back(interior_[static_cast<std::size_t>(r)]);
     stats_.nonzeros += operator_.nonZeros();
+  };
+  std::vector<Index> kept;
+  if (patched_all_) {
+    keep_rows(patched_all_->evaluation_rows(points_, interior_, &kept), kept);
   } else if (is_compact(options_.kernel) && !dense) {
     // Only rows with weights are kept, so skipped nodes cost nothing per move.
-    std::vector<Index> kept;
-    operator_ = detail::compact_kernel_rows(points_, interior_, all_.within(), k, kernel, &kept);
-    evaluated_.reserve(kept.size());
-    for (const Index r : kept) evaluated_.push_back(interior_[static_cast<std::size_t>(r)]);
-    stats_.nonzeros += operator_.nonZeros();
+    keep_rows(detail::compact_kernel_rows(points_, interior_, all_.within(), k, kernel, &kept), kept);
   } else {
     evaluated_ = interior_;
     operator_.resize(0, 0);
@@ -546,10 +576,6 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
     }
   }
   stats_.evaluated_nodes = options_.polynomial ? static_cast<Index>(interior_.size()) : static_cast<Index>(evaluated_.size());
-  stats_.factorizations = with_all([](auto& system) { return system.report().factorizations; }) +
-                          (k > n_constrained_ ? with_constrained([](auto& system) { return system.report().factorizations; }) : 0);
-  ready_ = true;
-  stats_.setup_seconds = watch.seconds();
 }
 
 template <int Dim>

@@ -117,8 +117,6 @@ class DistributedRbfMover {
   /// boundary, or what RbfMover::setup throws.
   void setup(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary);
 
-  /// Collective. Throws InputError on every rank for BoundarySolve::petsc with options it does
-  /// not take.
   /// Collective. Displacement (Dim × part.size()) of every local node for the displacements
   /// `d` (Dim × boundary.size()) of this rank's boundary entries; only owned entries are
   /// read. Throws on every rank for a wrong shape or a non-finite value on any rank, and what
@@ -141,6 +139,26 @@ class DistributedRbfMover {
     if (!ready_) throw InputError(std::string("DistributedRbfMover::") + where + ": setup() was not called");
   }
 
+  /// The whole boundary's owned entries, as every rank gathers them in rank order.
+  struct GatheredBoundary {
+    static constexpr int stride = 3 * Dim + 1;
+    std::vector<int> kinds;
+    std::vector<double> geometry;  ///< per entry: position, normal, direction, radius
+    bool radius_per_entry = false;  ///< some rank was given support_radii
+  };
+  // setup()'s stages, in order.
+  /// Gathers the owned entries (owned_entries_, counts_) and sorts them by global id
+  /// (sorted_ids_, slot_of_gathered_); throws on every rank for no entry or a twice-owned node.
+  [[nodiscard]] GatheredBoundary gather_boundary(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary);
+  /// The inner mover's column of each local node (column_, entry_slot_, inner_columns_).
+  void number_columns(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary);
+  /// The inner mover's reference points (the centres, then this rank's other nodes), the
+  /// centres' radii when given, and its boundary.
+  [[nodiscard]] ResolvedBoundary<Dim> inner_boundary(const PartitionView<Dim>& part, const GatheredBoundary& gathered,
+                                                     Points<Dim>& points, std::vector<double>& radii) const;
+  /// Whether the boundary system goes through PETSc (BoundarySolveOptions); throws on every
+  /// rank when PETSc is demanded and cannot take it.
+  [[nodiscard]] bool choose_petsc(const GatheredBoundary& gathered, const Points<Dim>& centres) const;
   /// Why PETSc cannot solve this boundary system (empty: it can).
   [[nodiscard]] std::string petsc_obstacle(const std::vector<int>& kinds, bool radius_per_entry, const Points<Dim>& centres) const;
   void setup_petsc(const PartitionView<Dim>& part, Points<Dim> centres);
@@ -191,16 +209,51 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
   n_local_ = n;
   owned_.resize(static_cast<std::size_t>(n));
   for (Index i = 0; i < n; ++i) owned_[static_cast<std::size_t>(i)] = part.owns(i) ? 1 : 0;
+  const GatheredBoundary gathered = gather_boundary(part, boundary);
+  const auto m = static_cast<Index>(sorted_ids_.size());
+  number_columns(part, boundary);
+  Points<Dim> points;
+  std::vector<double> radii;
+  const ResolvedBoundary<Dim> centres = inner_boundary(part, gathered, points, radii);
 
+  // The default radius from the whole boundary, as the serial mover takes it: the gathered
+  // nodes and the largest displacement over the ranks.
+  radius_ = options_.support_radius;
+  if (radius_ == 0.0 && !gathered.radius_per_entry) {
+    double largest = 0.0, global_largest = 0.0;
+    for (const Index k : owned_entries_) largest = std::max(largest, boundary.displacements.col(k).norm());
+    MPI_Allreduce(&largest, &global_largest, 1, MPI_DOUBLE, MPI_MAX, comm_);
+    radius_ = suggest_support_radius(Points<Dim>(points.leftCols(m)), global_largest);
+  }
+  gathered_.resize(Dim, m);
+  petsc_ = choose_petsc(gathered, points.leftCols(m));
+  if (petsc_) {
+    setup_petsc(part, Points<Dim>(points.leftCols(m)));
+  } else {
+    system_.reset();
+    RbfOptions options = options_;
+    options.support_radius = radius_;
+    options.support_radii = std::move(radii);
+    inner_ = RbfMover<Dim>(std::move(options));
+    collective(comm_, [&] { inner_.setup_reference(std::move(points), centres); });
+    stats_ = inner_.stats();
+    stats_.evaluated_nodes = std::min(stats_.evaluated_nodes, n);
+  }
+  ready_ = true;
+  stats_.setup_seconds = watch.seconds();
+}
+
+template <int Dim>
+typename DistributedRbfMover<Dim>::GatheredBoundary DistributedRbfMover<Dim>::gather_boundary(
+    const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary) {
   // This rank's owned entries, packed for the gather.
   owned_entries_.clear();
   std::vector<std::int64_t> ids;
   std::vector<int> kinds;
-  std::vector<double> geometry;  // position, normal, direction, radius per entry
+  std::vector<double> geometry;
   const bool per_entry_radius = !options_.support_radii.empty();
   int radius_flag = per_entry_radius ? 1 : 0, any_radius = 0;
   MPI_Allreduce(&radius_flag, &any_radius, 1, MPI_INT, MPI_MAX, comm_);
-  constexpr int stride = 3 * Dim + 1;
   for (Index k = 0; k < boundary.size(); ++k) {
     const Index node = boundary.nodes[static_cast<std::size_t>(k)];
     if (!part.owns(node)) continue;
@@ -213,8 +266,7 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
     geometry.push_back(per_entry_radius ? options_.support_radii[static_cast<std::size_t>(k)] : 0.0);
   }
   const std::vector<std::int64_t> all_ids = all_gather(comm_, ids, &counts_);
-  const std::vector<int> all_kinds = all_gather(comm_, kinds);
-  const std::vector<double> all_geometry = all_gather(comm_, geometry);
+  GatheredBoundary gathered{all_gather(comm_, kinds), all_gather(comm_, geometry), any_radius != 0};
   const auto m = static_cast<Index>(all_ids.size());
 
   std::vector<Index> order(static_cast<std::size_t>(m));
@@ -232,8 +284,14 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
     if (sorted_ids_[static_cast<std::size_t>(s)] == sorted_ids_[static_cast<std::size_t>(s - 1)])
       throw InputError("DistributedRbfMover::setup: global node " + std::to_string(sorted_ids_[static_cast<std::size_t>(s)]) +
                        " is an owned boundary node on two ranks (each node must have one owner)");
+  return gathered;
+}
 
+template <int Dim>
+void DistributedRbfMover<Dim>::number_columns(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary) {
   // Inner mover: the centres first (sorted), then this rank's nodes that are not centres.
+  const Index n = part.size();
+  const auto m = static_cast<Index>(sorted_ids_.size());
   column_.assign(static_cast<std::size_t>(n), -1);
   entry_slot_.assign(static_cast<std::size_t>(boundary.size()), -1);
   Index interior = 0;
@@ -245,24 +303,28 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
     else
       column_[static_cast<std::size_t>(i)] = m + interior++;
   }
-  for (Index e = 0; e < static_cast<Index>(owned_entries_.size()); ++e)
-    entry_slot_[static_cast<std::size_t>(owned_entries_[static_cast<std::size_t>(e)])] =
-        column_[static_cast<std::size_t>(boundary.nodes[static_cast<std::size_t>(owned_entries_[static_cast<std::size_t>(e)])])];
-
+  for (const Index e : owned_entries_)
+    entry_slot_[static_cast<std::size_t>(e)] = column_[static_cast<std::size_t>(boundary.nodes[static_cast<std::size_t>(e)])];
   inner_columns_ = m + interior;
-  Points<Dim> points(Dim, inner_columns_);
+}
+
+template <int Dim>
+ResolvedBoundary<Dim> DistributedRbfMover<Dim>::inner_boundary(const PartitionView<Dim>& part, const GatheredBoundary& gathered,
+                                                               Points<Dim>& points, std::vector<double>& radii) const {
+  const auto m = static_cast<Index>(sorted_ids_.size());
+  points.resize(Dim, inner_columns_);
   ResolvedBoundary<Dim> centres;
   centres.nodes.resize(static_cast<std::size_t>(m));
   centres.kinds.resize(static_cast<std::size_t>(m));
   centres.displacements.setZero(Dim, m);
   centres.normals.resize(Dim, m);
   centres.directions.resize(Dim, m);
-  std::vector<double> radii(any_radius != 0 ? static_cast<std::size_t>(m) : 0);
+  radii.assign(gathered.radius_per_entry ? static_cast<std::size_t>(m) : 0, 0.0);
   for (Index j = 0; j < m; ++j) {
     const Index s = slot_of_gathered_[static_cast<std::size_t>(j)];
-    const double* g = all_geometry.data() + j * stride;
+    const double* g = gathered.geometry.data() + j * GatheredBoundary::stride;
     centres.nodes[static_cast<std::size_t>(s)] = s;
-    centres.kinds[static_cast<std::size_t>(s)] = static_cast<BoundaryKind>(all_kinds[static_cast<std::size_t>(j)]);
+    centres.kinds[static_cast<std::size_t>(s)] = static_cast<BoundaryKind>(gathered.kinds[static_cast<std::size_t>(j)]);
     for (int d = 0; d < Dim; ++d) {
       points(d, s) = g[d];
       centres.normals(d, s) = g[Dim + d];
@@ -270,45 +332,26 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
     }
     if (!radii.empty()) radii[static_cast<std::size_t>(s)] = g[3 * Dim];
   }
-  for (Index i = 0; i < n; ++i)
+  for (Index i = 0; i < part.size(); ++i)
     if (column_[static_cast<std::size_t>(i)] >= m) points.col(column_[static_cast<std::size_t>(i)]) = part.points.col(i);
+  return centres;
+}
 
-  // The default radius from the whole boundary, as the serial mover takes it: the gathered
-  // nodes and the largest displacement over the ranks.
-  radius_ = options_.support_radius;
-  if (radius_ == 0.0 && any_radius == 0) {
-    double largest = 0.0, global_largest = 0.0;
-    for (const Index k : owned_entries_) largest = std::max(largest, boundary.displacements.col(k).norm());
-    MPI_Allreduce(&largest, &global_largest, 1, MPI_DOUBLE, MPI_MAX, comm_);
-    radius_ = suggest_support_radius(Points<Dim>(points.leftCols(m)), global_largest);
-  }
-  gathered_.resize(Dim, m);
-  // Every rank decides alike: the inputs are the gathered arrays.
-  // The obstacles (a k-d tree over the centres among them) are looked for only when PETSc is wanted.
+template <int Dim>
+bool DistributedRbfMover<Dim>::choose_petsc(const GatheredBoundary& gathered, const Points<Dim>& centres) const {
+  // Every rank decides alike: the inputs are the gathered arrays. The obstacles (a k-d tree
+  // over the centres among them) are looked for only when PETSc is wanted.
+  const Index m = centres.cols();
   const int sharing = ranks_on_node(comm_);
   const int rounds = (sharing + cores_of_node() - 1) / cores_of_node();
   const bool crowded = size_of(comm_) > 1 && m * sharing * rounds >= solve_.petsc_min_node_centres;
   const bool wanted = solve_.kind == BoundarySolve::petsc ||
                       (solve_.kind == BoundarySolve::automatic && (m >= solve_.petsc_min_centres || crowded));
-  const std::string obstacle = wanted ? petsc_obstacle(all_kinds, any_radius != 0, points.leftCols(m)) : std::string();
+  const std::string obstacle = wanted ? petsc_obstacle(gathered.kinds, gathered.radius_per_entry, centres) : std::string();
   if (solve_.kind == BoundarySolve::petsc && !obstacle.empty())
     throw InputError("DistributedRbfMover::setup: the boundary system cannot go through PETSc: " + obstacle +
                      " (use BoundarySolve::replicated)");
-  petsc_ = wanted && obstacle.empty();
-  if (petsc_) {
-    setup_petsc(part, Points<Dim>(points.leftCols(m)));
-  } else {
-    system_.reset();
-    RbfOptions options = options_;
-    options.support_radius = radius_;
-    options.support_radii = std::move(radii);
-    inner_ = RbfMover<Dim>(std::move(options));
-    collective(comm_, [&] { inner_.setup_reference(std::move(points), centres); });
-    stats_ = inner_.stats();
-    stats_.evaluated_nodes = std::min(stats_.evaluated_nodes, n);
-  }
-  ready_ = true;
-  stats_.setup_seconds = watch.seconds();
+  return wanted && obstacle.empty();
 }
 
 template <int Dim>
