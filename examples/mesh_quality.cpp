@@ -83,16 +83,8 @@ int run(Mesh<Dim>& mesh, const Settings& s) {
     }
     w.end_object();
     if (foam) {
-      w.key("checkmesh").begin_object();
-      w.key("solution_directions").value(foam->solution_directions);
-      w.key("max_non_orthogonality").value(foam->max_non_orthogonality).key("average_non_orthogonality").value(foam->average_non_orthogonality);
-      w.key("severely_non_orthogonal_faces").value(foam->num_severely_non_orthogonal);
-      w.key("non_orthogonality_errors").value(foam->num_non_orthogonality_errors);
-      w.key("max_skewness").value(foam->max_skewness).key("highly_skewed_faces").value(foam->num_highly_skewed);
-      w.key("max_aspect_ratio").value(foam->max_aspect_ratio).key("high_aspect_ratio_cells").value(foam->num_high_aspect_ratio);
-      w.key("min_volume").value(foam->min_volume).key("max_volume").value(foam->max_volume).key("total_volume").value(foam->total_volume);
-      w.key("nonpositive_volume_cells").value(foam->num_nonpositive_volumes);
-      w.end_object();
+      w.key("checkmesh");
+      write_json(w, *foam);
     }
     w.end_object();
     std::cout << '\n';
@@ -100,14 +92,8 @@ int run(Mesh<Dim>& mesh, const Settings& s) {
     std::cout << s.file << ": " << Dim << "D, " << mesh.num_nodes() << " nodes, " << mesh.num_cells() << " cells\n";
     for (const auto& r : reports) print_report(std::cout, r);
     if (foam) {
-      std::cout << "checkMesh measures (" << foam->solution_directions << " solution directions):\n"
-                << "  non-orthogonality max " << foam->max_non_orthogonality << " deg, average " << foam->average_non_orthogonality
-                << " deg, " << foam->num_severely_non_orthogonal << " faces above 70, " << foam->num_non_orthogonality_errors
-                << " at 90 or more\n"
-                << "  skewness max " << foam->max_skewness << ", " << foam->num_highly_skewed << " faces above 4\n"
-                << "  aspect ratio max " << foam->max_aspect_ratio << ", " << foam->num_high_aspect_ratio << " cells above 1000\n"
-                << "  volume min " << foam->min_volume << ", max " << foam->max_volume << ", total " << foam->total_volume << ", "
-                << foam->num_nonpositive_volumes << " cells of zero or negative volume\n";
+      std::cout << "checkMesh measures:\n";
+      write_text(std::cout, *foam, 2);
     }
   }
   return 0;

@@ -369,8 +369,8 @@ if(TARGET move_mesh_mpi)
              COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_serial_peer.msh" --group wall --rotate 5
                      --fixed farfield --json)
   smoke_test(NAME move_mesh_mpi.rbf.json REQUIRES examples_demo_mesh SETUP examples_mpi_moved RANKS 3
-             KEYS ranks,threads_per_rank,setup_seconds,move_seconds,after/min
-             VALUES ranks=3,threads_per_rank=1,boundary_solve=replicated,after/invalid=0
+             KEYS ranks,threads_per_rank,setup_seconds,move_seconds,after/min,after/histogram,mover_steps
+             VALUES ranks=3,threads_per_rank=1,boundary_solve=replicated,method=rbf,steps=1,after/invalid=0
              COMMAND move_mesh_mpi "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_mpi.msh" --group wall --rotate 5
                      --fixed farfield --boundary-solve replicated --json)
   smoke_test(NAME move_mesh_mpi.rbf_petsc.json REQUIRES examples_demo_mesh RANKS 2

@@ -148,30 +148,28 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
       throw InvalidMeshError("move_mesh_mpi: " + std::to_string(after.num_invalid) + " of " + std::to_string(after.num_elements) +
                              " cells invalid after the motion (--strict: nothing written)");
     write_mesh(a.output, *whole);
+    // move_mesh's report: the slowest rank's times, rank 0's other figures.
+    MoverStats step = stats;
+    step.setup_seconds = seconds[0];
+    step.move_seconds = seconds[1];
+    const MoveReport report{config.method, 1, whole->num_nodes(), seconds[0], seconds[1], before, after, {step}};
     if (a.json) {
       JsonWriter w(std::cout);
-      w.begin_object().key("input").value(a.input).key("output").value(a.output).key("method").value(config.method);
+      w.begin_object().key("input").value(a.input).key("output").value(a.output);
       w.key("ranks").value(ranks).key("threads_per_rank").value(num_threads());
       if (std::holds_alternative<RbfOptions>(config.options))
         w.key("support_radius").value(radius).key("boundary_solve").value(name(boundary_solve));
       else
         w.key("solver").value(name(parallel.elasticity.solver));
-      w.key("nodes").value(whole->num_nodes()).key("boundary_nodes").value(stats.boundary_nodes);
-      w.key("setup_seconds").value(seconds[0]).key("move_seconds").value(seconds[1]);
-      w.key("before").begin_object().key("min").value(before.min).key("mean").value(before.mean);
-      w.key("invalid").value(before.num_invalid).end_object();
-      w.key("after").begin_object().key("min").value(after.min).key("mean").value(after.mean);
-      w.key("invalid").value(after.num_invalid).end_object();
+      write_json_fields(w, report);
       w.end_object();
       std::cout << "\n";
     } else {
       std::cout << "moved " << whole->num_nodes() << " nodes with " << config.method << " on " << ranks << " rank(s) of "
                 << num_threads() << " thread(s)"
                 << (std::holds_alternative<RbfOptions>(config.options) ? std::string(", boundary solve ") + name(boundary_solve) : "")
-                << "\n"
-                << "  setup " << seconds[0] << " s, move " << seconds[1] << " s (slowest rank)\n"
-                << "  skew before: min " << before.min << " mean " << before.mean << " invalid " << before.num_invalid << "\n"
-                << "  skew after:  min " << after.min << " mean " << after.mean << " invalid " << after.num_invalid << "\n";
+                << " (times: the slowest rank)\n";
+      write_text(std::cout, report, 2);
     }
     if (invalid) {
       std::cerr << "wrote " << a.output << " WITH " << after.num_invalid << " INVALID CELLS of " << after.num_elements << "\n";

@@ -117,12 +117,17 @@ py::array_t<double> to_rows(Points<Dim> p) {
                              owner->data(), free_when_done);
 }
 
-// A described report as Python objects: reports as dicts, lists as lists, enums by name.
+// A described report as Python objects: reports and keyed lists as dicts, lists as lists,
+// enums by name.
 template <class V>
 py::object to_py(const V& v) {
   if constexpr (DescribedFields<V>) {
     py::dict d;
     visit_fields(v, [&](std::string_view key, const auto& x, std::string_view) { d[py::str(std::string(key))] = to_py(x); });
+    return d;
+  } else if constexpr (detail::is_keyed_list<V>::value) {
+    py::dict d;
+    for (const auto& [key, x] : v) d[py::str(key)] = to_py(x);
     return d;
   } else if constexpr (detail::is_field_list<V>::value) {
     py::list items;

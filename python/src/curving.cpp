@@ -4,6 +4,7 @@
 
 #include "meshmotion/curving/curve_mesh.hpp"
 #include "meshmotion/curving/geometry_text.hpp"
+#include "meshmotion/io/mesh_summary.hpp"
 
 #include <algorithm>
 #include <string>
@@ -75,7 +76,9 @@ void bind_curving(py::module_& m) {
         if (report == "quality") return field_keys(QualityReport{});
         if (report == "mover_stats") return field_keys(MoverStats{});
         if (report == "untangle") return field_keys(UntangleReport{});
-        throw InputError("report_fields: unknown report '" + report + "' (expected curve, quality, mover_stats or untangle)");
+        if (report == "summary") return field_keys(MeshSummary{});
+        throw InputError("report_fields: unknown report '" + report +
+                         "' (expected curve, quality, mover_stats, untangle or summary)");
       },
       py::arg("report"), "the keys of a report's dict, from its one description");
 }

@@ -3,6 +3,7 @@
 #include "bindings.hpp"
 
 #include "meshmotion/core/orientation.hpp"
+#include "meshmotion/io/mesh_summary.hpp"
 
 #include <map>
 #include <string>
@@ -69,6 +70,8 @@ void bind_mesh(py::module_& m) {
              py::arg("file_ids"), "node indices of the file's node ids")
         .def("orient", [](M& mesh) { return std::string(name(orient_consistently(mesh).found)); },
              "mirror a consistently reversed mesh; returns what was found: positive, reversed or mixed")
+        .def("summary", [](const M& mesh) { return to_py(summarize(mesh)); },
+             "mesh_info's summary as a dict: counts per element type, groups, bounding box, edge lengths, orientation")
         .def("copy", [](const M& mesh) { return M(mesh); })
         .def("__repr__", [suffix](const M& mesh) {
           return "<meshmotion.Mesh" + suffix + ": " + std::to_string(mesh.num_nodes()) + " nodes, " +

@@ -46,6 +46,15 @@ def test_points_are_a_view_without_copy():
     assert list(mesh.groups["bottom"]) == list(range(0, mesh.num_nodes, 7))
 
 
+def test_summary_is_mesh_infos_from_its_description():
+    summary = grid().summary()
+    assert list(summary) == mm.report_fields("summary")
+    assert summary["cells"] == {"quad4": 48} and summary["facets"] == {"line2": 28}
+    assert summary["bbox_min"] == [0.0, 0.0] and summary["bbox_max"] == [1.0, 1.0]
+    assert [g["name"] for g in summary["groups"]] == ["bottom", "top", "left", "right"]
+    assert summary["groups"][0]["nodes"] == 9 and summary["orientation"] == "positive"
+
+
 def test_write_and_read_back(tmp_path=None):
     mesh = grid()
     file = scratch("python_grid.msh")

@@ -580,8 +580,20 @@ TEST_CASE("mesh summary counts groups, edges and orientation", "[io]") {
   REQUIRE(s.groups.size() == 1);
   CHECK(s.groups[0].num_elements == 1);
   CHECK(s.groups[0].num_nodes == 2);
-  CHECK(to_json(s).find("\"negative_cells\":1") != std::string::npos);
+  const std::string json = to_json(s);
+  CHECK(json.find("\"negative_cells\":1") != std::string::npos);
   CHECK(to_text(s).find("bottom") != std::string::npos);
+  // The JSON comes from the summary's description: every key, counts keyed by type, the box in
+  // the mesh's dimension, groups as objects.
+  for (const std::string& key : field_keys(s)) {
+    INFO(key);
+    CHECK(json.find("\"" + key + "\":") != std::string::npos);
+  }
+  CHECK(json.find("\"cells\":{\"tri3\":2}") != std::string::npos);
+  CHECK(json.find("\"lower\":{}") != std::string::npos);
+  CHECK(json.find("\"bbox_max\":[2,1]") != std::string::npos);
+  CHECK(json.find("\"groups\":[{\"name\":\"bottom\",\"dim\":1,\"tag\":5,\"elements\":1,\"nodes\":2}]") != std::string::npos);
+  CHECK(json.find("\"orientation\":\"mixed\"") != std::string::npos);
 }
 
 TEST_CASE("malformed files give ParseError with file, line and what was expected", "[io]") {

@@ -20,6 +20,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -359,6 +360,17 @@ TEST_CASE("OpenFOAM: checkMesh's measures agree with checkMesh on the shared cas
   CHECK(h.max_volume == Approx(2.0).epsilon(1e-14));
   CHECK(h.total_volume == Approx(4.0).epsilon(1e-14));
   CHECK(h.num_nonpositive_volumes == 0);
+  // mesh_quality's "checkmesh" object and text come from the description: every field in both.
+  std::ostringstream json, text;
+  JsonWriter w(json);
+  write_json(w, h);
+  write_text(text, h);
+  for (const std::string& key : field_keys(h)) {
+    INFO(key);
+    CHECK(json.str().find("\"" + key + "\":") != std::string::npos);
+    CHECK(text.str().find(key + ": ") != std::string::npos);
+  }
+  CHECK(json.str().find("\"solution_directions\":2,") != std::string::npos);
   const fs::path dir = test::scratch_path("foam_quality");
   write_case(dir, hanging);
   if (const std::string report = check_mesh(dir); !report.empty()) require_checkmesh_values(h, report);

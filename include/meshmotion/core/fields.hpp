@@ -14,7 +14,8 @@
 /// programs and the Python module pick it up.
 ///
 /// A result field is a number, a bool, a string, an enum with `name()`, a fixed or growing
-/// list of these, a struct with its own `visit_fields` (an object), or a list of such structs.
+/// list of these, a struct with its own `visit_fields` (an object), a list of such structs, or
+/// a list of (name, value) pairs (an object keyed by the names: counts per element type).
 ///
 /// \code
 /// JsonWriter w(std::cout);
@@ -33,6 +34,7 @@
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace meshmotion {
@@ -49,6 +51,12 @@ template <class T, class A>
 struct is_field_list<std::vector<T, A>> : std::true_type {};
 template <class T, std::size_t N>
 struct is_field_list<std::array<T, N>> : std::true_type {};
+
+// (name, value) pairs: an object keyed by the names.
+template <class T>
+struct is_keyed_list : std::false_type {};
+template <class V, class A>
+struct is_keyed_list<std::vector<std::pair<std::string, V>, A>> : std::true_type {};
 
 // A list of reports (an array of objects): one line per item in text.
 template <class T>
@@ -106,6 +114,13 @@ template <class V>
 void write_json_value(JsonWriter& w, const V& v) {
   if constexpr (DescribedFields<V>) {
     write_json(w, v);
+  } else if constexpr (is_keyed_list<V>::value) {
+    w.begin_object();
+    for (const auto& [key, x] : v) {
+      w.key(key);
+      write_json_value(w, x);
+    }
+    w.end_object();
   } else if constexpr (is_field_list<V>::value) {
     w.begin_array();
     for (const auto& x : v) write_json_value(w, x);
@@ -127,6 +142,13 @@ template <class V>
       out += std::string(key) + '=' + inline_text(x);
     });
     return out;
+  } else if constexpr (is_keyed_list<V>::value) {
+    std::string out;
+    for (const auto& [key, x] : v) {
+      if (!out.empty()) out += ", ";
+      out += key + ' ' + inline_text(x);
+    }
+    return out.empty() ? std::string("none") : out;
   } else if constexpr (is_field_list<V>::value) {
     std::string out;
     for (const auto& x : v) {

@@ -6,6 +6,7 @@
 
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/fields.hpp"
 #include "meshmotion/core/json.hpp"
 #include "meshmotion/core/orientation.hpp"
 
@@ -30,6 +31,15 @@ struct GroupSummary {
   Index num_nodes = 0;
 };
 
+template <class F>
+void visit_fields(const GroupSummary& g, F&& f) {
+  f("name", g.name, "the group's name (empty for a tag without a name)");
+  f("dim", g.dim, "dimension of its elements");
+  f("tag", g.tag, "its tag");
+  f("elements", g.num_elements, "elements of the group");
+  f("nodes", g.num_nodes, "distinct nodes of its elements");
+}
+
 /// Summary of a mesh (see summarize()).
 struct MeshSummary {
   int dim = 0;
@@ -41,6 +51,27 @@ struct MeshSummary {
   double min_edge = 0, max_edge = 0;               ///< over the straight vertex edges of the cells
   OrientationReport orientation;
 };
+
+template <class F>
+void visit_fields(const MeshSummary& s, F&& f) {
+  const auto corner = [&](const std::array<double, 3>& p) {
+    return std::vector<double>(p.begin(), p.begin() + std::clamp(s.dim, 0, 3));
+  };
+  f("dim", s.dim, "dimension of the mesh");
+  f("nodes", s.num_nodes, "nodes");
+  f("auxiliary_nodes", s.num_auxiliary_nodes, "of the nodes: centres of polyhedra cut into tetrahedra");
+  f("cells", s.cells, "cells per element type");
+  f("facets", s.facets, "boundary facets per element type");
+  f("lower", s.lower, "lower-dimensional elements per type (edges, points)");
+  f("groups", s.groups, "named groups and tags found on facets or lower elements");
+  f("bbox_min", corner(s.bbox_min), "lowest coordinates");
+  f("bbox_max", corner(s.bbox_max), "highest coordinates");
+  f("min_edge", s.min_edge, "shortest straight vertex edge of a cell");
+  f("max_edge", s.max_edge, "longest straight vertex edge of a cell");
+  f("negative_cells", s.orientation.num_negative, "cells of negative signed measure");
+  f("degenerate_cells", s.orientation.num_degenerate, "cells of zero signed measure");
+  f("orientation", s.orientation.orientation(), "positive, reversed (every cell negative) or mixed");
+}
 
 /// Computes the summary: groups are the named groups plus any other tag found on facets or
 /// lower elements; edge lengths are those of the cells' vertex-to-vertex edges.
@@ -137,37 +168,6 @@ namespace detail {
          std::to_string(s.orientation.num_negative) + " of " + std::to_string(s.orientation.num_cells) +
          " cells negative, " + std::to_string(s.orientation.num_degenerate) + " degenerate\n";
   return out;
-}
-
-/// Writes the summary as one JSON object.
-inline void write_json(JsonWriter& w, const MeshSummary& s) {
-  const auto counts = [&](const char* key, const std::vector<std::pair<std::string, Index>>& list) {
-    w.key(key).begin_object();
-    for (const auto& [type, n] : list) w.key(type).value(n);
-    w.end_object();
-  };
-  const auto point = [&](const char* key, const std::array<double, 3>& p) {
-    w.key(key).begin_array();
-    for (int d = 0; d < s.dim; ++d) w.value(p[static_cast<std::size_t>(d)]);
-    w.end_array();
-  };
-  w.begin_object().key("dim").value(s.dim).key("nodes").value(s.num_nodes);
-  if (s.num_auxiliary_nodes > 0) w.key("auxiliary_nodes").value(s.num_auxiliary_nodes);
-  counts("cells", s.cells);
-  counts("facets", s.facets);
-  counts("lower", s.lower);
-  w.key("groups").begin_array();
-  for (const auto& g : s.groups) {
-    w.begin_object().key("name").value(g.name).key("dim").value(g.dim).key("tag").value(g.tag);
-    w.key("elements").value(g.num_elements).key("nodes").value(g.num_nodes).end_object();
-  }
-  w.end_array();
-  point("bbox_min", s.bbox_min);
-  point("bbox_max", s.bbox_max);
-  w.key("min_edge").value(s.min_edge).key("max_edge").value(s.max_edge);
-  w.key("negative_cells").value(s.orientation.num_negative).key("degenerate_cells").value(s.orientation.num_degenerate);
-  w.key("orientation").value(name(s.orientation.orientation()));
-  w.end_object();
 }
 
 /// The summary as one JSON object (one line).

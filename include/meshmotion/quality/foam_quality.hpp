@@ -47,6 +47,27 @@ struct FoamQuality {
   Index worst_non_orthogonal_face = -1, worst_skewed_face = -1, worst_aspect_ratio_cell = -1, smallest_cell = -1;
 };
 
+template <class F>
+void visit_fields(const FoamQuality& q, F&& f) {
+  f("solution_directions", q.solution_directions, "3, or 2 when empty patches remove a direction");
+  f("max_non_orthogonality", q.max_non_orthogonality, "degrees, over internal faces");
+  f("average_non_orthogonality", q.average_non_orthogonality, "degrees: the angle of the average cosine");
+  f("severely_non_orthogonal_faces", q.num_severely_non_orthogonal, "internal faces above 70 degrees and below 90");
+  f("non_orthogonality_errors", q.num_non_orthogonality_errors, "internal faces at 90 degrees or more");
+  f("max_skewness", q.max_skewness, "checkMesh's face skewness");
+  f("highly_skewed_faces", q.num_highly_skewed, "faces of skewness above 4");
+  f("max_aspect_ratio", q.max_aspect_ratio, "checkMesh's cell aspect ratio");
+  f("high_aspect_ratio_cells", q.num_high_aspect_ratio, "cells of aspect ratio above 1000");
+  f("min_volume", q.min_volume, "smallest cell volume");
+  f("max_volume", q.max_volume, "largest cell volume");
+  f("total_volume", q.total_volume, "sum of the cell volumes");
+  f("nonpositive_volume_cells", q.num_nonpositive_volumes, "cells of volume below 1e-300");
+  f("worst_non_orthogonal_face", q.worst_non_orthogonal_face, "face of the largest non-orthogonality (-1: none)");
+  f("worst_skewed_face", q.worst_skewed_face, "face of the largest skewness (-1: none)");
+  f("worst_aspect_ratio_cell", q.worst_aspect_ratio_cell, "cell of the largest aspect ratio (-1: none)");
+  f("smallest_cell", q.smallest_cell, "cell of the smallest volume (-1: none)");
+}
+
 namespace detail {
 
 /// Face centres and area vectors, as OpenFOAM computes them.
