@@ -33,7 +33,8 @@ int main(int argc, char** argv) {
       w.end_object();
       std::cout << "\n";
     } else {
-      std::cout << file << ": " << to_text(summary);
+      std::cout << file << ":\n";
+      write_text(std::cout, summary, 2);
     }
     return examples::exit_ok;
   });

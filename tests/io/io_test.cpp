@@ -583,12 +583,16 @@ TEST_CASE("mesh summary counts groups, edges and orientation", "[io]") {
   const std::string json = to_json(s);
   CHECK(json.find("\"negative_cells\":1") != std::string::npos);
   CHECK(to_text(s).find("bottom") != std::string::npos);
-  // The JSON comes from the summary's description: every key, counts keyed by type, the box in
-  // the mesh's dimension, groups as objects.
+  // JSON and text come from the summary's description: every key, counts keyed by type, the
+  // box in the mesh's dimension, groups as objects.
+  const std::string text = to_text(s);
   for (const std::string& key : field_keys(s)) {
     INFO(key);
     CHECK(json.find("\"" + key + "\":") != std::string::npos);
+    CHECK(text.find(key + ":") != std::string::npos);
   }
+  CHECK(text.find("cells: tri3 2\n") != std::string::npos);
+  CHECK(text.find("groups:\n  - name=bottom dim=1 tag=5 elements=1 nodes=2\n") != std::string::npos);
   CHECK(json.find("\"cells\":{\"tri3\":2}") != std::string::npos);
   CHECK(json.find("\"lower\":{}") != std::string::npos);
   CHECK(json.find("\"bbox_max\":[2,1]") != std::string::npos);

@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -129,45 +128,11 @@ template <int Dim>
   return s;
 }
 
-namespace detail {
-[[nodiscard]] inline std::string format_real(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.10g", v);
-  return buffer;
-}
-}  // namespace detail
-
-/// The summary as readable lines.
+/// The summary as readable lines "key: value", from its description (write_text).
 [[nodiscard]] inline std::string to_text(const MeshSummary& s) {
-  std::string out = std::to_string(s.dim) + "D mesh, " + std::to_string(s.num_nodes) + " nodes" +
-                    (s.num_auxiliary_nodes > 0 ? " (" + std::to_string(s.num_auxiliary_nodes) +
-                                                     " of them cell and face centres of polyhedra cut into tetrahedra)"
-                                               : std::string()) +
-                    "\n";
-  const auto list = [&](const char* title, const std::vector<std::pair<std::string, Index>>& counts) {
-    out += title;
-    if (counts.empty()) out += " none";
-    for (const auto& [type, n] : counts) out += " " + type + " " + std::to_string(n);
-    out += "\n";
-  };
-  list("cells:", s.cells);
-  list("facets:", s.facets);
-  list("lower:", s.lower);
-  out += "groups:" + std::string(s.groups.empty() ? " none" : "") + "\n";
-  for (const auto& g : s.groups)
-    out += "  " + (g.name.empty() ? "(unnamed)" : g.name) + " (dim " + std::to_string(g.dim) + ", tag " + std::to_string(g.tag) +
-           "): " + std::to_string(g.num_elements) + " elements, " + std::to_string(g.num_nodes) + " nodes\n";
-  out += "bounding box: [";
-  for (int d = 0; d < s.dim; ++d) (out += d ? ", " : "") += detail::format_real(s.bbox_min[static_cast<std::size_t>(d)]);
-  out += "] to [";
-  for (int d = 0; d < s.dim; ++d) (out += d ? ", " : "") += detail::format_real(s.bbox_max[static_cast<std::size_t>(d)]);
-  out += "]\nedge length: min " + detail::format_real(s.min_edge) + ", max " + detail::format_real(s.max_edge) + "\n";
-  const CellOrientation o = s.orientation.orientation();
-  out += "orientation: " + std::string(name(o)) +
-         (o == CellOrientation::reversed ? " (every cell negative: the file's convention)" : "") + ", " +
-         std::to_string(s.orientation.num_negative) + " of " + std::to_string(s.orientation.num_cells) +
-         " cells negative, " + std::to_string(s.orientation.num_degenerate) + " degenerate\n";
-  return out;
+  std::ostringstream out;
+  write_text(out, s);
+  return out.str();
 }
 
 /// The summary as one JSON object (one line).
