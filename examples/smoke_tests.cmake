@@ -405,3 +405,14 @@ add_test(NAME examples.curve_mesh.options_markdown_matches_docs
          COMMAND "${CMAKE_COMMAND}" -DPROGRAM=$<TARGET_FILE:curve_mesh> -DDOC=${PROJECT_SOURCE_DIR}/docs/options.md
                  -P "${CMAKE_CURRENT_LIST_DIR}/compare_output.cmake")
 set_tests_properties(examples.curve_mesh.options_markdown_matches_docs PROPERTIES LABELS examples)
+
+# CHOLMOD (with OpenBLAS) and CGNS (with HDF5) are loaded by the first run that needs them,
+# not at every program's start (core/detail/shared_library.hpp): the programs do not list them.
+find_program(MESHMOTION_LDD ldd)
+if(MESHMOTION_LDD AND (MESHMOTION_HAVE_CHOLMOD OR MESHMOTION_HAVE_CGNS))
+  foreach(program curve_mesh move_mesh)
+    add_test(NAME examples.${program}.starts_without_cholmod_or_cgns COMMAND ${MESHMOTION_LDD} $<TARGET_FILE:${program}>)
+    set_tests_properties(examples.${program}.starts_without_cholmod_or_cgns PROPERTIES LABELS examples
+                         PASS_REGULAR_EXPRESSION "libc\\.so" FAIL_REGULAR_EXPRESSION "libcholmod|libopenblas|libcgns|libhdf5")
+  endforeach()
+endif()

@@ -8,6 +8,7 @@
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/types.hpp"
+#include "meshmotion/solvers/detail/cholmod_library.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 #include "meshmotion/solvers/solver_options.hpp"
 
@@ -15,9 +16,6 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
-#ifdef MESHMOTION_HAVE_CHOLMOD
-#include <Eigen/CholmodSupport>
-#endif
 
 #include <algorithm>
 #include <cmath>
@@ -103,7 +101,7 @@ std::unique_ptr<SparseBackend> make_backend(const SolverOptions& o) {
   switch (o.kind) {
     case SolverKind::cholmod_supernodal:
 #ifdef MESHMOTION_HAVE_CHOLMOD
-      return std::make_unique<DirectBackend<Eigen::CholmodSupernodalLLT<SparseMatrix, Lower>>>();
+      return std::make_unique<DirectBackend<CholmodSupernodalLLT>>();
 #else
       throw InputError("cholmod_supernodal: this build has no CHOLMOD (install libsuitesparse-dev and configure again)");
 #endif

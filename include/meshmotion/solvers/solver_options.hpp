@@ -18,7 +18,7 @@ enum class SolverKind {
   cg_jacobi,               ///< Eigen::ConjugateGradient with a diagonal preconditioner: SPD, iterative
   cg_incomplete_cholesky,  ///< Eigen::ConjugateGradient with IncompleteCholesky: SPD, iterative
   bicgstab,                ///< Eigen::BiCGSTAB with a diagonal preconditioner: any square, iterative
-  /// CHOLMOD's supernodal Cholesky through Eigen's CholmodSupport: SPD, direct; only in builds
+  /// CHOLMOD's supernodal Cholesky (loaded on first use): SPD, direct; only in builds
   /// with SuiteSparse (MESHMOTION_HAVE_CHOLMOD, set by CMake when libsuitesparse-dev is found).
   cholmod_supernodal,
 };
