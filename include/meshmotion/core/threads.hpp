@@ -14,6 +14,7 @@
 #include <charconv>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -45,6 +46,37 @@ inline int openmp_default_threads() {
   return n;
 }
 #endif
+
+/// An exception cannot leave an OpenMP region: the runtime ends the program (a bad_alloc in a
+/// worker thread ended a move with "terminate called", rc 134 and no JSON error). Each
+/// iteration of a region runs through run(), which keeps the first exception and skips the
+/// iterations after it; the caller rethrows it once the region has ended. A region's
+/// worksharing loop must still be reached by every thread (its barrier waits for all), so
+/// run() wraps iterations and per-thread set-up, never a whole region.
+class RegionErrors {
+ public:
+  template <class F>
+  void run(F&& body) noexcept {
+    if (failed_.load(std::memory_order_relaxed)) return;
+    try {
+      body();
+    } catch (...) {
+      failed_.store(true, std::memory_order_relaxed);
+#ifdef _OPENMP
+#pragma omp critical(meshmotion_region_errors)
+#endif
+      if (!first_) first_ = std::current_exception();
+    }
+  }
+  /// Rethrows the first exception an iteration raised, if any. Call after the region.
+  void rethrow() const {
+    if (first_) std::rethrow_exception(first_);
+  }
+
+ private:
+  std::atomic<bool> failed_{false};
+  std::exception_ptr first_;
+};
 }  // namespace detail
 
 /// Threads of the library's parallel loops, of Eigen's dense products and of the libraries

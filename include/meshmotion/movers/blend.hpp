@@ -122,6 +122,7 @@ class BlendMover {
     // node and no node is written twice, so the operator does not depend on the order.
     std::vector<std::vector<Eigen::Triplet<double, Index>>> lists(static_cast<std::size_t>(num_threads()));
     Index evaluated = 0;
+    detail::RegionErrors errors;
 #pragma omp parallel num_threads(static_cast<int>(lists.size())) reduction(+ : evaluated)
     {
 #ifdef _OPENMP
@@ -130,48 +131,54 @@ class BlendMover {
       std::vector<Eigen::Triplet<double, Index>>& triplets = lists[0];
 #endif
       std::array<double, max_facet_nodes> shape{};
-      std::vector<detail::WallPoint<Dim>> closest(walls.size());
-      std::vector<double> phi(walls.size(), 0.0);
+      std::vector<detail::WallPoint<Dim>> closest;
+      std::vector<double> phi;
+      errors.run([&] {
+        closest.resize(walls.size());
+        phi.assign(walls.size(), 0.0);
+      });
       // Nodes near a wall cost a closest-facet search, the others a pruned search per wall.
 #pragma omp for schedule(dynamic, 1024)
-      for (Index v = 0; v < n; ++v) {
-        const Index k = slot_[static_cast<std::size_t>(v)];
-        if (k >= 0 && boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed) {
-          triplets.emplace_back(k, v, 1.0);
-          continue;
-        }
-        if (k >= 0 && boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::fixed) continue;
-        const Vec<Dim> x = mesh.points.col(v);
-        bool any = false;
-        for (const std::size_t b : active) {
-          phi[b] = 0.0;
-          if (!distance[b].vertex_within(x, reach[b])) continue;
-          closest[b] = distance[b].closest(x);
-          const double length = length_at(b, closest[b].facet);
-          phi[b] = length > 0.0 ? rbf_value(RbfKernel::wendland2, closest[b].distance, length) : 0.0;
-          any = any || phi[b] > 0.0;
-        }
-        if (!any) continue;
-        ++evaluated;
-        for (const std::size_t b : active) {
-          if (phi[b] == 0.0) continue;
-          // Another wall c within reach damps b's share to zero on c. In a gap narrower than
-          // L_c the damping runs over the gap's width d_b + d_c instead: over L_c it would
-          // suppress b's share already at b's own first cells (the 30P30N flap gap folded).
-          double weight = phi[b];
-          for (const std::size_t c : active)
-            if (c != b && phi[c] > 0.0)
-              weight *= 1.0 - rbf_value(RbfKernel::wendland2, closest[c].distance,
-                                        std::min(length_at(c, closest[c].facet), closest[b].distance + closest[c].distance));
-          const detail::WallFacet& f = distance[b].facets()[static_cast<std::size_t>(closest[b].facet)];
-          shape_functions(f.type, closest[b].xi, std::span<double>(shape.data(), static_cast<std::size_t>(num_nodes(f.type))));
-          for (int j = 0; j < num_nodes(f.type); ++j)
-            if (weight * shape[static_cast<std::size_t>(j)] != 0.0)
-              triplets.emplace_back(slot_[static_cast<std::size_t>(f.nodes[static_cast<std::size_t>(j)])], v,
-                                    weight * shape[static_cast<std::size_t>(j)]);
-        }
-      }
+      for (Index v = 0; v < n; ++v)
+        errors.run([&] {
+          const Index k = slot_[static_cast<std::size_t>(v)];
+          if (k >= 0 && boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed) {
+            triplets.emplace_back(k, v, 1.0);
+            return;
+          }
+          if (k >= 0 && boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::fixed) return;
+          const Vec<Dim> x = mesh.points.col(v);
+          bool any = false;
+          for (const std::size_t b : active) {
+            phi[b] = 0.0;
+            if (!distance[b].vertex_within(x, reach[b])) continue;
+            closest[b] = distance[b].closest(x);
+            const double length = length_at(b, closest[b].facet);
+            phi[b] = length > 0.0 ? rbf_value(RbfKernel::wendland2, closest[b].distance, length) : 0.0;
+            any = any || phi[b] > 0.0;
+          }
+          if (!any) return;
+          ++evaluated;
+          for (const std::size_t b : active) {
+            if (phi[b] == 0.0) continue;
+            // Another wall c within reach damps b's share to zero on c. In a gap narrower than
+            // L_c the damping runs over the gap's width d_b + d_c instead: over L_c it would
+            // suppress b's share already at b's own first cells (the 30P30N flap gap folded).
+            double weight = phi[b];
+            for (const std::size_t c : active)
+              if (c != b && phi[c] > 0.0)
+                weight *= 1.0 - rbf_value(RbfKernel::wendland2, closest[c].distance,
+                                          std::min(length_at(c, closest[c].facet), closest[b].distance + closest[c].distance));
+            const detail::WallFacet& f = distance[b].facets()[static_cast<std::size_t>(closest[b].facet)];
+            shape_functions(f.type, closest[b].xi, std::span<double>(shape.data(), static_cast<std::size_t>(num_nodes(f.type))));
+            for (int j = 0; j < num_nodes(f.type); ++j)
+              if (weight * shape[static_cast<std::size_t>(j)] != 0.0)
+                triplets.emplace_back(slot_[static_cast<std::size_t>(f.nodes[static_cast<std::size_t>(j)])], v,
+                                      weight * shape[static_cast<std::size_t>(j)]);
+          }
+        });
     }
+    errors.rethrow();
     evaluated_ = evaluated;
     std::vector<Eigen::Triplet<double, Index>> triplets;
     for (const auto& list : lists) triplets.insert(triplets.end(), list.begin(), list.end());

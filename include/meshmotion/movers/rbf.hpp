@@ -318,11 +318,14 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
 #pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
       for (Index r = 0; r < n_eval; ++r) out.col(evaluated_[static_cast<std::size_t>(r)]) = evaluated_values_.row(r).transpose();
     } else {
+      detail::RegionErrors errors;
 #pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
-      for (Index r = 0; r < n_eval; ++r) {
-        const Index node = evaluated_[static_cast<std::size_t>(r)];
-        out.col(node) = (kernel_row(points_.col(node)) * alpha_).transpose();
-      }
+      for (Index r = 0; r < n_eval; ++r)
+        errors.run([&] {
+          const Index node = evaluated_[static_cast<std::size_t>(r)];
+          out.col(node) = (kernel_row(points_.col(node)) * alpha_).transpose();
+        });
+      errors.rethrow();
     }
     if (!options_.polynomial) return;
     const auto n_interior = static_cast<Index>(interior_.size());
@@ -570,8 +573,11 @@ void RbfMover<Dim>::build_evaluation(const detail::RbfKernelSettings& kernel) {
     if (dense) {
       dense_operator_.resize(static_cast<Index>(evaluated_.size()), k);
       const auto n_eval = static_cast<Index>(evaluated_.size());
+      detail::RegionErrors errors;
 #pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
-      for (Index r = 0; r < n_eval; ++r) dense_operator_.row(r) = kernel_row(points_.col(evaluated_[static_cast<std::size_t>(r)]));
+      for (Index r = 0; r < n_eval; ++r)
+        errors.run([&] { dense_operator_.row(r) = kernel_row(points_.col(evaluated_[static_cast<std::size_t>(r)])); });
+      errors.rethrow();
       stats_.nonzeros += dense_operator_.size();
     }
   }

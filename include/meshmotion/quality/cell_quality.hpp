@@ -131,13 +131,16 @@ template <int Dim>
   Index offset = 0;
   for (const auto& block : mesh.cells) {
     const Index n = block.size();
+    detail::RegionErrors errors;
 #if defined(_OPENMP)
 #pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
 #endif
-    for (Index e = 0; e < n; ++e) {
-      const auto q = knupp_quality(block.type, detail::gather(mesh, block, e), reference);
-      out[static_cast<std::size_t>(offset + e)] = {detail::select(q, metric), q.valid};
-    }
+    for (Index e = 0; e < n; ++e)
+      errors.run([&] {
+        const auto q = knupp_quality(block.type, detail::gather(mesh, block, e), reference);
+        out[static_cast<std::size_t>(offset + e)] = {detail::select(q, metric), q.valid};
+      });
+    errors.rethrow();
     offset += n;
   }
   return out;

@@ -371,15 +371,18 @@ template <int Dim>
       throw InputError("scaled_jacobians: a " + std::to_string(Dim) + "D mesh has a cell block of " +
                        std::string(name(block.type)) + " (expected elements of dimension " + std::to_string(Dim) + ")");
     (void)detail::jacobian_space(block.type);  // build the tables before the threads start
+    detail::RegionErrors errors;
 #if defined(_OPENMP)
 #pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(dynamic, 256)
 #endif
-    for (Index e = 0; e < n; ++e) {
-      detail::ElementCoords<Dim> x(Dim, nn);
-      const auto nodes = block.element(e);
-      for (int i = 0; i < nn; ++i) x.col(i) = mesh.points.col(nodes[static_cast<std::size_t>(i)]);
-      out[static_cast<std::size_t>(offset + e)] = detail::scaled_jacobian_fixed<Dim>(block.type, x, options);
-    }
+    for (Index e = 0; e < n; ++e)
+      errors.run([&] {
+        detail::ElementCoords<Dim> x(Dim, nn);
+        const auto nodes = block.element(e);
+        for (int i = 0; i < nn; ++i) x.col(i) = mesh.points.col(nodes[static_cast<std::size_t>(i)]);
+        out[static_cast<std::size_t>(offset + e)] = detail::scaled_jacobian_fixed<Dim>(block.type, x, options);
+      });
+    errors.rethrow();
     offset += n;
   }
   return out;

@@ -306,6 +306,7 @@ template <int Dim, class CellFn>
   for (auto& l : lists) l.reserve(static_cast<std::size_t>(entries / static_cast<Index>(threads) + 64));
   for (Index b = 0; b < static_cast<Index>(mesh.cells.size()); ++b) {
     const Index n_cells = mesh.cells[static_cast<std::size_t>(b)].size();
+    detail::RegionErrors errors;
 #pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
     for (Index e = 0; e < n_cells; ++e) {
 #ifdef _OPENMP
@@ -313,8 +314,9 @@ template <int Dim, class CellFn>
 #else
       std::vector<Triplet>& mine = lists[0];
 #endif
-      cell(b, e, mine);
+      errors.run([&] { cell(b, e, mine); });
     }
+    errors.rethrow();
   }
   std::vector<Triplet> all;
   all.reserve(static_cast<std::size_t>(entries));

@@ -188,41 +188,45 @@ class PartitionOfUnityRbf {
       double value;
     };
     std::vector<std::vector<Entry>> found(static_cast<std::size_t>(chunks));
+    RegionErrors errors;
 #pragma omp parallel num_threads(::meshmotion::num_threads())
     {
       std::vector<Neighbor> patches, hits;
-      std::vector<double> share(systems_.size(), 0.0);  // per patch, its weight at x (0: not covering)
+      std::vector<double> share;  // per patch, its weight at x (0: not covering)
+      errors.run([&] { share.assign(systems_.size(), 0.0); });
 #pragma omp for schedule(dynamic, 1)
-      for (Index c = 0; c < chunks; ++c) {
-        auto& entries = found[static_cast<std::size_t>(c)];
-        for (Index r = n * c / chunks; r < n * (c + 1) / chunks; ++r) {
-          const Vec<Dim> x = points.col(rows[static_cast<std::size_t>(r)]);
-          patch_tree_.radius_search(x, largest_radius_, patches);
-          // Patch order, not the tree's: the weights' sum is then the same on any thread count.
-          std::sort(patches.begin(), patches.end());
-          double total = 0.0;
-          for (const auto& [j, d2] : patches) {
-            share[j] = rbf_value(RbfKernel::wendland2, std::sqrt(d2), patch_radius_[j]);
-            total += share[j];
-          }
-          const std::size_t before = entries.size();
-          if (total > 0.0) {
-            tree_.radius_search(x, kernel_.radius, hits);
-            for (const auto& [centre, h2] : hits) {
-              const double phi = rbf_value(kernel_.kernel, std::sqrt(h2), kernel_.radius) / total;
-              for (const Index packed : membership_.row(static_cast<Index>(centre))) {
-                const Index j = packed >> 32;
-                const double w = share[static_cast<std::size_t>(j)];
-                if (w > 0.0)
-                  entries.push_back({static_cast<int>(offsets_[static_cast<std::size_t>(j)] + (packed & 0xffffffff)), w * phi});
+      for (Index c = 0; c < chunks; ++c)
+        errors.run([&] {
+          auto& entries = found[static_cast<std::size_t>(c)];
+          for (Index r = n * c / chunks; r < n * (c + 1) / chunks; ++r) {
+            const Vec<Dim> x = points.col(rows[static_cast<std::size_t>(r)]);
+            patch_tree_.radius_search(x, largest_radius_, patches);
+            // Patch order, not the tree's: the weights' sum is then the same on any thread count.
+            std::sort(patches.begin(), patches.end());
+            double total = 0.0;
+            for (const auto& [j, d2] : patches) {
+              share[j] = rbf_value(RbfKernel::wendland2, std::sqrt(d2), patch_radius_[j]);
+              total += share[j];
+            }
+            const std::size_t before = entries.size();
+            if (total > 0.0) {
+              tree_.radius_search(x, kernel_.radius, hits);
+              for (const auto& [centre, h2] : hits) {
+                const double phi = rbf_value(kernel_.kernel, std::sqrt(h2), kernel_.radius) / total;
+                for (const Index packed : membership_.row(static_cast<Index>(centre))) {
+                  const Index j = packed >> 32;
+                  const double w = share[static_cast<std::size_t>(j)];
+                  if (w > 0.0)
+                    entries.push_back({static_cast<int>(offsets_[static_cast<std::size_t>(j)] + (packed & 0xffffffff)), w * phi});
+                }
               }
             }
+            for (const auto& [j, d2] : patches) share[j] = 0.0;
+            count[static_cast<std::size_t>(r)] = static_cast<int>(entries.size() - before);
           }
-          for (const auto& [j, d2] : patches) share[j] = 0.0;
-          count[static_cast<std::size_t>(r)] = static_cast<int>(entries.size() - before);
-        }
-      }
+        });
     }
+    errors.rethrow();
     Eigen::SparseMatrix<double, Eigen::RowMajor, int> m = rows_of_counts(count, num_coefficients(), kept);
     std::size_t at = 0;
     for (const auto& entries : found)

@@ -98,19 +98,22 @@ template <int Dim, class Within>
   // rows with many and with no neighbours; each range's pairs go to one buffer, in row order.
   const Index chunks = std::clamp<Index>(n / 256, 1, 64);
   std::vector<std::vector<Neighbor>> found(static_cast<std::size_t>(chunks));
+  RegionErrors errors;
 #pragma omp parallel num_threads(::meshmotion::num_threads())
   {
     std::vector<Neighbor> buffer;
 #pragma omp for schedule(dynamic, 1)
-    for (Index c = 0; c < chunks; ++c) {
-      std::vector<Neighbor>& pairs = found[static_cast<std::size_t>(c)];
-      for (Index r = n * c / chunks; r < n * (c + 1) / chunks; ++r) {
-        within(Vec<Dim>(points.col(rows[static_cast<std::size_t>(r)])), buffer);
-        count[static_cast<std::size_t>(r)] = static_cast<int>(buffer.size());
-        pairs.insert(pairs.end(), buffer.begin(), buffer.end());
-      }
-    }
+    for (Index c = 0; c < chunks; ++c)
+      errors.run([&] {
+        std::vector<Neighbor>& pairs = found[static_cast<std::size_t>(c)];
+        for (Index r = n * c / chunks; r < n * (c + 1) / chunks; ++r) {
+          within(Vec<Dim>(points.col(rows[static_cast<std::size_t>(r)])), buffer);
+          count[static_cast<std::size_t>(r)] = static_cast<int>(buffer.size());
+          pairs.insert(pairs.end(), buffer.begin(), buffer.end());
+        }
+      });
   }
+  errors.rethrow();
   Eigen::SparseMatrix<double, Eigen::RowMajor, int> m = rows_of_counts(count, n_centres, kept);
   // Where each range's pairs start.
   std::vector<Index> start(found.size() + 1, 0);
