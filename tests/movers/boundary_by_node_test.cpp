@@ -163,6 +163,39 @@ TEST_CASE("prescribed group: displacements given to move() by node", "[movers][b
   CHECK_THAT(input_error_of([&] { (void)b.column(interior); }), Catch::Contains("not a boundary node"));
 }
 
+TEST_CASE("boundary messages name a node by the file's id too, where the file numbers it otherwise", "[movers][boundary]") {
+  Mesh<2> mesh = rectangle_mesh({});
+  const Ramp ramp = shuffled_ramp(mesh);
+  const Index top_node = mesh.group_nodes("top").front();
+  std::vector<Index> nodes = ramp.nodes;
+  nodes[3] = top_node;
+  const auto message = [&] {
+    return input_error_of([&] {
+      BoundarySpec<2> spec;
+      spec.moving("bottom", nodes, ramp.displacements);
+      (void)spec.resolve(mesh);
+    });
+  };
+  // A .msh numbers from 1: the user's id is the index + 1.
+  CHECK_THAT(message(), Catch::Contains("node " + std::to_string(top_node) + " (id " + std::to_string(top_node + 1) +
+                                        " in the file) is not in the group"));
+  // SU2 and OpenFOAM number from 0: index and id agree, and only one is given.
+  mesh.first_node_id = 0;
+  CHECK_THAT(message(), Catch::Contains("node " + std::to_string(top_node) + " is not in the group"));
+  mesh.node_ids.resize(static_cast<std::size_t>(mesh.num_nodes()));
+  for (Index i = 0; i < mesh.num_nodes(); ++i) mesh.node_ids[static_cast<std::size_t>(i)] = 1000 + 3 * i;
+  CHECK_THAT(message(), Catch::Contains("(id " + std::to_string(1000 + 3 * top_node) + " in the file)"));
+
+  // Two prescribed groups giving a shared node different displacements.
+  mesh.node_ids.clear();
+  mesh.first_node_id = 1;
+  const Index corner = mesh.group_nodes("left").front();
+  BoundarySpec<2> clash;
+  clash.moving("left", Translation<2>{Vec<2>(0.1, 0.0)}).moving("bottom", Translation<2>{Vec<2>(0.0, 0.1)});
+  CHECK_THAT(input_error_of([&] { (void)clash.resolve(mesh); }),
+             Catch::Contains("node " + std::to_string(corner) + " (id " + std::to_string(corner + 1) + " in the file) gets two"));
+}
+
 TEST_CASE("file node ids map to node indices", "[movers][boundary]") {
   Mesh<2> mesh = rectangle_mesh({});
   const std::vector<std::int64_t> ids{1, 5, 3};

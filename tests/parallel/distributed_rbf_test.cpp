@@ -344,8 +344,14 @@ TEST_CASE("distributed RBF: an error on one rank is raised on every rank", "[par
 }
 
 TEST_CASE("partition_mesh keeps every node once, and gather_owned restores the whole numbering", "[parallel][mesh]") {
-  const Mesh<3> mesh = box_mesh({.nx = 5, .ny = 4, .nz = 3, .cells = BoxCells::tet_pyramid_prism});
+  Mesh<3> mesh = box_mesh({.nx = 5, .ny = 4, .nz = 3, .cells = BoxCells::tet_pyramid_prism});
+  mesh.first_node_id = 0;  // as SU2 and OpenFOAM number
   const DistributedMesh<3> part = partition_mesh(world(), mesh);
+  // Each local node keeps the file's id of its node in the whole mesh.
+  double wrong_id = 0.0;
+  for (Index i = 0; i < part.local.num_nodes(); ++i)
+    if (part.local.node_id(i) != mesh.node_id(static_cast<Index>(part.global_ids[static_cast<std::size_t>(i)]))) wrong_id = 1.0;
+  CHECK(global_max(wrong_id) == 0.0);
   Index owned = part.num_owned, cells = part.local.num_cells();
   MPI_Allreduce(MPI_IN_PLACE, &owned, 1, MPI_INT64_T, MPI_SUM, world());
   MPI_Allreduce(MPI_IN_PLACE, &cells, 1, MPI_INT64_T, MPI_SUM, world());

@@ -175,6 +175,15 @@ struct Mesh {
     return node_ids.empty() ? static_cast<std::int64_t>(i) + first_node_id : node_ids[static_cast<std::size_t>(i)];
   }
 
+  /// "node i" for messages, with the file's id beside the index when the two differ (a user
+  /// looks the node up by the file's id; the index is what the library's arrays use).
+  [[nodiscard]] std::string describe_node(Index i) const {
+    std::string text = "node " + std::to_string(i);
+    if (i < 0 || i >= num_nodes()) return text;
+    const std::int64_t id = node_id(i);
+    return id == i ? text : text + " (id " + std::to_string(id) + " in the file)";
+  }
+
   /// The node indices of file node ids (node_id()'s inverse), in the order given. Throws
   /// InputError naming the first id that no node has.
   [[nodiscard]] std::vector<Index> node_indices(std::span<const std::int64_t> ids) const {
@@ -266,11 +275,8 @@ void validate(const Mesh<Dim>& mesh) {
   for (Index i = 0; i < n; ++i)
     for (int d = 0; d < Dim; ++d)
       if (!std::isfinite(mesh.points(d, i)))
-        throw InputError("validate: node " + std::to_string(i) +
-                         (static_cast<std::size_t>(i) < mesh.node_ids.size()
-                              ? " (id " + std::to_string(mesh.node_ids[static_cast<std::size_t>(i)]) + " in the file)"
-                              : std::string()) +
-                         " has a non-finite coordinate (" + std::to_string(mesh.points(d, i)) + ")");
+        throw InputError("validate: " + mesh.describe_node(i) + " has a non-finite coordinate (" +
+                         std::to_string(mesh.points(d, i)) + ")");
   if (!mesh.node_ids.empty() && static_cast<Index>(mesh.node_ids.size()) != n)
     throw InputError("validate: " + std::to_string(mesh.node_ids.size()) + " node ids for " +
                      std::to_string(n) + " nodes");

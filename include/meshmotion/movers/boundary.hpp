@@ -323,10 +323,11 @@ class BoundarySpec {
   /// linearly), so a driver can split the motion into steps. Throws InputError for an unknown
   /// group (listing the known ones), a wrong-sized or non-finite displacement array, or a
   /// non-planar sliding group.
+  /// Messages name a node by its index and, where the file numbers it otherwise, its id there.
   [[nodiscard]] ResolvedBoundary<Dim> resolve(const Mesh<Dim>& mesh, double to = 1.0, double from = 0.0) const {
     GroupNodes nodes;
     for (const auto& g : groups_) nodes.emplace(g.name, mesh.group_nodes(g.name));
-    return resolve(mesh.points, nodes, to, from);
+    return resolve_nodes(mesh.points, nodes, to, from, &mesh);
   }
 
   /// Resolves with explicit node lists per group name (for MeshLike meshes without groups).
@@ -334,6 +335,30 @@ class BoundarySpec {
   /// node indices outside [0, n_nodes).
   [[nodiscard]] ResolvedBoundary<Dim> resolve(const Points<Dim>& points, const GroupNodes& group_nodes,
                                               double to = 1.0, double from = 0.0) const {
+    return resolve_nodes(points, group_nodes, to, from, nullptr);
+  }
+
+ private:
+  struct Group {
+    std::string name;
+    BoundaryKind kind;
+    std::optional<Motion<Dim>> motion;
+    Points<Dim> displacements;
+    std::optional<Vec<Dim>> normal;
+    std::vector<Index> node_order{};  ///< nodes of `displacements`' columns; empty: the sorted group
+    bool later = false;               ///< prescribed, displacements given to move()
+  };
+  using Entry = BoundaryEntry<Dim>;
+
+  /// How messages name node v: with the file's id when the nodes come from a mesh.
+  struct NodeNames {
+    const Mesh<Dim>* mesh = nullptr;
+    [[nodiscard]] std::string operator()(Index v) const { return mesh ? mesh->describe_node(v) : "node " + std::to_string(v); }
+  };
+
+  [[nodiscard]] ResolvedBoundary<Dim> resolve_nodes(const Points<Dim>& points, const GroupNodes& group_nodes, double to,
+                                                    double from, const Mesh<Dim>* mesh) const {
+    const NodeNames node_name{mesh};
     BoundaryCollector<Dim> entries(points.cols());
     for (auto g = groups_.begin(); g != groups_.end(); ++g)
       for (auto h = groups_.begin(); h != g; ++h)
@@ -351,26 +376,14 @@ class BoundarySpec {
       std::vector<Index> list = found->second;
       for (const Index v : list)
         if (v < 0 || v >= points.cols())
-          throw InputError("BoundarySpec::resolve: group '" + g.name + "' refers to node " + std::to_string(v) +
+          throw InputError("BoundarySpec::resolve: group '" + g.name + "' refers to " + node_name(v) +
                            " (expected 0 to " + std::to_string(points.cols() - 1) + ")");
       std::sort(list.begin(), list.end());
       list.erase(std::unique(list.begin(), list.end()), list.end());
-      add_group(g, list, points, to, from, entries);
+      add_group(g, list, points, to, from, node_name, entries);
     }
     return entries.resolve();
   }
-
- private:
-  struct Group {
-    std::string name;
-    BoundaryKind kind;
-    std::optional<Motion<Dim>> motion;
-    Points<Dim> displacements;
-    std::optional<Vec<Dim>> normal;
-    std::vector<Index> node_order{};  ///< nodes of `displacements`' columns; empty: the sorted group
-    bool later = false;               ///< prescribed, displacements given to move()
-  };
-  using Entry = BoundaryEntry<Dim>;
 
   /// Sine of the angle below which two plane normals count as parallel (and a line as lying
   /// in a plane).
@@ -410,35 +423,35 @@ class BoundarySpec {
   }
 
   // The displacements of a group given with their nodes, in the order of the sorted `list`.
-  static Points<Dim> by_node(const Group& g, const std::vector<Index>& list, Index num_nodes) {
+  static Points<Dim> by_node(const Group& g, const std::vector<Index>& list, Index num_nodes, const NodeNames& node_name) {
     std::vector<Index> slot(static_cast<std::size_t>(num_nodes), -1);
     for (std::size_t k = 0; k < list.size(); ++k) slot[static_cast<std::size_t>(list[k])] = static_cast<Index>(k);
     Points<Dim> out(Dim, static_cast<Index>(list.size()));
     std::vector<char> given(list.size(), 0);
-    const std::string where = "BoundarySpec::resolve: group '" + g.name + "': node ";
+    const std::string where = "BoundarySpec::resolve: group '" + g.name + "': ";
     for (std::size_t k = 0; k < g.node_order.size(); ++k) {
       const Index v = g.node_order[k];
       if (v < 0 || v >= num_nodes)
-        throw InputError(where + std::to_string(v) + " is not a node of the mesh (expected 0 to " +
+        throw InputError(where + "node " + std::to_string(v) + " is not a node of the mesh (expected 0 to " +
                          std::to_string(num_nodes - 1) + ")");
       const Index s = slot[static_cast<std::size_t>(v)];
-      if (s < 0) throw InputError(where + std::to_string(v) + " is not in the group");
-      if (given[static_cast<std::size_t>(s)]) throw InputError(where + std::to_string(v) + " is given twice");
+      if (s < 0) throw InputError(where + node_name(v) + " is not in the group");
+      if (given[static_cast<std::size_t>(s)]) throw InputError(where + node_name(v) + " is given twice");
       if (!g.displacements.col(static_cast<Index>(k)).allFinite())
-        throw InputError(where + std::to_string(v) + " has a non-finite displacement");
+        throw InputError(where + node_name(v) + " has a non-finite displacement");
       given[static_cast<std::size_t>(s)] = 1;
       out.col(s) = g.displacements.col(static_cast<Index>(k));
     }
     const auto missing = std::find(given.begin(), given.end(), 0);
     if (missing != given.end())
-      throw InputError(where + std::to_string(list[static_cast<std::size_t>(missing - given.begin())]) +
+      throw InputError(where + node_name(list[static_cast<std::size_t>(missing - given.begin())]) +
                        " has no displacement (" + std::to_string(std::count(given.begin(), given.end(), 0)) + " of " +
                        std::to_string(list.size()) + " group nodes missing)");
     return out;
   }
 
   static void add_group(const Group& g, const std::vector<Index>& list, const Points<Dim>& points, double to,
-                        double from, BoundaryCollector<Dim>& entries) {
+                        double from, const NodeNames& node_name, BoundaryCollector<Dim>& entries) {
     const auto n = static_cast<Index>(list.size());
     Points<Dim> targets = Points<Dim>::Zero(Dim, n);
     if (g.kind == BoundaryKind::prescribed) {
@@ -447,7 +460,7 @@ class BoundarySpec {
       } else if (g.later) {
         // zero until move()'s input says otherwise
       } else if (!g.node_order.empty()) {
-        targets = (to - from) * by_node(g, list, points.cols());
+        targets = (to - from) * by_node(g, list, points.cols(), node_name);
       } else {
         if (g.displacements.cols() != n)
           throw InputError("BoundarySpec::resolve: group '" + g.name + "' has " + std::to_string(n) +
@@ -469,7 +482,7 @@ class BoundarySpec {
       if (e.kind == BoundaryKind::prescribed && g.kind == BoundaryKind::prescribed) {
         const double scale = std::max({1.0, e.displacement.norm(), incoming.displacement.norm()});
         if ((e.displacement - incoming.displacement).norm() > 1e-12 * scale)
-          throw InputError("BoundarySpec::resolve: node " + std::to_string(list[k]) +
+          throw InputError("BoundarySpec::resolve: " + node_name(list[k]) +
                            " gets two different displacements (group '" + g.name + "' conflicts with an earlier group)");
       } else if (g.kind == BoundaryKind::sliding && e.kind == BoundaryKind::sliding) {
         intersect(e, normal);

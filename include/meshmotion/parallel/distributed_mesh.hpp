@@ -58,6 +58,7 @@ struct PartitionView {
 
 /// A rank's part of a mesh: local nodes (owned first, then ghosts, each by ascending global
 /// id), the cells assigned to this rank, the facets whose nodes are all local, and every group.
+/// `local.node_ids` holds each local node's id in the file, so messages name the user's ids.
 template <int Dim>
 struct DistributedMesh {
   MPI_Comm comm = MPI_COMM_WORLD;

@@ -270,7 +270,8 @@ template <int Dim>
       part.local.points.col(static_cast<Index>(i)) = whole.points.col(nodes[i]);
       part.global_ids.push_back(nodes[i]);
       part.owner.push_back(owner[static_cast<std::size_t>(nodes[i])]);
-      if (!whole.node_ids.empty()) part.local.node_ids.push_back(whole.node_ids[static_cast<std::size_t>(nodes[i])]);
+      // A part's nodes are not a run of the file's numbering: each keeps its own id.
+      part.local.node_ids.push_back(whole.node_id(nodes[i]));
     }
     c = 0;
     for (const auto& block : whole.cells) {
