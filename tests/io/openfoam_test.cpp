@@ -348,6 +348,20 @@ TEST_CASE("OpenFOAM: corrupt counts, labels and classes are refused before anyth
   // A face relabelled to a cell of its own: a cell of one face.
   CHECK_THAT(edited("owner", Format::ascii, [](std::string& t) { t.replace(t.rfind("\n2\n"), 3, "\n3\n"); }),
              Catch::Contains("owner") && Catch::Contains("cell 3 is bounded by 1 face in the owner and neighbour lists"));
+  // An owner/neighbour pair relabelled: the face would turn into the other cell.
+  CHECK_THAT(edited("neighbour", Format::ascii, [](std::string& t) { t.replace(t.rfind("2\n)"), 3, "0\n)"); }),
+             Catch::Contains("neighbour") && Catch::Contains("internal face 2 has owner 1 and neighbour 0"));
+  // A face listed the wrong way round, internal or on the boundary: its cell is open.
+  CHECK_THAT(edited("faces", Format::ascii, [](std::string& t) { t.replace(t.find("4(3 11 12 4)"), 12, "4(4 12 11 3)"); }),
+             Catch::Contains("faces") && Catch::Contains("cell 1 is open") && Catch::Contains("face 2 points into it"));
+  CHECK_THAT(edited("faces", Format::binary, [](std::string& t) {
+               // Binary faces: the compact list's labels, 4 bytes each; swap face 3's 2nd and 4th.
+               const std::string label8("\x08\0\0\0\x0d\0\0\0\x05\0\0\0", 12);
+               const auto at = t.find(label8);
+               std::swap_ranges(t.begin() + static_cast<std::ptrdiff_t>(at), t.begin() + static_cast<std::ptrdiff_t>(at) + 4,
+                                t.begin() + static_cast<std::ptrdiff_t>(at) + 8);
+             }),
+             Catch::Contains("cell 0 is open") && Catch::Contains("face 3 points into it"));
 }
 
 TEST_CASE("OpenFOAM: checkMesh's measures agree with checkMesh on the shared case, a moved one and a polyhedral one",

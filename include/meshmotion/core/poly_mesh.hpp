@@ -35,6 +35,16 @@ struct PolyMesh {
     return {face_nodes.data() + face_offsets[static_cast<std::size_t>(f)],
             static_cast<std::size_t>(face_offsets[static_cast<std::size_t>(f) + 1] - face_offsets[static_cast<std::size_t>(f)])};
   }
+  /// The vector area of face f (half the sum of its edges' cross products), pointing out of
+  /// its owner. Exact for warped faces too: a closed cell's faces sum to zero, each edge
+  /// counted once each way.
+  [[nodiscard]] Vec<3> face_area(Index f) const {
+    const auto v = face(f);
+    const Vec<3> first = points.col(v[0]);
+    Vec<3> sum = Vec<3>::Zero();
+    for (std::size_t i = 1; i + 1 < v.size(); ++i) sum += (points.col(v[i]) - first).cross(points.col(v[i + 1]) - first);
+    return 0.5 * sum;
+  }
 };
 
 }  // namespace meshmotion

@@ -140,6 +140,43 @@ inline void read_foam_faces(const std::filesystem::path& file, PolyMesh& mesh) {
   return patches;
 }
 
+/// Calls fail(message) for the first cell whose faces, each turned out of the cell, do not close
+/// (OpenFOAM's checkMesh "open cells", with its threshold): a face listed the wrong way round,
+/// or given to the wrong cell. Names the face whose reversal would close the cell when one does.
+template <class Fail>
+void check_closed_cells(const PolyMesh& mesh, Fail&& fail) {
+  const auto n = static_cast<std::size_t>(mesh.num_cells);
+  std::vector<Vec<3>> sum(n, Vec<3>::Zero());
+  std::vector<double> total(n, 0.0);
+  std::vector<Vec<3>> area(static_cast<std::size_t>(mesh.num_faces()));
+  for (Index f = 0; f < mesh.num_faces(); ++f) {
+    const auto i = static_cast<std::size_t>(f);
+    area[i] = mesh.face_area(f);
+    const auto o = static_cast<std::size_t>(mesh.owner[i]);
+    sum[o] += area[i];
+    total[o] += area[i].norm();
+    if (f < mesh.num_internal_faces()) {
+      const auto nb = static_cast<std::size_t>(mesh.neighbour[i]);
+      sum[nb] -= area[i];
+      total[nb] += area[i].norm();
+    }
+  }
+  constexpr double closed = 1e-6;
+  for (std::size_t c = 0; c < n; ++c) {
+    if (sum[c].norm() <= closed * total[c]) continue;
+    std::string culprit;
+    for (Index f = 0; f < mesh.num_faces() && culprit.empty(); ++f) {
+      const auto i = static_cast<std::size_t>(f);
+      const bool owned = static_cast<std::size_t>(mesh.owner[i]) == c;
+      if (!owned && !(f < mesh.num_internal_faces() && static_cast<std::size_t>(mesh.neighbour[i]) == c)) continue;
+      if ((sum[c] - (owned ? 2.0 : -2.0) * area[i]).norm() <= closed * total[c])
+        culprit = "; face " + std::to_string(f) + " points into it, as if listed the wrong way round";
+    }
+    fail("cell " + std::to_string(c) + " is open: its faces' area vectors, turned out of the cell, sum to " +
+         std::to_string(sum[c].norm() / total[c]) + " of their total (at most 1e-06)" + culprit);
+  }
+}
+
 /// The label list of a polyMesh file (owner, neighbour).
 [[nodiscard]] inline std::vector<Index> read_foam_labels(const std::filesystem::path& file, std::string_view what, Index max_uniform) {
   const std::string text = read_foam_file(file);
@@ -191,10 +228,15 @@ inline void read_foam_faces(const std::filesystem::path& file, PolyMesh& mesh) {
     if (mesh.owner[f] < 0 || mesh.owner[f] >= max_cells)
       fail("owner", "face " + std::to_string(f) + " has owner " + std::to_string(mesh.owner[f]) + " (" + std::to_string(nf) +
                         " faces bound at most " + std::to_string(max_cells) + " cells, numbered from 0)");
-  for (std::size_t f = 0; f < mesh.neighbour.size(); ++f)
+  for (std::size_t f = 0; f < mesh.neighbour.size(); ++f) {
     if (mesh.neighbour[f] < 0 || mesh.neighbour[f] >= max_cells || mesh.neighbour[f] == mesh.owner[f])
       fail("neighbour", "internal face " + std::to_string(f) + " has neighbour " + std::to_string(mesh.neighbour[f]) + " (owner " +
                             std::to_string(mesh.owner[f]) + ", at most " + std::to_string(max_cells) + " cells)");
+    // The face's orientation is the owner's: a swapped pair turns it into the other cell.
+    if (mesh.neighbour[f] < mesh.owner[f])
+      fail("neighbour", "internal face " + std::to_string(f) + " has owner " + std::to_string(mesh.owner[f]) + " and neighbour " +
+                            std::to_string(mesh.neighbour[f]) + " (OpenFOAM's owner is the lower-numbered cell)");
+  }
   Index cells = 0;
   for (const Index c : mesh.owner) cells = std::max(cells, c + 1);
   for (const Index c : mesh.neighbour) cells = std::max(cells, c + 1);
@@ -207,6 +249,7 @@ inline void read_foam_faces(const std::filesystem::path& file, PolyMesh& mesh) {
                         (faces_of[static_cast<std::size_t>(c)] == 1 ? " face" : " faces") +
                         " in the owner and neighbour lists (a cell has 4 at least)");
   mesh.num_cells = cells;
+  detail::check_closed_cells(mesh, [&](const std::string& what) { fail("faces", what); });
   Index next = mesh.num_internal_faces();
   for (const auto& p : mesh.patches) {
     if (p.start != next || p.start + p.size > nf)
