@@ -23,7 +23,7 @@ run(${CMAKE_COMMAND} -S ${SOURCE} -B ${BUILD} -DCMAKE_CXX_COMPILER=${CLANG} -DCM
     "-DCMAKE_CXX_FLAGS=${sanitize}" -DMESHMOTION_BUILD_FUZZERS=ON -DMESHMOTION_WARNINGS_AS_ERRORS=OFF
     -DMESHMOTION_BUILD_EXAMPLES=OFF -DMESHMOTION_BUILD_PYTHON=OFF -DMESHMOTION_BUILD_COMPILED=OFF
     -DMESHMOTION_WITH_PARALLEL=OFF -DMESHMOTION_WITH_CAD=OFF -DMESHMOTION_USE_OPENMP=OFF -DMESHMOTION_INSTALL=OFF)
-set(readers gmsh su2 vtu openfoam)
+file(READ ${BUILD}/tests/fuzz/readers.txt readers)
 set(targets meshmotion_io_tests)
 foreach(reader ${readers})
   list(APPEND targets fuzz_${reader})
@@ -41,6 +41,7 @@ foreach(reader ${readers})
   set(scratch ${BUILD}/scratch_${reader})
   file(REMOVE_RECURSE ${scratch})
   file(MAKE_DIRECTORY ${scratch})
-  run(${BUILD}/tests/fuzz/fuzz_${reader} -max_total_time=${SECONDS} -rss_limit_mb=2048 -timeout=20
+  run(${CMAKE_COMMAND} -E env LSAN_OPTIONS=suppressions=${SOURCE}/tests/fuzz/cgns.supp
+      ${BUILD}/tests/fuzz/fuzz_${reader} -max_total_time=${SECONDS} -rss_limit_mb=2048 -timeout=20
       -artifact_prefix=${BUILD}/crashes/${reader}- ${scratch} ${SOURCE}/tests/fuzz/corpus/${reader})
 endforeach()
