@@ -42,7 +42,9 @@ inline void add_motion_options(CLI::App& app, MotionArguments& a) {
   rotate->excludes(translate)->excludes(file);
   translate->excludes(file);
   app.add_option("--fixed", a.fixed, "Fixed groups");
-  app.add_option("--sliding", a.sliding, "Groups sliding in their plane");
+  app.add_option("--sliding", a.sliding,
+                 "Groups sliding in their plane; NAME:NX,NY[,NZ] gives the plane's normal (each node slides in its own "
+                 "plane of that normal: an OpenFOAM 'empty' patch holding the front and the back of a 2D case)");
   app.add_option("--support-radius", a.support_radius, "support radius of rbf (default: heuristic from the boundary)");
 }
 
@@ -114,6 +116,24 @@ Motion<Dim> motion(const MotionArguments& a) {
   }
 }
 
+/// A --sliding entry: the group's name and, after its last ':', the normal when one is given
+/// ("defaultFaces:0,0,1"). A name holding ':' with no normal after it stays whole.
+template <int Dim>
+std::pair<std::string, std::optional<Vec<Dim>>> sliding_entry(const std::string& entry) {
+  const auto colon = entry.rfind(':');
+  if (colon == std::string::npos) return {entry, std::nullopt};
+  const std::string tail = entry.substr(colon + 1);
+  if (tail.empty() || tail.find_first_not_of("0123456789+-.eE,") != std::string::npos) return {entry, std::nullopt};
+  std::vector<double> normal;
+  std::istringstream in(tail);
+  for (std::string field; std::getline(in, field, ',');) {
+    double x = 0.0;
+    parse_option_value("--sliding " + entry.substr(0, colon) + " normal", field, x);
+    normal.push_back(x);
+  }
+  return {entry.substr(0, colon), vec<Dim>(normal, "sliding NAME:normal")};
+}
+
 /// The boundary conditions the arguments give, on `mesh`.
 template <int Dim>
 BoundarySpec<Dim> boundary_spec(const MotionArguments& a, const Mesh<Dim>& mesh) {
@@ -125,7 +145,10 @@ BoundarySpec<Dim> boundary_spec(const MotionArguments& a, const Mesh<Dim>& mesh)
     spec.moving(a.group, motion<Dim>(a));
   }
   for (const auto& g : a.fixed) spec.fixed(g);
-  for (const auto& g : a.sliding) spec.sliding(g);
+  for (const auto& entry : a.sliding) {
+    auto [group, normal] = sliding_entry<Dim>(entry);
+    spec.sliding(std::move(group), normal);
+  }
   for (const auto& o : spec.overlaps(mesh))
     std::cerr << "note: " << o.nodes << " node" << (o.nodes == 1 ? "" : "s") << " of '" << o.winner << "' (" << name(o.winner_kind)
               << ") " << (o.nodes == 1 ? "is" : "are") << " also in '" << o.other << "' (" << name(o.other_kind) << "): "

@@ -370,6 +370,22 @@ smoke_test(NAME move_mesh.openfoam_in_place_needs_overwrite.json REQUIRES exampl
            COMMAND move_mesh "${smoke_dir}/foam_case" -o "${smoke_dir}/foam_case" --group top --translate 0.05,0,0
                    --fixed bottom --json)
 
+# A 2D case stored in 3D: front (y = 0) and back (y = 1) are one group, two parallel planes.
+# It slides with the normal given (each node in its own plane); without it no plane fits.
+file(WRITE "${smoke_dir}/two_hexes_front_back.su2" "NDIME= 3\nNELEM= 2\n12 0 1 4 3 6 7 10 9 0\n12 1 2 5 4 7 8 11 10 1\n"
+     "NPOIN= 12\n0 0 0 0\n1 0 0 1\n2 0 0 2\n0 1 0 3\n1 1 0 4\n2 1 0 5\n0 0 1 6\n1 0 1 7\n2 0 1 8\n0 1 1 9\n1 1 1 10\n"
+     "2 1 1 11\nNMARK= 3\nMARKER_TAG= bottom\nMARKER_ELEMS= 2\n9 0 3 4 1\n9 1 4 5 2\nMARKER_TAG= top\nMARKER_ELEMS= 2\n"
+     "9 6 7 10 9\n9 7 8 11 10\nMARKER_TAG= frontAndBack\nMARKER_ELEMS= 4\n9 0 1 7 6\n9 1 2 8 7\n9 3 9 10 4\n9 4 10 11 5\n")
+smoke_test(NAME move_mesh.sliding_with_normal.json KEYS output VALUES after/invalid=0
+           COMMAND move_mesh "${smoke_dir}/two_hexes_front_back.su2" -o "${smoke_dir}/front_back_moved.vtu" --group top
+                   --translate 0.05,0,0 --fixed bottom --sliding frontAndBack:0,1,0 --method le --json)
+smoke_test(NAME move_mesh.sliding_two_planes_without_normal.json EXPECT_RC 1 KEYS error VALUES kind=input
+           COMMAND move_mesh "${smoke_dir}/two_hexes_front_back.su2" -o "${smoke_dir}/front_back_refused.vtu" --group top
+                   --translate 0.05,0,0 --fixed bottom --sliding frontAndBack --method le --json)
+smoke_test(NAME move_mesh.sliding_normal_of_two_values.json EXPECT_RC 1 KEYS error VALUES kind=input
+           COMMAND move_mesh "${smoke_dir}/two_hexes_front_back.su2" -o "${smoke_dir}/front_back_refused.vtu" --group top
+                   --translate 0.05,0,0 --fixed bottom --sliding frontAndBack:0,1 --json)
+
 # move_mesh_mpi: the same mesh as move_mesh's, byte for byte, from 3 ranks with the boundary
 # system replicated (the serial mover's factorization); through PETSc on request; elasticity
 # through PETSc; an unknown group or boundary solve refused by every rank with rank 0's message.
