@@ -6,6 +6,8 @@
 
 #include "meshmotion/core/types.hpp"
 
+#include <Eigen/Geometry>  // cross()
+
 #include <span>
 #include <string>
 #include <vector>
