@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <string>
 #include <utility>
@@ -182,6 +183,38 @@ TEST_CASE("blend mover: the default length is blending_factor wall layers, and l
   CHECK(one.invalid() == 0);
   CHECK(six.invalid() == 0);
   CHECK(1.0 - six.quality.min < 0.5 * (1.0 - one.quality.min));
+}
+
+TEST_CASE("blend mover: a layer estimate of the same wall vertices is reused, one of other walls is not", "[curving]") {
+  OMeshOptions o;
+  o.n_around = 64;
+  o.triangles = true;
+  const Mesh<2> mesh = o_mesh(o);
+  BoundarySpec<2> spec;
+  spec.moving("wall", Translation<2>{Vec<2>(1e-4, 0.0)});
+  spec.fixed("farfield");
+  const ResolvedBoundary<2> boundary = spec.resolve(mesh);
+  const auto lengths = [&](std::shared_ptr<const BoundaryLayerEstimate> estimate) {
+    BlendOptions options;
+    options.layer_estimate = std::move(estimate);
+    BlendMover<2> mover(options);
+    mover.setup(mesh, boundary);
+    return mover.blending_lengths();
+  };
+  const std::vector<double> own = lengths(nullptr);
+  REQUIRE(own.size() == 1);
+  REQUIRE(own[0] > 0.0);
+  // The same estimate handed in gives the same length, bit for bit.
+  const BoundaryLayerEstimate wall = estimate_boundary_layer(mesh, std::vector<std::string>{"wall"});
+  CHECK(lengths(std::make_shared<const BoundaryLayerEstimate>(wall)) == own);
+  // It is what the mover uses: doubled thicknesses double the length.
+  BoundaryLayerEstimate doubled = wall;
+  for (double& t : doubled.node_thickness) t *= 2.0;
+  CHECK(lengths(std::make_shared<const BoundaryLayerEstimate>(doubled))[0] == 2.0 * own[0]);
+  // An estimate over other wall vertices (the far field too) is not this setup's: ignored.
+  BoundaryLayerEstimate other = estimate_boundary_layer(mesh, std::vector<std::string>{"wall", "farfield"});
+  for (double& t : other.node_thickness) t *= 2.0;
+  CHECK(lengths(std::make_shared<const BoundaryLayerEstimate>(other)) == own);
 }
 
 namespace {

@@ -53,6 +53,7 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -814,10 +815,13 @@ template <int Dim>
         else return false;
       }, config.options);
   const bool estimate = !walls.empty() && ((sized && options.support_radius <= 0.0) || default_length);
+  std::shared_ptr<const BoundaryLayerEstimate> layers;
   if (estimate) {
     detail::report_progress(options.progress, "estimating the boundary layer of the curved walls");
     clock = detail::Stopwatch{};
-    result.layers = estimate_boundary_layer(result.curved, std::span<const std::string>(walls), options.layer).walls;
+    layers = std::make_shared<const BoundaryLayerEstimate>(
+        estimate_boundary_layer(result.curved, std::span<const std::string>(walls), options.layer));
+    result.layers = layers->walls;
     result.seconds.layer = clock.seconds();
   }
   std::vector<int> wall_of;
@@ -851,6 +855,10 @@ template <int Dim>
         if constexpr (TakesActiveRadius<O>)
           if (!(o.active_radius > 0.0)) o.active_radius = options.active_radius_factor * result.support_radius;
         if constexpr (TakesLayerOptions<O>) o.layer = options.layer;
+        // The blend's walls are the moving facets, the estimate's the curved groups: the
+        // mover checks they hold the same vertices. A later step would see a moved mesh.
+        if constexpr (requires { o.layer_estimate = layers; })
+          if (options.steps == 1) o.layer_estimate = layers;
       },
       config.options);
   AnyMover<Dim> mover = make_mover(config);

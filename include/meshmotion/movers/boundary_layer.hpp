@@ -89,6 +89,48 @@ template <int Dim>
   return shortest > 0.0 ? longest / shortest : std::numeric_limits<double>::infinity();
 }
 
+namespace detail {
+
+/// A wall's thickness from its vertices' values: their median (nth_element of the middle).
+[[nodiscard]] inline double median_thickness(std::vector<double>& values) {
+  if (values.empty()) return 0.0;
+  auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  return *mid;
+}
+
+/// Each wall's thickness from an estimate made on the same mesh for the same wall vertices
+/// grouped differently (a vertex's thickness depends on every wall's facets, not on how they
+/// are grouped), without a second estimate; a vertex of two walls counts for the first, as
+/// in the estimate. Empty when the estimate's wall vertices are not exactly those of `walls`.
+template <class Walls>
+[[nodiscard]] std::vector<double> regrouped_thickness(const BoundaryLayerEstimate& estimate, const Walls& walls) {
+  std::vector<Index> vertices;
+  for (const auto& wall : walls)
+    for (const auto& f : wall)
+      for (int k = 0; k < num_vertices(f.type); ++k) vertices.push_back(f.nodes[static_cast<std::size_t>(k)]);
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  if (vertices != estimate.wall_nodes) return {};
+  std::vector<double> thickness;
+  std::vector<char> seen(vertices.size(), 0);
+  for (const auto& wall : walls) {
+    std::vector<double> values;
+    for (const auto& f : wall)
+      for (int k = 0; k < num_vertices(f.type); ++k) {
+        const auto s = static_cast<std::size_t>(
+            std::lower_bound(vertices.begin(), vertices.end(), f.nodes[static_cast<std::size_t>(k)]) - vertices.begin());
+        if (seen[s]) continue;
+        seen[s] = 1;
+        values.push_back(estimate.node_thickness[s]);
+      }
+    thickness.push_back(median_thickness(values));
+  }
+  return thickness;
+}
+
+}  // namespace detail
+
 /// Layer thickness of walls given as straight facet lists (`walls[w]`: the facets of wall
 /// w, P1 or P2; only vertices are used) in a mesh of any cells. WallLayer::group and tag are
 /// left empty. A vertex shared by two walls belongs to the first. Throws InputError for a
@@ -214,10 +256,8 @@ template <int Dim>
     for (std::size_t s = 0; s < out.wall_nodes.size(); ++s)
       if (owner[s] == w) values.push_back(out.node_thickness[s]);
     if (values.empty()) continue;
-    auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), mid, values.end());
-    out.walls[w].thickness = *mid;
     out.walls[w].max_thickness = *std::max_element(values.begin(), values.end());
+    out.walls[w].thickness = detail::median_thickness(values);
   }
   return out;
 }
