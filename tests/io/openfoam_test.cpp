@@ -348,6 +348,15 @@ TEST_CASE("OpenFOAM: corrupt counts, labels and classes are refused before anyth
   // A face relabelled to a cell of its own: a cell of one face.
   CHECK_THAT(edited("owner", Format::ascii, [](std::string& t) { t.replace(t.rfind("\n2\n"), 3, "\n3\n"); }),
              Catch::Contains("owner") && Catch::Contains("cell 3 is bounded by 1 face in the owner and neighbour lists"));
+  // The vector area of a face: a unit square in z = 0 points along +z; no vertex, no area.
+  PolyMesh square;
+  square.points = Points<3>::Zero(3, 4);
+  square.points.row(0) << 0, 1, 1, 0;
+  square.points.row(1) << 0, 0, 1, 1;
+  square.face_nodes = {0, 1, 2, 3};
+  square.face_offsets = {0, 4, 4};
+  CHECK(square.face_area(0) == Vec<3>(0, 0, 1));
+  CHECK(square.face_area(1) == Vec<3>::Zero());
   // An owner/neighbour pair relabelled: the face would turn into the other cell.
   CHECK_THAT(edited("neighbour", Format::ascii, [](std::string& t) { t.replace(t.rfind("2\n)"), 3, "0\n)"); }),
              Catch::Contains("neighbour") && Catch::Contains("internal face 2 has owner 1 and neighbour 0"));

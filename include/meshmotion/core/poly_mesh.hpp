@@ -39,9 +39,10 @@ struct PolyMesh {
   }
   /// The vector area of face f (half the sum of its edges' cross products), pointing out of
   /// its owner. Exact for warped faces too: a closed cell's faces sum to zero, each edge
-  /// counted once each way.
+  /// counted once each way. Zero for a face of fewer than three vertices.
   [[nodiscard]] Vec<3> face_area(Index f) const {
     const auto v = face(f);
+    if (v.size() < 3) return Vec<3>::Zero();
     const Vec<3> first = points.col(v[0]);
     Vec<3> sum = Vec<3>::Zero();
     for (std::size_t i = 1; i + 1 < v.size(); ++i) sum += (points.col(v[i]) - first).cross(points.col(v[i + 1]) - first);
