@@ -148,17 +148,17 @@ void check_closed_cells(const PolyMesh& mesh, Fail&& fail) {
   const auto n = static_cast<std::size_t>(mesh.num_cells);
   std::vector<Vec<3>> sum(n, Vec<3>::Zero());
   std::vector<double> total(n, 0.0);
-  std::vector<Vec<3>> area(static_cast<std::size_t>(mesh.num_faces()));
   for (Index f = 0; f < mesh.num_faces(); ++f) {
     const auto i = static_cast<std::size_t>(f);
-    area[i] = mesh.face_area(f);
+    const Vec<3> area = mesh.face_area(f);
+    const double size = area.norm();
     const auto o = static_cast<std::size_t>(mesh.owner[i]);
-    sum[o] += area[i];
-    total[o] += area[i].norm();
+    sum[o] += area;
+    total[o] += size;
     if (f < mesh.num_internal_faces()) {
       const auto nb = static_cast<std::size_t>(mesh.neighbour[i]);
-      sum[nb] -= area[i];
-      total[nb] += area[i].norm();
+      sum[nb] -= area;
+      total[nb] += size;
     }
   }
   constexpr double closed = 1e-6;
@@ -169,7 +169,7 @@ void check_closed_cells(const PolyMesh& mesh, Fail&& fail) {
       const auto i = static_cast<std::size_t>(f);
       const bool owned = static_cast<std::size_t>(mesh.owner[i]) == c;
       if (!owned && !(f < mesh.num_internal_faces() && static_cast<std::size_t>(mesh.neighbour[i]) == c)) continue;
-      if ((sum[c] - (owned ? 2.0 : -2.0) * area[i]).norm() <= closed * total[c])
+      if ((sum[c] - (owned ? 2.0 : -2.0) * mesh.face_area(f)).norm() <= closed * total[c])
         culprit = "; face " + std::to_string(f) + " points into it, as if listed the wrong way round";
     }
     fail("cell " + std::to_string(c) + " is open: its faces' area vectors, turned out of the cell, sum to " +
