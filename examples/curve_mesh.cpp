@@ -76,11 +76,14 @@ template <int Dim>
 CurveOptions<Dim> given_curve_options(const Arguments& args) {
   CurveOptions<Dim> options;
   set_curve_options(options, examples::given_options(args.options));
-  if (!args.json)
-    options.progress = [start = std::chrono::steady_clock::now()](const std::string& line) {
-      const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      std::fprintf(stderr, "[%7.3f s] %s\n", t, line.c_str());
-    };
+  // Each stage is named in an out-of-memory message; on stderr it is timed, unless --json.
+  const std::string input = args.input.empty() ? "the demo mesh" : args.input;
+  options.progress = [start = std::chrono::steady_clock::now(), input, quiet = args.json](const std::string& line) {
+    examples::set_stage("curving " + input + ": " + line);
+    if (quiet) return;
+    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "[%7.3f s] %s\n", t, line.c_str());
+  };
   return options;
 }
 
@@ -135,11 +138,12 @@ int run(Mesh<Dim> linear, const Arguments& args) {
   }
   const CurveResult<Dim> result = curve_mesh(linear, options);
   const std::vector<double>& values = result.cell_quality;
-  write_mesh(args.output, result.curved);
+  examples::write_output(args.output, result.curved);
   const std::filesystem::path vtu = with_extension(args.output, ".vtu");
   VtuFields fields;
   fields.cell_data.emplace_back("scaled_jacobian",
                                 Eigen::Map<const Eigen::MatrixXd>(values.data(), 1, static_cast<Index>(values.size())));
+  examples::set_stage("writing " + vtu.string());
   write_vtu(vtu, result.curved, fields);
   if constexpr (Dim == 2) {
     if (!args.svg.empty()) {
@@ -348,7 +352,7 @@ int main(int argc, char** argv) {
     examples::check_output(args.input, args.output, order, args.overwrite);
     examples::check_output(args.input, with_extension(args.output, ".vtu"), order, args.overwrite);
     if (!args.svg.empty()) check_output_folder(args.svg);
-    AnyMesh mesh = read_mesh(args.input);
+    AnyMesh mesh = examples::read_input(args.input);
     return std::visit([&](auto& m) { return run(std::move(m), args); }, mesh);
   });
 }

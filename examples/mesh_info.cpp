@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
   app.add_flag("--json", json, "print one JSON object instead of text");
   if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv)) return *rc;
   return examples::guarded(json, [&] {
-    const AnyMesh mesh = read_mesh(file);
+    const AnyMesh mesh = examples::read_input(file);
     const auto summary = std::visit([](const auto& m) { return summarize(m); }, mesh);
     if (json) {
       JsonWriter w(std::cout);

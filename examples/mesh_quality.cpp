@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
   if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv)) return *rc;
   return examples::guarded(s.json, [&] {
     if (!s.vtu.empty()) examples::check_output(s.file, s.vtu, 2, false);
-    AnyMesh mesh = read_mesh(s.file);
+    AnyMesh mesh = examples::read_input(s.file);
     return std::visit([&](auto& m) { return run(m, s); }, mesh);
   });
 }

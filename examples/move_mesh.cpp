@@ -52,6 +52,7 @@ int run(const Arguments& a, Mesh<Dim> mesh) {
   MoverConfig<Dim> config = mover_config<Dim>(a.mover.method, given);
   const std::optional<double> radius = examples::set_support_radius(config, a.motion, given, spec, mesh);
   AnyMover<Dim> mover = make_mover(config);
+  examples::set_stage("moving " + a.input + " with " + a.mover.method);
   const QualityReport before = quality_report(mesh, Metric::skew);
   const StepResult<Dim> result = run_steps(mover, mesh, spec, StepOptions{a.steps, Metric::skew});
   const MoveReport report = move_report(a.mover.method, before, result);
@@ -60,7 +61,7 @@ int run(const Arguments& a, Mesh<Dim> mesh) {
   if (invalid && a.strict)
     throw InvalidMeshError("move_mesh: " + std::to_string(after.num_invalid) + " of " + std::to_string(after.num_elements) +
                            " cells invalid after the motion (--strict: nothing written)");
-  write_mesh(a.output, result.mesh);
+  examples::write_output(a.output, result.mesh);
   if (a.json) {
     JsonWriter w(std::cout);
     w.begin_object().key("input").value(a.input).key("output").value(a.output);
@@ -109,6 +110,6 @@ int main(int argc, char** argv) {
     if (a.input.empty() || a.output.empty()) throw InputError("move_mesh: give an input mesh and -o OUTPUT (see --help)");
     examples::require_motion(a.motion, "move_mesh");
     examples::check_output(a.input, a.output, 1, a.overwrite);
-    return std::visit([&](auto& mesh) { return run(a, std::move(mesh)); }, *std::make_unique<AnyMesh>(read_mesh(a.input)));
+    return std::visit([&](auto& mesh) { return run(a, std::move(mesh)); }, *std::make_unique<AnyMesh>(examples::read_input(a.input)));
   });
 }

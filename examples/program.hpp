@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <iostream>
@@ -23,6 +24,11 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
+
+#if defined(__unix__)
+#include <sys/resource.h>
+#endif
 
 namespace meshmotion::examples {
 
@@ -38,6 +44,31 @@ inline void print_error_json(std::string_view message, std::string_view kind, in
   JsonWriter w(std::cout);
   w.begin_object().key("error").value(message).key("kind").value(kind).key("exit_code").value(exit_code).end_object();
   std::cout << "\n";
+}
+
+/// What the program is doing now ("reading case.su2", "moving case.su2 with rbf"). An error
+/// whose own message names nothing (running out of memory, an exception from outside the
+/// library) is reported with it, so that a user knows which input and which stage failed.
+inline std::string& current_stage() {
+  static std::string stage;
+  return stage;
+}
+inline void set_stage(std::string stage) { current_stage() = std::move(stage); }
+
+/// "out of memory while moving case.su2 with rbf (peak resident memory 1.25 GB): ...".
+[[nodiscard]] inline std::string out_of_memory_message() {
+  // The stage's text is freed on unwinding: these few bytes are available again.
+  std::string m = "out of memory";
+  if (!current_stage().empty()) m += " while " + current_stage();
+#if defined(__unix__)
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) == 0 && usage.ru_maxrss > 0) {
+    char peak[64];
+    std::snprintf(peak, sizeof peak, " (peak resident memory %.3g GB)", static_cast<double>(usage.ru_maxrss) / (1024.0 * 1024.0));
+    m += peak;
+  }
+#endif
+  return m + ": the case needs more than this process may allocate (see ulimit -v, or a larger machine)";
 }
 
 /// Parses the command line. --help and --version print and give exit 0; every other parse
@@ -89,16 +120,29 @@ int guarded(bool json, Body&& body) {
   } catch (const Error& e) {
     return fail(e.what(), "error", exit_error);
   } catch (const std::bad_alloc&) {
-    return fail("out of memory: the case needs more than this process may allocate (see ulimit -v, or a larger machine)",
-                "memory", exit_error);
+    return fail(out_of_memory_message().c_str(), "memory", exit_error);
   } catch (const std::exception& e) {
     // Not one of the library's errors (a standard library length or range error): still one
     // message and the error object, never an abort.
-    const std::string what = std::string("internal error: ") + e.what();
+    const std::string stage = current_stage().empty() ? "" : " while " + current_stage();
+    const std::string what = "internal error" + stage + ": " + e.what();
     return fail(what.c_str(), "internal", exit_error);
   } catch (...) {
     return fail("internal error: an exception of unknown type", "internal", exit_error);
   }
+}
+
+/// read_mesh() with the stage set.
+[[nodiscard]] inline AnyMesh read_input(const std::filesystem::path& file) {
+  set_stage("reading " + file.string());
+  return read_mesh(file);
+}
+
+/// write_mesh() with the stage set.
+template <int Dim>
+void write_output(const std::filesystem::path& file, const Mesh<Dim>& mesh) {
+  set_stage("writing " + file.string());
+  write_mesh(file, mesh);
 }
 
 /// Refuses, before any work, an output the program could not write (unknown format, a format

@@ -218,7 +218,7 @@ int main_body(int argc, char** argv) {
         examples::require_motion(a.motion, "move_mesh_mpi");
         if (!root) return;
         examples::check_output(a.input, a.output, 1, a.overwrite);
-        mesh = std::make_unique<AnyMesh>(read_mesh(a.input));
+        mesh = std::make_unique<AnyMesh>(examples::read_input(a.input));
         dim = std::holds_alternative<Mesh<2>>(*mesh) ? 2 : 3;
       });
       MPI_Bcast(&dim, 1, MPI_INT, 0, comm);
