@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <concepts>
 #include <cstdint>
 #include <iostream>
 #include <optional>
@@ -170,9 +171,19 @@ std::optional<double> set_support_radius(MoverConfig<Dim>& config, const MotionA
             parse_option_value("support_radius", *a.support_radius, o.support_radius);
           } else if (std::none_of(given.begin(), given.end(), [](const auto& kv) { return kv.first == "support_radius"; })) {
             const ResolvedBoundary<Dim> b = spec.resolve(mesh);
-            Points<Dim> at(Dim, b.size());
-            for (Index k = 0; k < b.size(); ++k) at.col(k) = mesh.points.col(b.nodes[static_cast<std::size_t>(k)]);
-            o.support_radius = suggest_support_radius(at, b.displacements);
+            if constexpr (std::same_as<O, RbfOptions>) {
+              // The mover's own default, within its memory budget (RbfOptions::max_memory_bytes).
+              const DefaultSupportRadius fitted = default_support_radius(mesh.points, b, o);
+              o.support_radius = fitted.radius;
+              if (fitted.reduced)
+                std::cerr << "note: support radius reduced to " << format_option_value(fitted.radius)
+                          << " to keep the system and the evaluation operator within the memory budget "
+                             "(RbfOptions::max_memory_bytes; docs/interpolation.md)\n";
+            } else {
+              Points<Dim> at(Dim, b.size());
+              for (Index k = 0; k < b.size(); ++k) at.col(k) = mesh.points.col(b.nodes[static_cast<std::size_t>(k)]);
+              o.support_radius = suggest_support_radius(at, b.displacements);
+            }
           }
           radius = o.support_radius;
         } else if (a.support_radius) {

@@ -660,3 +660,47 @@ TEST_CASE("global kernels: the cached evaluation matrix gives the uncached resul
     CHECK((cached.derivative_reverse(v) - direct.derivative_reverse(v)).cwiseAbs().maxCoeff() < 1e-12);
   }
 }
+
+TEST_CASE("rbf: the memory is estimated before assembly, a default radius shrinks to the budget and a given one is refused",
+          "[movers]") {
+  // A quarter turn of the whole boundary: the default radius (5 × the largest displacement)
+  // reaches every centre from every node, a dense system and operator (about 14 MB estimated here).
+  const Grid<3> g = grid<3>(10);
+  BoundarySpec<3> spec;
+  spec.moving("outer", Rotation3D{Vec<3>(0.5, 0.5, 0.5), Vec<3>(0.0, 0.0, 1.0), 1.5707963267948966});
+  const auto boundary = spec.resolve(g.mesh.points, with_outer<3>(g.groups));
+  RbfMover<3> unlimited;
+  unlimited.setup(g.mesh, boundary);
+  CHECK_FALSE(unlimited.support_radius_reduced());  // within max(1 KiB a node, 256 MiB)
+
+  RbfOptions options;
+  options.max_memory_bytes = 1e6;
+  RbfMover<3> limited(options);
+  limited.setup(g.mesh, boundary);
+  CHECK(limited.support_radius_reduced());
+  // What the programs take as the default is the mover's.
+  const DefaultSupportRadius fitted = default_support_radius(g.mesh.points, boundary, options);
+  CHECK(fitted.reduced);
+  CHECK(fitted.radius == limited.support_radius());
+  CHECK(limited.support_radius() < 0.5 * unlimited.support_radius());
+  CHECK(12.0 * static_cast<double>(limited.stats().nonzeros) < options.max_memory_bytes);
+  CHECK(12.0 * static_cast<double>(unlimited.stats().nonzeros) > 4.0 * options.max_memory_bytes);
+  // Still an interpolant of the rotation.
+  const Points<3> moved = limited.move(boundary.displacements);
+  for (Index b = 0; b < boundary.size(); ++b)
+    CHECK((moved.col(boundary.nodes[static_cast<std::size_t>(b)]) - boundary.displacements.col(b)).norm() < 1e-12);
+
+  options.support_radius = unlimited.support_radius();
+  RbfMover<3> given(options);
+  try {
+    given.setup(g.mesh, boundary);
+    FAIL("a given radius beyond max_memory_bytes was accepted");
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    CHECK(what.find("max_memory_bytes") != std::string::npos);
+    CHECK(what.find("support radius " + format_option_value(options.support_radius)) != std::string::npos);
+  }
+  options.max_memory_bytes = -1.0;
+  RbfMover<3> negative(options);
+  CHECK_THROWS_AS(negative.setup(g.mesh, boundary), InputError);
+}

@@ -22,6 +22,8 @@
 
 #if defined(__linux__) && defined(__GLIBC__)
 #include <malloc.h>
+#endif
+#if defined(__unix__)
 #include <unistd.h>
 #endif
 
@@ -48,6 +50,15 @@ namespace detail {
 }
 
 }  // namespace detail
+
+/// The machine's physical memory in bytes; 0 when unknown.
+[[nodiscard]] inline double physical_memory_bytes() {
+#if defined(__unix__) && defined(_SC_PHYS_PAGES) && defined(_SC_PAGE_SIZE)
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  if (pages > 0 && page > 0) return static_cast<double>(pages) * static_cast<double>(page);
+#endif
+  return 0.0;
+}
 
 /// Call first in main(). On Linux with glibc ≥ 2.35 and transparent huge pages in "madvise"
 /// mode, re-executes the program (same pid, arguments and environment, plus

@@ -76,6 +76,8 @@ void visit_options(RbfOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "partition_of_unity", o.partition_of_unity, "local systems on overlapping patches (boundaries of ~100k+ nodes)");
   f(prefix + "patch_centres", o.patch_centres, "partition of unity: most centres per patch before the overlap");
   f(prefix + "patch_overlap", o.patch_overlap, "partition of unity: overlap, x each patch's radius (at least the support radius)");
+  f(prefix + "max_memory_bytes", o.max_memory_bytes,
+    "compact kernels: estimated memory allowed, bytes (0: half the machine's); a default radius is reduced to fit");
 }
 
 template <class F>

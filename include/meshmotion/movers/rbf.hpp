@@ -33,6 +33,8 @@
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh_like.hpp"
+#include "meshmotion/core/option_text.hpp"
+#include "meshmotion/core/process_memory.hpp"
 #include "meshmotion/core/threads.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary.hpp"
@@ -43,6 +45,7 @@
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
 #include "meshmotion/movers/support_radius.hpp"
+#include "meshmotion/spatial/kd_tree.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 #include "meshmotion/solvers/solver_options.hpp"
 
@@ -50,6 +53,7 @@
 #include <concepts>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -100,6 +104,15 @@ struct RbfOptions {
   /// Partition of unity: each patch's ball reaches this fraction of its radius, and at least
   /// the support radius, beyond its own centres.
   double patch_overlap = 0.25;
+  /// Compact kernels with one radius, without partition of unity: the most memory (bytes) the
+  /// system, its factor and the evaluation operator may take, estimated before assembly from
+  /// a sample of nodes and centres; 0 (default): half the machine's memory. A radius given
+  /// beyond it is refused. The default radius is reduced until the estimate fits
+  /// max(1 KiB per mesh node, an eighth of the machine's memory) and this limit: a large
+  /// rotation's default radius (5 × the largest displacement) can reach the whole domain,
+  /// which made the system and the operator dense (22 GB on a 28k-node case).
+  /// support_radius_reduced() says when it was.
+  double max_memory_bytes = 0.0;
 };
 
 /// The options an RBF mover runs with: `options` with the polynomial on where the kernel needs
@@ -107,6 +120,126 @@ struct RbfOptions {
 [[nodiscard]] inline RbfOptions effective_options(RbfOptions options) {
   options.polynomial = options.polynomial || needs_polynomial(options.kernel);
   return options;
+}
+
+namespace detail {
+
+/// The positions of the boundary's nodes (Dim × boundary.size()); throws InputError for a node
+/// outside `points`.
+template <int Dim>
+[[nodiscard]] Points<Dim> boundary_positions(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary,
+                                             const char* where) {
+  Points<Dim> at(Dim, boundary.size());
+  for (Index k = 0; k < boundary.size(); ++k) {
+    const Index v = boundary.nodes[static_cast<std::size_t>(k)];
+    if (v < 0 || v >= points.cols())
+      throw InputError(std::string(where) + ": boundary node " + std::to_string(v) + " out of range (expected 0 to " +
+                       std::to_string(points.cols() - 1) + ")");
+    at.col(k) = points.col(v);
+  }
+  return at;
+}
+
+/// Whether RbfOptions::max_memory_bytes applies: compact kernels with one radius, one system.
+[[nodiscard]] inline bool memory_checked(const RbfOptions& o) {
+  return is_compact(o.kernel) && !o.partition_of_unity && o.support_radii.empty();
+}
+
+/// RbfOptions::max_memory_bytes, or half the machine's memory for 0 (no limit when unknown).
+[[nodiscard]] inline double memory_limit(const RbfOptions& o) {
+  if (!(o.max_memory_bytes >= 0.0))
+    throw InputError("RbfMover::setup: max_memory_bytes must be >= 0 (got " + format_option_value(o.max_memory_bytes) + ")");
+  if (o.max_memory_bytes > 0.0) return o.max_memory_bytes;
+  const double machine = physical_memory_bytes();
+  return machine > 0.0 ? 0.5 * machine : std::numeric_limits<double>::infinity();
+}
+
+/// Estimated peak bytes of a compact RBF of `radius` with its centres at `centres` (`tree`
+/// holds them) evaluated at the other nodes of `points`, from the neighbour counts of a sample
+/// of centres and of nodes. The system: 40 bytes a nonzero while it is assembled (the
+/// neighbour pairs, 16, and the matrix in both storage orders, 12 each) and its factor (fill
+/// taken as 4× the nonzeros, up to a dense triangle), twice when nodes slide. The evaluation
+/// operator: 28 bytes a nonzero (pairs and matrix), or 8 an entry where setup stores it
+/// dense. Measured against the peak resident memory of move_mesh: within a factor of 1.5.
+template <int Dim>
+[[nodiscard]] double compact_rbf_bytes(const Points<Dim>& points, const Points<Dim>& centres, const KdTree<Dim>& tree,
+                                       bool sliding, double radius, const RbfOptions& options) {
+  const auto mean_count = [&](const Points<Dim>& at) {
+    const Index n = at.cols(), samples = std::min<Index>(n, 256);
+    std::vector<Neighbor> found;
+    double total = 0.0;
+    for (Index s = 0; s < samples; ++s) total += static_cast<double>(tree.radius_search(Vec<Dim>(at.col(s * n / samples)), radius, found));
+    return samples == 0 ? 0.0 : total / static_cast<double>(samples);
+  };
+  const auto k = static_cast<double>(centres.cols());
+  const double evaluated = std::max(0.0, static_cast<double>(points.cols()) - k);
+  const double system_nonzeros = mean_count(centres) * k;
+  double bytes = 40.0 * system_nonzeros + 8.0 * std::min(0.5 * k * k, 4.0 * system_nonzeros);
+  if (sliding) bytes *= 2.0;
+  const double operator_nonzeros = mean_count(points) * evaluated;
+  const double dense = 8.0 * evaluated * k;
+  const bool cached = operator_nonzeros > 0.5 * evaluated * k && dense <= static_cast<double>(options.max_evaluation_cache_bytes);
+  return bytes + (cached ? dense : 28.0 * operator_nonzeros);
+}
+
+[[nodiscard]] inline std::string gigabytes(double bytes) { return format_option_value(bytes / 1e9) + " GB"; }
+
+template <int Dim>
+[[nodiscard]] bool any_sliding(const ResolvedBoundary<Dim>& boundary) {
+  return std::any_of(boundary.kinds.begin(), boundary.kinds.end(), [](BoundaryKind k) { return k == BoundaryKind::sliding; });
+}
+
+}  // namespace detail
+
+/// default_support_radius()'s answer.
+struct DefaultSupportRadius {
+  double radius = 0.0;
+  bool reduced = false;  ///< reduced from suggest_support_radius() to fit the memory budget
+};
+
+/// The support radius an RbfMover given none takes, for the mesh's nodes `points` (Dim ×
+/// n_nodes) and `boundary` (its nodes and displacements): suggest_support_radius(), reduced
+/// until the memory estimate of RbfOptions::max_memory_bytes fits max(1 KiB per node, an
+/// eighth of the machine's memory) and that limit (compact kernels, one system). The programs and Python take it
+/// from here too. Throws InputError as suggest_support_radius() does, or for a boundary node
+/// outside `points`.
+template <int Dim>
+[[nodiscard]] DefaultSupportRadius default_support_radius(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary,
+                                                          const RbfOptions& options) {
+  const Points<Dim> centres = detail::boundary_positions(points, boundary, "RbfMover::setup");
+  DefaultSupportRadius out{suggest_support_radius(centres, boundary.displacements), false};
+  if (!detail::memory_checked(options)) return out;
+  const double limit = detail::memory_limit(options);
+  const double machine = physical_memory_bytes();
+  const double floor = machine > 0.0 ? machine / 8.0 : 2.0 * 1024.0 * 1024.0 * 1024.0;
+  const double budget = std::min(limit, std::max(1024.0 * static_cast<double>(points.cols()), floor));
+  const KdTree<Dim> tree(centres);
+  const bool sliding = detail::any_sliding(boundary);
+  double bytes = detail::compact_rbf_bytes(points, centres, tree, sliding, out.radius, options);
+  // Counts around a surface of centres grow as r²: a few rescaling rounds settle the radius.
+  for (int round = 0; round < 8 && bytes > budget; ++round) {
+    out.radius *= 0.95 * std::sqrt(budget / bytes);
+    out.reduced = true;
+    bytes = detail::compact_rbf_bytes(points, centres, tree, sliding, out.radius, options);
+  }
+  return out;
+}
+
+/// Refuses (InputError with the estimate and the limit) a given `radius` whose memory
+/// estimate exceeds RbfOptions::max_memory_bytes (compact kernels, one system).
+template <int Dim>
+void check_support_radius_memory(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary, double radius,
+                                 const RbfOptions& options) {
+  if (!detail::memory_checked(options) || boundary.size() == 0) return;
+  const double limit = detail::memory_limit(options);
+  const Points<Dim> centres = detail::boundary_positions(points, boundary, "RbfMover::setup");
+  const double bytes =
+      detail::compact_rbf_bytes(points, centres, KdTree<Dim>(centres), detail::any_sliding(boundary), radius, options);
+  if (bytes > limit)
+    throw InputError("RbfMover::setup: support radius " + format_option_value(radius) + " needs about " +
+                     detail::gigabytes(bytes) + " for the system and the evaluation operator, beyond the limit of " +
+                     detail::gigabytes(limit) + " (max_memory_bytes; 0: half this machine's memory); give a smaller "
+                     "support_radius, partition_of_unity, or a larger max_memory_bytes");
 }
 
 /// The RBF mover in Dim dimensions; models MeshMover.
@@ -126,6 +259,9 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   /// True when the last setup stored a dense evaluation matrix: a global kernel, or a compact
   /// one whose support covers most centres (see RbfOptions::max_evaluation_cache_bytes).
   [[nodiscard]] bool evaluation_cached() const noexcept { return dense_operator_.size() > 0; }
+  /// True when the last setup reduced the default support radius to fit its memory budget
+  /// (RbfOptions::max_memory_bytes).
+  [[nodiscard]] bool support_radius_reduced() const noexcept { return radius_reduced_; }
   /// Patches of the partition of unity after setup (0: one global system).
   [[nodiscard]] Index patches() const noexcept { return patched_all_ ? patched_all_->num_patches() : 0; }
 
@@ -175,8 +311,6 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   // setup_reference()'s stages, in order.
   /// Refuses options the boundary cannot take; radius_ from support_radius.
   void check_options(const ResolvedBoundary<Dim>& boundary);
-  /// The default support radius, from the boundary's extent and displacements.
-  [[nodiscard]] static double default_radius(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary);
   /// Merges coincident boundary nodes into centres, constrained ones first and sliding ones
   /// after (centre_of_, source_, n_constrained_, projectors_); returns the centres.
   [[nodiscard]] Points<Dim> merge_centres(const ResolvedBoundary<Dim>& boundary);
@@ -387,13 +521,21 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   Eigen::MatrixXd seed_rows_;               ///< a reverse product's seed, gathered by rows
   Poly beta_ = Poly::Zero();
   double radius_ = 0.0;  ///< the last setup's support radius
+  bool radius_reduced_ = false;  ///< the default radius_ was reduced to fit the memory budget
 };
 
 template <int Dim>
 void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<Dim>& boundary) {
   const detail::Stopwatch watch;
   check_options(boundary);
-  if (options_.support_radii.empty() && radius_ == 0.0) radius_ = default_radius(points, boundary);
+  radius_reduced_ = false;
+  if (options_.support_radii.empty() && radius_ == 0.0) {
+    const DefaultSupportRadius fitted = default_support_radius(points, boundary, options_);
+    radius_ = fitted.radius;
+    radius_reduced_ = fitted.reduced;
+  } else if (options_.support_radii.empty()) {
+    check_support_radius_memory(points, boundary, radius_, options_);
+  }
   points_ = std::move(points);
   if (!points_.allFinite()) throw InputError("RbfMover::setup: mesh has a non-finite coordinate");
   detail::check_boundary<Dim>("RbfMover::setup", boundary, points_.cols(), false);
@@ -424,6 +566,7 @@ void RbfMover<Dim>::check_options(const ResolvedBoundary<Dim>& boundary) {
     throw InputError("RbfMover::setup: support radius must be positive, or 0 for the default (got " +
                      std::to_string(options_.support_radius) + ")");
   radius_ = options_.support_radius;
+  (void)detail::memory_limit(options_);  // refuses a negative max_memory_bytes whatever the kernel
   if (!options_.support_radii.empty()) {
     if (static_cast<Index>(options_.support_radii.size()) != boundary.size())
       throw InputError("RbfMover::setup: " + std::to_string(options_.support_radii.size()) +
@@ -444,19 +587,6 @@ void RbfMover<Dim>::check_options(const ResolvedBoundary<Dim>& boundary) {
   if (options_.patch_centres < 1) refuse("needs patch_centres >= 1 (got " + std::to_string(options_.patch_centres) + ")");
   if (!(options_.patch_overlap >= 0.0) || !std::isfinite(options_.patch_overlap))
     refuse("needs a finite patch_overlap >= 0 (got " + std::to_string(options_.patch_overlap) + ")");
-}
-
-template <int Dim>
-double RbfMover<Dim>::default_radius(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary) {
-  Points<Dim> at(Dim, boundary.size());
-  for (Index k = 0; k < boundary.size(); ++k) {
-    const Index v = boundary.nodes[static_cast<std::size_t>(k)];
-    if (v < 0 || v >= points.cols())
-      throw InputError("RbfMover::setup: boundary node " + std::to_string(v) + " out of range (expected 0 to " +
-                       std::to_string(points.cols() - 1) + ")");
-    at.col(k) = points.col(v);
-  }
-  return suggest_support_radius(at, boundary.displacements);
 }
 
 template <int Dim>
