@@ -7,8 +7,9 @@
 // Writes OUTPUT (.msh/.cgns/.su2), OUTPUT's .vtu beside it (per-cell certified scaled Jacobian),
 // and in 2D an SVG picture coloured by quality when --svg is given (always in the demo), with
 // a red ring on every invalid cell (too thin to see at a zoom that shows the body).
-// The input file is never modified. Exit codes: 0 curved and valid, 1 error (nothing
-// written), 2 written with invalid cells (the last line says so) or refused by --strict.
+// The input file is never modified. Exit codes: 0 curved, valid and on the geometry, 1 error
+// (nothing written), 2 written with invalid cells or facets off the geometry (the last lines
+// say so) or refused by --strict.
 
 #include "meshmotion/core/json.hpp"
 #include "meshmotion/core/option_text.hpp"
@@ -112,8 +113,10 @@ int run(Mesh<Dim> linear, const Arguments& args) {
   CurveOptions<Dim> options = curve_options<Dim>(args);
   std::string cad_report;
   std::vector<std::string> on_model;  // the groups curved on the CAD file
+  double cad_seconds = 0.0;
   if (cad_geometry(args)) {
 #ifdef MESHMOTION_HAVE_CAD
+    const auto start = std::chrono::steady_clock::now();
     // Kept for the whole run: the groups' geometry refers to it.
     static std::optional<CadModel> model;
     model.emplace(CadModel::read(args.geometry.front()));
@@ -130,13 +133,16 @@ int run(Mesh<Dim> linear, const Arguments& args) {
         on_model.push_back(m.group);
       }
     cad_report = describe_cad_matches(matches);
+    cad_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!args.json) std::fprintf(stderr, "CAD model %s:\n%s", args.geometry.front().c_str(), cad_report.c_str());
 #else
     throw InputError("--geometry " + args.geometry.front() + ": CAD files need the CAD component, which this build lacks "
                      "(install libocct-modeling-algorithms-dev libocct-data-exchange-dev and reconfigure)");
 #endif
   }
-  const CurveResult<Dim> result = curve_mesh(linear, options);
+  CurveResult<Dim> result = curve_mesh(linear, options);
+  result.seconds.cad = cad_seconds;
+  result.seconds.total += cad_seconds;
   const std::vector<double>& values = result.cell_quality;
   examples::write_output(args.output, result.curved);
   const std::filesystem::path vtu = with_extension(args.output, ".vtu");
@@ -200,14 +206,25 @@ int run(Mesh<Dim> linear, const Arguments& args) {
     }
     std::string sliding;
     for (const std::string& g : result.sliding_groups) sliding.append(sliding.empty() ? "; sliding: '" : ", '").append(g).append("'");
-    if (q.num_invalid == 0)
+    if (q.num_invalid == 0 && result.off_geometry() == 0 && result.reversed_cells == 0)
       std::printf("wrote %s, %s%s%s (curved: %s%s)\n", args.output.c_str(), vtu.string().c_str(), args.svg.empty() ? "" : ", ",
                   args.svg.c_str(), curved_on.empty() ? "none" : curved_on.c_str(), sliding.c_str());
   }
-  if (q.num_invalid > 0) {
+  if (q.num_invalid > 0 || result.off_geometry() > 0 || result.reversed_cells > 0) {
     std::fflush(stdout);
-    std::fprintf(stderr, "wrote %s WITH %lld INVALID CELLS of %lld\n", args.output.c_str(),
-                 static_cast<long long>(q.num_invalid), static_cast<long long>(q.num_elements));
+    if (q.num_invalid > 0)
+      std::fprintf(stderr, "wrote %s WITH %lld INVALID CELLS of %lld\n", args.output.c_str(),
+                   static_cast<long long>(q.num_invalid), static_cast<long long>(q.num_elements));
+    // Valid cells in the wrong place: a wall taken the long way round, a model that fits badly.
+    for (const GeometryDistance& w : result.geometry_distance)
+      if (w.facets_off > 0)
+        std::fprintf(stderr, "wrote %s WITH %lld FACETS OF '%s' OFF ITS GEOMETRY (up to %.3g x a facet's size, %.3g; tolerance %.3g)\n",
+                     args.output.c_str(), static_cast<long long>(w.facets_off), w.group.c_str(), w.max_relative_distance,
+                     w.max_distance, options.geometry_tolerance);
+    if (result.reversed_cells > 0)
+      std::fprintf(stderr, "wrote %s WITH %lld CELLS TURNED OVER BY MOVING %lld VERTICES ONTO THE GEOMETRY (up to %.3g)\n",
+                   args.output.c_str(), static_cast<long long>(result.reversed_cells), static_cast<long long>(result.moved_vertices),
+                   result.max_boundary_displacement);
     return examples::exit_invalid;
   }
   return examples::exit_ok;
@@ -263,6 +280,7 @@ void print_options_markdown() {
                                      "`curve_mesh --json` (beside input, output, vtu, dim, nodes, cells, options) and Python's report dict.");
   print_fields_table<CurveTimes>("seconds", "Seconds per stage of the pipeline.");
   print_fields_table<WallLayer>("layers", "One per curved wall whose layer was estimated.");
+  print_fields_table<GeometryDistance>("geometry_distance", "One per curved group: how far its facets are from its geometry.");
   print_fields_table<UntangleReport>("untangle", "What the untangling did.");
   print_fields_table<QualityReport>("quality", "A quality report (`mesh_quality --json`, Python's quality_report).");
   print_fields_table<WorstElement>("worst", "One of the lowest cells.");

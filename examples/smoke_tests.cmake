@@ -136,6 +136,12 @@ add_test(NAME examples.curve_mesh.demo.curved_on COMMAND curve_mesh --demo -o "$
          WORKING_DIRECTORY "${smoke_dir}")
 set_tests_properties(examples.curve_mesh.demo.curved_on PROPERTIES LABELS examples
                      PASS_REGULAR_EXPRESSION "wrote [^\n]*demo_text.msh[^\n]*\\(curved: 'wall' on the given --geometry, 'farfield' by spline\\)")
+# The geometric certificate: with a tolerance no facet meets, the mesh is written, the
+# report counts the facets off their geometry, and the program exits 2.
+smoke_test(NAME curve_mesh.demo.off_geometry EXPECT_RC 2
+           KEYS geometry_distance/0/max_relative_distance,geometry_distance/1/facets_off
+           VALUES off_geometry=256,geometry_distance/0/group=wall,geometry_distance/0/geometry=projection
+           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_off.msh" --geometry-tolerance 1e-9 --json)
 smoke_test(NAME mesh_info.json REQUIRES examples_demo_mesh
            KEYS file,mesh/nodes,mesh/cells,mesh/groups
            COMMAND mesh_info "${smoke_dir}/demo.msh" --json)
@@ -152,7 +158,8 @@ smoke_test(NAME mesh_info.moved.json REQUIRES examples_moved_mesh
 
 # The sphere on its STEP file with no flag but --geometry and --order (../shared/data): the
 # symmetry plane, planar, slides by default (fixed it gave 0.61, docs/curving.md), the planar
-# far field is already on the model, and the minimum reaches the tuned row (0.8560).
+# far field is already on the model, the minimum reaches the tuned row (0.8560), and every
+# curved facet is on the model.
 set(sphere_mesh "${MESHMOTION_SHARED_DATA_DIR}/meshopt_sphere_symmetry_linear_tet.msh")
 set(sphere_step "${MESHMOTION_SHARED_DATA_DIR}/meshopt_Sphere25CSymmetry.stp")
 if(NOT MESHMOTION_HAVE_CAD)
@@ -162,7 +169,7 @@ elseif(NOT EXISTS "${sphere_mesh}" OR NOT EXISTS "${sphere_step}")
 else()
   smoke_test(NAME curve_mesh.sphere_step.defaults
              KEYS curved_groups,sliding_groups/0
-             VALUES sliding_groups/0=20,invalid=0
+             VALUES sliding_groups/0=20,invalid=0,off_geometry=0
              AT_LEAST min_scaled_jacobian=0.855
              COMMAND curve_mesh "${sphere_mesh}" -o "${smoke_dir}/sphere_p3.msh" --order 3 --geometry "${sphere_step}" --json)
 endif()

@@ -346,6 +346,11 @@ def test_curve_mesh_puts_the_high_order_nodes_on_the_circle():
     wall = curved.groups["wall"]
     np.testing.assert_allclose(np.linalg.norm(curved.points[wall], axis=1), 0.5, rtol=0, atol=1e-12)
     assert report["invalid"] == 0 and report["quality"]["min"] > 0.5
+    # The geometric certificate: the wall's facets, sampled inside, are on the circle.
+    distance = {w["group"]: w for w in report["geometry_distance"]}
+    assert distance["wall"]["geometry"] == "projection" and distance["wall"]["facets"] == len(wall) // 2
+    assert distance["wall"]["max_node_distance"] < 1e-12 and 0 < distance["wall"]["max_distance"] < 1e-3
+    assert report["off_geometry"] == 0
     with pytest.raises(ValueError, match="did you mean 'support_radius'"):
         mm.curve_mesh(mesh, suport_radius=0.3)
     with pytest.raises(ValueError, match="circle:X,Y,R"):

@@ -29,12 +29,14 @@
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/curving/boundary_spline.hpp"
 #include "meshmotion/curving/geometry.hpp"
+#include "meshmotion/curving/geometry_distance.hpp"
 #include "meshmotion/curving/inner_nodes.hpp"
 #include "meshmotion/curving/surface_reconstruction.hpp"
 
 #include <algorithm>
 #include <array>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -69,11 +71,19 @@ struct BoundaryGeometry {
   /// projection of its place on the straight facet. Nodes inside a facet always go to the
   /// projection of their place on the facet curved by its edges.
   BoundaryPlacement<Dim> placement{};
+  /// For Kind::projection, optional: the projection of a point of a facet searched from its
+  /// vertices' places (a CAD model's local search), for the geometric certificate's many
+  /// samples. Without it, `projection`.
+  BoundaryNearby<Dim> nearby{};
 
-  [[nodiscard]] static BoundaryGeometry straight() { return {Kind::straight, {}, {}}; }
-  [[nodiscard]] static BoundaryGeometry spline() { return {Kind::spline, {}, {}}; }
-  [[nodiscard]] static BoundaryGeometry project(BoundaryProjection<Dim> p, BoundaryPlacement<Dim> q = {}) {
-    return {Kind::projection, std::move(p), std::move(q)};
+  [[nodiscard]] static BoundaryGeometry straight() { return {Kind::straight, {}, {}, {}}; }
+  [[nodiscard]] static BoundaryGeometry spline() { return {Kind::spline, {}, {}, {}}; }
+  [[nodiscard]] static BoundaryGeometry project(BoundaryProjection<Dim> p, BoundaryPlacement<Dim> q = {}, BoundaryNearby<Dim> n = {}) {
+    return {Kind::projection, std::move(p), std::move(q), std::move(n)};
+  }
+  /// The closest point of the geometry to x, a point of the facet through `vertices` at `weights`.
+  [[nodiscard]] Vec<Dim> project_in_facet(std::span<const Vec<Dim>> vertices, std::span<const double> weights, const Vec<Dim>& x) const {
+    return nearby ? nearby(vertices, weights, x) : projection(x);
   }
 };
 
@@ -107,6 +117,8 @@ struct SnappedBoundary {
   Points<Dim> displacements;   ///< Dim × nodes.size(): to the true boundary (0 for those already on it)
   Index moved_vertices = 0;    ///< linear vertices that were off the geometry
   double max_displacement = 0.0;
+  /// Per curved group tag: what its facets are measured against (measure_geometry_distance()).
+  std::map<int, GeometryReference<Dim>> references;
 };
 
 namespace detail {
@@ -139,8 +151,10 @@ inline const FacetNodeWeights& facet_node_weights(ElementType t) {
 /// 3D reconstruction of group `tag`: every edge node of its triangle facets to the
 /// reconstructed edge at its fraction of the edge, every node inside a facet to the
 /// reconstructed triangle at its barycentric place; the vertices stay and join the wall.
+/// Returns the reconstruction as the group's reference: the surface at a point's barycentric
+/// place, or its ridge curve on a ridge edge (null for a group without facets).
 template <class Claim>
-void snap_to_reconstruction(const Mesh<3>& mesh, int tag, const SnapOptions& options, Claim&& claim) {
+[[nodiscard]] FacetReference<3> snap_to_reconstruction(const Mesh<3>& mesh, int tag, const SnapOptions& options, Claim&& claim) {
   std::vector<Index> triangles;
   for (const auto& block : mesh.facets)
     for (Index e = 0; e < block.size(); ++e) {
@@ -151,8 +165,10 @@ void snap_to_reconstruction(const Mesh<3>& mesh, int tag, const SnapOptions& opt
       const auto el = block.element(e);
       triangles.insert(triangles.end(), el.begin(), el.begin() + 3);
     }
-  if (triangles.empty()) return;
-  const SurfaceReconstruction surface(mesh.points, triangles, SurfaceReconstructionOptions{3, options.corner_angle});
+  if (triangles.empty()) return {};
+  const auto shared = std::make_shared<const SurfaceReconstruction>(mesh.points, triangles,
+                                                                    SurfaceReconstructionOptions{3, options.corner_angle});
+  const SurfaceReconstruction& surface = *shared;
   Index triangle = 0;  // the reconstruction's numbering: the facets in the order given above
   for (const auto& block : mesh.facets) {
     const FacetNodeWeights& table = facet_node_weights(block.type);
@@ -174,6 +190,15 @@ void snap_to_reconstruction(const Mesh<3>& mesh, int tag, const SnapOptions& opt
       ++triangle;
     }
   }
+  return [shared](const FacetPoint<3>& p) -> Vec<3> {
+    const std::span<const double> w = p.weights;
+    for (int k = 0; k < 3; ++k) {
+      const auto a = static_cast<std::size_t>((k + 1) % 3), b = static_cast<std::size_t>((k + 2) % 3);
+      if (std::abs(w[static_cast<std::size_t>(k)]) < 1e-12 && shared->is_ridge(p.facet[a], p.facet[b]))
+        return shared->edge_point(p.facet[a], p.facet[b], w[b]);
+    }
+    return shared->point(p.ordinal, Vec<3>(w[0], w[1], w[2]));
+  };
 }
 
 }  // namespace detail
@@ -192,6 +217,7 @@ template <int Dim>
       throw InputError("snap_boundary: facet block " + std::string(name(block.type)) +
                        " is linear (expected a high-order mesh from to_quadratic or convert_to_order)");
   std::map<Index, Vec<Dim>> target;  // node -> new position, first group wins
+  std::map<int, GeometryReference<Dim>> references;
   const auto claim = [&](Index v, const Vec<Dim>& x) { target.emplace(v, x); };
   Index moved_vertices = 0;
   const double extent = mesh.num_nodes() > 0
@@ -205,12 +231,18 @@ template <int Dim>
     if (geo.kind == Kind::straight) continue;
     if (geo.kind == Kind::spline) {
       if constexpr (Dim == 3) {
-        detail::snap_to_reconstruction(mesh, tag, options, claim);
+        if (FacetReference<3> at = detail::snap_to_reconstruction(mesh, tag, options, claim))
+          references.emplace(tag, GeometryReference<3>{"reconstruction", std::move(at)});
       } else {
         const std::vector<BoundaryChain> chains = boundary_chains(mesh, tag);
         if (chains.empty()) continue;
-        const BoundarySpline spline(mesh.points, chains,
-                                    BoundarySplineOptions{options.corner_angle, options.corner_nodes, {}, {}});
+        const auto shared = std::make_shared<const BoundarySpline>(
+            mesh.points, chains, BoundarySplineOptions{options.corner_angle, options.corner_nodes, {}, {}});
+        const BoundarySpline& spline = *shared;
+        references.emplace(tag, GeometryReference<2>{"spline", [shared](const FacetPoint<2>& p) {
+                             const auto f = shared->find_facet(p.facet[0], p.facet[1]);
+                             return f ? shared->closest_point(f->facet, p.x).point : p.x;
+                           }});
         for (const auto& block : mesh.facets)
           for (Index e = 0; e < block.size(); ++e) {
             if (block.tags[static_cast<std::size_t>(e)] != tag) continue;
@@ -233,6 +265,9 @@ template <int Dim>
     }
     if (!geo.projection)
       throw InputError("snap_boundary: group tag " + std::to_string(tag) + " asks for a projection but has no callback");
+    references.emplace(tag, GeometryReference<Dim>{"projection", [geo](const FacetPoint<Dim>& p) {
+                         return geo.project_in_facet(p.vertices, p.weights, p.x);
+                       }});
     // Vertices first: the edge and face nodes are placed from the projected vertices.
     std::map<Index, Vec<Dim>> vertex;
     const auto vertex_position = [&](Index v) -> const Vec<Dim>& {
@@ -289,6 +324,7 @@ template <int Dim>
   }
   SnappedBoundary<Dim> out;
   out.moved_vertices = moved_vertices;
+  out.references = std::move(references);
   out.displacements.resize(Dim, static_cast<Index>(target.size()));
   Index k = 0;
   for (const auto& [node, x] : target) {

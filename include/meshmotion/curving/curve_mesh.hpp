@@ -17,6 +17,9 @@
 /// 4. Certification: the certified scaled Jacobian (thesis eq. 3.3) of every cell; strict
 ///    mode throws InvalidMeshError when invalid cells remain, default mode reports them.
 /// 5. Untangling of the cells below a threshold (curving/untangle.hpp).
+/// 6. The geometric certificate: each curved wall's distance to the geometry it was curved
+///    onto, sampled inside its facets (curving/geometry_distance.hpp); strict mode throws
+///    InvalidMeshError when a facet is farther than geometry_tolerance × its size.
 ///
 /// The blend's default length and the RBF's default support radius follow the boundary layer
 /// (movers/boundary_layer.hpp): a factor × each curved wall's own layer thickness, or on a
@@ -27,6 +30,7 @@
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/fields.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/orientation.hpp"
 #include "meshmotion/core/topology.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/curving/boundary_snapping.hpp"
@@ -140,7 +144,14 @@ struct CurveOptions {
   SnapOptions snap{};
   BoundaryLayerOptions layer{};
   ReportOptions report{};
-  /// Throw InvalidMeshError when invalid cells remain (default: report them).
+  /// A curved facet whose distance to its geometry (bounded by sampling, geometry_distance.hpp)
+  /// exceeds this × its size is off the geometry: reported, and refused in strict mode. The
+  /// facets of the data folder's cases are at most 0.004 of their size from a CAD model or a
+  /// spline, 0.025 from a coarse 3D reconstruction; a node on the far side of a closed curve
+  /// puts its facet at more than 1 (docs/curving.md, "What is certified").
+  double geometry_tolerance = 0.1;
+  /// Throw InvalidMeshError when invalid cells, facets off the geometry or cells turned over by
+  /// the snapping remain (default: report them).
   bool strict = false;
   /// Called with a line of text before each stage.
   std::function<void(const std::string&)> progress{};
@@ -170,29 +181,35 @@ void visit_options(CurveOptions<Dim>& o, F&& f, const std::string& prefix = {}) 
   visit_options(o.snap, f, prefix);
   visit_options(o.layer, f, prefix);
   visit_options(o.report, f, prefix);
-  f(prefix + "strict", o.strict, "write nothing when invalid cells remain");
+  f(prefix + "geometry_tolerance", o.geometry_tolerance,
+    "a curved facet farther than this x its size from its geometry is off it (reported; refused when strict)");
+  f(prefix + "strict", o.strict, "write nothing when invalid cells, facets off the geometry or turned-over cells remain");
 }
 
 /// Wall-clock seconds of each stage.
 struct CurveTimes {
+  double cad = 0.0;  ///< reading a CAD file and matching it to the groups (by the caller: curve_mesh's --geometry FILE)
   double quadratic = 0.0;
   double snap = 0.0;
   double layer = 0.0;  ///< boundary-layer estimate for the default radius
   double regularize = 0.0;
   double untangle = 0.0;
   double certify = 0.0;
+  double distance = 0.0;  ///< the geometric certificate
   double total = 0.0;
 };
 
 template <class F>
 void visit_fields(const CurveTimes& t, F&& f) {
+  f("cad", t.cad, "reading the CAD file and matching its entities to the groups (the program's --geometry FILE)");
   f("quadratic", t.quadratic, "conversion to the curved order");
   f("snap", t.snap, "snapping the boundary to the geometry");
   f("layer", t.layer, "estimating the walls' boundary layers");
   f("regularize", t.regularize, "the mover's setup and moves");
   f("untangle", t.untangle, "optimizing the cells below the threshold");
   f("certify", t.certify, "certifying the scaled Jacobian");
-  f("total", t.total, "the whole pipeline");
+  f("distance", t.distance, "measuring the curved walls' distance to their geometry");
+  f("total", t.total, "the whole pipeline, with the CAD stage");
 }
 
 /// What curve_mesh() produced and measured.
@@ -211,6 +228,10 @@ struct CurveResult {
   std::vector<WallLayer> layers;    ///< estimated layers of the curved walls (when estimated)
   Index snapped_nodes = 0;          ///< boundary nodes given a position on the true boundary
   Index moved_vertices = 0;         ///< linear vertices that were off the geometry
+  /// Cells whose straight shape (their vertices) the snapping's vertex moves turned over: the
+  /// validity certificate measures each cell against its orientation in the input, which such a
+  /// cell no longer has even where its scaled Jacobian is positive.
+  Index reversed_cells = 0;
   double max_boundary_displacement = 0.0;
   Index moved_nodes = 0;            ///< nodes not on the boundary that the regularization moved
   Index solver_iterations = 0;      ///< summed over steps
@@ -218,7 +239,14 @@ struct CurveResult {
   UntangleReport untangle;          ///< what the untangling did (cells_below = 0: nothing to do)
   QualityReport quality;            ///< certified scaled Jacobian
   std::vector<double> cell_quality;  ///< the certified scaled Jacobian of each cell, in cell order
+  std::vector<GeometryDistance> geometry_distance;  ///< per curved group, the distance of its facets to its geometry
   [[nodiscard]] Index invalid() const noexcept { return quality.num_invalid; }
+  /// Curved facets farther than CurveOptions::geometry_tolerance from their geometry.
+  [[nodiscard]] Index off_geometry() const noexcept {
+    Index n = 0;
+    for (const GeometryDistance& w : geometry_distance) n += w.facets_off;
+    return n;
+  }
 };
 
 /// The report of CurveResult: every field but the mesh and the per-cell values.
@@ -235,6 +263,7 @@ void visit_fields(const CurveResult<Dim>& r, F&& f) {
   f("layers", r.layers, "estimated boundary layers of the curved walls");
   f("snapped_nodes", r.snapped_nodes, "boundary nodes given their place on the geometry");
   f("moved_vertices", r.moved_vertices, "linear vertices that were off the geometry");
+  f("reversed_cells", r.reversed_cells, "cells whose straight shape the snapping's vertex moves turned over");
   f("max_boundary_displacement", r.max_boundary_displacement, "largest move of a boundary node");
   f("moved_nodes", r.moved_nodes, "nodes off the boundary that the regularization moved");
   f("solver_iterations", r.solver_iterations, "iterative solver iterations, summed over the steps");
@@ -242,6 +271,8 @@ void visit_fields(const CurveResult<Dim>& r, F&& f) {
   f("untangle", r.untangle, "what the untangling did");
   f("invalid", r.invalid(), "cells whose certified scaled Jacobian is not positive");
   f("quality", r.quality, "certified scaled Jacobian of the curved mesh");
+  f("geometry_distance", r.geometry_distance, "per curved group: its facets' distance to the geometry it was curved onto");
+  f("off_geometry", r.off_geometry(), "curved facets farther than geometry_tolerance x their size from their geometry");
   f("seconds", r.seconds, "wall-clock seconds per stage");
 }
 
@@ -634,6 +665,86 @@ inline void report_progress(const std::function<void(const std::string&)>& progr
   if (progress) progress(line);
 }
 
+/// A cell (block and element) and whether its straight shape's measure was positive.
+struct CellSign {
+  std::size_t block = 0;
+  Index element = 0;
+  bool positive = true;
+};
+
+/// The cells with a vertex that `snapped` moves, each with the sign of its straight measure now.
+template <int Dim>
+[[nodiscard]] std::vector<CellSign> cells_at_moved_vertices(const Mesh<Dim>& mesh, const SnappedBoundary<Dim>& snapped) {
+  std::vector<CellSign> out;
+  if (snapped.moved_vertices == 0) return out;
+  std::vector<char> moved(static_cast<std::size_t>(mesh.num_nodes()), 0);
+  for (std::size_t k = 0; k < snapped.nodes.size(); ++k)
+    if (snapped.displacements.col(static_cast<Index>(k)).squaredNorm() > 0.0) moved[static_cast<std::size_t>(snapped.nodes[k])] = 1;
+  for (std::size_t b = 0; b < mesh.cells.size(); ++b) {
+    const ElementBlock& block = mesh.cells[b];
+    const int nv = num_vertices(block.type);
+    for (Index e = 0; e < block.size(); ++e) {
+      const auto el = block.element(e);
+      if (std::any_of(el.begin(), el.begin() + nv, [&](Index v) { return moved[static_cast<std::size_t>(v)] != 0; }))
+        out.push_back({b, e, signed_measure(mesh, block.type, el) > 0.0});
+    }
+  }
+  return out;
+}
+
+/// How many of `cells` have a straight measure of the other sign in `mesh`.
+template <int Dim>
+[[nodiscard]] Index count_reversed(const Mesh<Dim>& mesh, const std::vector<CellSign>& cells) {
+  return static_cast<Index>(std::count_if(cells.begin(), cells.end(), [&](const CellSign& c) {
+    const ElementBlock& block = mesh.cells[c.block];
+    return (signed_measure(mesh, block.type, block.element(c.element)) > 0.0) != c.positive;
+  }));
+}
+
+/// Throws InvalidMeshError when the snapping turned cells over (CurveResult::reversed_cells).
+template <int Dim>
+void refuse_reversed(const CurveResult<Dim>& result) {
+  if (result.reversed_cells == 0) return;
+  throw InvalidMeshError("curve_mesh: " + std::to_string(result.reversed_cells) + " cells were turned over by moving " +
+                         std::to_string(result.moved_vertices) + " vertices onto the geometry (up to " +
+                         format_option_value(result.max_boundary_displacement) +
+                         "; the certificate measures a cell against its orientation in the input); expected none: the mesh does "
+                         "not fit the geometry there");
+}
+
+/// Throws InvalidMeshError naming the count and the worst cell when `result` has invalid cells.
+template <int Dim>
+void refuse_invalid(const CurveResult<Dim>& result) {
+  if (result.quality.num_invalid == 0) return;
+  const WorstElement& w = result.quality.worst.front();
+  std::ostringstream where;
+  where << "(" << w.centroid[0] << ", " << w.centroid[1] << (Dim == 3 ? ", " + std::to_string(w.centroid[2]) : "") << ")";
+  throw InvalidMeshError("curve_mesh: " + std::to_string(result.quality.num_invalid) + " of " +
+                         std::to_string(result.quality.num_elements) + " cells are invalid after " + result.method +
+                         " regularization (worst: " + std::string(name(w.type)) + " cell " + std::to_string(w.id) +
+                         ", file id " + std::to_string(w.file_id) + ", at " + where.str() +
+                         ", certified scaled Jacobian " + std::to_string(w.value) + "; expected > 0)");
+}
+
+/// Throws InvalidMeshError naming the count and the farthest facet when `result` has curved
+/// facets off their geometry.
+template <int Dim>
+void refuse_off_geometry(const CurveResult<Dim>& result, double tolerance) {
+  if (result.off_geometry() == 0) return;
+  const auto worst = std::max_element(result.geometry_distance.begin(), result.geometry_distance.end(),
+                                      [](const GeometryDistance& a, const GeometryDistance& b) {
+                                        return a.max_relative_distance < b.max_relative_distance;
+                                      });
+  std::ostringstream where;
+  where << "(" << worst->worst_at[0] << ", " << worst->worst_at[1];
+  if (Dim == 3) where << ", " << worst->worst_at[2];
+  where << ")";
+  throw InvalidMeshError("curve_mesh: " + std::to_string(result.off_geometry()) + " curved facets are off their geometry (worst: group '" +
+                         worst->group + "', a facet at " + where.str() + " up to " + format_option_value(worst->max_relative_distance) +
+                         " x its size from its " + worst->geometry + "; expected at most geometry_tolerance " +
+                         format_option_value(tolerance) + ")");
+}
+
 }  // namespace detail
 
 /// Runs the regularization and certification on a P2 mesh whose boundary is already snapped
@@ -705,16 +816,7 @@ void regularize_and_certify(Mover& mover, const ResolvedBoundary<Dim>& boundary,
     result.seconds.untangle = untangle_clock.seconds();
   }
   result.quality = make_report(mesh, Metric::scaled_jacobian, cells, options.report);
-  if (options.strict && result.quality.num_invalid > 0) {
-    const WorstElement& w = result.quality.worst.front();
-    std::ostringstream where;
-    where << "(" << w.centroid[0] << ", " << w.centroid[1] << (Dim == 3 ? ", " + std::to_string(w.centroid[2]) : "") << ")";
-    throw InvalidMeshError("curve_mesh: " + std::to_string(result.quality.num_invalid) + " of " +
-                           std::to_string(result.quality.num_elements) + " cells are invalid after " + result.method +
-                           " regularization (worst: " + std::string(name(w.type)) + " cell " + std::to_string(w.id) +
-                           ", file id " + std::to_string(w.file_id) + ", at " + where.str() +
-                           ", certified scaled Jacobian " + std::to_string(w.value) + "; expected > 0)");
-  }
+  if (options.strict) detail::refuse_invalid(result);
 }
 
 /// regularize_and_certify() with the mover seeing the whole boundary.
@@ -750,6 +852,9 @@ template <int Dim>
   // The angle between two facets' directions: 0 to 180 degrees (720 is a slip, not a corner).
   if (!(options.snap.corner_angle >= 0.0 && options.snap.corner_angle <= 180.0))
     throw InputError("curve_mesh: corner_angle must be 0 to 180 degrees (got " + format_option_value(options.snap.corner_angle) + ")");
+  if (!(options.geometry_tolerance > 0.0) || !std::isfinite(options.geometry_tolerance))
+    throw InputError("curve_mesh: geometry_tolerance must be a positive number (got " + format_option_value(options.geometry_tolerance) +
+                     ")");
   if (options.centre_reach < 0.0)
     throw InputError("curve_mesh: centre_reach must be non-negative (got " + format_option_value(options.centre_reach) + ")");
   CurveResult<Dim> result;
@@ -801,6 +906,7 @@ template <int Dim>
   const std::vector<char> still = detail::drop_unmoved_walls(result.curved, snapped, walls, options.snap);
   result.sliding_groups = detail::sliding_groups(result.curved, options, result.curved_groups, walls, planar);
   const ResolvedBoundary<Dim> boundary = detail::curving_boundary(result.curved, snapped, still, result.sliding_groups);
+  const std::vector<detail::CellSign> at_moved_vertices = detail::cells_at_moved_vertices(result.curved, snapped);
   result.seconds.snap = clock.seconds();
 
   // What the mover's options take decides what the pipeline measures for it: a support radius
@@ -862,12 +968,20 @@ template <int Dim>
       },
       config.options);
   AnyMover<Dim> mover = make_mover(config);
-  if (moves_interior) {
-    regularize_and_certify(mover, boundary, given, options, result);
-  } else {
-    CurveOptions<Dim> snap_only = options;
-    snap_only.untangle.enabled = false;
-    regularize_and_certify(mover, boundary, given, snap_only, result);
+  // Strict mode refuses below, the geometry first: a wall in the wrong place explains invalid cells.
+  CurveOptions<Dim> stage = options;
+  stage.strict = false;
+  if (!moves_interior) stage.untangle.enabled = false;
+  regularize_and_certify(mover, boundary, given, stage, result);
+  result.reversed_cells = detail::count_reversed(result.curved, at_moved_vertices);
+  detail::report_progress(options.progress, "measuring the curved walls' distance to their geometry");
+  clock = detail::Stopwatch{};
+  result.geometry_distance = measure_geometry_distance(result.curved, snapped.references, options.geometry_tolerance);
+  result.seconds.distance = clock.seconds();
+  if (options.strict) {
+    detail::refuse_off_geometry(result, options.geometry_tolerance);
+    detail::refuse_reversed(result);
+    detail::refuse_invalid(result);
   }
   result.seconds.total = total.seconds();
   return result;

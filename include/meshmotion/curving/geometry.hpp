@@ -27,6 +27,13 @@ using BoundaryProjection = std::function<Vec<Dim>(const Vec<Dim>&)>;
 template <int Dim>
 using BoundaryPlacement = std::function<Vec<Dim>(std::span<const Vec<Dim>> vertices, std::span<const double> weights)>;
 
+/// The closest point of the true boundary to x, a point of the facet through `vertices` (on the
+/// geometry) where its vertices weigh `weights`: a local search from the vertices' places,
+/// much cheaper than a global projection on a CAD model.
+template <int Dim>
+using BoundaryNearby =
+    std::function<Vec<Dim>(std::span<const Vec<Dim>> vertices, std::span<const double> weights, const Vec<Dim>& x)>;
+
 namespace detail {
 
 /// Throws InputError naming `where` when p has a NaN or infinite coordinate.
