@@ -177,6 +177,15 @@ TEST_CASE("CAD: high-order wall nodes at even parameter steps of the model's cur
     CHECK(curved.invalid() == 0);
     const Mesh<2>& c = curved.curved;
     for (const Index v : c.group_nodes("wall")) CHECK(std::abs(c.points.col(v).norm() - 0.5) < 1e-9 * model.diagonal());
+    // The geometric certificate measures the wall on the model: the long way round put a facet
+    // 0.44 from the circle, several times its size; here every facet is within 1e-3 of its size.
+    const auto on_wall = std::find_if(curved.geometry_distance.begin(), curved.geometry_distance.end(),
+                                      [](const GeometryDistance& d) { return d.group == "wall"; });
+    REQUIRE(on_wall != curved.geometry_distance.end());
+    CHECK(on_wall->geometry == "projection");
+    CHECK(on_wall->max_node_distance < 1e-9 * model.diagonal());
+    CHECK(on_wall->max_relative_distance < 1e-3);
+    CHECK(curved.off_geometry() == 0);
     // The circle's parameter is the angle: edge node j of a facet sits at angle a0 + j/p (a1 - a0).
     const int wall = c.group("wall").tag;
     Index checked = 0;
