@@ -15,7 +15,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -127,6 +126,11 @@ std::array<double, 2> CadModel::periods(int dim, int index) const {
   return impl_->shape->periods(dim, index);
 }
 
+double CadModel::arc_length_parameter(int index, double a, double b, double fraction) const {
+  check_entity(*this, 1, index);
+  return impl_->shape->arc_length_parameter(index, a, b, fraction);
+}
+
 double default_cad_tolerance(const CadModel& model) { return 1e-6 * model.diagonal(); }
 
 namespace {
@@ -226,38 +230,16 @@ double unwrap(double value, double reference, double period) {
   return value + period * std::round((reference - value) / period);
 }
 
-// Where the arc length along t ↦ curve(t), t in [0, 1], reaches `fraction` of the whole: the
-// high-order nodes of an edge go at equal lengths, not at equal parameters, which a CAD
-// parametrization need not make equal (Gmsh places them the same way). A polyline of 16
-// chords measures it: the edge of a mesh spans a small arc, where chords are exact to far
-// below the placement's effect on quality, and the point found stays on the model.
-double equal_length_parameter(const std::function<Vec<3>(double)>& curve, double fraction) {
-  constexpr int pieces = 16;
-  std::array<double, pieces + 1> length{};
-  Vec<3> previous = curve(0.0);
-  for (int k = 1; k <= pieces; ++k) {
-    const Vec<3> x = curve(static_cast<double>(k) / pieces);
-    length[static_cast<std::size_t>(k)] = length[static_cast<std::size_t>(k - 1)] + (x - previous).norm();
-    previous = x;
-  }
-  if (!(length.back() > 0.0)) return fraction;
-  const double target = fraction * length.back();
-  int k = 1;
-  while (k < pieces && length[static_cast<std::size_t>(k)] < target) ++k;
-  const double a = length[static_cast<std::size_t>(k - 1)], b = length[static_cast<std::size_t>(k)];
-  return (static_cast<double>(k - 1) + (b > a ? (target - a) / (b - a) : 0.0)) / pieces;
-}
-
 // The point at fraction `t` of the arc length between two vertices along an edge of the
 // model they share (their parameter range on it, unwrapped on a closed edge), or none.
 bool along_common_edge(const CadModel& model, const std::vector<const std::vector<CadPoint>*>& ends, double t, Vec<3>& out) {
   for (const CadPoint& a : *ends[0]) {
     const auto b = std::find_if(ends[1]->begin(), ends[1]->end(), [&](const CadPoint& c) { return c.index == a.index; });
     if (b == ends[1]->end()) continue;
+    // At equal lengths, not at equal parameters, which a CAD parametrization need not make
+    // equal (Gmsh places them the same way).
     const double period = model.periods(1, a.index)[0];
-    const double du = unwrap(b->u, a.u, period) - a.u;
-    const auto along = [&](double s) { return model.point_at(1, a.index, a.u + s * du); };
-    out = along(equal_length_parameter(along, t));
+    out = model.point_at(1, a.index, model.arc_length_parameter(a.index, a.u, unwrap(b->u, a.u, period), t));
     return true;
   }
   return false;
@@ -466,8 +448,16 @@ BoundaryGeometry<Dim> cad_boundary(const CadModel& model, const CadGroupMatch& m
     // entities are edges).
     const Located on = locate_vertices(vertices, weights);
     Vec<3> at;
-    if (on.weights.size() == 2 && along_common_edge(*cad, dim == 1 ? on.entities : on.edges, on.weights[1], at))
+    if (on.weights.size() == 2 && along_common_edge(*cad, dim == 1 ? on.entities : on.edges, on.weights[1], at)) {
+      // On a face group, onto the face: an edge's curve may lie only within the model's
+      // tolerance of it (IGES trims faces by curves in their parameters, and OpenCASCADE builds
+      // the edge's 3D curve from them: a torus's seam nodes were 2e-6 off the torus). A point
+      // already on the face to round-off stays as it is.
+      if (dim == 2)
+        if (const auto p = near_common_face(*cad, on.entities, on.weights, at); p && (p->point - at).norm() > 1e-12 * cad->diagonal())
+          at = p->point;
       return restrict_to<Dim>(at);
+    }
     // Across a face (and inside one): the projection of the straight place, on the nearest
     // curve of the surface to the straight edge. A parameter line would follow the face's
     // parametrization instead: two vertices on one latitude of a sphere would be joined along

@@ -17,6 +17,7 @@
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
 #include <GeomAPI_ProjectPointOnCurve.hxx>
+#include <GCPnts_AbscissaPoint.hxx>
 #include <Geom_Curve.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESControl_Reader.hxx>
@@ -40,6 +41,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 namespace meshmotion::detail {
 namespace {
@@ -106,6 +108,7 @@ class OcctShape final : public CadShape {
   std::optional<CadPoint> closest_point_near(int face, const Vec<3>& x, double u0, double v0) const override;
   Vec<3> point_at(int dim, int index, double u, double v) const override;
   std::array<double, 2> periods(int dim, int index) const override;
+  double arc_length_parameter(int edge, double a, double b, double fraction) const override;
 
  private:
   std::filesystem::path file_;
@@ -197,6 +200,10 @@ CadPoint OcctShape::closest_point(int dim, int index, const Vec<3>& x) const {
     out.u = uv.X();
     out.v = uv.Y();
   }
+  // OpenCASCADE's extremum stops at its precision (a torus stored as a surface of revolution,
+  // as IGES has it, came out 3e-6 off its closest point): Newton's method takes it to round-off.
+  if (const std::optional<CadPoint> polished = closest_point_near(index, x, out.u, out.v))
+    if (polished->distance <= out.distance) return *polished;
   return out;
 }
 
@@ -224,6 +231,13 @@ std::optional<CadPoint> OcctShape::closest_point_near(int index, const Vec<3>& x
     converged = std::abs(du) * su.Magnitude() + std::abs(dv) * sv.Magnitude() < 1e-14 * std::max(diagonal_, 1e-300);
   }
   if (converged) {
+    // Back into the face's range by whole periods: the search may end past a periodic face's
+    // seam (and IGES's trimming closes 2e-10 short of the period).
+    const auto into_range = [](double t, bool periodic, double period, double first) {
+      return periodic && period > 0.0 ? first + std::fmod(std::fmod(t - first, period) + period, period) : t;
+    };
+    u = into_range(u, surface.IsUPeriodic(), surface.IsUPeriodic() ? surface.UPeriod() : 0.0, surface.FirstUParameter());
+    v = into_range(v, surface.IsVPeriodic(), surface.IsVPeriodic() ? surface.VPeriod() : 0.0, surface.FirstVParameter());
     CadPoint out;
     out.dim = 2;
     out.index = index;
@@ -279,6 +293,54 @@ std::array<double, 2> OcctShape::periods(int dim, int index) const {
   const BRepAdaptor_Surface s(TopoDS::Face(faces_(index)));
   return {period_of(s.IsUPeriodic(), s.IsUPeriodic() ? s.UPeriod() : 0.0, s.IsUClosed(), s.FirstUParameter(), s.LastUParameter()),
           period_of(s.IsVPeriodic(), s.IsVPeriodic() ? s.VPeriod() : 0.0, s.IsVClosed(), s.FirstVParameter(), s.LastVParameter())};
+}
+
+// OpenCASCADE integrates the length piecewise between the curve's breaks of continuity (a
+// B-spline circle's speed jumps at its knots) and inverts it by Newton's method, both to
+// round-off here: a circle stored as a periodic circle (STEP) or a closed B-spline (IGES) then
+// gets the same nodes to 1e-12, where a polyline of chords left the B-spline's 1e-5 apart.
+double OcctShape::arc_length_parameter(int edge, double a, double b, double fraction) const {
+  const BRepAdaptor_Curve c(TopoDS::Edge(edges_(edge)));
+  const double first = c.FirstParameter(), last = c.LastParameter();
+  // Pieces of the way from a to b in the curve's own range: a closed, non-periodic curve
+  // cannot be evaluated past its seam, so a way across it continues from the other end.
+  struct Piece {
+    double from, to, shift;  // curve parameters, and what unwraps them
+  };
+  std::vector<Piece> pieces;
+  if (!c.IsPeriodic() && c.IsClosed() && last > first) {
+    const double period = last - first;
+    const double shift = a - wrap(a, false, true, first, last), from = a - shift, to = b - shift;
+    if (to > last)
+      pieces = {{from, last, shift}, {first, to - period, shift + period}};
+    else if (to < first)
+      pieces = {{from, first, shift}, {last, to + period, shift - period}};
+    else
+      pieces = {{from, to, shift}};
+  } else {
+    pieces = {{a, b, 0.0}};
+  }
+  constexpr double tolerance = 1e-13;
+  std::vector<double> lengths;
+  double total = 0.0;
+  for (const Piece& p : pieces) {
+    lengths.push_back(GCPnts_AbscissaPoint::Length(c, std::min(p.from, p.to), std::max(p.from, p.to), tolerance));
+    total += lengths.back();
+  }
+  if (!(total > 0.0)) return a + fraction * (b - a);
+  double remaining = fraction * total;
+  for (std::size_t k = 0; k < pieces.size(); ++k) {
+    const Piece& p = pieces[k];
+    if (remaining > lengths[k] && k + 1 < pieces.size()) {
+      remaining -= lengths[k];
+      continue;
+    }
+    const double direction = p.to >= p.from ? 1.0 : -1.0;
+    const double guess = p.from + (p.to - p.from) * std::clamp(remaining / std::max(lengths[k], 1e-300), 0.0, 1.0);
+    const GCPnts_AbscissaPoint at(c, direction * remaining, p.from, guess, tolerance);
+    return (at.IsDone() ? at.Parameter() : guess) + p.shift;
+  }
+  return b;
 }
 
 }  // namespace
