@@ -378,11 +378,19 @@ UntangleReport untangle(Mesh<Dim>& mesh, std::span<const char> fixed, std::vecto
     if (low < options.threshold) break;  // the untangling could not lift these; a round would not either
     std::iota(order.begin(), order.end(), Index{0});
     const auto count = std::min<std::size_t>(static_cast<std::size_t>(options.raise_cells), order.size());
-    std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(count), order.end(),
-                      [&](Index a, Index b) { return quality[static_cast<std::size_t>(a)] < quality[static_cast<std::size_t>(b)]; });
+    std::nth_element(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(count - 1), order.end(),
+                     [&](Index a, Index b) { return quality[static_cast<std::size_t>(a)] < quality[static_cast<std::size_t>(b)]; });
+    // The worst cells and every cell tied with the last of them, worst first and tied cells in
+    // cell order: on a mesh with symmetries many cells share a value to round-off, and choosing
+    // among them (or ordering the sweep) by round-off curved one geometry stored as a circle and
+    // as a B-spline 0.05 apart.
+    const auto level = [&](Index c) { return std::round(quality[static_cast<std::size_t>(c)] * 1e9); };
+    const double last = level(order[count - 1]);
     const double target = low + options.raise_margin;
     std::vector<Index> seeds;
-    for (std::size_t k = 0; k < count && quality[static_cast<std::size_t>(order[k])] < target; ++k) seeds.push_back(order[k]);
+    for (Index c = 0; c < static_cast<Index>(quality.size()); ++c)
+      if (level(c) <= last && quality[static_cast<std::size_t>(c)] < target) seeds.push_back(c);
+    std::stable_sort(seeds.begin(), seeds.end(), [&](Index a, Index b) { return level(a) < level(b); });
     add(optimizer.run(seeds, target, options.raise_layers, options.max_sweeps, budget, true, quality));
     if (!(minimum() > low + 1e-4)) break;
     ++report.raise_rounds;
