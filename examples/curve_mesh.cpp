@@ -114,14 +114,17 @@ int run(Mesh<Dim> linear, const Arguments& args) {
   std::string cad_report;
   std::vector<std::string> on_model;  // the groups curved on the CAD file
   double cad_seconds = 0.0;
+#ifdef MESHMOTION_HAVE_CAD
+  // Kept for the whole run: the groups' geometry refers to it.
+  static std::optional<CadModel> model;
+  std::vector<CadGroupMatch> matches;
+#endif
   if (cad_geometry(args)) {
 #ifdef MESHMOTION_HAVE_CAD
     const auto start = std::chrono::steady_clock::now();
-    // Kept for the whole run: the groups' geometry refers to it.
-    static std::optional<CadModel> model;
     model.emplace(CadModel::read(args.geometry.front()));
     name_unnamed_facet_groups(linear);  // as curve_mesh() does: the matches name groups by their tags
-    const std::vector<CadGroupMatch> matches = match_cad_groups(linear, *model, args.cad_tolerance, args.groups);
+    matches = match_cad_groups(linear, *model, args.cad_tolerance, args.groups);
     require_cad_fit(linear, *model, matches);
     // Unless named, a planar group is left to curve_mesh(), which keeps it straight and lets it
     // slide where it meets a curved group (a symmetry plane): snapping onto a plane moves nothing.
@@ -141,6 +144,15 @@ int run(Mesh<Dim> linear, const Arguments& args) {
 #endif
   }
   CurveResult<Dim> result = curve_mesh(linear, options);
+#ifdef MESHMOTION_HAVE_CAD
+  if (model) {
+    // Each node's place on the model goes into the .msh, so the curved mesh goes back into
+    // Gmsh's CAD-aware tools (and into this program again) tied to the model.
+    const auto start = std::chrono::steady_clock::now();
+    place_on_cad(result.curved, *model, matches, args.cad_tolerance);
+    cad_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+#endif
   result.seconds.cad = cad_seconds;
   result.seconds.total += cad_seconds;
   const std::vector<double>& values = result.cell_quality;

@@ -167,11 +167,16 @@ if(NOT MESHMOTION_HAVE_CAD)
 elseif(NOT EXISTS "${sphere_mesh}" OR NOT EXISTS "${sphere_step}")
   message(STATUS "examples: ${MESHMOTION_SHARED_DATA_DIR} lacks the sphere's mesh and STEP file: its smoke test is skipped")
 else()
-  smoke_test(NAME curve_mesh.sphere_step.defaults
+  smoke_test(NAME curve_mesh.sphere_step.defaults SETUP examples_sphere_p3
              KEYS curved_groups,sliding_groups/0
              VALUES sliding_groups/0=20,invalid=0,off_geometry=0
              AT_LEAST min_scaled_jacobian=0.855
              COMMAND curve_mesh "${sphere_mesh}" -o "${smoke_dir}/sphere_p3.msh" --order 3 --geometry "${sphere_step}" --json)
+  # Its .msh places every node of the model's faces and edges on them (3908 of the P3 nodes).
+  smoke_test(NAME mesh_info.sphere_p3.on_model REQUIRES examples_sphere_p3
+             KEYS mesh/nodes_on_model
+             VALUES mesh/nodes_on_model=3908
+             COMMAND mesh_info "${smoke_dir}/sphere_p3.msh" --json)
 endif()
 
 # Orders 3 and 4: the demo curved at order 3 (and its .su2 in SU2's DG-FEM format read back

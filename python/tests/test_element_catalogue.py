@@ -1,6 +1,6 @@
 """The element catalogue against Gmsh and VTK themselves (Debian python3-gmsh, python3-vtk9):
-every type's reference nodes in Gmsh's order, and the node order of every VTK Lagrange cell
-the .vtu writer uses, at every order the library holds."""
+every type's reference nodes in Gmsh's order, the node order of every VTK Lagrange cell the
+.vtu writer uses, at every order the library holds, and Gmsh's reading of written .msh files."""
 
 import os
 import pathlib
@@ -189,3 +189,55 @@ def test_vtu_written_by_vtk_reads_back(type_name, mode):
     np.testing.assert_array_equal(back.points, mesh.points)
     assert back.cells[0][0] == type_name
     np.testing.assert_array_equal(back.cells[0][1], mesh.cells[0][1])
+
+
+def gmsh_mesh_state(gmsh):
+    """Each entity's physical groups and nodes (tags, coordinates, parameters), as Gmsh sees them."""
+    state = {}
+    for dim, tag in gmsh.model.getEntities():
+        nodes, coords, params = gmsh.model.mesh.getNodes(dim, tag, includeBoundary=False, returnParametricCoord=True)
+        state[(dim, tag)] = (list(gmsh.model.getPhysicalGroupsForEntity(dim, tag)), np.asarray(nodes), np.asarray(coords),
+                             np.asarray(params))
+    return state
+
+
+@pytest.mark.parametrize("version", ["2.2", "4.1"])
+def test_msh_written_back_keeps_gmsh_s_entities_and_parameters(gmsh, version):
+    """A mesh Gmsh made on an OpenCASCADE model, saved with its nodes' parameters as 2.2
+    ($ParametricNodes) or 4.1, read and written (4.1) by the library: Gmsh reads the written
+    file with the entities, groups, nodes and parameters it reads from its own 4.1 file."""
+    gmsh.model.add("sphere_in_box")
+    occ = gmsh.model.occ
+    occ.cut([(3, occ.addBox(-2, -2, -2, 4, 4, 4))], [(3, occ.addSphere(0, 0, 0, 0.5))])
+    occ.synchronize()
+    gmsh.model.addPhysicalGroup(3, [1], 1)
+    for face in gmsh.model.getEntities(2):
+        gmsh.model.addPhysicalGroup(2, [face[1]], 10 + face[1])
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.8)
+    gmsh.model.mesh.generate(3)
+    gmsh.option.setNumber("Mesh.SaveParametric", 1)
+    files = {}
+    for v in ("2.2", "4.1"):
+        gmsh.option.setNumber("Mesh.MshFileVersion", float(v))
+        files[v] = scratch(f"gmsh_sphere_{v}.msh")
+        gmsh.write(str(files[v]))
+    gmsh.model.remove()
+
+    ours_file = scratch(f"ours_sphere_from_{version}.msh")
+    mm.write_mesh(ours_file, mm.read_mesh(files[version]))
+    states = []
+    for file in (files["4.1"], ours_file):
+        gmsh.open(str(file))
+        states.append(gmsh_mesh_state(gmsh))
+        gmsh.model.remove()
+    theirs, ours = states
+    assert sum(len(s[1]) for s in theirs.values()) > 100
+    for key, (groups, nodes, coords, params) in theirs.items():
+        if len(nodes) == 0:  # an entity without nodes or elements need not be listed
+            continue
+        assert key in ours, key
+        our_groups, our_nodes, our_coords, our_params = ours[key]
+        assert groups == our_groups, key
+        np.testing.assert_array_equal(nodes, our_nodes)
+        np.testing.assert_array_equal(coords, our_coords)
+        np.testing.assert_array_equal(params, our_params)

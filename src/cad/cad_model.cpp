@@ -23,6 +23,7 @@
 #include <sstream>
 #include <unordered_map>
 #include <unordered_set>
+#include <utility>
 
 namespace meshmotion {
 
@@ -282,6 +283,16 @@ std::optional<CadPoint> near_common_face(const CadModel& model, const std::vecto
   return std::nullopt;
 }
 
+// The closest point to x of a face one of `vertices` lies on, within the tolerance, searched
+// from that vertex's parameters there (a local search), or none.
+std::optional<CadPoint> on_a_face(const CadModel& model, const std::vector<const VertexOnCad*>& vertices, const Vec<3>& x,
+                                  double tolerance) {
+  for (const VertexOnCad* vertex : vertices)
+    for (const CadPoint& f : vertex->entities)
+      if (const CadPoint p = model.closest_point_near(2, f.index, x, f.u, f.v); p.distance <= tolerance) return p;
+  return std::nullopt;
+}
+
 }  // namespace
 
 template <int Dim>
@@ -468,6 +479,99 @@ BoundaryGeometry<Dim> cad_boundary(const CadModel& model, const CadGroupMatch& m
 }
 
 template <int Dim>
+void place_on_cad(Mesh<Dim>& mesh, const CadModel& model, const std::vector<CadGroupMatch>& matches, double tolerance) {
+  if (!(tolerance > 0.0)) tolerance = default_cad_tolerance(model);
+  std::vector<NodeParametrization> out(static_cast<std::size_t>(mesh.num_nodes()), NodeParametrization{Dim, 1, 0.0, 0.0});
+  for (auto& block : mesh.cells) {
+    if (block.entities.empty()) block.entities.assign(static_cast<std::size_t>(block.size()), 1);
+    for (Index e = 0; e < block.size(); ++e)
+      if (const int entity = block.entities[static_cast<std::size_t>(e)]; entity != 0)
+        for (const Index v : block.element(e)) out[static_cast<std::size_t>(v)].entity_tag = entity;
+  }
+  // A group's tag: its name's, or the number an unnamed tag was named by (match_cad_groups).
+  std::map<int, const CadGroupMatch*> match_of_tag;
+  for (const CadGroupMatch& m : matches) {
+    if (!m.matched()) continue;
+    const auto named = std::find_if(mesh.groups.begin(), mesh.groups.end(),
+                                    [&](const PhysicalGroup& g) { return g.dim == Dim - 1 && g.name == m.group; });
+    if (named != mesh.groups.end()) match_of_tag[named->tag] = &m;
+    else if (!m.group.empty() && std::all_of(m.group.begin(), m.group.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      match_of_tag[std::stoi(m.group)] = &m;
+  }
+  const auto set = [&](Index v, const CadPoint& at) {
+    out[static_cast<std::size_t>(v)] = NodeParametrization{at.dim, at.index, at.u, at.dim == 2 ? at.v : 0.0};
+  };
+  // The vertices are located by a global search, or a local one from a vertex of the same facet;
+  // the other nodes of a facet from its vertices: on a model edge one of them lies on, else on
+  // a face of theirs by a local search (the global search for every node took twice the
+  // curving's time on the sphere at P3).
+  std::unordered_map<Index, VertexOnCad> vertices;
+  std::vector<char> done(static_cast<std::size_t>(mesh.num_nodes()), 0);
+  for (auto& block : mesh.facets) {
+    const auto nv = static_cast<std::size_t>(num_vertices(block.type));
+    for (Index e = 0; e < block.size(); ++e) {
+      const auto m = match_of_tag.find(block.tags[static_cast<std::size_t>(e)]);
+      if (m == match_of_tag.end()) continue;
+      const CadGroupMatch& match = *m->second;
+      const auto el = block.element(e);
+      // The vertices found before first: a face of theirs is searched locally for the others.
+      std::vector<const VertexOnCad*> corner(nv, nullptr), found;
+      for (std::size_t k = 0; k < nv; ++k)
+        if (const auto it = vertices.find(el[k]); it != vertices.end()) found.push_back(corner[k] = &it->second);
+      for (std::size_t k = 0; k < nv; ++k) {
+        if (corner[k] != nullptr) continue;
+        const Vec<3> x = embed<Dim>(mesh.points.col(el[k]));
+        VertexOnCad on;
+        if (const auto f = match.dim == 2 ? on_a_face(model, found, x, tolerance) : std::nullopt) {
+          on.entities = {*f};
+          on.edges = model.entities_within(1, model.face_edges(f->index), x, tolerance);
+        } else {
+          on = locate(model, match, x, tolerance);
+        }
+        found.push_back(corner[k] = &vertices.emplace(el[k], std::move(on)).first->second);
+        if (!corner[k]->edges.empty() || !corner[k]->entities.empty())
+          set(el[k], !corner[k]->edges.empty() ? corner[k]->edges.front() : corner[k]->entities.front());
+      }
+      // Model edges a vertex lies on (in 2D the group's own entities are edges). Not only those
+      // two vertices share: a vertex at a model corner, located from one face, lists that
+      // face's edges only.
+      std::vector<int> edges;
+      for (const VertexOnCad* c : corner)
+        for (const CadPoint& p : match.dim == 1 ? c->entities : c->edges)
+          if (std::find(edges.begin(), edges.end(), p.index) == edges.end()) edges.push_back(p.index);
+      // The facet's entity: the face (2D: the edge) a node inside it, or all its vertices, lie on.
+      int entity = 0;
+      for (const CadPoint& f : corner[0]->entities)
+        if (std::all_of(corner.begin(), corner.end(), [&](const VertexOnCad* c) {
+              return std::any_of(c->entities.begin(), c->entities.end(), [&](const CadPoint& g) { return g.index == f.index; });
+            }))
+          entity = f.index;
+      for (std::size_t k = nv; k < el.size(); ++k) {
+        const Index v = el[k];
+        if (std::exchange(done[static_cast<std::size_t>(v)], 1) == 0) {
+          const Vec<3> x = embed<Dim>(mesh.points.col(v));
+          std::optional<CadPoint> at;
+          for (const int edge : edges)
+            if (const CadPoint c = model.closest_point(1, edge, x); c.distance <= tolerance && (!at || c.distance < at->distance)) at = c;
+          if (!at && match.dim == 2) at = on_a_face(model, corner, x, tolerance);
+          if (!at) {
+            const VertexOnCad on = locate(model, match, x, tolerance);
+            if (!on.edges.empty() || !on.entities.empty()) at = !on.edges.empty() ? on.edges.front() : on.entities.front();
+          }
+          if (at) set(v, *at);
+        }
+        if (const NodeParametrization& p = out[static_cast<std::size_t>(v)]; p.entity_dim == match.dim) entity = p.entity_tag;
+      }
+      if (entity != 0) {
+        if (block.entities.empty()) block.entities.assign(static_cast<std::size_t>(block.size()), 0);
+        block.entities[static_cast<std::size_t>(e)] = entity;
+      }
+    }
+  }
+  mesh.node_params = std::move(out);
+}
+
+template <int Dim>
 void require_cad_fit(const Mesh<Dim>& mesh, const CadModel& model, const std::vector<CadGroupMatch>& matches) {
   if (std::any_of(matches.begin(), matches.end(), [](const CadGroupMatch& m) { return m.matched(); })) return;
   std::ostringstream msg;
@@ -514,5 +618,7 @@ template std::vector<CadGroupMatch> match_cad_groups<2>(const Mesh<2>&, const Ca
 template std::vector<CadGroupMatch> match_cad_groups<3>(const Mesh<3>&, const CadModel&, double, const std::vector<std::string>&);
 template BoundaryGeometry<2> cad_boundary<2>(const CadModel&, const CadGroupMatch&, double);
 template BoundaryGeometry<3> cad_boundary<3>(const CadModel&, const CadGroupMatch&, double);
+template void place_on_cad<2>(Mesh<2>&, const CadModel&, const std::vector<CadGroupMatch>&, double);
+template void place_on_cad<3>(Mesh<3>&, const CadModel&, const std::vector<CadGroupMatch>&, double);
 
 }  // namespace meshmotion

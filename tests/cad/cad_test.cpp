@@ -34,8 +34,11 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <set>
 #include <span>
 #include <string>
+#include <tuple>
+#include <type_traits>
 #include <vector>
 
 using namespace meshmotion;
@@ -558,5 +561,153 @@ TEST_CASE("CAD: one model as BREP, STEP, IGES (both modes) and NURBS gives the s
     // seam's 3D curve from them to its tolerance: the seam's nodes, on the torus to round-off,
     // are 3e-7 along it from the BREP's.
     compare(curved.curved, reference.curved, {"wall", "outer"}, format == CadFormat::iges_faces ? 1e-6 : 1e-9, 1e-9);
+  }
+}
+
+TEST_CASE("CAD: the curved mesh's .msh places each node on the model as Gmsh numbers it and reads back located", "[cad]") {
+  // Every node of a matched group gets the entity it lies on (a face, or an edge of it: seams,
+  // ridges, borders) and its parameters there, and every facet its face; the others lie in the
+  // domain. The point at those
+  // parameters is the node, to round-off, for a periodic model and for IGES's closed B-splines.
+  const auto check_on_model = [](const auto& mesh, const CadModel& model, double tolerance = 1e-12) {
+    constexpr int dim = std::decay_t<decltype(mesh)>::dim;
+    const std::vector<NodeParametrization>& params = mesh.node_params;
+    REQUIRE(params.size() == static_cast<std::size_t>(mesh.num_nodes()));
+    std::vector<char> on_wall(params.size(), 0);
+    for (const auto& block : mesh.facets)
+      for (const Index v : block.connectivity) on_wall[static_cast<std::size_t>(v)] = 1;
+    double off = 0.0;
+    for (std::size_t i = 0; i < params.size(); ++i) {
+      const NodeParametrization& p = params[i];
+      CHECK((p.entity_dim < dim) == (on_wall[i] != 0));
+      if (p.entity_dim == dim) continue;
+      Vec<3> x = Vec<3>::Zero();
+      x.head<dim>() = mesh.points.col(static_cast<Index>(i));
+      off = std::max(off, (model.point_at(p.entity_dim, p.entity_tag, p.u, p.v) - x).norm());
+    }
+    CHECK(off < tolerance * model.diagonal());
+    // Each facet is in the model entity its nodes inside an entity lie in; the cells in one.
+    for (const auto& block : mesh.facets) {
+      REQUIRE(block.entities.size() == static_cast<std::size_t>(block.size()));
+      for (Index e = 0; e < block.size(); ++e) {
+        const int entity = block.entities[static_cast<std::size_t>(e)];
+        CHECK(entity != 0);
+        for (const Index v : block.element(e))
+          if (params[static_cast<std::size_t>(v)].entity_dim == dim - 1) CHECK(params[static_cast<std::size_t>(v)].entity_tag == entity);
+      }
+    }
+    for (const auto& block : mesh.cells) CHECK(block.entities == std::vector<int>(static_cast<std::size_t>(block.size()), 1));
+  };
+  // Written and read back (4.1 and 2.2), the parameters are the same numbers, and a mesh read
+  // back is located on the model by them: its face nodes without a search.
+  const auto round_trip = [](const auto& mesh, const CadModel& model) {
+    using M = std::decay_t<decltype(mesh)>;
+    for (const MshVersion version : {MshVersion::v4_1, MshVersion::v2_2}) {
+      const auto file = test::scratch_path("on_model.msh");
+      write_gmsh(file, mesh, {version, false});
+      const M back = read_mesh_as<M::dim>(file);
+      for (std::size_t b = 0; b < mesh.facets.size(); ++b) CHECK(back.facets[b].entities == mesh.facets[b].entities);
+      for (std::size_t b = 0; b < mesh.cells.size(); ++b) CHECK(back.cells[b].entities == mesh.cells[b].entities);
+      REQUIRE(back.node_params.size() == mesh.node_params.size());
+      for (std::size_t i = 0; i < back.node_params.size(); ++i) {
+        const auto &p = mesh.node_params[i], &q = back.node_params[i];
+        REQUIRE(std::tuple{p.entity_dim, p.entity_tag, p.u, p.v} == std::tuple{q.entity_dim, q.entity_tag, q.u, q.v});
+      }
+      for (const CadGroupMatch& m : match_cad_groups(back, model)) {
+        INFO(describe_cad_matches({m}));
+        CHECK(m.matched());
+        CHECK(m.file_mismatches == 0);
+        // Every vertex the file puts inside one of the group's entities (not on an edge of them).
+        std::set<Index> inside;
+        for (const auto& block : back.facets)
+          for (Index e = 0; e < block.size(); ++e)
+            if (block.tags[static_cast<std::size_t>(e)] == back.group(m.group).tag)
+              for (int k = 0; k < num_vertices(block.type); ++k)
+                if (const Index v = block.element(e)[static_cast<std::size_t>(k)]; back.node_params[static_cast<std::size_t>(v)].entity_dim == m.dim)
+                  inside.insert(v);
+        CHECK(m.by_file > 0);
+        CHECK(m.by_file == static_cast<Index>(inside.size()));
+      }
+    }
+  };
+  SECTION("2D circles, P3, as BREP and as IGES") {
+    const Mesh<2> mesh = o_mesh(small_o_mesh());
+    for (const CadFormat format : {CadFormat::brep, CadFormat::iges_brep}) {
+      const CadModel model = CadModel::read(write_model(circles(0.5, 4.0), "circle_model", format));
+      const auto matches = match_cad_groups(mesh, model);
+      CurveResult<2> result = curve_on_model(mesh, model, 3);
+      place_on_cad(result.curved, model, matches);
+      check_on_model(result.curved, model);
+      round_trip(result.curved, model);
+    }
+  }
+  SECTION("3D torus shell, P2: the seams' nodes on the seam edges") {
+    const Mesh<3> shell = torus_shell(24, 12, 2);
+    for (const CadFormat format : {CadFormat::brep, CadFormat::iges_faces}) {
+      const auto file = write_model(tori(), "tori", format);
+      INFO(file.filename().string());
+      const CadModel model = CadModel::read(file);
+      const auto matches = match_cad_groups(shell, model);
+      CurveOptions<3> options;
+      options.order = 2;
+      for (const auto& m : matches) options.geometry.insert_or_assign(m.group, cad_boundary<3>(model, m));
+      CurveResult<3> result = curve_mesh(shell, options);
+      auto& curved = result.curved;
+      place_on_cad(curved, model, matches);
+      // IGES's faces mode: OpenCASCADE builds the seams' 3D curves from the faces' parameter
+      // curves, within the model's tolerance of the torus (the nodes are on the torus to
+      // round-off, 3e-6 from the curve), and some seam nodes are farther than the matching's
+      // tolerance from that curve: those stay on the face, which they are on.
+      const bool iges_faces = format == CadFormat::iges_faces;
+      check_on_model(curved, model, iges_faces ? 1e-6 : 1e-12);
+      // The tori's seams are the circles at angle 0 around the axis and around the tube.
+      Index on_seam = 0;
+      for (Index v = 0; v < curved.num_nodes(); ++v) {
+        const Vec<3> x = curved.points.col(v);
+        const double theta = std::atan2(x[1], x[0]), phi = std::atan2(x[2], std::hypot(x[0], x[1]) - 1.0);
+        const bool seam = std::abs(theta) < 1e-9 || std::abs(phi) < 1e-9;
+        const int entity_dim = curved.node_params[static_cast<std::size_t>(v)].entity_dim;
+        if (entity_dim == 3) continue;
+        INFO("node " << v << " at theta " << theta << ", phi " << phi);
+        if (entity_dim == 1) CHECK(seam);
+        if (!iges_faces) CHECK((entity_dim == 1) == seam);
+        on_seam += seam ? 1 : 0;
+      }
+      CHECK(on_seam == 2 * (2 * 24 + 2 * 12 - 1));  // two tori, each two seams at P2 less their common node
+      round_trip(curved, model);
+    }
+  }
+  SECTION("the sphere's Gmsh mesh: its vertices get the file's own entities and places") {
+    MESHMOTION_REQUIRE_DATA(sphere_mesh, "meshopt_sphere_symmetry_linear_tet.msh");
+    MESHMOTION_REQUIRE_DATA(sphere_step, "meshopt_Sphere25CSymmetry.stp");
+    const CadModel sphere = CadModel::read(sphere_step);
+    const Mesh<3> linear = read_mesh_as<3>(sphere_mesh);
+    const auto matches = match_cad_groups(linear, sphere);
+    CurveOptions<3> options;
+    options.sliding = {"20"};
+    for (const auto& m : matches)
+      if (m.group == "7") options.geometry.insert_or_assign(m.group, cad_boundary<3>(sphere, m));
+    CurveResult<3> result = curve_mesh(linear, options);
+    place_on_cad(result.curved, sphere, matches);
+    check_on_model(result.curved, sphere);
+    const auto& params = result.curved.node_params;
+    Index compared = 0;
+    for (Index v = 0; v < linear.num_nodes(); ++v) {
+      const NodeParametrization &file = linear.node_params[static_cast<std::size_t>(v)], &ours = params[static_cast<std::size_t>(v)];
+      INFO("node " << v << " in the file on (" << file.entity_dim << ", " << file.entity_tag << "), ours (" << ours.entity_dim
+                   << ", " << ours.entity_tag << ")");
+      if (file.entity_dim == 0) {  // a model vertex: we give it an edge ending there
+        CHECK(ours.entity_dim == 1);
+        continue;
+      }
+      REQUIRE(ours.entity_dim == file.entity_dim);
+      // (the symmetry plane's nodes slide in it)
+      if (file.entity_dim == 3 || (result.curved.points.col(v) - linear.points.col(v)).norm() > 0.0) continue;
+      CHECK(ours.entity_tag == file.entity_tag);
+      CHECK((sphere.point_at(ours.entity_dim, ours.entity_tag, ours.u, ours.v) -
+             sphere.point_at(file.entity_dim, file.entity_tag, file.u, file.v)).norm() < 1e-9 * sphere.diagonal());
+      ++compared;
+    }
+    CHECK(compared > 300);  // the wall's and the box's (396)
   }
 }

@@ -40,6 +40,9 @@ void require_same_mesh(const Mesh<Dim>& a, const Mesh<Dim>& b, bool exact_ids = 
       CHECK(x.connectivity == y.connectivity);
       CHECK(x.tags == y.tags);
       if (exact_ids && !x.ids.empty()) CHECK(x.ids == y.ids);
+      // The model entities the elements came with (Gmsh's elementary tags) are kept.
+      if (exact_ids && !x.entities.empty() && std::find(x.entities.begin(), x.entities.end(), 0) == x.entities.end())
+        CHECK(x.entities == y.entities);
     }
   }
   REQUIRE(a.groups.size() == b.groups.size());

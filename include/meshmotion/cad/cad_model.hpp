@@ -131,6 +131,17 @@ template <int Dim>
 template <int Dim>
 [[nodiscard]] BoundaryGeometry<Dim> cad_boundary(const CadModel& model, const CadGroupMatch& match, double tolerance = 0.0);
 
+/// Ties `mesh` (a mesh curved on `model`) to the model's entities, as a .msh file keeps them
+/// (Gmsh's $ParametricNodes and elementary tags), so that it goes back into Gmsh with the model:
+/// - Mesh::node_params: a node of a facet of a matched group lies within `tolerance` (≤ 0:
+///   default_cad_tolerance()) of the group's entities and, in 3D, on an edge of them when one
+///   is within it (a seam, a ridge, a border with another face); it is given that entity and
+///   its parameters there. Every other node lies in the domain: the entity of a cell holding it.
+/// - ElementBlock::entities of the facets of matched groups: the face (in 2D, the edge) their
+///   nodes lie on; of cells without entities: 1 (the model's one volume, or surface in 2D).
+template <int Dim>
+void place_on_cad(Mesh<Dim>& mesh, const CadModel& model, const std::vector<CadGroupMatch>& matches, double tolerance = 0.0);
+
 /// Throws InputError when `matches` (match_cad_groups() of `mesh`) matched no group: a user who
 /// gives a model wants it used, not a silent fallback. The message names the group that came
 /// closest and how far its farthest vertex is, and the ratio of the mesh's size to the

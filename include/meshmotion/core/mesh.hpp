@@ -19,12 +19,16 @@ namespace meshmotion {
 
 /// Elements of one type: a flat connectivity array (num_nodes(type) entries per element, in
 /// the library's local order), a physical tag per element and, optionally, the element ids
-/// the file gave them.
+/// and the model entities the file gave them.
 struct ElementBlock {
   ElementType type = ElementType::tri3;
   std::vector<Index> connectivity;  ///< size() * num_nodes(type) node indices (0-based)
   std::vector<int> tags;            ///< physical tag per element, 0 when none
   std::vector<std::int64_t> ids;    ///< ids from the file; empty means 1, 2, ... in file order
+  /// The model entity (Gmsh's elementary tag: the CAD face, edge or volume) of each element, 0
+  /// where unknown; empty when the file gave none. Kept so that a written .msh still refers to
+  /// the model's entities.
+  std::vector<int> entities;
 
   [[nodiscard]] Index size() const noexcept {
     return static_cast<Index>(connectivity.size()) / num_nodes(type);
@@ -47,12 +51,14 @@ struct ElementBlock {
                        std::to_string(num_nodes(type)) + " nodes (got " + std::to_string(nodes.size()) + ")");
     connectivity.insert(connectivity.end(), nodes.begin(), nodes.end());
     tags.push_back(tag);
+    if (!entities.empty()) entities.push_back(0);
   }
   void add(std::initializer_list<Index> nodes, int tag = 0) { add(std::span<const Index>(nodes.begin(), nodes.size()), tag); }
 
   void reserve(Index n) {
     connectivity.reserve(static_cast<std::size_t>(n * num_nodes(type)));
     tags.reserve(static_cast<std::size_t>(n));
+    if (!entities.empty()) entities.reserve(static_cast<std::size_t>(n));
   }
 };
 
@@ -117,7 +123,7 @@ struct Mesh {
     auto& list = blocks_of_dim(dimension(t));
     for (auto& b : list)
       if (b.type == t) return b;
-    list.push_back(ElementBlock{t, {}, {}, {}});
+    list.push_back(ElementBlock{t, {}, {}, {}, {}});
     return list.back();
   }
   /// The block of type t, or nullptr.
@@ -286,6 +292,10 @@ void validate(const Mesh<Dim>& mesh) {
   if (!mesh.node_params.empty() && static_cast<Index>(mesh.node_params.size()) != n)
     throw InputError("validate: " + std::to_string(mesh.node_params.size()) +
                      " node parametrizations for " + std::to_string(n) + " nodes");
+  for (std::size_t i = 0; i < mesh.node_params.size(); ++i)
+    if (mesh.node_params[i].entity_dim < 0 || mesh.node_params[i].entity_dim > 3)
+      throw InputError("validate: node " + std::to_string(i) + " lies in an entity of dimension " +
+                       std::to_string(mesh.node_params[i].entity_dim) + " (expected 0 to 3)");
   const auto check_blocks = [&](const std::vector<ElementBlock>& list, int list_dim) {
     for (const auto& b : list) {
       const std::string what = std::string(name(b.type)) + " block";
@@ -301,6 +311,9 @@ void validate(const Mesh<Dim>& mesh) {
                          std::to_string(b.size()) + " elements");
       if (!b.ids.empty() && static_cast<Index>(b.ids.size()) != b.size())
         throw InputError("validate: " + what + " has " + std::to_string(b.ids.size()) + " ids for " +
+                         std::to_string(b.size()) + " elements");
+      if (!b.entities.empty() && static_cast<Index>(b.entities.size()) != b.size())
+        throw InputError("validate: " + what + " has " + std::to_string(b.entities.size()) + " entity tags for " +
                          std::to_string(b.size()) + " elements");
       for (std::size_t k = 0; k < b.connectivity.size(); ++k) {
         const Index v = b.connectivity[k];

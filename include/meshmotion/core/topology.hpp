@@ -183,7 +183,7 @@ template <MeshLike M>
       for (int k = 0; k < n; ++k) nodes.push_back(source.node(b, e, local_nodes[static_cast<std::size_t>(k)]));
       auto it = std::find_if(out.begin(), out.end(), [ft](const ElementBlock& blk) { return blk.type == ft; });
       if (it == out.end()) {
-        out.push_back(ElementBlock{ft, {}, {}, {}});
+        out.push_back(ElementBlock{ft, {}, {}, {}, {}});
         it = out.end() - 1;
       }
       it->add(nodes, tag);

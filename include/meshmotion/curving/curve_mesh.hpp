@@ -201,7 +201,7 @@ struct CurveTimes {
 
 template <class F>
 void visit_fields(const CurveTimes& t, F&& f) {
-  f("cad", t.cad, "reading the CAD file and matching its entities to the groups (the program's --geometry FILE)");
+  f("cad", t.cad, "reading the CAD file, matching its entities to the groups and placing the curved nodes on them (the program's --geometry FILE)");
   f("quadratic", t.quadratic, "conversion to the curved order");
   f("snap", t.snap, "snapping the boundary to the geometry");
   f("layer", t.layer, "estimating the walls' boundary layers");

@@ -195,7 +195,7 @@ template <int Dim>
       if (!table) table = std::make_unique<detail::OrderTable>(detail::make_order_table(t, target));
       const int n = num_nodes(target), nv = num_vertices(t);
       const bool own_interior = list == &input.cells;
-      ElementBlock q{target, {}, b.tags, b.ids};
+      ElementBlock q{target, {}, b.tags, b.ids, b.entities};
       q.connectivity.reserve(static_cast<std::size_t>(b.size() * n));
       for (Index e = 0; e < b.size(); ++e) {
         const auto el = b.element(e);

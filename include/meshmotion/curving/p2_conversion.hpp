@@ -103,7 +103,7 @@ template <int Dim>
       const ElementType t = b.type;
       const ElementType qt = dimension(t) == 0 ? t : quadratic_type(t, options.complete);
       const int nv = num_vertices(t);
-      ElementBlock q{qt, {}, b.tags, b.ids};
+      ElementBlock q{qt, {}, b.tags, b.ids, b.entities};
       q.connectivity.reserve(static_cast<std::size_t>(b.size() * num_nodes(qt)));
       for (Index e = 0; e < b.size(); ++e) {
         const auto el = b.element(e);

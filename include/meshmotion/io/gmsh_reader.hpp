@@ -3,7 +3,8 @@
 /// Gmsh .msh reader: versions 2.2 and 4.1, ASCII and binary (detected from $MeshFormat, with
 /// the endianness check word honoured), P1 and P2 elements of every catalogue type (Gmsh ids
 /// 1-19 and 15 for points), $PhysicalNames, 4.1 $Entities (physical tags of entities become
-/// element tags), 2.2 $ParametricNodes and 4.1 parametric node blocks (kept in
+/// element tags), the elements' entities (2.2's elementary tag, 4.1's block entity: kept in
+/// ElementBlock::entities), 2.2 $ParametricNodes and 4.1 parametric node blocks (kept in
 /// Mesh::node_params), arbitrary node and element ids (kept in node_ids / ElementBlock::ids).
 /// Unknown sections are skipped. The whole file is parsed from one buffer with from_chars.
 
@@ -320,7 +321,7 @@ class GmshParser {
     int& index = block_of_type_[static_cast<std::size_t>(type)];
     if (index < 0) {
       index = static_cast<int>(raw_.blocks.size());
-      raw_.blocks.push_back(ElementBlock{type, {}, {}, {}});
+      raw_.blocks.push_back(ElementBlock{type, {}, {}, {}, {}});
     }
     return raw_.blocks[static_cast<std::size_t>(index)];
   }
@@ -367,6 +368,7 @@ class GmshParser {
           const std::int32_t* rec = buffer.data() + e * per;
           block.ids.push_back(rec[0]);
           block.tags.push_back(num_tags > 0 ? rec[1] : 0);
+          block.entities.push_back(num_tags > 1 ? rec[2] : 0);
           for (int k = 0; k < num_nodes(type); ++k) block.connectivity.push_back(node_index(rec[1 + num_tags + k], rec[0], bin));
         }
         done += n;
@@ -377,13 +379,15 @@ class GmshParser {
         const auto id = text_.integer<std::int64_t>("element id");
         ElementBlock& block = block_for(text_.integer<int>("element type"));
         const auto num_tags = text_.integer<int>("number of tags", 0, 64);
-        int physical = 0;
+        int physical = 0, entity = 0;
         for (int t = 0; t < num_tags; ++t) {
           const int tag = text_.integer<int>("element tag");
           if (t == 0) physical = tag;
+          if (t == 1) entity = tag;
         }
         block.ids.push_back(id);
         block.tags.push_back(physical);
+        block.entities.push_back(entity);
         for (int k = 0; k < block.nodes_per_element(); ++k)
           block.connectivity.push_back(node_index(text_.integer<std::int64_t>("element node"), id));
         if (!text_.at_line_end())
@@ -423,6 +427,7 @@ class GmshParser {
         const auto first = static_cast<std::size_t>(block.size());
         block.ids.resize(first + n);
         block.tags.resize(first + n, physical);
+        block.entities.resize(first + n, entity);
         block.connectivity.resize((first + n) * per);
         Index* nodes = block.connectivity.data() + first * per;
         constexpr auto largest = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
@@ -456,6 +461,7 @@ class GmshParser {
           const auto id = text_.integer<std::int64_t>("element tag");
           block.ids.push_back(id);
           block.tags.push_back(physical);
+          block.entities.push_back(entity);
           for (int k = 0; k < block.nodes_per_element(); ++k)
             block.connectivity.push_back(node_index(text_.integer<std::int64_t>("element node"), id));
           if (!text_.at_line_end())

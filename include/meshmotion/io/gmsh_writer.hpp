@@ -2,9 +2,11 @@
 /// \file
 /// Gmsh .msh writer: version 2.2 or 4.1, ASCII or binary. Node and element ids of the mesh are
 /// written as they are (1, 2, ... where the mesh has none), so numbering survives round trips;
-/// element tags become physical tags (4.1: one entity per dimension and tag), groups become
-/// $PhysicalNames, node parametrizations become 2.2 ASCII $ParametricNodes. Elements are
-/// written by increasing dimension (lower, facets, cells), each block in its order.
+/// element tags become physical tags and element entities elementary tags (4.1: the entities
+/// in $Entities, with an entity made for each dimension and physical tag of elements without
+/// one), groups become $PhysicalNames, node parametrizations become 2.2 ASCII $ParametricNodes
+/// or 4.1 parametric node blocks. Elements are written by increasing dimension (lower,
+/// facets, cells), each block in its order; nodes in their order.
 
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
@@ -13,9 +15,11 @@
 #include "meshmotion/io/detail/number_format.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -116,7 +120,8 @@ void format_gmsh_v2(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
         f.value<int>(2);
       }
       f.value<std::int32_t>(tag);
-      f.value<std::int32_t>(tag);  // elementary entity: the mesh keeps none, the physical tag stands in
+      // The elementary entity: the element's own, else its physical tag stands in.
+      f.value<std::int32_t>(b->entities.empty() || b->entities[static_cast<std::size_t>(e)] == 0 ? tag : b->entities[static_cast<std::size_t>(e)]);
       for (const Index v : b->element(e)) f.value<std::int32_t>(msh_node_id(mesh, v));
       f.end_of_record();
     }
@@ -125,35 +130,83 @@ void format_gmsh_v2(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
   f.text("$EndElements\n");
 }
 
+// The model entities a 4.1 file declares: the elements' own (ElementBlock::entities) and the
+// nodes' (Mesh::node_params), each with at most one physical tag. An element without an entity,
+// or whose entity already carries another physical tag, goes to an entity made for its
+// (dimension, physical tag), numbered after the largest tag of that dimension in use.
+class GmshEntities {
+ public:
+  template <int Dim>
+  GmshEntities(const Mesh<Dim>& mesh, const std::vector<const ElementBlock*>& blocks) {
+    for (const auto* b : blocks) {
+      const int dim = dimension(b->type);
+      for (Index e = 0; e < b->size(); ++e) {
+        const int given = given_entity(*b, e);
+        if (given != 0) physical_.emplace(std::pair{dim, given}, b->tags[static_cast<std::size_t>(e)]);
+      }
+    }
+    for (const auto& p : mesh.node_params) physical_.emplace(std::pair{p.entity_dim, p.entity_tag}, 0);
+    for (const auto& [key, physical] : physical_) largest_[static_cast<std::size_t>(key.first)] = std::max(largest_[static_cast<std::size_t>(key.first)], key.second);
+    for (const auto* b : blocks)
+      for (Index e = 0; e < b->size(); ++e) (void)of(*b, e);
+    // Nodes without a parametrization lie in the mesh's own domain: the first cell's entity.
+    volume_ = mesh.cells.empty() || mesh.cells.front().empty() ? made(Dim, 0) : of(mesh.cells.front(), 0);
+  }
+
+  /// The entity element e of block b is written in.
+  [[nodiscard]] int of(const ElementBlock& b, Index e) {
+    const std::array<int, 3> key{dimension(b.type), b.tags[static_cast<std::size_t>(e)], given_entity(b, e)};
+    if (key != last_key_) {  // elements come in long runs of one entity: one lookup per run
+      const auto [dim, physical, given] = key;
+      const auto it = given != 0 ? physical_.find({dim, given}) : physical_.end();
+      last_entity_ = it != physical_.end() && it->second == physical ? given : made(dim, physical);
+      last_key_ = key;
+    }
+    return last_entity_;
+  }
+  [[nodiscard]] int volume() const noexcept { return volume_; }
+  /// (dimension, tag) -> physical tag, 0 for none; in file order.
+  [[nodiscard]] const std::map<std::pair<int, int>, int>& all() const noexcept { return physical_; }
+
+ private:
+  [[nodiscard]] static int given_entity(const ElementBlock& b, Index e) {
+    return b.entities.empty() ? 0 : b.entities[static_cast<std::size_t>(e)];
+  }
+  int made(int dim, int physical) {
+    const auto it = made_.find({dim, physical});
+    if (it != made_.end()) return it->second;
+    const int tag = ++largest_[static_cast<std::size_t>(dim)];
+    made_.emplace(std::pair{dim, physical}, tag);
+    physical_.emplace(std::pair{dim, tag}, physical);
+    return tag;
+  }
+
+  std::map<std::pair<int, int>, int> physical_;
+  std::map<std::pair<int, int>, int> made_;
+  std::array<int, 4> largest_{};
+  std::array<int, 3> last_key_{-1, 0, 0};
+  int last_entity_ = 0;
+  int volume_ = 0;
+};
+
 template <int Dim>
 void format_gmsh_v4(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
   const auto blocks = blocks_in_file_order(mesh);
-  // One entity per (dimension, physical tag); entity tags are positions from 1.
-  std::vector<std::vector<int>> entity_tags(4);
-  entity_tags[Dim].push_back(0);  // the entity that holds the nodes, without a physical tag
-  const auto entity_of = [&](int dim, int tag) {
-    auto& list = entity_tags[static_cast<std::size_t>(dim)];
-    const auto it = std::find(list.begin(), list.end(), tag);
-    if (it != list.end()) return static_cast<int>(it - list.begin()) + 1;
-    list.push_back(tag);
-    return static_cast<int>(list.size());
-  };
-  for (const auto* b : blocks)
-    for (const int tag : b->tags) entity_of(dimension(b->type), tag);
+  GmshEntities entities(mesh, blocks);
 
   const auto size = [&](std::uint64_t v, char sep = ' ') { f.value<std::uint64_t>(v, sep); };
   f.text("$Entities\n");
-  for (int d = 0; d < 4; ++d) size(entity_tags[static_cast<std::size_t>(d)].size(), d == 3 ? '\n' : ' ');
-  for (int d = 0; d < 4; ++d)
-    for (std::size_t k = 0; k < entity_tags[static_cast<std::size_t>(d)].size(); ++k) {
-      const int physical = entity_tags[static_cast<std::size_t>(d)][k];
-      f.value<std::int32_t>(static_cast<int>(k) + 1);
-      for (int c = 0; c < (d == 0 ? 3 : 6); ++c) f.value<double>(0.0);
-      size(physical != 0 ? 1 : 0);
-      if (physical != 0) f.value<std::int32_t>(physical);
-      if (d > 0) size(0);
-      f.end_of_record();
-    }
+  std::array<std::uint64_t, 4> count{};
+  for (const auto& [key, physical] : entities.all()) ++count[static_cast<std::size_t>(key.first)];
+  for (int d = 0; d < 4; ++d) size(count[static_cast<std::size_t>(d)], d == 3 ? '\n' : ' ');
+  for (const auto& [key, physical] : entities.all()) {
+    f.value<std::int32_t>(key.second);
+    for (int c = 0; c < (key.first == 0 ? 3 : 6); ++c) f.value<double>(0.0);
+    size(physical != 0 ? 1 : 0);
+    if (physical != 0) f.value<std::int32_t>(physical);
+    if (key.first > 0) size(0);
+    f.end_of_record();
+  }
   f.text(binary ? "\n" : "");
   f.text("$EndEntities\n");
 
@@ -165,38 +218,56 @@ void format_gmsh_v4(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
   if (mesh.num_nodes() == 0) min_id = 0;
   f.text("$Nodes\n");
   const Index n = mesh.num_nodes();
-  size(n > 0 ? 1 : 0);
+  // Node blocks: runs of consecutive nodes in one entity, so the nodes keep their order.
+  const bool parametric = !mesh.node_params.empty();
+  const auto entity_of_node = [&](Index i) {
+    if (!parametric) return std::pair{Dim, entities.volume()};
+    const auto& p = mesh.node_params[static_cast<std::size_t>(i)];
+    return std::pair{p.entity_dim, p.entity_tag};
+  };
+  std::vector<Index> run_starts;
+  for (Index i = 0; i < n; ++i)
+    if (i == 0 || entity_of_node(i) != entity_of_node(i - 1)) run_starts.push_back(i);
+  run_starts.push_back(n);
+  size(run_starts.size() - 1);
   size(static_cast<std::uint64_t>(n));
   size(static_cast<std::uint64_t>(min_id));
   size(static_cast<std::uint64_t>(max_id), '\n');
-  if (n > 0) {
-    f.value<std::int32_t>(Dim);
-    f.value<std::int32_t>(1);
-    f.value<std::int32_t>(0);
-    size(static_cast<std::uint64_t>(n), '\n');
-    for (Index i = 0; i < n; ++i) {
+  for (std::size_t r = 0; r + 1 < run_starts.size(); ++r) {
+    const Index first = run_starts[r], last = run_starts[r + 1];
+    const auto [dim, tag] = entity_of_node(first);
+    const int num_params = parametric && dim >= 1 && dim <= 2 ? dim : 0;
+    f.value<std::int32_t>(dim);
+    f.value<std::int32_t>(tag);
+    f.value<std::int32_t>(num_params > 0 ? 1 : 0);
+    size(static_cast<std::uint64_t>(last - first), '\n');
+    for (Index i = first; i < last; ++i) {
       size(static_cast<std::uint64_t>(msh_node_id(mesh, i)), '\n');
       f.end_of_record();
     }
-    for (Index i = 0; i < n; ++i) {
+    for (Index i = first; i < last; ++i) {
       for (int d = 0; d < 3; ++d) f.value<double>(d < Dim ? mesh.points(d, i) : 0.0);
+      if (num_params > 0) f.value<double>(mesh.node_params[static_cast<std::size_t>(i)].u);
+      if (num_params > 1) f.value<double>(mesh.node_params[static_cast<std::size_t>(i)].v);
       f.end_of_record();
     }
   }
   f.text(binary ? "\n" : "");
   f.text("$EndNodes\n");
 
-  // Element blocks: runs of consecutive elements with the same tag, so block order is kept.
+  // Element blocks: runs of consecutive elements in one entity, so block order is kept.
   struct Run {
     const ElementBlock* block;
+    int entity;
     Index first, last;
   };
   std::vector<Run> runs;
   std::int64_t min_el = std::numeric_limits<std::int64_t>::max(), max_el = 0, position = 0;
   for (const auto* b : blocks)
     for (Index e = 0; e < b->size(); ++e, ++position) {
-      if (runs.empty() || runs.back().block != b || b->tags[static_cast<std::size_t>(e)] != b->tags[static_cast<std::size_t>(e - 1)])
-        runs.push_back({b, e, e + 1});
+      const int entity = entities.of(*b, e);
+      if (runs.empty() || runs.back().block != b || runs.back().entity != entity)
+        runs.push_back({b, entity, e, e + 1});
       else
         runs.back().last = e + 1;
       const auto id = element_id(*b, e, position);
@@ -219,7 +290,7 @@ void format_gmsh_v4(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
     }
     const int dim = dimension(run.block->type);
     f.value<std::int32_t>(dim);
-    f.value<std::int32_t>(entity_of(dim, run.block->tags[static_cast<std::size_t>(run.first)]));
+    f.value<std::int32_t>(run.entity);
     f.value<std::int32_t>(element_info(run.block->type).gmsh_id);
     size(static_cast<std::uint64_t>(run.last - run.first), '\n');
     for (Index e = run.first; e < run.last; ++e) {

@@ -44,6 +44,7 @@ struct MeshSummary {
   int dim = 0;
   Index num_nodes = 0;
   Index num_auxiliary_nodes = 0;  ///< of num_nodes: centres of polyhedra cut into tetrahedra
+  Index num_on_model = 0;         ///< of num_nodes: placed on a model curve or surface (Mesh::node_params)
   std::vector<std::pair<std::string, Index>> cells, facets, lower;  ///< type name, count
   std::vector<GroupSummary> groups;
   std::array<double, 3> bbox_min{}, bbox_max{};   ///< z is 0 in 2D
@@ -59,6 +60,7 @@ void visit_fields(const MeshSummary& s, F&& f) {
   f("dim", s.dim, "dimension of the mesh");
   f("nodes", s.num_nodes, "nodes");
   f("auxiliary_nodes", s.num_auxiliary_nodes, "of the nodes: centres of polyhedra cut into tetrahedra");
+  f("nodes_on_model", s.num_on_model, "of the nodes: those the file places on a model curve or surface, with their parameters there");
   f("cells", s.cells, "cells per element type");
   f("facets", s.facets, "boundary facets per element type");
   f("lower", s.lower, "lower-dimensional elements per type (edges, points)");
@@ -80,6 +82,8 @@ template <int Dim>
   s.dim = Dim;
   s.num_nodes = mesh.num_nodes();
   s.num_auxiliary_nodes = mesh.num_auxiliary_nodes;
+  s.num_on_model = std::count_if(mesh.node_params.begin(), mesh.node_params.end(),
+                                 [](const NodeParametrization& p) { return p.entity_dim == 1 || p.entity_dim == 2; });
   const auto counts = [](const std::vector<ElementBlock>& list) {
     std::vector<std::pair<std::string, Index>> out;
     for (const auto& b : list) out.emplace_back(std::string(name(b.type)), b.size());

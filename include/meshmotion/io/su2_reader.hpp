@@ -153,7 +153,7 @@ class Su2Parser {
     int& index = block_of_type_[static_cast<std::size_t>(type)];
     if (index < 0) {
       index = static_cast<int>(raw_.blocks.size());
-      raw_.blocks.push_back(ElementBlock{type, {}, {}, {}});
+      raw_.blocks.push_back(ElementBlock{type, {}, {}, {}, {}});
     }
     index_out = index;
     return raw_.blocks[static_cast<std::size_t>(index)];

@@ -394,7 +394,7 @@ inline std::optional<VtkReadCell> element_of_vtk(int vtk_type, int n) {
       const detail::VtkReadCell& cell = elements[e].cell;
       const ElementType et = cell.type;
       auto& blocks = mesh.blocks_of_dim(dimension(et));
-      if (blocks.empty() || blocks.back().type != et) blocks.push_back(ElementBlock{et, {}, {}, {}});
+      if (blocks.empty() || blocks.back().type != et) blocks.push_back(ElementBlock{et, {}, {}, {}, {}});
       std::copy_n(nodes.begin() + static_cast<std::ptrdiff_t>(elements[e].first), num_nodes(et), listed.begin());
       if (new_hexahedra && static_cast<int>(type[e]) == element_info(et).vtk_lagrange_id && shape(et) == Shape::hexahedron) {
         // From file version 2.2 VTK lists the nodes of the hexahedron's edges 10 and 11 the

@@ -120,6 +120,7 @@ void pack_blocks(Packer& out, const std::vector<ElementBlock>& blocks) {
     out.put(b.connectivity);
     out.put(b.tags);
     out.put(b.ids);
+    out.put(b.entities);
   }
 }
 
@@ -130,6 +131,7 @@ inline std::vector<ElementBlock> unpack_blocks(Unpacker& in) {
     b.connectivity = in.get<Index>();
     b.tags = in.get<int>();
     b.ids = in.get<std::int64_t>();
+    b.entities = in.get<int>();
   }
   return blocks;
 }
@@ -273,25 +275,26 @@ template <int Dim>
       // A part's nodes are not a run of the file's numbering: each keeps its own id.
       part.local.node_ids.push_back(whole.node_id(nodes[i]));
     }
+    const auto copy_element = [&](const ElementBlock& block, Index e, ElementBlock& local) {
+      for (const Index v : block.element(e)) local.connectivity.push_back(local_of[static_cast<std::size_t>(v)]);
+      const auto k = static_cast<std::size_t>(e);
+      local.tags.push_back(block.tags[k]);
+      if (!block.ids.empty()) local.ids.push_back(block.ids[k]);
+      if (!block.entities.empty()) local.entities.push_back(block.entities[k]);
+    };
     c = 0;
     for (const auto& block : whole.cells) {
-      ElementBlock local{block.type, {}, {}, {}};
-      for (Index e = 0; e < block.size(); ++e, ++c) {
-        if (ranks[c] != r) continue;
-        for (const Index v : block.element(e)) local.connectivity.push_back(local_of[static_cast<std::size_t>(v)]);
-        local.tags.push_back(block.tags[static_cast<std::size_t>(e)]);
-        if (!block.ids.empty()) local.ids.push_back(block.ids[static_cast<std::size_t>(e)]);
-      }
+      ElementBlock local{block.type, {}, {}, {}, {}};
+      for (Index e = 0; e < block.size(); ++e, ++c)
+        if (ranks[c] == r) copy_element(block, e, local);
       if (!local.empty()) part.local.cells.push_back(std::move(local));
     }
     for (const auto& block : whole.facets) {
-      ElementBlock local{block.type, {}, {}, {}};
+      ElementBlock local{block.type, {}, {}, {}, {}};
       for (Index e = 0; e < block.size(); ++e) {
         const auto el = block.element(e);
-        if (!std::all_of(el.begin(), el.end(), [&](Index v) { return local_of[static_cast<std::size_t>(v)] >= 0; })) continue;
-        for (const Index v : el) local.connectivity.push_back(local_of[static_cast<std::size_t>(v)]);
-        local.tags.push_back(block.tags[static_cast<std::size_t>(e)]);
-        if (!block.ids.empty()) local.ids.push_back(block.ids[static_cast<std::size_t>(e)]);
+        if (std::all_of(el.begin(), el.end(), [&](Index v) { return local_of[static_cast<std::size_t>(v)] >= 0; }))
+          copy_element(block, e, local);
       }
       if (!local.empty()) part.local.facets.push_back(std::move(local));
     }

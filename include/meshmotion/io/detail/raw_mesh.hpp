@@ -39,7 +39,7 @@ struct RawMesh {
   ElementBlock& block(ElementType t) {
     for (auto& b : blocks)
       if (b.type == t) return b;
-    blocks.push_back(ElementBlock{t, {}, {}, {}});
+    blocks.push_back(ElementBlock{t, {}, {}, {}, {}});
     return blocks.back();
   }
 };
