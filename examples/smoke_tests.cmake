@@ -442,7 +442,7 @@ endif()
 #   build/examples/curve_mesh --options-markdown > docs/options.md
 add_test(NAME examples.curve_mesh.options_markdown_matches_docs
          COMMAND "${CMAKE_COMMAND}" -DPROGRAM=$<TARGET_FILE:curve_mesh> -DDOC=${PROJECT_SOURCE_DIR}/docs/options.md
-                 -P "${CMAKE_CURRENT_LIST_DIR}/compare_output.cmake")
+                 -DGENERATED=${CMAKE_CURRENT_BINARY_DIR}/options.md.generated -P "${CMAKE_CURRENT_LIST_DIR}/compare_output.cmake")
 set_tests_properties(examples.curve_mesh.options_markdown_matches_docs PROPERTIES LABELS examples)
 
 # CHOLMOD (with OpenBLAS) and CGNS (with HDF5) are loaded by the first run that needs them,
