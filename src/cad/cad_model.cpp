@@ -488,17 +488,17 @@ void place_on_cad(Mesh<Dim>& mesh, const CadModel& model, const std::vector<CadG
       if (const int entity = block.entities[static_cast<std::size_t>(e)]; entity != 0)
         for (const Index v : block.element(e)) out[static_cast<std::size_t>(v)].entity_tag = entity;
   }
-  // A group's tag: its name's, or the number an unnamed tag was named by (match_cad_groups).
+  name_unnamed_facet_groups(mesh);  // the names match_cad_groups() gave them
   std::map<int, const CadGroupMatch*> match_of_tag;
   for (const CadGroupMatch& m : matches) {
-    if (!m.matched()) continue;
-    const auto named = std::find_if(mesh.groups.begin(), mesh.groups.end(),
+    const auto group = std::find_if(mesh.groups.begin(), mesh.groups.end(),
                                     [&](const PhysicalGroup& g) { return g.dim == Dim - 1 && g.name == m.group; });
-    if (named != mesh.groups.end()) match_of_tag[named->tag] = &m;
-    else if (!m.group.empty() && std::all_of(m.group.begin(), m.group.end(), [](char c) { return c >= '0' && c <= '9'; }))
-      match_of_tag[std::stoi(m.group)] = &m;
+    if (m.matched() && group != mesh.groups.end()) match_of_tag[group->tag] = &m;
   }
-  const auto set = [&](Index v, const CadPoint& at) {
+  // A located node's entity: the model edge it lies on, else its face (in 2D, its edge).
+  const auto set = [&](Index v, const VertexOnCad& on) {
+    if (on.edges.empty() && on.entities.empty()) return;
+    const CadPoint& at = !on.edges.empty() ? on.edges.front() : on.entities.front();
     out[static_cast<std::size_t>(v)] = NodeParametrization{at.dim, at.index, at.u, at.dim == 2 ? at.v : 0.0};
   };
   // The vertices are located by a global search, or a local one from a vertex of the same facet;
@@ -529,8 +529,7 @@ void place_on_cad(Mesh<Dim>& mesh, const CadModel& model, const std::vector<CadG
           on = locate(model, match, x, tolerance);
         }
         found.push_back(corner[k] = &vertices.emplace(el[k], std::move(on)).first->second);
-        if (!corner[k]->edges.empty() || !corner[k]->entities.empty())
-          set(el[k], !corner[k]->edges.empty() ? corner[k]->edges.front() : corner[k]->entities.front());
+        set(el[k], *corner[k]);
       }
       // Model edges a vertex lies on (in 2D the group's own entities are edges). Not only those
       // two vertices share: a vertex at a model corner, located from one face, lists that
@@ -550,15 +549,13 @@ void place_on_cad(Mesh<Dim>& mesh, const CadModel& model, const std::vector<CadG
         const Index v = el[k];
         if (std::exchange(done[static_cast<std::size_t>(v)], 1) == 0) {
           const Vec<3> x = embed<Dim>(mesh.points.col(v));
-          std::optional<CadPoint> at;
+          VertexOnCad on;
           for (const int edge : edges)
-            if (const CadPoint c = model.closest_point(1, edge, x); c.distance <= tolerance && (!at || c.distance < at->distance)) at = c;
-          if (!at && match.dim == 2) at = on_a_face(model, corner, x, tolerance);
-          if (!at) {
-            const VertexOnCad on = locate(model, match, x, tolerance);
-            if (!on.edges.empty() || !on.entities.empty()) at = !on.edges.empty() ? on.edges.front() : on.entities.front();
-          }
-          if (at) set(v, *at);
+            if (const CadPoint c = model.closest_point(1, edge, x); c.distance <= tolerance && (on.edges.empty() || c.distance < on.edges[0].distance))
+              on.edges = {c};
+          if (on.edges.empty() && match.dim == 2)
+            if (const auto f = on_a_face(model, corner, x, tolerance)) on.entities = {*f};
+          set(v, on.edges.empty() && on.entities.empty() ? locate(model, match, x, tolerance) : on);
         }
         if (const NodeParametrization& p = out[static_cast<std::size_t>(v)]; p.entity_dim == match.dim) entity = p.entity_tag;
       }

@@ -139,6 +139,7 @@ template <int Dim>
 ///   its parameters there. Every other node lies in the domain: the entity of a cell holding it.
 /// - ElementBlock::entities of the facets of matched groups: the face (in 2D, the edge) their
 ///   nodes lie on; of cells without entities: 1 (the model's one volume, or surface in 2D).
+/// Facet tags without a group get one named by their number, as match_cad_groups() names them.
 template <int Dim>
 void place_on_cad(Mesh<Dim>& mesh, const CadModel& model, const std::vector<CadGroupMatch>& matches, double tolerance = 0.0);
 
