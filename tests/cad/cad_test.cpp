@@ -496,12 +496,11 @@ TEST_CASE("CAD: one model as BREP, STEP, IGES (both modes) and NURBS gives the s
   // and NURBS conversion makes every curve and surface a B-spline: the placement works on the
   // geometry, not its parametrization, so every file gives the mesh of the BREP to 1e-9, the
   // untangling's rounds included (on these symmetric meshes they choose among cells that tie
-  // to round-off: by round-off, the meshes were 0.05 apart). On the 2D meshes at P2 the
-  // rounds' compass search still takes, on one file and not the other, a step whose gain is at
-  // round-off: the inside nodes agree to 1e-2 there (4e-3 on the ellipse), the walls to 1e-9.
+  // to round-off, and its search took steps whose gain was at round-off: by round-off, the
+  // meshes were 0.05 and 4e-3 apart).
   constexpr std::array formats{CadFormat::step, CadFormat::iges_faces, CadFormat::iges_brep, CadFormat::nurbs};
   const auto compare = [](const auto& curved, const auto& reference, const std::vector<std::string>& groups, double tolerance,
-                          double inside) {
+                          double inside = 0.0) {
     REQUIRE(curved.points.cols() == reference.points.cols());
     double boundary = 0.0;
     for (const auto& g : groups)
@@ -535,7 +534,7 @@ TEST_CASE("CAD: one model as BREP, STEP, IGES (both modes) and NURBS gives the s
         INFO(file.filename().string() << ", order " << p);
         const CurveResult<2> curved = curve(CadModel::read(file));
         CHECK(curved.off_geometry() == 0);
-        compare(curved.curved, reference.curved, {"wall", "farfield"}, 1e-9, p == 2 ? 1e-2 : 1e-9);
+        compare(curved.curved, reference.curved, {"wall", "farfield"}, 1e-9);
       }
     }
   }
@@ -559,8 +558,15 @@ TEST_CASE("CAD: one model as BREP, STEP, IGES (both modes) and NURBS gives the s
     CHECK(curved.off_geometry() == 0);
     // IGES's faces mode trims each face by curves in its parameters, and OpenCASCADE builds the
     // seam's 3D curve from them to its tolerance: the seam's nodes, on the torus to round-off,
-    // are 3e-7 along it from the BREP's.
-    compare(curved.curved, reference.curved, {"wall", "outer"}, format == CadFormat::iges_faces ? 1e-6 : 1e-9, 1e-9);
+    // are 3e-7 along it from the BREP's. That is another input, and the untangling's choices
+    // (which cells are the worst, which step gains) are not continuous in it: the nodes inside
+    // differ by up to 1e-2 while the certified minimum is the same.
+    if (format == CadFormat::iges_faces) {
+      compare(curved.curved, reference.curved, {"wall", "outer"}, 1e-6, 2e-2);
+      CHECK(curved.untangle.min_after == Approx(reference.untangle.min_after).margin(1e-6));
+    } else {
+      compare(curved.curved, reference.curved, {"wall", "outer"}, 1e-9);
+    }
   }
 }
 
