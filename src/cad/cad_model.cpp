@@ -132,6 +132,13 @@ double CadModel::arc_length_parameter(int index, double a, double b, double frac
   return impl_->shape->arc_length_parameter(index, a, b, fraction);
 }
 
+double CadModel::isoline_arc_length_parameter(int index, int fixed, double at, double a, double b, double fraction) const {
+  check_entity(*this, 2, index);
+  if (fixed != 0 && fixed != 1)
+    throw InputError("CadModel::isoline_arc_length_parameter: the fixed parameter is 0 (u) or 1 (v), got " + std::to_string(fixed));
+  return impl_->shape->isoline_arc_length_parameter(index, fixed, at, a, b, fraction);
+}
+
 double default_cad_tolerance(const CadModel& model) { return 1e-6 * model.diagonal(); }
 
 namespace {
@@ -244,6 +251,28 @@ bool along_common_edge(const CadModel& model, const std::vector<const std::vecto
     return true;
   }
   return false;
+}
+
+// The point at fraction `t` of the arc length between two vertices along an isoline of a face
+// they share (one parameter equal once the other is unwrapped), when that point is within
+// 1e-3 of their distance of `near` (the isoline is then the edge `near` lies on), or none.
+std::optional<Vec<3>> along_common_isoline(const CadModel& model, const std::vector<const std::vector<CadPoint>*>& ends, double t,
+                                           const Vec<3>& near) {
+  for (const CadPoint& a : *ends[0]) {
+    const auto b = std::find_if(ends[1]->begin(), ends[1]->end(), [&](const CadPoint& c) { return c.index == a.index; });
+    if (b == ends[1]->end()) continue;
+    const std::array<double, 2> period = model.periods(2, a.index);
+    const std::array<double, 2> from{a.u, a.v}, to{unwrap(b->u, a.u, period[0]), unwrap(b->v, a.v, period[1])};
+    for (int fixed = 0; fixed < 2; ++fixed) {
+      const int moving = 1 - fixed;
+      if (std::abs(to[fixed] - from[fixed]) > 1e-9 * (1.0 + std::abs(from[fixed])) || to[moving] == from[moving]) continue;
+      std::array<double, 2> uv = from;
+      uv[moving] = model.isoline_arc_length_parameter(a.index, fixed, from[fixed], from[moving], to[moving], t);
+      const Vec<3> x = model.point_at(2, a.index, uv[0], uv[1]);
+      if ((x - near).norm() <= 1e-3 * (b->point - a.point).norm()) return x;
+    }
+  }
+  return std::nullopt;
 }
 
 // A vertex's place from the mesh file (an entity tag and parameters): the model's point there
@@ -463,10 +492,12 @@ BoundaryGeometry<Dim> cad_boundary(const CadModel& model, const CadGroupMatch& m
       // On a face group, onto the face: an edge's curve may lie only within the model's
       // tolerance of it (IGES trims faces by curves in their parameters, and OpenCASCADE builds
       // the edge's 3D curve from them: a torus's seam nodes were 2e-6 off the torus). A point
-      // already on the face to round-off stays as it is.
+      // already on the face to round-off stays as it is. Along an isoline of the face (a seam
+      // is one), the node is where the exact edge would put it: the closest point of the face
+      // to the rebuilt curve's point was 3e-7 along the seam from it.
       if (dim == 2)
         if (const auto p = near_common_face(*cad, on.entities, on.weights, at); p && (p->point - at).norm() > 1e-12 * cad->diagonal())
-          at = p->point;
+          at = along_common_isoline(*cad, on.entities, on.weights[1], at).value_or(p->point);
       return restrict_to<Dim>(at);
     }
     // Across a face (and inside one): the projection of the straight place, on the nearest

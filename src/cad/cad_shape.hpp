@@ -40,10 +40,13 @@ class CadShape {
   /// The parameter of edge `edge` between a and b (unwrapped: b may lie past the seam of a
   /// closed edge) where the arc length from a reaches `fraction` of the length from a to b.
   [[nodiscard]] virtual double arc_length_parameter(int edge, double a, double b, double fraction) const = 0;
+  /// The same along an isoline of face `face`: parameter `fixed` (0: u, 1: v) held at `at`,
+  /// a and b values of the other one.
+  [[nodiscard]] virtual double isoline_arc_length_parameter(int face, int fixed, double at, double a, double b, double fraction) const = 0;
 };
 
 /// Raised whenever CadShape changes: a module built from other sources is refused.
-inline constexpr int cad_module_version = 2;
+inline constexpr int cad_module_version = 3;
 
 }  // namespace meshmotion::detail
 

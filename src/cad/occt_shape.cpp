@@ -6,6 +6,7 @@
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/io/detail/read_file.hpp"
 
+#include <Adaptor3d_IsoCurve.hxx>
 #include <BRepAdaptor_Curve.hxx>
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepBndLib.hxx>
@@ -109,6 +110,7 @@ class OcctShape final : public CadShape {
   Vec<3> point_at(int dim, int index, double u, double v) const override;
   std::array<double, 2> periods(int dim, int index) const override;
   double arc_length_parameter(int edge, double a, double b, double fraction) const override;
+  double isoline_arc_length_parameter(int face, int fixed, double at, double a, double b, double fraction) const override;
 
  private:
   std::filesystem::path file_;
@@ -299,8 +301,7 @@ std::array<double, 2> OcctShape::periods(int dim, int index) const {
 // B-spline circle's speed jumps at its knots) and inverts it by Newton's method, both to
 // round-off here: a circle stored as a periodic circle (STEP) or a closed B-spline (IGES) then
 // gets the same nodes to 1e-12, where a polyline of chords left the B-spline's 1e-5 apart.
-double OcctShape::arc_length_parameter(int edge, double a, double b, double fraction) const {
-  const BRepAdaptor_Curve c(TopoDS::Edge(edges_(edge)));
+double arc_length_on(const Adaptor3d_Curve& c, double a, double b, double fraction) {
   const double first = c.FirstParameter(), last = c.LastParameter();
   // Pieces of the way from a to b in the curve's own range: a closed, non-periodic curve
   // cannot be evaluated past its seam, so a way across it continues from the other end.
@@ -341,6 +342,15 @@ double OcctShape::arc_length_parameter(int edge, double a, double b, double frac
     return (at.IsDone() ? at.Parameter() : guess) + p.shift;
   }
   return b;
+}
+
+double OcctShape::arc_length_parameter(int edge, double a, double b, double fraction) const {
+  return arc_length_on(BRepAdaptor_Curve(TopoDS::Edge(edges_(edge))), a, b, fraction);
+}
+
+double OcctShape::isoline_arc_length_parameter(int face, int fixed, double at, double a, double b, double fraction) const {
+  const Handle(BRepAdaptor_Surface) surface = new BRepAdaptor_Surface(TopoDS::Face(faces_(face)));
+  return arc_length_on(Adaptor3d_IsoCurve(surface, fixed == 0 ? GeomAbs_IsoU : GeomAbs_IsoV, at), a, b, fraction);
 }
 
 }  // namespace

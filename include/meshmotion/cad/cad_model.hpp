@@ -75,6 +75,9 @@ class CadModel {
   /// reaches `fraction` of the length from a to b, to round-off. On a closed edge b may lie
   /// past the seam (a parameter unwrapped by whole periods): the way goes across it.
   [[nodiscard]] double arc_length_parameter(int index, double a, double b, double fraction) const;
+  /// The same along an isoline of face `index`: its parameter `fixed` (0: u, 1: v) held at
+  /// `at`, a and b values of the other parameter (unwrapped across a seam like b above).
+  [[nodiscard]] double isoline_arc_length_parameter(int index, int fixed, double at, double a, double b, double fraction) const;
   /// The edges bounding face `index`.
   [[nodiscard]] std::vector<int> face_edges(int index) const;
   /// The closest points of the entities of dimension `dim` among `candidates` (empty: all)
