@@ -20,7 +20,7 @@ if(STEP STREQUAL "install")
   file(REMOVE_RECURSE "${WORK_DIR}/meshmotion-build" "${prefix}")
   run(${CMAKE_COMMAND} -S "${SOURCE_DIR}" -B "${WORK_DIR}/meshmotion-build" ${common}
       -DMESHMOTION_BUILD_TESTS=OFF -DMESHMOTION_BUILD_EXAMPLES=OFF -DMESHMOTION_BUILD_BENCHMARKS=OFF
-      -DMESHMOTION_INSTALL=ON -DMESHMOTION_BUILD_COMPILED=OFF)
+      -DMESHMOTION_INSTALL=ON -DMESHMOTION_BUILD_COMPILED=OFF -DMESHMOTION_WITH_OPENFOAM=OFF)
   # Only the CAD component, where OpenCASCADE is installed, has anything to compile.
   run(${CMAKE_COMMAND} --build "${WORK_DIR}/meshmotion-build" --parallel 2)
   run(${CMAKE_COMMAND} --install "${WORK_DIR}/meshmotion-build" --prefix "${prefix}")

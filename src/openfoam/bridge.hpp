@@ -1,0 +1,41 @@
+#pragma once
+// The plugin's two halves meet here: OpenFOAM v1912's headers compile as C++17 only, the
+// library needs C++20, so each side is its own translation unit and they pass plain arrays.
+// Nothing here names an OpenFOAM or a meshmotion type.
+
+#include <string>
+#include <vector>
+
+namespace meshmotion::foam {
+
+/// A boundary point's part in the motion.
+enum class PointRole { prescribed = 0, sliding_plane = 1, sliding_line = 2 };
+
+/// The mesh and its boundary as the OpenFOAM side sees them (3 × n, point after point).
+struct BridgeInput {
+  std::string method;                 ///< a registered mover (rbf, elasticity, ...)
+  std::string options;                ///< "key=value key=value" of that mover's typed options
+  std::vector<double> points;         ///< 3 × n: points0
+  std::vector<long> boundary;         ///< the boundary points, ascending
+  std::vector<int> roles;             ///< PointRole of each
+  std::vector<double> directions;     ///< 3 × boundary: the plane's normal, or the line's direction
+};
+
+class Bridge {
+ public:
+  /// Sets the mover up (its factorization is reused by every move). Throws std::runtime_error
+  /// with meshmotion's message.
+  explicit Bridge(const BridgeInput& input);
+  ~Bridge();
+  Bridge(const Bridge&) = delete;
+  Bridge& operator=(const Bridge&) = delete;
+  /// `boundary_displacements` (3 × boundary; sliding entries ignored) to every point's
+  /// displacement (3 × n).
+  void move(const std::vector<double>& boundary_displacements, std::vector<double>& out);
+
+ private:
+  struct Impl;
+  Impl* impl_;
+};
+
+}  // namespace meshmotion::foam

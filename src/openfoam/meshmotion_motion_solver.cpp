@@ -1,0 +1,213 @@
+// The OpenFOAM half of the plugin (C++17, against Debian's OpenFOAM v1912): a
+// displacementMotionSolver that constant/dynamicMeshDict selects as `motionSolver meshmotion;`.
+// The boundary motion is 0/pointDisplacement's, so every point patch field drives it; the mover
+// is set up once from points0 (again when the topology changes) and moves the interior at each
+// solve().
+
+#include "bridge.hpp"
+
+#include "addToRunTimeSelectionTable.H"
+#include "displacementMotionSolver.H"
+#include "mapPolyMesh.H"
+#include "OStringStream.H"
+#include "Pstream.H"
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace Foam
+{
+
+class meshmotionMotionSolver
+:
+    public displacementMotionSolver
+{
+    std::unique_ptr<meshmotion::foam::Bridge> bridge_;
+    std::vector<long> boundary_;
+    std::vector<int> roles_;
+
+    void setup();
+
+public:
+
+    TypeName("meshmotion");
+
+    meshmotionMotionSolver(const polyMesh& mesh, const IOdictionary& dict)
+    :
+        displacementMotionSolver(mesh, dict, typeName)
+    {
+        setup();
+    }
+
+    tmp<pointField> curPoints() const override
+    {
+        tmp<pointField> points(points0() + pointDisplacement_.primitiveField());
+        twoDCorrectPoints(points.ref());
+        return points;
+    }
+
+    void solve() override;
+
+    void updateMesh(const mapPolyMesh& map) override
+    {
+        displacementMotionSolver::updateMesh(map);
+        setup();
+    }
+};
+
+defineTypeNameAndDebug(meshmotionMotionSolver, 0);
+addToRunTimeSelectionTable(motionSolver, meshmotionMotionSolver, dictionary);
+
+
+namespace
+{
+
+// The patch types whose points slide in the patch's plane.
+bool slides(const word& type)
+{
+    return type == "slip" || type == "empty" || type == "symmetryPlane" || type == "symmetry" || type == "wedge";
+}
+
+// Every entry of meshmotionCoeffs but `method`, as the library's "key=value" text.
+std::string option_text(const dictionary& coeffs)
+{
+    std::string text;
+    for (const entry& e : coeffs)
+    {
+        if (e.keyword() == "method") continue;
+        if (!e.isStream())
+        {
+            FatalIOErrorInFunction(coeffs) << "meshmotion: option '" << e.keyword()
+                << "' is a sub-dictionary; every option is a key and a value" << exit(FatalIOError);
+        }
+        OStringStream value;
+        const ITstream& tokens = e.stream();
+        forAll(tokens, t)
+        {
+            if (t) value << ' ';
+            value << tokens[t];
+        }
+        text += e.keyword() + "=" + value.str() + " ";
+    }
+    return text;
+}
+
+}  // namespace
+
+
+void meshmotionMotionSolver::setup()
+{
+    if (Pstream::parRun())
+    {
+        FatalErrorInFunction << "meshmotion: decomposed cases are not supported yet; run the motion serially"
+            << exit(FatalError);
+    }
+    const polyMesh& m = mesh();
+    const dictionary& coeffs = coeffDict();
+    meshmotion::foam::BridgeInput input;
+    input.method = coeffs.lookupOrDefault<word>("method", "rbf");
+    input.options = option_text(coeffs);
+
+    // Each boundary point: prescribed when a patch fixes its value, else sliding on the planes
+    // of its sliding patches (two planes: along their common line).
+    const label n = m.nPoints();
+    std::vector<char> prescribed(n, 0);
+    std::vector<std::vector<vector>> planes(n);
+    forAll(m.boundaryMesh(), patchi)
+    {
+        const pointPatchVectorField& field = pointDisplacement_.boundaryField()[patchi];
+        const polyPatch& patch = m.boundaryMesh()[patchi];
+        const labelList& points = patch.meshPoints();
+        if (field.fixesValue())
+        {
+            forAll(points, i) prescribed[points[i]] = 1;
+        }
+        else if (slides(field.type()) || slides(patch.type()))
+        {
+            const vectorField& normals = patch.pointNormals();
+            forAll(points, i)
+            {
+                std::vector<vector>& p = planes[points[i]];
+                const vector& normal = normals[i];
+                bool known = false;
+                for (const vector& q : p) known = known || mag(normal ^ q) < 1e-6;
+                if (!known) p.push_back(normal);
+            }
+        }
+    }
+    boundary_.clear();
+    roles_.clear();
+    for (label v = 0; v < n; ++v)
+    {
+        if (!prescribed[v] && planes[v].empty()) continue;
+        vector along = Zero;
+        int role = int(meshmotion::foam::PointRole::prescribed);
+        if (!prescribed[v] && planes[v].size() == 1)
+        {
+            role = int(meshmotion::foam::PointRole::sliding_plane);
+            along = planes[v][0];
+        }
+        else if (!prescribed[v] && planes[v].size() == 2)
+        {
+            role = int(meshmotion::foam::PointRole::sliding_line);
+            along = planes[v][0] ^ planes[v][1];
+            along /= mag(along);
+        }
+        boundary_.push_back(v);
+        roles_.push_back(role);
+        for (direction d = 0; d < 3; ++d) input.directions.push_back(along[d]);
+    }
+    input.boundary = boundary_;
+    input.roles = roles_;
+    const pointField& p0 = points0();
+    input.points.resize(3 * p0.size());
+    forAll(p0, i)
+    {
+        for (direction d = 0; d < 3; ++d) input.points[3 * i + d] = p0[i][d];
+    }
+    bridge_.reset();
+    try
+    {
+        bridge_ = std::make_unique<meshmotion::foam::Bridge>(input);
+    }
+    catch (const std::exception& e)
+    {
+        FatalErrorInFunction << e.what() << exit(FatalError);
+    }
+    Info<< "meshmotion: " << input.method.c_str() << " set up on " << label(boundary_.size())
+        << " boundary points of " << n << endl;
+}
+
+
+void meshmotionMotionSolver::solve()
+{
+    movePoints(mesh().points());
+    // The patches' values on their points: OpenFOAM's own rule for a point of several patches.
+    pointDisplacement_.boundaryFieldRef().updateCoeffs();
+    pointDisplacement_.correctBoundaryConditions();
+    const vectorField& values = pointDisplacement_.primitiveField();
+    std::vector<double> d(3 * boundary_.size(), 0.0);
+    for (std::size_t k = 0; k < boundary_.size(); ++k)
+    {
+        if (roles_[k] != int(meshmotion::foam::PointRole::prescribed)) continue;
+        for (direction c = 0; c < 3; ++c) d[3 * k + c] = values[boundary_[k]][c];
+    }
+    std::vector<double> out;
+    try
+    {
+        bridge_->move(d, out);
+    }
+    catch (const std::exception& e)
+    {
+        FatalErrorInFunction << e.what() << exit(FatalError);
+    }
+    vectorField& displacement = pointDisplacement_.primitiveFieldRef();
+    forAll(displacement, i)
+    {
+        displacement[i] = vector(out[3 * i], out[3 * i + 1], out[3 * i + 2]);
+    }
+}
+
+}  // namespace Foam

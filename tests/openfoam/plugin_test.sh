@@ -1,0 +1,111 @@
+#!/usr/bin/env bash
+# The plugin inside OpenFOAM's own time loop: Debian's moveDynamicMesh on a cube whose lid
+# follows a uniformFixedValue table, whose side walls are fixed and whose front slips, with
+# `motionSolver meshmotion;`. Checks: the lid's points where the table puts them, the front's in
+# their plane, the walls' still, every step's mesh valid (OpenFOAM's own checks), one set-up for
+# the four steps; an unknown option refused with its name, and a method that needs cells.
+#
+#   plugin_test.sh LIBMESHMOTIONFOAM WORK_DIR
+set -euo pipefail
+lib=$1
+work=$2
+if [[ -f /usr/share/openfoam/etc/bashrc ]]; then
+  # It reads unset variables and ends on a failing test.
+  set +eu
+  # shellcheck disable=SC1091
+  source /usr/share/openfoam/etc/bashrc >/dev/null 2>&1
+  set -eu
+fi
+command -v moveDynamicMesh >/dev/null || { echo "plugin_test: moveDynamicMesh not found (Debian's openfoam)"; exit 1; }
+rm -rf "$work" && mkdir -p "$work/system" "$work/constant" "$work/0"
+cd "$work"
+header='FoamFile { version 2.0; format ascii; class dictionary; object'
+cat > system/blockMeshDict <<EOD
+$header blockMeshDict; }
+convertToMeters 1;
+vertices ((0 0 0) (1 0 0) (1 1 0) (0 1 0) (0 0 1) (1 0 1) (1 1 1) (0 1 1));
+blocks (hex (0 1 2 3 4 5 6 7) (10 10 10) simpleGrading (1 1 1));
+boundary
+(
+    lid { type wall; faces ((4 5 6 7)); }
+    walls { type wall; faces ((0 3 2 1) (0 4 7 3) (1 2 6 5) (3 7 6 2)); }
+    front { type wall; faces ((0 1 5 4)); }
+);
+EOD
+cat > system/controlDict <<EOD
+$header controlDict; }
+application moveDynamicMesh; startFrom startTime; startTime 0; stopAt endTime; endTime 4; deltaT 1;
+writeControl timeStep; writeInterval 1; writeFormat ascii; writePrecision 17; writeCompression off;
+timeFormat general; timePrecision 6; runTimeModifiable false;
+EOD
+cat > system/fvSchemes <<EOD
+$header fvSchemes; }
+ddtSchemes { default Euler; } gradSchemes { default Gauss linear; } divSchemes { default none; }
+laplacianSchemes { default Gauss linear corrected; } interpolationSchemes { default linear; }
+snGradSchemes { default corrected; }
+EOD
+echo "$header fvSolution; } solvers {}" > system/fvSolution
+write_dynamic() {
+  cat > constant/dynamicMeshDict <<EOD
+$header dynamicMeshDict; }
+dynamicFvMesh dynamicMotionSolverFvMesh;
+motionSolverLibs ("libfvMotionSolvers.so" "$lib");
+motionSolver meshmotion;
+meshmotionCoeffs { method rbf; $1 }
+EOD
+}
+cat > 0/pointDisplacement <<EOD
+FoamFile { version 2.0; format ascii; class pointVectorField; object pointDisplacement; }
+dimensions [0 1 0 0 0 0 0];
+internalField uniform (0 0 0);
+boundaryField
+{
+    lid { type uniformFixedValue; uniformValue table ((0 (0 0 0)) (4 (0.04 0 -0.2))); }
+    walls { type fixedValue; value uniform (0 0 0); }
+    front { type slip; }
+}
+EOD
+blockMesh > log.blockMesh 2>&1 || { tail -5 log.blockMesh; exit 1; }
+write_dynamic "support_radius 2;"
+moveDynamicMesh > log.move 2>&1 || { tail -20 log.move; exit 1; }
+setups=$(grep -c "meshmotion: rbf set up" log.move || true)
+valid=$(grep -c "^Mesh OK" log.move || true)
+[[ $setups == 1 ]] || { echo "FAIL: $setups set-ups for 4 steps (expected 1)"; exit 1; }
+[[ $valid -ge 4 ]] || { echo "FAIL: OpenFOAM's mesh check passed $valid times (expected every step)"; tail -30 log.move; exit 1; }
+/usr/bin/python3 - <<'EOD'
+import re
+def points(path):
+    return [tuple(map(float, p)) for p in re.findall(r"\(([-0-9.e+]+) ([-0-9.e+]+) ([-0-9.e+]+)\)", open(path).read())]
+p0 = points("constant/polyMesh/points")
+worst = {"lid": 0.0, "front": 0.0, "walls": 0.0}
+for t in (1, 2, 3, 4):
+    p = points(f"{t}/polyMesh/points")
+    assert len(p) == len(p0)
+    lid = (0.01 * t, 0.0, -0.05 * t)
+    interior_moved = 0
+    for a, b in zip(p0, p):
+        d = [b[k] - a[k] for k in range(3)]
+        if abs(a[2] - 1.0) < 1e-12 and not (a[0] < 1e-12 or a[0] > 1 - 1e-12 or a[1] > 1 - 1e-12):
+            worst["lid"] = max(worst["lid"], max(abs(d[k] - lid[k]) for k in range(3)))
+        elif abs(a[1]) < 1e-12:
+            worst["front"] = max(worst["front"], abs(d[1]))
+        elif a[0] < 1e-12 or a[0] > 1 - 1e-12 or a[1] > 1 - 1e-12 or a[2] < 1e-12:
+            worst["walls"] = max(worst["walls"], max(abs(x) for x in d))
+        else:
+            interior_moved += abs(d[2]) > 1e-6
+    assert interior_moved > 0, f"step {t}: the interior did not move"
+print("largest deviations:", worst)
+assert worst["lid"] < 1e-12, worst
+assert worst["front"] < 1e-12, worst
+assert worst["walls"] < 1e-12, worst
+EOD
+# An option the mover does not have: OpenFOAM's fatal error, naming it.
+rm -rf 1 2 3 4
+write_dynamic "no_such_option 1;"
+if moveDynamicMesh > log.bad 2>&1; then echo "FAIL: an unknown option was accepted"; exit 1; fi
+grep -q "no_such_option" log.bad || { echo "FAIL: the error does not name the option"; tail -20 log.bad; exit 1; }
+# A method that needs the cells the plugin does not pass yet: refused, saying so.
+sed -i 's/method rbf;/method elasticity;/' constant/dynamicMeshDict
+if moveDynamicMesh > log.bad 2>&1; then echo "FAIL: a method needing cells was accepted"; exit 1; fi
+grep -q "needs the mesh's cells" log.bad || { echo "FAIL: the error does not say why"; tail -20 log.bad; exit 1; }
+echo "plugin_test: passed"
