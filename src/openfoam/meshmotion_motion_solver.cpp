@@ -67,7 +67,14 @@ namespace
 // The patch types whose points slide in the patch's plane.
 bool slides(const word& type)
 {
-    return type == "slip" || type == "empty" || type == "symmetryPlane" || type == "symmetry" || type == "wedge";
+    return type == "slip" || type == "symmetryPlane" || type == "symmetry";
+}
+
+// A 2D case's front and back: their points are interior to the mover (as centres they made
+// every point of the case one), and curPoints() keeps them 2D as OpenFOAM's own solvers do.
+bool two_dimensional(const word& type)
+{
+    return type == "empty" || type == "wedge";
 }
 
 // Every entry of meshmotionCoeffs but `method`, as the library's "key=value" text.
@@ -124,7 +131,7 @@ void meshmotionMotionSolver::setup()
         {
             forAll(points, i) prescribed[points[i]] = 1;
         }
-        else if (slides(field.type()) || slides(patch.type()))
+        else if (!two_dimensional(patch.type()) && (slides(field.type()) || slides(patch.type())))
         {
             const vectorField& normals = patch.pointNormals();
             forAll(points, i)

@@ -3,11 +3,12 @@
 # follows a uniformFixedValue table, whose side walls are fixed and whose front slips, with
 # `motionSolver meshmotion;`. Checks: the lid's points where the table puts them, the front's in
 # their plane, the walls' still, every step's mesh valid (OpenFOAM's own checks), one set-up for
-# the four steps; an unknown option refused with its name, and a method that needs cells.
+# the four steps; the same in a 2D case turned by angularOscillatingDisplacement; an unknown
+# option refused with its name, and a method that needs cells.
 #
 #   plugin_test.sh LIBMESHMOTIONFOAM WORK_DIR
 set -euo pipefail
-lib=$1
+lib=$(realpath "$1")
 work=$2
 if [[ -f /usr/share/openfoam/etc/bashrc ]]; then
   # It reads unset variables and ends on a failing test.
@@ -104,6 +105,65 @@ rm -rf 1 2 3 4
 write_dynamic "no_such_option 1;"
 if moveDynamicMesh > log.bad 2>&1; then echo "FAIL: an unknown option was accepted"; exit 1; fi
 grep -q "no_such_option" log.bad || { echo "FAIL: the error does not name the option"; tail -20 log.bad; exit 1; }
+# A 2D case (one cell thick, front and back `empty`) whose bottom wall turns by
+# angularOscillatingDisplacement: the bottom's points where the rotation puts them, the mesh
+# still 2D with front and back moved alike, only the walls' points as the mover's boundary.
+mkdir -p "$work/2d/system" "$work/2d/constant" "$work/2d/0"
+cp system/controlDict system/fvSchemes system/fvSolution "$work/2d/system/"
+cd "$work/2d"
+cat > system/blockMeshDict <<EOD
+$header blockMeshDict; }
+convertToMeters 1;
+vertices ((0 0 0) (2 0 0) (2 1 0) (0 1 0) (0 0 0.1) (2 0 0.1) (2 1 0.1) (0 1 0.1));
+blocks (hex (0 1 2 3 4 5 6 7) (40 20 1) simpleGrading (1 1 1));
+boundary
+(
+    bottom { type wall; faces ((0 1 5 4)); }
+    walls { type wall; faces ((3 7 6 2) (0 4 7 3) (1 2 6 5)); }
+    frontAndBack { type empty; faces ((0 3 2 1) (4 5 6 7)); }
+);
+EOD
+cat > 0/pointDisplacement <<EOD
+FoamFile { version 2.0; format ascii; class pointVectorField; object pointDisplacement; }
+dimensions [0 1 0 0 0 0 0];
+internalField uniform (0 0 0);
+boundaryField
+{
+    bottom { type angularOscillatingDisplacement; axis (0 0 1); origin (1 0 0); angle0 0; amplitude 0.2;
+             omega 0.5; value uniform (0 0 0); }
+    walls { type fixedValue; value uniform (0 0 0); }
+    frontAndBack { type empty; }
+}
+EOD
+write_dynamic ""
+blockMesh > log.blockMesh 2>&1 || { tail -5 log.blockMesh; exit 1; }
+moveDynamicMesh > log.move 2>&1 || { tail -20 log.move; exit 1; }
+grep -q "meshmotion: rbf set up on 240 boundary points of 1722" log.move ||
+  { echo "FAIL: the 2D case's boundary is not the walls' 240 points"; grep meshmotion log.move; exit 1; }
+valid=$(grep -c "^Mesh OK" log.move || true)
+[[ $valid -ge 4 ]] || { echo "FAIL: OpenFOAM's mesh check passed $valid times (expected every step)"; tail -30 log.move; exit 1; }
+/usr/bin/python3 - <<'EOD'
+import math, re
+def points(path):
+    return [tuple(map(float, p)) for p in re.findall(r"\(([-0-9.e+]+) ([-0-9.e+]+) ([-0-9.e+]+)\)", open(path).read())]
+p0 = points("constant/polyMesh/points")
+for t in (1, 2, 3, 4):
+    p = points(f"{t}/polyMesh/points")
+    angle = 0.2 * math.sin(0.5 * t)
+    c, s = math.cos(angle), math.sin(angle)
+    bottom = off_plane = 0.0
+    by_column = {}
+    for a, b in zip(p0, p):
+        off_plane = max(off_plane, abs(b[2] - a[2]))
+        by_column.setdefault((round(a[0], 9), round(a[1], 9)), []).append((b[0] - a[0], b[1] - a[1]))
+        if abs(a[1]) < 1e-12 and 1e-12 < a[0] < 2 - 1e-12:
+            x, y = a[0] - 1.0, a[1]
+            bottom = max(bottom, math.hypot(b[0] - (1.0 + c * x - s * y), b[1] - (s * x + c * y)))
+    apart = max(abs(v[0][0] - v[1][0]) + abs(v[0][1] - v[1][1]) for v in by_column.values())
+    assert bottom < 1e-12 and off_plane == 0.0 and apart < 1e-12, (t, bottom, off_plane, apart)
+print("2D case: bottom on its rotation, front and back alike, z unchanged")
+EOD
+cd "$work"
 # A method that needs the cells the plugin does not pass yet: refused, saying so.
 sed -i 's/method rbf;/method elasticity;/' constant/dynamicMeshDict
 if moveDynamicMesh > log.bad 2>&1; then echo "FAIL: a method needing cells was accepted"; exit 1; fi
