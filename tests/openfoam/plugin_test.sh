@@ -9,7 +9,7 @@
 #   plugin_test.sh LIBMESHMOTIONFOAM WORK_DIR
 set -euo pipefail
 lib=$(realpath "$1")
-work=$2
+work=$(realpath -m "$2")
 if [[ -f /usr/share/openfoam/etc/bashrc ]]; then
   # It reads unset variables and ends on a failing test.
   set +eu
@@ -18,34 +18,39 @@ if [[ -f /usr/share/openfoam/etc/bashrc ]]; then
   set -eu
 fi
 command -v moveDynamicMesh >/dev/null || { echo "plugin_test: moveDynamicMesh not found (Debian's openfoam)"; exit 1; }
-rm -rf "$work" && mkdir -p "$work/system" "$work/constant" "$work/0"
-cd "$work"
 header='FoamFile { version 2.0; format ascii; class dictionary; object'
-cat > system/blockMeshDict <<EOD
+# A case in folder $1 from blockMesh: vertices $2, block $3, patches $4, point patch fields $5.
+make_case() {
+  mkdir -p "$1/system" "$1/constant" "$1/0"
+  cd "$1"
+  cat > system/blockMeshDict <<EOD
 $header blockMeshDict; }
 convertToMeters 1;
-vertices ((0 0 0) (1 0 0) (1 1 0) (0 1 0) (0 0 1) (1 0 1) (1 1 1) (0 1 1));
-blocks (hex (0 1 2 3 4 5 6 7) (10 10 10) simpleGrading (1 1 1));
-boundary
-(
-    lid { type wall; faces ((4 5 6 7)); }
-    walls { type wall; faces ((0 3 2 1) (0 4 7 3) (1 2 6 5) (3 7 6 2)); }
-    front { type wall; faces ((0 1 5 4)); }
-);
+vertices ($2);
+blocks (hex (0 1 2 3 4 5 6 7) $3 simpleGrading (1 1 1));
+boundary ($4);
 EOD
-cat > system/controlDict <<EOD
+  cat > system/controlDict <<EOD
 $header controlDict; }
 application moveDynamicMesh; startFrom startTime; startTime 0; stopAt endTime; endTime 4; deltaT 1;
 writeControl timeStep; writeInterval 1; writeFormat ascii; writePrecision 17; writeCompression off;
 timeFormat general; timePrecision 6; runTimeModifiable false;
 EOD
-cat > system/fvSchemes <<EOD
+  cat > system/fvSchemes <<EOD
 $header fvSchemes; }
 ddtSchemes { default Euler; } gradSchemes { default Gauss linear; } divSchemes { default none; }
 laplacianSchemes { default Gauss linear corrected; } interpolationSchemes { default linear; }
 snGradSchemes { default corrected; }
 EOD
-echo "$header fvSolution; } solvers {}" > system/fvSolution
+  echo "$header fvSolution; } solvers {}" > system/fvSolution
+  cat > 0/pointDisplacement <<EOD
+FoamFile { version 2.0; format ascii; class pointVectorField; object pointDisplacement; }
+dimensions [0 1 0 0 0 0 0];
+internalField uniform (0 0 0);
+boundaryField { $5 }
+EOD
+  blockMesh > log.blockMesh 2>&1 || { tail -5 log.blockMesh; exit 1; }
+}
 write_dynamic() {
   cat > constant/dynamicMeshDict <<EOD
 $header dynamicMeshDict; }
@@ -55,24 +60,27 @@ motionSolver meshmotion;
 meshmotionCoeffs { method rbf; $1 }
 EOD
 }
-cat > 0/pointDisplacement <<EOD
-FoamFile { version 2.0; format ascii; class pointVectorField; object pointDisplacement; }
-dimensions [0 1 0 0 0 0 0];
-internalField uniform (0 0 0);
-boundaryField
-{
-    lid { type uniformFixedValue; uniformValue table ((0 (0 0 0)) (4 (0.04 0 -0.2))); }
-    walls { type fixedValue; value uniform (0 0 0); }
-    front { type slip; }
+# The four steps with meshmotionCoeffs options $1: one set-up, OpenFOAM's mesh check passed at
+# every step, and the set-up's line matching $2.
+move() {
+  write_dynamic "$1"
+  moveDynamicMesh > log.move 2>&1 || { tail -20 log.move; exit 1; }
+  local setups valid
+  setups=$(grep -c "meshmotion: rbf set up" log.move || true)
+  valid=$(grep -c "^Mesh OK" log.move || true)
+  [[ $setups == 1 ]] || { echo "FAIL: $setups set-ups for 4 steps (expected 1)"; exit 1; }
+  [[ $valid -ge 4 ]] || { echo "FAIL: OpenFOAM's mesh check passed $valid times (expected every step)"; tail -30 log.move; exit 1; }
+  grep -q "$2" log.move || { echo "FAIL: no set-up line matching '$2'"; grep meshmotion log.move; exit 1; }
 }
-EOD
-blockMesh > log.blockMesh 2>&1 || { tail -5 log.blockMesh; exit 1; }
-write_dynamic "support_radius 2;"
-moveDynamicMesh > log.move 2>&1 || { tail -20 log.move; exit 1; }
-setups=$(grep -c "meshmotion: rbf set up" log.move || true)
-valid=$(grep -c "^Mesh OK" log.move || true)
-[[ $setups == 1 ]] || { echo "FAIL: $setups set-ups for 4 steps (expected 1)"; exit 1; }
-[[ $valid -ge 4 ]] || { echo "FAIL: OpenFOAM's mesh check passed $valid times (expected every step)"; tail -30 log.move; exit 1; }
+rm -rf "$work"
+make_case "$work" "(0 0 0) (1 0 0) (1 1 0) (0 1 0) (0 0 1) (1 0 1) (1 1 1) (0 1 1)" "(10 10 10)" \
+  "lid { type wall; faces ((4 5 6 7)); }
+   walls { type wall; faces ((0 3 2 1) (0 4 7 3) (1 2 6 5) (3 7 6 2)); }
+   front { type wall; faces ((0 1 5 4)); }" \
+  "lid { type uniformFixedValue; uniformValue table ((0 (0 0 0)) (4 (0.04 0 -0.2))); }
+   walls { type fixedValue; value uniform (0 0 0); }
+   front { type slip; }"
+move "support_radius 2;" "set up on .* boundary points of 1331"
 /usr/bin/python3 - <<'EOD'
 import re
 def points(path):
@@ -108,40 +116,15 @@ grep -q "no_such_option" log.bad || { echo "FAIL: the error does not name the op
 # A 2D case (one cell thick, front and back `empty`) whose bottom wall turns by
 # angularOscillatingDisplacement: the bottom's points where the rotation puts them, the mesh
 # still 2D with front and back moved alike, only the walls' points as the mover's boundary.
-mkdir -p "$work/2d/system" "$work/2d/constant" "$work/2d/0"
-cp system/controlDict system/fvSchemes system/fvSolution "$work/2d/system/"
-cd "$work/2d"
-cat > system/blockMeshDict <<EOD
-$header blockMeshDict; }
-convertToMeters 1;
-vertices ((0 0 0) (2 0 0) (2 1 0) (0 1 0) (0 0 0.1) (2 0 0.1) (2 1 0.1) (0 1 0.1));
-blocks (hex (0 1 2 3 4 5 6 7) (40 20 1) simpleGrading (1 1 1));
-boundary
-(
-    bottom { type wall; faces ((0 1 5 4)); }
-    walls { type wall; faces ((3 7 6 2) (0 4 7 3) (1 2 6 5)); }
-    frontAndBack { type empty; faces ((0 3 2 1) (4 5 6 7)); }
-);
-EOD
-cat > 0/pointDisplacement <<EOD
-FoamFile { version 2.0; format ascii; class pointVectorField; object pointDisplacement; }
-dimensions [0 1 0 0 0 0 0];
-internalField uniform (0 0 0);
-boundaryField
-{
-    bottom { type angularOscillatingDisplacement; axis (0 0 1); origin (1 0 0); angle0 0; amplitude 0.2;
-             omega 0.5; value uniform (0 0 0); }
-    walls { type fixedValue; value uniform (0 0 0); }
-    frontAndBack { type empty; }
-}
-EOD
-write_dynamic ""
-blockMesh > log.blockMesh 2>&1 || { tail -5 log.blockMesh; exit 1; }
-moveDynamicMesh > log.move 2>&1 || { tail -20 log.move; exit 1; }
-grep -q "meshmotion: rbf set up on 240 boundary points of 1722" log.move ||
-  { echo "FAIL: the 2D case's boundary is not the walls' 240 points"; grep meshmotion log.move; exit 1; }
-valid=$(grep -c "^Mesh OK" log.move || true)
-[[ $valid -ge 4 ]] || { echo "FAIL: OpenFOAM's mesh check passed $valid times (expected every step)"; tail -30 log.move; exit 1; }
+make_case "$work/2d" "(0 0 0) (2 0 0) (2 1 0) (0 1 0) (0 0 0.1) (2 0 0.1) (2 1 0.1) (0 1 0.1)" "(40 20 1)" \
+  "bottom { type wall; faces ((0 1 5 4)); }
+   walls { type wall; faces ((3 7 6 2) (0 4 7 3) (1 2 6 5)); }
+   frontAndBack { type empty; faces ((0 3 2 1) (4 5 6 7)); }" \
+  "bottom { type angularOscillatingDisplacement; axis (0 0 1); origin (1 0 0); angle0 0; amplitude 0.2;
+            omega 0.5; value uniform (0 0 0); }
+   walls { type fixedValue; value uniform (0 0 0); }
+   frontAndBack { type empty; }"
+move "" "set up on 240 boundary points of 1722"
 /usr/bin/python3 - <<'EOD'
 import math, re
 def points(path):
