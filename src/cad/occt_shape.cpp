@@ -10,13 +10,12 @@
 #include <BRepAdaptor_Curve.hxx>
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepBndLib.hxx>
-#include <BRepBuilderAPI_MakeVertex.hxx>
-#include <BRepExtrema_DistShapeShape.hxx>
 #include <BRepTools.hxx>
 #include <BRepTopAdaptor_FClass2d.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
+#include <Extrema_ExtPS.hxx>
 #include <GeomAPI_ProjectPointOnCurve.hxx>
 #include <GCPnts_AbscissaPoint.hxx>
 #include <Geom_Curve.hxx>
@@ -25,6 +24,7 @@
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
 #include <STEPControl_Reader.hxx>
+#include <Precision.hxx>
 #include <ShapeAnalysis_Surface.hxx>
 #include <Standard_Failure.hxx>
 #include <TopExp.hxx>
@@ -34,7 +34,6 @@
 #include <TopoDS_Edge.hxx>
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Shape.hxx>
-#include <TopoDS_Vertex.hxx>
 
 #include <algorithm>
 #include <cmath>
@@ -119,11 +118,42 @@ class OcctShape final : public CadShape {
   std::vector<Bnd_Box> face_boxes_, edge_boxes_;
   std::vector<std::vector<int>> face_edges_;
   double diagonal_ = 0.0;
-  // Each face's classifier of parameter points (inside, on or outside its boundary), built on
-  // first use; the mutex keeps the model's const methods safe to call from several threads.
-  mutable std::vector<std::unique_ptr<BRepTopAdaptor_FClass2d>> classifiers_;
-  mutable std::mutex classifiers_mutex_;
+  // What the queries on a face need, built on its first use and kept: its surface (a
+  // BRepAdaptor_Surface takes its parameter bounds from the face's edges, and on a plane
+  // projects each edge to get them: rebuilt per query, that was a tenth of curving the sphere),
+  // the global search with its grid of samples, and the classifier of parameter points (built
+  // per query by BRepExtrema, they were a third of it). Queries evaluate the surface through
+  // shallow copies, which keep their own B-spline caches, and use the search and the
+  // classifier under the face's mutex: the model's const methods stay safe to call from
+  // several threads.
+  struct FaceQueries {
+    FaceQueries(const TopoDS_Face& face, double tolerance);
+    BRepAdaptor_Surface surface;
+    Handle(Adaptor3d_Surface) searched;  // the search's own copy
+    Extrema_ExtPS search;
+    BRepTopAdaptor_FClass2d classifier;
+    std::mutex mutex;
+  };
+  FaceQueries& queries(int face) const;
+  mutable std::vector<std::unique_ptr<FaceQueries>> queries_;
+  mutable std::mutex queries_mutex_;
 };
+
+OcctShape::FaceQueries::FaceQueries(const TopoDS_Face& face, double tolerance)
+    : surface(face), searched(surface.ShallowCopy()), classifier(face, tolerance) {
+  // The tolerances BRepExtrema gives the same search: the face's, in parameters.
+  const double face_tolerance = BRep_Tool::Tolerance(face);
+  search.Initialize(*searched, surface.FirstUParameter(), surface.LastUParameter(), surface.FirstVParameter(),
+                    surface.LastVParameter(), std::max(surface.UResolution(face_tolerance), Precision::PConfusion()),
+                    std::max(surface.VResolution(face_tolerance), Precision::PConfusion()));
+}
+
+OcctShape::FaceQueries& OcctShape::queries(int face) const {
+  const std::lock_guard<std::mutex> lock(queries_mutex_);
+  auto& q = queries_[static_cast<std::size_t>(face - 1)];
+  if (!q) q = std::make_unique<FaceQueries>(TopoDS::Face(faces_(face)), 1e-9 * std::max(diagonal_, 1e-300));
+  return *q;
+}
 
 OcctShape::OcctShape(const std::filesystem::path& file) : file_(file) {
   shape_ = read_shape(file);
@@ -142,7 +172,7 @@ OcctShape::OcctShape(const std::filesystem::path& file) : file_(file) {
     for (int e = 1; e <= bounding.Extent(); ++e) ids.push_back(edges_.FindIndex(bounding(e)));
     face_edges_.push_back(std::move(ids));
   }
-  classifiers_.resize(static_cast<std::size_t>(faces_.Extent()));
+  queries_.resize(static_cast<std::size_t>(faces_.Extent()));
   for (int e = 1; e <= edges_.Extent(); ++e) {
     Bnd_Box box;
     BRepBndLib::Add(edges_(e), box);
@@ -186,19 +216,40 @@ CadPoint OcctShape::closest_point(int dim, int index, const Vec<3>& x) const {
     out.distance = best;
     return out;
   }
-  const TopoDS_Face& face = TopoDS::Face(faces_(index));
-  const TopoDS_Vertex vertex = BRepBuilderAPI_MakeVertex(p).Vertex();
-  BRepExtrema_DistShapeShape extrema(vertex, face);
-  if (!extrema.IsDone() || extrema.NbSolution() == 0)
-    throw InputError(file_.string() + ": no closest point on face " + std::to_string(index));
-  out.distance = extrema.Value();
-  out.point = from_gp(extrema.PointOnShape2(1));
-  if (extrema.SupportTypeShape2(1) == BRepExtrema_IsInFace) {
-    extrema.ParOnFaceS2(1, out.u, out.v);
-  } else {
-    // On the face's boundary: its surface parameters there.
+  // The nearest extremum of the surface inside the face, or the nearest point of its boundary
+  // (what BRepExtrema_DistShapeShape finds between a vertex and a face).
+  out.distance = std::numeric_limits<double>::infinity();
+  FaceQueries& q = queries(index);
+  {
+    const std::lock_guard<std::mutex> lock(q.mutex);
+    q.search.Perform(p);
+    for (int i = 1; q.search.IsDone() && i <= q.search.NbExt(); ++i) {
+      const double d = std::sqrt(q.search.SquareDistance(i));
+      if (d >= out.distance) continue;
+      double u = 0, v = 0;
+      q.search.Point(i).Parameter(u, v);
+      if (const TopAbs_State state = q.classifier.Perform(gp_Pnt2d(u, v)); state == TopAbs_IN || state == TopAbs_ON) {
+        out.distance = d;
+        out.u = u;
+        out.v = v;
+        out.point = from_gp(q.search.Point(i).Value());
+      }
+    }
+  }
+  bool on_boundary = false;
+  for (const int edge : face_edges_[static_cast<std::size_t>(index - 1)]) {
+    if (box_distance(1, edge, x) >= out.distance) continue;
+    if (const CadPoint c = closest_point(1, edge, x); c.distance < out.distance) {
+      out.distance = c.distance;
+      out.point = c.point;
+      on_boundary = true;
+    }
+  }
+  if (!std::isfinite(out.distance)) throw InputError(file_.string() + ": no closest point on face " + std::to_string(index));
+  if (on_boundary) {  // its surface parameters there
+    const TopoDS_Face& face = TopoDS::Face(faces_(index));
     ShapeAnalysis_Surface surface(BRep_Tool::Surface(face));
-    const gp_Pnt2d uv = surface.ValueOfUV(extrema.PointOnShape2(1), 1e-9 * std::max(diagonal_, 1e-300));
+    const gp_Pnt2d uv = surface.ValueOfUV(to_gp(out.point), 1e-9 * std::max(diagonal_, 1e-300));
     out.u = uv.X();
     out.v = uv.Y();
   }
@@ -210,8 +261,8 @@ CadPoint OcctShape::closest_point(int dim, int index, const Vec<3>& x) const {
 }
 
 std::optional<CadPoint> OcctShape::closest_point_near(int index, const Vec<3>& x, double u0, double v0) const {
-  const TopoDS_Face& face = TopoDS::Face(faces_(index));
-  const BRepAdaptor_Surface surface(face);
+  FaceQueries& q = queries(index);
+  const Handle(Adaptor3d_Surface) surface = q.surface.ShallowCopy();
   // Newton's method on the squared distance, to round-off: from a start next to the answer it
   // converges in a few steps (OpenCASCADE's local extremum stops at its parameter tolerance,
   // 1e-9, which moved a sphere's edge nodes 5e-7 off their great circles).
@@ -221,7 +272,7 @@ std::optional<CadPoint> OcctShape::closest_point_near(int index, const Vec<3>& x
   for (int iteration = 0; iteration < 30 && !converged; ++iteration) {
     gp_Pnt s;
     gp_Vec su, sv, suu, svv, suv;
-    surface.D2(u, v, s, su, sv, suu, svv, suv);
+    surface->D2(u, v, s, su, sv, suu, svv, suv);
     const gp_Vec r(p, s);
     const double gu = r.Dot(su), gv = r.Dot(sv);
     const double huu = su.Dot(su) + r.Dot(suu), hvv = sv.Dot(sv) + r.Dot(svv), huv = su.Dot(sv) + r.Dot(suv);
@@ -238,8 +289,8 @@ std::optional<CadPoint> OcctShape::closest_point_near(int index, const Vec<3>& x
     const auto into_range = [](double t, bool periodic, double period, double first) {
       return periodic && period > 0.0 ? first + std::fmod(std::fmod(t - first, period) + period, period) : t;
     };
-    u = into_range(u, surface.IsUPeriodic(), surface.IsUPeriodic() ? surface.UPeriod() : 0.0, surface.FirstUParameter());
-    v = into_range(v, surface.IsVPeriodic(), surface.IsVPeriodic() ? surface.VPeriod() : 0.0, surface.FirstVParameter());
+    u = into_range(u, surface->IsUPeriodic(), surface->IsUPeriodic() ? surface->UPeriod() : 0.0, surface->FirstUParameter());
+    v = into_range(v, surface->IsVPeriodic(), surface->IsVPeriodic() ? surface->VPeriod() : 0.0, surface->FirstVParameter());
     CadPoint out;
     out.dim = 2;
     out.index = index;
@@ -247,13 +298,11 @@ std::optional<CadPoint> OcctShape::closest_point_near(int index, const Vec<3>& x
     out.v = v;
     TopAbs_State state;
     {
-      const std::lock_guard<std::mutex> lock(classifiers_mutex_);
-      auto& classifier = classifiers_[static_cast<std::size_t>(index - 1)];
-      if (!classifier) classifier = std::make_unique<BRepTopAdaptor_FClass2d>(face, 1e-9 * std::max(diagonal_, 1e-300));
-      state = classifier->Perform(gp_Pnt2d(out.u, out.v));
+      const std::lock_guard<std::mutex> lock(q.mutex);
+      state = q.classifier.Perform(gp_Pnt2d(out.u, out.v));
     }
     if (state == TopAbs_IN || state == TopAbs_ON) {
-      out.point = from_gp(surface.Value(u, v));
+      out.point = from_gp(surface->Value(u, v));
       out.distance = (out.point - x).norm();
       return out;
     }
@@ -282,7 +331,8 @@ Vec<3> OcctShape::point_at(int dim, int index, double u, double v) const {
     const BRepAdaptor_Curve c(TopoDS::Edge(edges_(index)));
     return from_gp(c.Value(wrap(u, c.IsPeriodic(), c.IsClosed(), c.FirstParameter(), c.LastParameter())));
   }
-  const BRepAdaptor_Surface s(TopoDS::Face(faces_(index)));
+  const Handle(Adaptor3d_Surface) copy = queries(index).surface.ShallowCopy();
+  const Adaptor3d_Surface& s = *copy;
   return from_gp(s.Value(wrap(u, s.IsUPeriodic(), s.IsUClosed(), s.FirstUParameter(), s.LastUParameter()),
                          wrap(v, s.IsVPeriodic(), s.IsVClosed(), s.FirstVParameter(), s.LastVParameter())));
 }
@@ -292,7 +342,7 @@ std::array<double, 2> OcctShape::periods(int dim, int index) const {
     const BRepAdaptor_Curve c(TopoDS::Edge(edges_(index)));
     return {period_of(c.IsPeriodic(), c.IsPeriodic() ? c.Period() : 0.0, c.IsClosed(), c.FirstParameter(), c.LastParameter()), 0.0};
   }
-  const BRepAdaptor_Surface s(TopoDS::Face(faces_(index)));
+  const BRepAdaptor_Surface& s = queries(index).surface;  // its constant properties only
   return {period_of(s.IsUPeriodic(), s.IsUPeriodic() ? s.UPeriod() : 0.0, s.IsUClosed(), s.FirstUParameter(), s.LastUParameter()),
           period_of(s.IsVPeriodic(), s.IsVPeriodic() ? s.VPeriod() : 0.0, s.IsVClosed(), s.FirstVParameter(), s.LastVParameter())};
 }
@@ -349,8 +399,7 @@ double OcctShape::arc_length_parameter(int edge, double a, double b, double frac
 }
 
 double OcctShape::isoline_arc_length_parameter(int face, int fixed, double at, double a, double b, double fraction) const {
-  const Handle(BRepAdaptor_Surface) surface = new BRepAdaptor_Surface(TopoDS::Face(faces_(face)));
-  return arc_length_on(Adaptor3d_IsoCurve(surface, fixed == 0 ? GeomAbs_IsoU : GeomAbs_IsoV, at), a, b, fraction);
+  return arc_length_on(Adaptor3d_IsoCurve(queries(face).surface.ShallowCopy(), fixed == 0 ? GeomAbs_IsoU : GeomAbs_IsoV, at), a, b, fraction);
 }
 
 }  // namespace
