@@ -53,6 +53,14 @@ target_compile_definitions(meshmotion_foam_side PRIVATE WM_DP WM_LABEL_SIZE=32 N
 target_compile_options(meshmotion_foam_side PRIVATE -m64 -ftemplate-depth-100)
 add_library(meshmotionFoam SHARED src/openfoam/bridge.cpp $<TARGET_OBJECTS:meshmotion_foam_side>)
 target_link_libraries(meshmotionFoam PRIVATE ${MESHMOTION_LINK_TARGET} ${_foam_libraries})
+# Decomposed cases (-parallel) go through the distributed RBF mover: Debian's OpenFOAM runs on
+# the same Open MPI.
+if(MESHMOTION_HAVE_PARALLEL)
+  target_link_libraries(meshmotionFoam PRIVATE meshmotion::parallel)
+  target_compile_definitions(meshmotionFoam PRIVATE MESHMOTION_FOAM_PARALLEL)
+else()
+  message(STATUS "meshmotion: OpenFOAM plugin without the parallel layer: decomposed cases are refused")
+endif()
 if(TARGET meshmotion_warnings)
   target_link_libraries(meshmotionFoam PRIVATE meshmotion_warnings)
 endif()

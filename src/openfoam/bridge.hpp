@@ -19,18 +19,23 @@ struct BridgeInput {
   std::vector<long> boundary;         ///< the boundary points, ascending
   std::vector<int> roles;             ///< PointRole of each
   std::vector<double> directions;     ///< 3 × boundary: the plane's normal, or the line's direction
+  /// A decomposed case (-parallel), else empty: each point's number among the whole case's
+  /// points (a point shared by ranks has one) and the rank that owns it. The ranks then set
+  /// the mover up together over MPI_COMM_WORLD, as OpenFOAM's own communicator.
+  std::vector<long> global_ids;
+  std::vector<int> owners;
 };
 
 class Bridge {
  public:
   /// Sets the mover up (its factorization is reused by every move). Throws std::runtime_error
-  /// with meshmotion's message.
+  /// with meshmotion's message. Collective on a decomposed case.
   explicit Bridge(const BridgeInput& input);
   ~Bridge();
   Bridge(const Bridge&) = delete;
   Bridge& operator=(const Bridge&) = delete;
   /// `boundary_displacements` (3 × boundary; sliding entries ignored) to every point's
-  /// displacement (3 × n).
+  /// displacement (3 × n). Collective on a decomposed case, where each entry's owner gives it.
   void move(const std::vector<double>& boundary_displacements, std::vector<double>& out);
 
  private:

@@ -8,9 +8,12 @@
 
 #include "addToRunTimeSelectionTable.H"
 #include "displacementMotionSolver.H"
+#include "globalIndex.H"
+#include "globalMeshData.H"
 #include "mapPolyMesh.H"
 #include "OStringStream.H"
 #include "Pstream.H"
+#include "syncTools.H"
 
 #include <memory>
 #include <stdexcept>
@@ -27,6 +30,9 @@ class meshmotionMotionSolver
     std::unique_ptr<meshmotion::foam::Bridge> bridge_;
     std::vector<long> boundary_;
     std::vector<int> roles_;
+    // Points on a patch of this rank that fixes their value: their value is this rank's to give
+    // (a point of a decomposed case may be on a fixed patch only on another rank).
+    std::vector<char> fixedHere_;
 
     void setup();
 
@@ -106,11 +112,6 @@ std::string option_text(const dictionary& coeffs)
 
 void meshmotionMotionSolver::setup()
 {
-    if (Pstream::parRun())
-    {
-        FatalErrorInFunction << "meshmotion: decomposed cases are not supported yet; run the motion serially"
-            << exit(FatalError);
-    }
     const polyMesh& m = mesh();
     const dictionary& coeffs = coeffDict();
     meshmotion::foam::BridgeInput input;
@@ -118,48 +119,71 @@ void meshmotionMotionSolver::setup()
     input.options = option_text(coeffs);
 
     // Each boundary point: prescribed when a patch fixes its value, else sliding on the planes
-    // of its sliding patches (two planes: along their common line).
+    // of its sliding patches (two planes: along their common line). A plane's normal at a point
+    // is the mean of its faces' normals there. On a decomposed case both are summed over the
+    // ranks that hold the point, so every rank sees what the serial run sees.
     const label n = m.nPoints();
-    std::vector<char> prescribed(n, 0);
-    std::vector<std::vector<vector>> planes(n);
+    labelList prescribed(n, 0);
+    fixedHere_.assign(n, 0);
+    DynamicList<label> slidingPatches;
+    PtrList<vectorField> normalSums;
     forAll(m.boundaryMesh(), patchi)
     {
         const pointPatchVectorField& field = pointDisplacement_.boundaryField()[patchi];
         const polyPatch& patch = m.boundaryMesh()[patchi];
+        if (patch.coupled()) continue;  // processor and cyclic patches: not walls
         const labelList& points = patch.meshPoints();
         if (field.fixesValue())
         {
-            forAll(points, i) prescribed[points[i]] = 1;
+            forAll(points, i) prescribed[points[i]] = fixedHere_[points[i]] = 1;
         }
         else if (!two_dimensional(patch.type()) && (slides(field.type()) || slides(patch.type())))
         {
-            const vectorField& normals = patch.pointNormals();
-            forAll(points, i)
+            // On every rank alike: the patches are the same, in the same order, on all of them.
+            slidingPatches.append(patchi);
+            normalSums.append(new vectorField(n, Zero));
+            vectorField& sum = normalSums.last();
+            const vectorField& faceNormals = patch.faceNormals();
+            forAll(patch, facei)
             {
-                std::vector<vector>& p = planes[points[i]];
-                const vector& normal = normals[i];
-                bool known = false;
-                for (const vector& q : p) known = known || mag(normal ^ q) < 1e-6;
-                if (!known) p.push_back(normal);
+                for (const label p : patch.localFaces()[facei]) sum[points[p]] += faceNormals[facei];
             }
         }
+    }
+    syncTools::syncPointList(m, prescribed, maxEqOp<label>(), label(0));
+    forAll(normalSums, k)
+    {
+        syncTools::syncPointList(m, normalSums[k], plusEqOp<vector>(), vector::zero);
     }
     boundary_.clear();
     roles_.clear();
     for (label v = 0; v < n; ++v)
     {
-        if (!prescribed[v] && planes[v].empty()) continue;
+        std::vector<vector> planes;
+        if (!prescribed[v])
+        {
+            forAll(normalSums, k)
+            {
+                const vector& sum = normalSums[k][v];
+                if (mag(sum) == 0) continue;
+                const vector normal = sum / mag(sum);
+                bool known = false;
+                for (const vector& q : planes) known = known || mag(normal ^ q) < 1e-6;
+                if (!known) planes.push_back(normal);
+            }
+            if (planes.empty()) continue;
+        }
         vector along = Zero;
         int role = int(meshmotion::foam::PointRole::prescribed);
-        if (!prescribed[v] && planes[v].size() == 1)
+        if (planes.size() == 1)
         {
             role = int(meshmotion::foam::PointRole::sliding_plane);
-            along = planes[v][0];
+            along = planes[0];
         }
-        else if (!prescribed[v] && planes[v].size() == 2)
+        else if (planes.size() == 2)
         {
             role = int(meshmotion::foam::PointRole::sliding_line);
-            along = planes[v][0] ^ planes[v][1];
+            along = planes[0] ^ planes[1];
             along /= mag(along);
         }
         boundary_.push_back(v);
@@ -174,6 +198,16 @@ void meshmotionMotionSolver::setup()
     {
         for (direction d = 0; d < 3; ++d) input.points[3 * i + d] = p0[i][d];
     }
+    if (Pstream::parRun())
+    {
+        // One number per point of the whole case (a point shared by ranks has one), and its
+        // owner: the rank whose range of that numbering holds it.
+        labelList pointToGlobal, uniquePoints;
+        const autoPtr<globalIndex> numbering = m.globalData().mergePoints(pointToGlobal, uniquePoints);
+        input.global_ids.assign(pointToGlobal.begin(), pointToGlobal.end());
+        input.owners.resize(n);
+        forAll(pointToGlobal, i) input.owners[i] = numbering().whichProcID(pointToGlobal[i]);
+    }
     bridge_.reset();
     try
     {
@@ -183,8 +217,11 @@ void meshmotionMotionSolver::setup()
     {
         FatalErrorInFunction << e.what() << exit(FatalError);
     }
-    Info<< "meshmotion: " << input.method.c_str() << " set up on " << label(boundary_.size())
-        << " boundary points of " << n << endl;
+    Info<< "meshmotion: " << input.method.c_str() << " set up on "
+        << returnReduce(label(boundary_.size()), sumOp<label>()) << " boundary points of "
+        << returnReduce(n, sumOp<label>());
+    if (Pstream::parRun()) Info<< " on " << Pstream::nProcs() << " ranks (points on several ranks counted on each)";
+    Info<< endl;
 }
 
 
@@ -194,7 +231,14 @@ void meshmotionMotionSolver::solve()
     // The patches' values on their points: OpenFOAM's own rule for a point of several patches.
     pointDisplacement_.boundaryFieldRef().updateCoeffs();
     pointDisplacement_.correctBoundaryConditions();
-    const vectorField& values = pointDisplacement_.primitiveField();
+    // On a decomposed case, a point's value comes from a rank with a fixed patch there (the
+    // largest, as OpenFOAM syncs point values, where ranks' patches disagree).
+    vectorField values(pointDisplacement_.primitiveField());
+    forAll(values, i)
+    {
+        if (!fixedHere_[i]) values[i] = Zero;
+    }
+    syncTools::syncPointList(mesh(), values, maxMagSqrEqOp<vector>(), vector::zero);
     std::vector<double> d(3 * boundary_.size(), 0.0);
     for (std::size_t k = 0; k < boundary_.size(); ++k)
     {

@@ -3,13 +3,20 @@
 # follows a uniformFixedValue table, whose side walls are fixed and whose front slips, with
 # `motionSolver meshmotion;`. Checks: the lid's points where the table puts them, the front's in
 # their plane, the walls' still, every step's mesh valid (OpenFOAM's own checks), one set-up for
-# the four steps; the same in a 2D case turned by angularOscillatingDisplacement; an unknown
-# option refused with its name, and a method that needs cells.
+# the four steps; the same in a 2D case turned by angularOscillatingDisplacement; each case
+# decomposed on 2 ranks (`-parallel`) giving the serial points to 1e-12, with the points two
+# ranks share identical; pimpleFoam running a 2D channel whose wall turns, serially and on 2
+# ranks; an unknown option refused with its name, and a method that needs cells.
 #
-#   plugin_test.sh LIBMESHMOTIONFOAM WORK_DIR
+#   plugin_test.sh LIBMESHMOTIONFOAM WORK_DIR [MPIEXEC [FLAGS...]]
+#
+# Without MPIEXEC (a plugin built without meshmotion's parallel layer) the decomposed runs are
+# skipped with a message.
 set -euo pipefail
 lib=$(realpath "$1")
 work=$(realpath -m "$2")
+shift 2
+mpiexec=("$@")
 if [[ -f /usr/share/openfoam/etc/bashrc ]]; then
   # It reads unset variables and ends on a failing test.
   set +eu
@@ -19,7 +26,17 @@ if [[ -f /usr/share/openfoam/etc/bashrc ]]; then
 fi
 command -v moveDynamicMesh >/dev/null || { echo "plugin_test: moveDynamicMesh not found (Debian's openfoam)"; exit 1; }
 header='FoamFile { version 2.0; format ascii; class dictionary; object'
-# A case in folder $1 from blockMesh: vertices $2, block $3, patches $4, point patch fields $5.
+# system/controlDict for application $1: steps of $3 up to time $2, each written.
+control_dict() {
+  cat > system/controlDict <<EOD
+$header controlDict; }
+application $1; startFrom startTime; startTime 0; stopAt endTime; endTime $2; deltaT $3;
+writeControl timeStep; writeInterval 1; writeFormat ascii; writePrecision 17; writeCompression off;
+timeFormat general; timePrecision 6; runTimeModifiable false;
+EOD
+}
+# A case in folder $1 from blockMesh: vertices $2, block $3, patches $4, point patch fields $5,
+# curved edges $6 (optional).
 make_case() {
   mkdir -p "$1/system" "$1/constant" "$1/0"
   cd "$1"
@@ -28,14 +45,10 @@ $header blockMeshDict; }
 convertToMeters 1;
 vertices ($2);
 blocks (hex (0 1 2 3 4 5 6 7) $3 simpleGrading (1 1 1));
+edges (${6:-});
 boundary ($4);
 EOD
-  cat > system/controlDict <<EOD
-$header controlDict; }
-application moveDynamicMesh; startFrom startTime; startTime 0; stopAt endTime; endTime 4; deltaT 1;
-writeControl timeStep; writeInterval 1; writeFormat ascii; writePrecision 17; writeCompression off;
-timeFormat general; timePrecision 6; runTimeModifiable false;
-EOD
+  control_dict moveDynamicMesh 4 1
   cat > system/fvSchemes <<EOD
 $header fvSchemes; }
 ddtSchemes { default Euler; } gradSchemes { default Gauss linear; } divSchemes { default none; }
@@ -71,6 +84,47 @@ move() {
   [[ $setups == 1 ]] || { echo "FAIL: $setups set-ups for 4 steps (expected 1)"; exit 1; }
   [[ $valid -ge 4 ]] || { echo "FAIL: OpenFOAM's mesh check passed $valid times (expected every step)"; tail -30 log.move; exit 1; }
   grep -q "$2" log.move || { echo "FAIL: no set-up line matching '$2'"; grep meshmotion log.move; exit 1; }
+}
+# The current case decomposed on 2 ranks and run by application $1 with -parallel: every rank's
+# points at every written time equal the serial run's (already in the case) to 1e-12, and a
+# point two ranks share is the same on both.
+parallel_equals_serial() {
+  if [[ ${#mpiexec[@]} == 0 ]]; then
+    echo "plugin_test: $1 -parallel skipped: the plugin was built without meshmotion's parallel layer"
+    return
+  fi
+  cat > system/decomposeParDict <<EOD
+$header decomposeParDict; }
+numberOfSubdomains 2; method simple; coeffs { n (2 1 1); }
+EOD
+  decomposePar -force > log.decompose 2>&1 || { tail -5 log.decompose; exit 1; }
+  "${mpiexec[@]}" -np 2 "$1" -parallel > log.parallel 2>&1 || { tail -20 log.parallel; exit 1; }
+  grep -q "meshmotion: rbf set up .* on 2 ranks" log.parallel || { echo "FAIL: no set-up on 2 ranks"; tail -20 log.parallel; exit 1; }
+  /usr/bin/python3 - <<'EOD'
+import glob, os, re
+def vectors(path):
+    return [tuple(map(float, p)) for p in re.findall(r"\(([-0-9.e+]+) ([-0-9.e+]+) ([-0-9.e+]+)\)", open(path).read())]
+def labels(path):
+    text = open(path).read()
+    return [int(x) for x in text[text.index("(", text.index("}")) + 1:text.rindex(")")].split()]
+times = sorted(os.path.dirname(p).split("/")[1] for p in glob.glob("processor0/*/polyMesh/points") if "constant" not in p)
+assert times, "the decomposed run wrote no moved points"
+worst = apart = 0.0
+for t in times:
+    serial = vectors(f"{t}/polyMesh/points")
+    seen = {}
+    for rank in (0, 1):
+        address = labels(f"processor{rank}/constant/polyMesh/pointProcAddressing")
+        local = vectors(f"processor{rank}/{t}/polyMesh/points")
+        assert len(local) == len(address)
+        for a, x in zip(address, local):
+            worst = max(worst, max(abs(x[k] - serial[a][k]) for k in range(3)))
+            if a in seen:
+                apart = max(apart, max(abs(x[k] - seen[a][k]) for k in range(3)))
+            seen[a] = x
+print(f"2 ranks against serial at times {' '.join(times)}: largest difference {worst:.3g}, shared points apart {apart:.3g}")
+assert worst < 1e-12 and apart == 0.0, (worst, apart)
+EOD
 }
 rm -rf "$work"
 make_case "$work" "(0 0 0) (1 0 0) (1 1 0) (0 1 0) (0 0 1) (1 0 1) (1 1 1) (0 1 1)" "(10 10 10)" \
@@ -108,6 +162,7 @@ assert worst["lid"] < 1e-12, worst
 assert worst["front"] < 1e-12, worst
 assert worst["walls"] < 1e-12, worst
 EOD
+parallel_equals_serial moveDynamicMesh
 # An option the mover does not have: OpenFOAM's fatal error, naming it.
 rm -rf 1 2 3 4
 write_dynamic "no_such_option 1;"
@@ -146,6 +201,61 @@ for t in (1, 2, 3, 4):
     assert bottom < 1e-12 and off_plane == 0.0 and apart < 1e-12, (t, bottom, off_plane, apart)
 print("2D case: bottom on its rotation, front and back alike, z unchanged")
 EOD
+parallel_equals_serial moveDynamicMesh
+# pimpleFoam on a 2D channel whose bottom wall turns (the wall's velocity its motion's) under a
+# curved top that slips: the plugin moves the mesh inside the solver's time loop, serially and
+# on 2 ranks. The ranks meet at the top's crest, where each holds the faces of one side only:
+# the plane a point slides in is the serial one only when the ranks' normals are summed.
+make_case "$work/pimple" "(0 0 0) (2 0 0) (2 1 0) (0 1 0) (0 0 0.1) (2 0 0.1) (2 1 0.1) (0 1 0.1)" "(20 10 1)" \
+  "bottom { type wall; faces ((0 1 5 4)); }
+   top { type wall; faces ((3 7 6 2)); }
+   inlet { type patch; faces ((0 4 7 3)); }
+   outlet { type patch; faces ((1 2 6 5)); }
+   frontAndBack { type empty; faces ((0 3 2 1) (4 5 6 7)); }" \
+  "bottom { type angularOscillatingDisplacement; axis (0 0 1); origin (0.4 0 0); angle0 0; amplitude 0.1;
+            omega 20; value uniform (0 0 0); }
+   \"(inlet|outlet)\" { type fixedValue; value uniform (0 0 0); }
+   top { type slip; }
+   frontAndBack { type empty; }" \
+  "arc 3 2 (1 1.2 0) arc 7 6 (1 1.2 0.1)"
+write_dynamic "support_radius 3;"
+control_dict pimpleFoam 0.04 0.01
+cat > system/fvSchemes <<EOD
+$header fvSchemes; }
+ddtSchemes { default Euler; } gradSchemes { default Gauss linear; }
+divSchemes { default none; div(phi,U) Gauss linearUpwind grad(U); div((nuEff*dev2(T(grad(U))))) Gauss linear; }
+laplacianSchemes { default Gauss linear corrected; } interpolationSchemes { default linear; }
+snGradSchemes { default corrected; }
+EOD
+cat > system/fvSolution <<EOD
+$header fvSolution; }
+solvers {
+  "(p|pFinal|pcorr|pcorrFinal)" { solver PCG; preconditioner DIC; tolerance 1e-8; relTol 0; }
+  "(U|UFinal)" { solver smoothSolver; smoother symGaussSeidel; tolerance 1e-8; relTol 0; }
+}
+PIMPLE { correctPhi yes; nOuterCorrectors 1; nCorrectors 2; nNonOrthogonalCorrectors 0; }
+EOD
+echo "$header transportProperties; } transportModel Newtonian; nu 0.01;" > constant/transportProperties
+echo "$header turbulenceProperties; } simulationType laminar;" > constant/turbulenceProperties
+cat > 0/U <<EOD
+FoamFile { version 2.0; format ascii; class volVectorField; object U; }
+dimensions [0 1 -1 0 0 0 0]; internalField uniform (1 0 0);
+boundaryField { inlet { type fixedValue; value uniform (1 0 0); } outlet { type zeroGradient; }
+  bottom { type movingWallVelocity; value uniform (0 0 0); } top { type slip; } frontAndBack { type empty; } }
+EOD
+cat > 0/p <<EOD
+FoamFile { version 2.0; format ascii; class volScalarField; object p; }
+dimensions [0 2 -2 0 0 0 0]; internalField uniform 0;
+boundaryField { outlet { type fixedValue; value uniform 0; } "(inlet|top|bottom)" { type zeroGradient; }
+  frontAndBack { type empty; } }
+EOD
+pimpleFoam > log.pimple 2>&1 || { tail -20 log.pimple; exit 1; }
+[[ $(grep -c "meshmotion: rbf set up" log.pimple) == 1 ]] || { echo "FAIL: pimpleFoam did not set the plugin up once"; exit 1; }
+[[ $(grep -c "^Courant Number" log.pimple) -ge 4 ]] || { echo "FAIL: pimpleFoam did not run its 4 steps"; tail -20 log.pimple; exit 1; }
+checkMesh -latestTime > log.check 2>&1 || { tail -20 log.check; exit 1; }
+grep -q "^Mesh OK" log.check || { echo "FAIL: checkMesh fails the moved mesh"; tail -20 log.check; exit 1; }
+cmp -s constant/polyMesh/points 0.04/polyMesh/points && { echo "FAIL: pimpleFoam's mesh did not move"; exit 1; }
+parallel_equals_serial pimpleFoam
 cd "$work"
 # A method that needs the cells the plugin does not pass yet: refused, saying so.
 sed -i 's/method rbf;/method elasticity;/' constant/dynamicMeshDict
