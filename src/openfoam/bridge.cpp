@@ -2,6 +2,7 @@
 
 #include "bridge.hpp"
 
+#include "meshmotion/io/openfoam_polymesh.hpp"
 #include "meshmotion/movers/mover_options.hpp"
 #ifdef MESHMOTION_FOAM_PARALLEL
 #include "meshmotion/parallel/distributed_rbf.hpp"
@@ -29,8 +30,59 @@ KeyValues take_options(KeyValues& given, parallel::BoundarySolveOptions& solve) 
 }  // namespace
 #endif
 
+// A polyhedral case's cells are cut into tetrahedra around the centres of their cells and of
+// their faces of more than three points (to_mesh()). A boundary face's centre is on the
+// boundary, so it joins the mover's boundary: prescribed when all the face's points are, by
+// their mean displacement (exact for a rigid motion, the centre being their mean), else
+// sliding in the face's plane. Its entries come after the points'; per entry, the entries of
+// its face's points (empty: sliding).
+std::vector<std::vector<Index>> add_face_centres(const PolyMesh& poly, const Mesh<3>& mesh, ResolvedBoundary<3>& b) {
+  std::vector<std::vector<Index>> out;
+  if (mesh.num_auxiliary_nodes == 0) return out;
+  const Index np = poly.points.cols();
+  std::vector<Index> entry(static_cast<std::size_t>(np), -1);
+  for (std::size_t k = 0; k < b.nodes.size(); ++k) entry[static_cast<std::size_t>(b.nodes[k])] = static_cast<Index>(k);
+  std::vector<Index> nodes;
+  std::vector<Vec<3>> normals;
+  Index centre = np;
+  for (Index f = 0; f < poly.num_faces(); ++f) {
+    const auto v = poly.face(f);
+    if (v.size() <= 3) continue;
+    const Index node = centre++;
+    if (f < poly.num_internal_faces()) continue;
+    std::vector<Index> entries;
+    bool all_prescribed = true;
+    for (const Index p : v) {
+      const Index e = entry[static_cast<std::size_t>(p)];
+      if (e < 0) break;
+      entries.push_back(e);
+      all_prescribed = all_prescribed && b.kinds[static_cast<std::size_t>(e)] == BoundaryKind::prescribed;
+    }
+    if (entries.size() < v.size()) continue;  // a face of an unlisted patch: interior, as its points
+    nodes.push_back(node);
+    normals.push_back(all_prescribed ? Vec<3>::Zero() : Vec<3>(poly.face_area(f).normalized()));
+    out.push_back(all_prescribed ? std::move(entries) : std::vector<Index>{});
+  }
+  const Index nb = b.size(), added = static_cast<Index>(nodes.size());
+  for (Index k = 0; k < added; ++k) {
+    b.nodes.push_back(nodes[static_cast<std::size_t>(k)]);
+    b.kinds.push_back(out[static_cast<std::size_t>(k)].empty() ? BoundaryKind::sliding : BoundaryKind::prescribed);
+  }
+  b.displacements.conservativeResize(3, nb + added);
+  b.normals.conservativeResize(3, nb + added);
+  b.directions.conservativeResize(3, nb + added);
+  for (Index k = 0; k < added; ++k) {
+    b.displacements.col(nb + k).setZero();
+    b.normals.col(nb + k) = normals[static_cast<std::size_t>(k)];
+    b.directions.col(nb + k).setZero();
+  }
+  return out;
+}
+
 struct Bridge::Impl {
   std::optional<AnyMover<3>> mover;
+  std::vector<std::vector<Index>> centre_entries;  // add_face_centres()
+  Points<3> given, moved;                         // with the face centres' entries and nodes
 #ifdef MESHMOTION_FOAM_PARALLEL
   std::optional<parallel::DistributedRbfMover<3>> distributed;
   Points<3> points;  // the distributed mover's view of them must outlive its setup
@@ -40,11 +92,12 @@ struct Bridge::Impl {
   Index points_count = 0, boundary = 0;
 };
 
+bool needs_cells(const std::string& method) { return method != "rbf"; }
+
 Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
   try {
-    // The cells (OpenFOAM's polyhedra) are not passed yet: only movers that need none.
-    if (input.method != "rbf")
-      throw InputError("method '" + input.method + "' needs the mesh's cells, which this plugin does not pass to it yet; use method rbf");
+    if (!input.global_ids.empty() && needs_cells(input.method))
+      throw InputError("method '" + input.method + "' moves a decomposed case's cells, which this plugin does not pass between ranks yet; use method rbf");
     const auto n = static_cast<Index>(input.points.size() / 3), nb = static_cast<Index>(input.boundary.size());
     ResolvedBoundary<3> b;
     b.nodes.assign(input.boundary.begin(), input.boundary.end());
@@ -87,9 +140,25 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
     const KeyValues& rest = given;
 #endif
     Mesh<3> mesh;
-    mesh.points = points;
+    if (needs_cells(input.method)) {
+      PolyMesh poly;
+      poly.points = points;
+      poly.face_offsets.assign(input.face_offsets.begin(), input.face_offsets.end());
+      poly.face_nodes.assign(input.face_points.begin(), input.face_points.end());
+      poly.owner.assign(input.owner.begin(), input.owner.end());
+      poly.neighbour.assign(input.neighbour.begin(), input.neighbour.end());
+      poly.num_cells = input.cells;
+      const Index internal = poly.num_internal_faces();
+      poly.patches = {{"boundary", "patch", internal, poly.num_faces() - internal}};
+      mesh = to_mesh(poly);
+      impl->centre_entries = add_face_centres(poly, mesh, b);
+    } else {
+      mesh.points = points;
+    }
     impl->mover.emplace(make_mover(mover_config<3>(input.method, rest)));
     impl->mover->setup(mesh, b);
+    impl->given.setZero(3, b.size());
+    impl->moved.resize(3, mesh.num_nodes());
     impl_ = impl.release();
   } catch (const std::exception& e) {
     throw std::runtime_error(e.what());
@@ -109,9 +178,16 @@ void Bridge::move(const std::vector<double>& boundary_displacements, std::vector
       return;
     }
 #endif
-    out.resize(static_cast<std::size_t>(3 * impl_->points_count));
-    Eigen::Map<Points<3>> moved(out.data(), 3, impl_->points_count);
-    impl_->mover->move_into(d, moved);
+    Impl& m = *impl_;
+    m.given.leftCols(m.boundary) = d;
+    for (std::size_t k = 0; k < m.centre_entries.size(); ++k) {
+      const std::vector<Index>& face = m.centre_entries[k];
+      Vec<3> mean = Vec<3>::Zero();
+      for (const Index e : face) mean += d.col(e);
+      m.given.col(m.boundary + static_cast<Index>(k)) = face.empty() ? mean : Vec<3>(mean / static_cast<double>(face.size()));
+    }
+    m.mover->move_into(m.given, m.moved);
+    out.assign(m.moved.data(), m.moved.data() + 3 * m.points_count);
   } catch (const std::exception& e) {
     throw std::runtime_error(e.what());
   }

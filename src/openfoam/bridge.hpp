@@ -24,7 +24,15 @@ struct BridgeInput {
   /// the mover up together over MPI_COMM_WORLD, as OpenFOAM's own communicator.
   std::vector<long> global_ids;
   std::vector<int> owners;
+  /// The cells, for a method that needs them (needs_cells()): OpenFOAM's faces (face f's points
+  /// are face_points[face_offsets[f] .. face_offsets[f + 1])), each face's owner cell and
+  /// each internal face's neighbour (internal faces first), and the number of cells.
+  std::vector<long> face_offsets, face_points, owner, neighbour;
+  long cells = 0;
 };
+
+/// Whether `method` moves the interior through the mesh's cells (every method but rbf).
+bool needs_cells(const std::string& method);
 
 class Bridge {
  public:

@@ -198,6 +198,20 @@ void meshmotionMotionSolver::setup()
     {
         for (direction d = 0; d < 3; ++d) input.points[3 * i + d] = p0[i][d];
     }
+    if (meshmotion::foam::needs_cells(input.method) && !Pstream::parRun())
+    {
+        const faceList& faces = m.faces();
+        input.face_offsets.reserve(faces.size() + 1);
+        input.face_offsets.push_back(0);
+        for (const face& f : faces)
+        {
+            input.face_points.insert(input.face_points.end(), f.begin(), f.end());
+            input.face_offsets.push_back(long(input.face_points.size()));
+        }
+        input.owner.assign(m.faceOwner().begin(), m.faceOwner().end());
+        input.neighbour.assign(m.faceNeighbour().begin(), m.faceNeighbour().end());
+        input.cells = m.nCells();
+    }
     if (Pstream::parRun())
     {
         // One number per point of the whole case (a point shared by ranks has one), and its

@@ -116,7 +116,8 @@ struct SmallCell {
 
 /// The Mesh<3> of a polyMesh: its cells as tetrahedra, pyramids, prisms and hexahedra when
 /// they all are, else every cell cut into tetrahedra around auxiliary centre nodes; patches as
-/// facet groups. See the file comment.
+/// facet groups. See the file comment. The auxiliary nodes are, in this order, the centres of
+/// the faces of more than three points, in face order, then every cell's centre, in cell order.
 [[nodiscard]] inline Mesh<3> to_mesh(const PolyMesh& poly) {
   const Index nc = poly.num_cells, nf = poly.num_faces(), np = poly.points.cols();
   // Cell -> faces (CSR), each face oriented out of the cell.
