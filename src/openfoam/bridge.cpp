@@ -4,10 +4,13 @@
 
 #include "meshmotion/io/openfoam_polymesh.hpp"
 #include "meshmotion/movers/mover_options.hpp"
+#include "meshmotion/movers/rbf.hpp"
+#include "meshmotion/movers/support_radius.hpp"
 #ifdef MESHMOTION_FOAM_PARALLEL
 #include "meshmotion/parallel/distributed_rbf.hpp"
 #endif
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -79,17 +82,69 @@ std::vector<std::vector<Index>> add_face_centres(const PolyMesh& poly, const Mes
   return out;
 }
 
+// The RBF's default support radius (no support_radius or support_radii given) follows the
+// motion. A motion solver is set up before it moves, where the library's rule (five times the
+// largest boundary displacement, at least ten boundary spacings) sees no displacement and
+// gives the spacing's radius: a plate turned in a box kept its cells valid to 30 degrees with
+// it, to 90 with a radius of the box's size. So when a move's largest prescribed displacement
+// (over all ranks) outgrows the rule, the mover is set up again for twice that displacement:
+// once per doubling of the motion, never for an oscillation within the first period's reach.
 struct Bridge::Impl {
   std::optional<AnyMover<3>> mover;
+  MoverConfig<3> config;
+  Mesh<3> mesh;                                    // serial: what the mover was set up on
+  ResolvedBoundary<3> boundary;                    // with the face centres' entries
   std::vector<std::vector<Index>> centre_entries;  // add_face_centres()
   Points<3> given, moved;                         // with the face centres' entries and nodes
 #ifdef MESHMOTION_FOAM_PARALLEL
   std::optional<parallel::DistributedRbfMover<3>> distributed;
+  parallel::BoundarySolveOptions solve;
   Points<3> points;  // the distributed mover's view of them must outlive its setup
   std::vector<std::int64_t> global_ids;
   std::vector<int> owners;
 #endif
-  Index points_count = 0, boundary = 0;
+  Index points_count = 0, entries = 0;
+  bool growing_radius = false;
+  double radius = 0.0;
+  int setups = 0;
+
+  // Sets the mover up with the boundary displacements `d` (entries × 3) deciding the default
+  // radius; false when it would not grow (the serial rule's memory budget holds it).
+  bool set_up(const Points<3>& d) {
+    boundary.displacements.leftCols(d.cols()) = d;
+#ifdef MESHMOTION_FOAM_PARALLEL
+    if (!global_ids.empty()) {
+      const double before = radius;
+      distributed.emplace(std::get<RbfOptions>(config.options), solve);
+      distributed->setup(parallel::PartitionView<3>{MPI_COMM_WORLD, points, global_ids, owners}, boundary);
+      radius = distributed->support_radius();
+      ++setups;
+      return setups == 1 || radius > before;
+    }
+#endif
+    if (growing_radius) {
+      RbfOptions& rbf = std::get<RbfOptions>(config.options);
+      rbf.support_radius = 0.0;
+      const double fitted = default_support_radius(mesh.points, boundary, rbf).radius;
+      if (setups > 0 && !(fitted > radius)) return false;
+      rbf.support_radius = radius = fitted;
+    }
+    mover.emplace(make_mover(config));
+    mover->setup(mesh, boundary);
+    ++setups;
+    return true;
+  }
+
+  // The largest prescribed displacement of `d` over every rank.
+  [[nodiscard]] double largest(const Points<3>& d) const {
+    double out = 0.0;
+    for (Index k = 0; k < d.cols(); ++k)
+      if (boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed) out = std::max(out, d.col(k).norm());
+#ifdef MESHMOTION_FOAM_PARALLEL
+    if (!global_ids.empty()) MPI_Allreduce(MPI_IN_PLACE, &out, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+#endif
+    return out;
+  }
 };
 
 bool needs_cells(const std::string& method) { return method != "rbf"; }
@@ -99,7 +154,8 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
     if (!input.global_ids.empty() && needs_cells(input.method))
       throw InputError("method '" + input.method + "' moves a decomposed case's cells, which this plugin does not pass between ranks yet; use method rbf");
     const auto n = static_cast<Index>(input.points.size() / 3), nb = static_cast<Index>(input.boundary.size());
-    ResolvedBoundary<3> b;
+    auto impl = std::make_unique<Impl>();
+    ResolvedBoundary<3>& b = impl->boundary;
     b.nodes.assign(input.boundary.begin(), input.boundary.end());
     b.displacements = Points<3>::Zero(3, nb);
     b.normals = Points<3>::Zero(3, nb);
@@ -112,13 +168,20 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
       if (role == PointRole::sliding_line) b.directions.col(k) = along.col(k);
     }
     KeyValues given = parse_key_values(input.options);
-    auto impl = std::make_unique<Impl>();
     impl->points_count = n;
-    impl->boundary = nb;
+    impl->entries = nb;
     const Eigen::Map<const Points<3>> points(input.points.data(), 3, n);
 #ifdef MESHMOTION_FOAM_PARALLEL
-    parallel::BoundarySolveOptions solve;
-    const KeyValues rest = take_options(given, solve);
+    const KeyValues rest = take_options(given, impl->solve);
+#else
+    if (!input.global_ids.empty())
+      throw InputError("this plugin was built without meshmotion's parallel layer (MPI, PETSc, METIS): run the motion serially");
+    const KeyValues& rest = given;
+#endif
+    impl->config = mover_config<3>(input.method, rest);
+    if (const auto* rbf = std::get_if<RbfOptions>(&impl->config.options))
+      impl->growing_radius = rbf->support_radius == 0.0 && rbf->support_radii.empty();
+#ifdef MESHMOTION_FOAM_PARALLEL
     if (!input.global_ids.empty()) {
       // OpenFOAM has MPI running; PETSc, which the boundary system may take, is started once.
       PetscBool started = PETSC_FALSE;
@@ -127,19 +190,8 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
       impl->points = points;
       impl->global_ids.assign(input.global_ids.begin(), input.global_ids.end());
       impl->owners = input.owners;
-      const parallel::PartitionView<3> part{MPI_COMM_WORLD, impl->points, impl->global_ids, impl->owners};
-      auto config = mover_config<3>(input.method, rest);
-      impl->distributed.emplace(std::get<RbfOptions>(config.options), solve);
-      impl->distributed->setup(part, b);
-      impl_ = impl.release();
-      return;
     }
-#else
-    if (!input.global_ids.empty())
-      throw InputError("this plugin was built without meshmotion's parallel layer (MPI, PETSc, METIS): run the motion serially");
-    const KeyValues& rest = given;
 #endif
-    Mesh<3> mesh;
     if (needs_cells(input.method)) {
       PolyMesh poly;
       poly.points = points;
@@ -150,15 +202,14 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
       poly.num_cells = input.cells;
       const Index internal = poly.num_internal_faces();
       poly.patches = {{"boundary", "patch", internal, poly.num_faces() - internal}};
-      mesh = to_mesh(poly);
-      impl->centre_entries = add_face_centres(poly, mesh, b);
-    } else {
-      mesh.points = points;
+      impl->mesh = to_mesh(poly);
+      impl->centre_entries = add_face_centres(poly, impl->mesh, b);
+    } else if (input.global_ids.empty()) {
+      impl->mesh.points = points;
     }
-    impl->mover.emplace(make_mover(mover_config<3>(input.method, rest)));
-    impl->mover->setup(mesh, b);
+    impl->set_up(Points<3>::Zero(3, nb));
     impl->given.setZero(3, b.size());
-    impl->moved.resize(3, mesh.num_nodes());
+    impl->moved.resize(3, impl->mesh.num_nodes());
     impl_ = impl.release();
   } catch (const std::exception& e) {
     throw std::runtime_error(e.what());
@@ -167,24 +218,32 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
 
 Bridge::~Bridge() { delete impl_; }
 
+double Bridge::support_radius() const { return impl_->radius; }
+
+int Bridge::setups() const { return impl_->setups; }
+
 void Bridge::move(const std::vector<double>& boundary_displacements, std::vector<double>& out) {
   try {
-    const Eigen::Map<const Points<3>> d(boundary_displacements.data(), 3, impl_->boundary);
+    Impl& m = *impl_;
+    const Eigen::Map<const Points<3>> d(boundary_displacements.data(), 3, m.entries);
+    if (m.growing_radius) {
+      const double largest = m.largest(d);
+      if (SupportRadiusOptions{}.displacement_factor * largest > m.radius) m.growing_radius = m.set_up(1.5 * d);
+    }
 #ifdef MESHMOTION_FOAM_PARALLEL
-    if (impl_->distributed) {
+    if (m.distributed) {
       Points<3> moved;
-      impl_->distributed->move_into(d, moved);
+      m.distributed->move_into(d, moved);
       out.assign(moved.data(), moved.data() + moved.size());
       return;
     }
 #endif
-    Impl& m = *impl_;
-    m.given.leftCols(m.boundary) = d;
+    m.given.leftCols(m.entries) = d;
     for (std::size_t k = 0; k < m.centre_entries.size(); ++k) {
       const std::vector<Index>& face = m.centre_entries[k];
       Vec<3> mean = Vec<3>::Zero();
       for (const Index e : face) mean += d.col(e);
-      m.given.col(m.boundary + static_cast<Index>(k)) = face.empty() ? mean : Vec<3>(mean / static_cast<double>(face.size()));
+      m.given.col(m.entries + static_cast<Index>(k)) = face.empty() ? mean : Vec<3>(mean / static_cast<double>(face.size()));
     }
     m.mover->move_into(m.given, m.moved);
     out.assign(m.moved.data(), m.moved.data() + 3 * m.points_count);

@@ -45,6 +45,12 @@ class Bridge {
   /// `boundary_displacements` (3 × boundary; sliding entries ignored) to every point's
   /// displacement (3 × n). Collective on a decomposed case, where each entry's owner gives it.
   void move(const std::vector<double>& boundary_displacements, std::vector<double>& out);
+  /// The RBF's support radius (0 for other methods). Without a given one it grows with the
+  /// motion: a move whose largest prescribed displacement needs a larger one sets the mover
+  /// up again (bridge.cpp says when).
+  [[nodiscard]] double support_radius() const;
+  /// How many times the mover was set up.
+  [[nodiscard]] int setups() const;
 
  private:
   struct Impl;

@@ -11,6 +11,7 @@
 #include "globalIndex.H"
 #include "globalMeshData.H"
 #include "mapPolyMesh.H"
+#include "meshTools.H"
 #include "OStringStream.H"
 #include "Pstream.H"
 #include "syncTools.H"
@@ -235,6 +236,7 @@ void meshmotionMotionSolver::setup()
         << returnReduce(label(boundary_.size()), sumOp<label>()) << " boundary points of "
         << returnReduce(n, sumOp<label>());
     if (Pstream::parRun()) Info<< " on " << Pstream::nProcs() << " ranks (points on several ranks counted on each)";
+    if (bridge_->support_radius() > 0) Info<< " (support radius " << bridge_->support_radius() << ")";
     Info<< endl;
 }
 
@@ -260,6 +262,7 @@ void meshmotionMotionSolver::solve()
         for (direction c = 0; c < 3; ++c) d[3 * k + c] = values[boundary_[k]][c];
     }
     std::vector<double> out;
+    const int setups = bridge_->setups();
     try
     {
         bridge_->move(d, out);
@@ -268,11 +271,19 @@ void meshmotionMotionSolver::solve()
     {
         FatalErrorInFunction << e.what() << exit(FatalError);
     }
+    if (bridge_->setups() > setups)
+    {
+        Info<< "meshmotion: set up again for the motion's size (support radius " << bridge_->support_radius() << ")"
+            << endl;
+    }
     vectorField& displacement = pointDisplacement_.primitiveFieldRef();
     forAll(displacement, i)
     {
         displacement[i] = vector(out[3 * i], out[3 * i + 1], out[3 * i + 2]);
     }
+    // A 2D case moves in its plane: the movers through cells see a slab one cell thick, whose
+    // front and back would follow the elasticity's Poisson effect out of it.
+    meshTools::constrainDirection(mesh(), mesh().solutionD(), displacement);
 }
 
 }  // namespace Foam

@@ -170,6 +170,7 @@ EOD
 }
 move "method rbf; support_radius 2;" "rbf set up on .* boundary points of 1331"
 cube_check 1
+! grep -q "set up again" log.move || { echo "FAIL: a given radius was changed"; exit 1; }
 parallel_equals_serial moveDynamicMesh
 # A method that moves through the cells, on the decomposed case: refused, saying why.
 if [[ ${#mpiexec[@]} != 0 ]]; then
@@ -208,15 +209,17 @@ make_case "$work/2d" "(0 0 0) (2 0 0) (2 1 0) (0 1 0) (0 0 0.1) (2 0 0.1) (2 1 0
             omega 0.5; value uniform (0 0 0); }
    walls { type fixedValue; value uniform (0 0 0); }
    frontAndBack { type empty; }"
-move "method rbf;" "set up on 240 boundary points of 1722"
-/usr/bin/python3 - <<'EOD'
-import math, re
+# The 2D case's bottom on its rotation (amplitude $1), its front and back moved alike, its z
+# unchanged.
+two_d_check() {
+  AMPLITUDE=$1 /usr/bin/python3 - <<'EOD'
+import math, os, re
 def points(path):
     return [tuple(map(float, p)) for p in re.findall(r"\(([-0-9.e+]+) ([-0-9.e+]+) ([-0-9.e+]+)\)", open(path).read())]
 p0 = points("constant/polyMesh/points")
 for t in (1, 2, 3, 4):
     p = points(f"{t}/polyMesh/points")
-    angle = 0.2 * math.sin(0.5 * t)
+    angle = float(os.environ["AMPLITUDE"]) * math.sin(0.5 * t)
     c, s = math.cos(angle), math.sin(angle)
     bottom = off_plane = 0.0
     by_column = {}
@@ -230,7 +233,22 @@ for t in (1, 2, 3, 4):
     assert bottom < 1e-12 and off_plane == 0.0 and apart < 1e-12, (t, bottom, off_plane, apart)
 print("2D case: bottom on its rotation, front and back alike, z unchanged")
 EOD
+}
+move "method rbf;" "set up on 240 boundary points of 1722"
+# No radius given: the default one (ten boundary spacings, 0.5, before any motion) grows with the
+# motion, once here: to 7.5 times the largest displacement of the step that outgrew it.
+[[ $(grep -c "meshmotion: set up again for the motion's size (support radius 1.19" log.move) == 1 ]] \
+  || { echo "FAIL: the default radius did not grow once with the motion"; grep meshmotion log.move; exit 1; }
+two_d_check 0.2
 parallel_equals_serial moveDynamicMesh
+# Stiffened elasticity through the slab of hexahedra: its front and back, free in the mover,
+# kept in their planes (the Poisson effect moved them out, and the mesh collapsed). A tenth of
+# the turn: the bottom's second point moves further than its cell's height, which folds the
+# corner cell under elasticity (not under the RBF).
+rm -rf 1 2 3 4
+sed -i 's/amplitude 0.2;/amplitude 0.02;/' 0/pointDisplacement
+move "method sle;" "sle set up on 240 boundary points of 1722"
+two_d_check 0.02
 # pimpleFoam on a 2D channel whose bottom wall turns (the wall's velocity its motion's) under a
 # curved top that slips: the plugin moves the mesh inside the solver's time loop, serially and
 # on 2 ranks. The ranks meet at the top's crest, where each holds the faces of one side only:
