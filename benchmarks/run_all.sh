@@ -18,7 +18,7 @@
 # table shows its figures and the ratios. A benchmark that does not compile against the older
 # library is reported and skipped.
 #
-# --only runs the named benchmarks alone (e.g. --only conversion_bench,io_bench,curve_mesh_program,defaults_bench).
+# --only runs the named benchmarks alone (e.g. --only conversion_bench,io_bench,curve_mesh_program,defaults_bench,openfoam_plugin).
 #
 # Programs and benchmarks run with glibc's huge-page heap (GLIBC_TUNABLES, see
 # include/meshmotion/core/process_memory.hpp) for both builds; MESHMOTION_HUGE_PAGES=0 runs
@@ -202,6 +202,11 @@ fi
 # (this build only: the comparison is within it).
 if [[ -x "$build_dir/examples/curve_mesh" && ( -z "$only" || "$only" == *",defaults_bench,"* ) ]]; then
   run defaults_bench python3 "$here/defaults_bench.py" "$build_dir/examples/curve_mesh" --data "$source_dir/../shared/data"
+fi
+# The OpenFOAM plugin in OpenFOAM's time loop against displacementLaplacian (it says why when
+# the plugin or OpenFOAM is missing).
+if [[ -z "$only" || "$only" == *",openfoam_plugin,"* ]]; then
+  run openfoam_plugin "$here/openfoam_plugin.sh" "$build_dir" "$build_dir/openfoam_plugin"
 fi
 # The distributed movers at 1, 2 and 4 ranks (4 is oversubscribed on two cores and says so),
 # each against the serial mover in the same process.

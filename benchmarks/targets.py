@@ -54,6 +54,21 @@ def defaults_against_tuned(field, worst):
     return value
 
 
+def plugin_against_laplacian(rows, build):
+    """The worst over the openfoam_plugin cases of the largest angle the plugin's defaults keep
+    valid over displacementLaplacian's."""
+    ours, peer = {}, {}
+    for row in rows:
+        if row.get("build", "current") != build or row.get("bench") != "openfoam_plugin":
+            continue
+        if row["solver"] == "displacementLaplacian":
+            peer[row["case"]] = row["largest_valid_deg"]
+        elif row["options"] == "(defaults)":
+            ours[row["case"]] = row["largest_valid_deg"]
+    ratios = [ours[case] / peer[case] for case in ours if peer.get(case)]
+    return min(ratios) if ratios else None
+
+
 # (name, rows' fields to match or a function of (rows, build), field, "<=" or ">=", limit, unit)
 TARGETS = [
     ("P1->P2 30P30N quads (median)", {"bench": "conversion", "case": "30p30n-quads"}, "median_s", "<=", 0.015, "s"),
@@ -74,6 +89,8 @@ TARGETS = [
     ("distributed RBF box setup, 4 ranks (2 per core) / 1 rank", distributed_setup_growth(4), None, "<=", 1.2, "x"),
     ("defaults' minimum / hand-set's, worst case", defaults_against_tuned("quality_ratio", min), None, ">=", 0.98, "x"),
     ("defaults' time / hand-set's, worst case", defaults_against_tuned("time_ratio", max), None, "<=", 1.5, "x"),
+    ("OpenFOAM plugin defaults' largest valid angle / displacementLaplacian's, worst case", plugin_against_laplacian,
+     None, ">=", 1.0, "x"),
     ("PU RBF, 1M centres and 10M nodes: peak", {"bench": "pu_rbf", "mesh": "flat-707", "method": "pu"}, "peak_mb",
      "<=", 24576, "MB"),
 ]

@@ -1,0 +1,180 @@
+#!/usr/bin/env bash
+# The plugin inside OpenFOAM's own time loop (moveDynamicMesh, `motionSolver meshmotion;`)
+# against OpenFOAM's displacementLaplacian (inverseDistance diffusivity from the body, GAMG to
+# 1e-8 with minIter 3) on the same cases: a plate turning in a 2D box and a block turning in a
+# 3D box (blockMesh, made here), each turned over 8 steps to its final angle. Per case and
+# motion solver: the largest angle of 10, 20, ..., 90 degrees at which every step's mesh passes
+# OpenFOAM's own check, the time per step and the peak memory at 30 degrees, and the maximum
+# non-orthogonality there. The plugin's row without options (its defaults) is the one that
+# counts; `sle` stands beside it. One table, and one JSON line per case and solver:
+# {"bench": "openfoam_plugin", "case", "solver", "largest_valid_deg", "seconds_per_step",
+#  "max_rss_mb", "non_orthogonality", "time_ratio"} (time_ratio: per step, over
+# displacementLaplacian's).
+#
+#   benchmarks/openfoam_plugin.sh [BUILD_DIR=build] [WORK_DIR=/tmp/meshmotion_openfoam_plugin]
+#
+# Skipped with a message when the plugin was not built or Debian's openfoam is missing.
+set -euo pipefail
+build=$(realpath "${1:-build}")
+work=$(realpath -m "${2:-/tmp/meshmotion_openfoam_plugin}")
+lib="$build/libmeshmotionFoam.so"
+if [[ ! -f "$lib" ]]; then
+  echo "openfoam_plugin: $lib not built (Debian's openfoam and the OpenFOAM plugin, docs/openfoam_plugin.md): skipped"
+  exit 0
+fi
+if [[ -f /usr/share/openfoam/etc/bashrc ]]; then
+  set +eu  # it reads unset variables and ends on a failing test
+  # shellcheck disable=SC1091
+  source /usr/share/openfoam/etc/bashrc >/dev/null 2>&1
+  set -eu
+fi
+command -v moveDynamicMesh >/dev/null || { echo "openfoam_plugin: moveDynamicMesh not found (Debian's openfoam): skipped"; exit 0; }
+# OpenFOAM runs serial; the plugin's threads would otherwise compete with nothing but noise.
+export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
+exec /usr/bin/python3 - "$lib" "$work" <<'EOF'
+import json, math, os, re, shutil, subprocess, sys, time
+
+lib, work = sys.argv[1], sys.argv[2]
+HEADER = "FoamFile { version 2.0; format ascii; class dictionary; object %s; }\n"
+STEPS = 8
+ANGLES = [10, 20, 30, 45, 60, 75, 90]
+REFERENCE = 30  # the angle of the time, memory and non-orthogonality columns
+
+# Blocks of a box around a body: breaks along each axis, the middle block of each axis the body's
+# (a hole), `cells` per block and axis. 2D: one layer in z, front and back empty.
+CASES = {
+    "plate2d": dict(breaks=[(-5, -1, 1, 5), (-5, -0.1, 0.1, 5), (0, 0.1)], cells=[(20, 20, 20), (20, 4, 20), (1,)]),
+    "block3d": dict(breaks=[(-3, -1, 1, 3), (-3, -0.3, 0.3, 3), (-3, -0.5, 0.5, 3)],
+                    cells=[(8, 12, 8), (8, 4, 8), (8, 6, 8)]),
+}
+SOLVERS = [
+    ("meshmotion", "(defaults)", "motionSolverLibs (\"libfvMotionSolvers.so\" \"%s\");\nmotionSolver meshmotion;\nmeshmotionCoeffs { }\n" % lib),
+    ("meshmotion", "method sle", "motionSolverLibs (\"libfvMotionSolvers.so\" \"%s\");\nmotionSolver meshmotion;\nmeshmotionCoeffs { method sle; }\n" % lib),
+    ("displacementLaplacian", "inverseDistance (body)",
+     "motionSolverLibs (\"libfvMotionSolvers.so\");\nmotionSolver displacementLaplacian;\n"
+     "displacementLaplacianCoeffs { diffusivity inverseDistance (body); }\n"),
+]
+
+
+def block_mesh(case, spec):
+    xs, ys, zs = spec["breaks"]
+    two_d = len(zs) == 2
+    index = {}
+    vertices = []
+    for k, z in enumerate(zs):
+        for j, y in enumerate(ys):
+            for i, x in enumerate(xs):
+                index[i, j, k] = len(vertices)
+                vertices.append(f"({x} {y} {z})")
+    blocks, faces = [], {"outer": [], "body": [], "frontAndBack": []}
+    nk = 1 if two_d else 3
+    hole = (1, 1, 0 if two_d else 1)
+    for k in range(nk):
+        for j in range(3):
+            for i in range(3):
+                if (i, j, k) == hole:
+                    continue
+                v = [index[i, j, k], index[i + 1, j, k], index[i + 1, j + 1, k], index[i, j + 1, k],
+                     index[i, j, k + 1], index[i + 1, j, k + 1], index[i + 1, j + 1, k + 1], index[i, j + 1, k + 1]]
+                nz = spec["cells"][2][0] if two_d else spec["cells"][2][k]
+                blocks.append(f"hex ({' '.join(map(str, v))}) ({spec['cells'][0][i]} {spec['cells'][1][j]} {nz}) simpleGrading (1 1 1)")
+                # Each face of the block, outward, and what lies beyond it.
+                for (di, dj, dk), face in [((-1, 0, 0), (v[0], v[4], v[7], v[3])), ((1, 0, 0), (v[1], v[2], v[6], v[5])),
+                                           ((0, -1, 0), (v[0], v[1], v[5], v[4])), ((0, 1, 0), (v[3], v[7], v[6], v[2])),
+                                           ((0, 0, -1), (v[0], v[3], v[2], v[1])), ((0, 0, 1), (v[4], v[5], v[6], v[7]))]:
+                    beyond = (i + di, j + dj, k + dk)
+                    text = f"({' '.join(map(str, face))})"
+                    if dk != 0 and two_d:
+                        faces["frontAndBack"].append(text)
+                    elif beyond == hole:
+                        faces["body"].append(text)
+                    elif not all(0 <= c < 3 for c in beyond[:2]) or not (0 <= beyond[2] < nk):
+                        faces["outer"].append(text)
+    types = {"outer": "wall", "body": "wall", "frontAndBack": "empty"}
+    boundary = "".join(f"{name} {{ type {types[name]}; faces ({' '.join(f)}); }}\n" for name, f in faces.items() if f)
+    os.makedirs(f"{case}/system", exist_ok=True)
+    with open(f"{case}/system/blockMeshDict", "w") as out:
+        out.write(HEADER % "blockMeshDict" + "convertToMeters 1;\nvertices (" + " ".join(vertices) + ");\nblocks (\n" +
+                  "\n".join(blocks) + "\n);\nedges ();\nboundary (\n" + boundary + ");\n")
+    return two_d
+
+
+def write_case(case, spec, angle, solver):
+    """A fresh case turning the body to `angle` degrees over STEPS steps with `solver`."""
+    shutil.rmtree(case, ignore_errors=True)
+    two_d = block_mesh(case, spec)
+    os.makedirs(f"{case}/constant", exist_ok=True)
+    os.makedirs(f"{case}/0", exist_ok=True)
+    with open(f"{case}/system/controlDict", "w") as out:
+        out.write(HEADER % "controlDict" + f"application moveDynamicMesh; startFrom startTime; startTime 0; stopAt endTime;"
+                  f" endTime {STEPS}; deltaT 1; writeControl timeStep; writeInterval {STEPS}; writeFormat binary;"
+                  " writePrecision 17; writeCompression off; timeFormat general; timePrecision 6; runTimeModifiable false;\n")
+    with open(f"{case}/system/fvSchemes", "w") as out:
+        out.write(HEADER % "fvSchemes" + "ddtSchemes { default Euler; } gradSchemes { default Gauss linear; }"
+                  " divSchemes { default none; } laplacianSchemes { default Gauss linear corrected; }"
+                  " interpolationSchemes { default linear; } snGradSchemes { default corrected; }\n")
+    with open(f"{case}/system/fvSolution", "w") as out:
+        out.write(HEADER % "fvSolution" + "solvers { \"cellDisplacement.*\" { solver GAMG; smoother GaussSeidel;"
+                  " tolerance 1e-8; relTol 0; minIter 3; } }\n")
+    with open(f"{case}/constant/dynamicMeshDict", "w") as out:
+        out.write(HEADER % "dynamicMeshDict" + "dynamicFvMesh dynamicMotionSolverFvMesh;\n" + solver)
+    omega = math.pi / 2 / STEPS  # the angle reaches its amplitude at the last step
+    empty = "frontAndBack { type empty; }" if two_d else ""
+    with open(f"{case}/0/pointDisplacement", "w") as out:
+        out.write("FoamFile { version 2.0; format ascii; class pointVectorField; object pointDisplacement; }\n"
+                  "dimensions [0 1 0 0 0 0 0]; internalField uniform (0 0 0);\nboundaryField {\n"
+                  f"body {{ type angularOscillatingDisplacement; axis (0 0 1); origin (0 0 0); angle0 0;"
+                  f" amplitude {math.radians(angle)}; omega {omega}; value uniform (0 0 0); }}\n"
+                  f"outer {{ type fixedValue; value uniform (0 0 0); }}\n{empty}\n}}\n")
+    log = subprocess.run(["blockMesh"], cwd=case, capture_output=True, text=True)
+    if log.returncode != 0:
+        sys.exit(f"openfoam_plugin: blockMesh failed in {case}:\n{log.stdout[-2000:]}{log.stderr[-2000:]}")
+
+
+def run(case):
+    """moveDynamicMesh: every step valid, seconds per step, peak memory (MB), last non-orthogonality."""
+    start = time.perf_counter()
+    done = subprocess.run(["/usr/bin/time", "-f", "%M", "moveDynamicMesh"], cwd=case, capture_output=True, text=True)
+    wall = time.perf_counter() - start
+    log = done.stdout
+    with open(f"{case}/log.moveDynamicMesh", "w") as out:
+        out.write(log + done.stderr)
+    ok = done.returncode == 0 and log.count("Mesh OK") >= STEPS and "Failed" not in log
+    times = [float(t) for t in re.findall(r"ExecutionTime = ([0-9.eE+-]+) s", log)]
+    per_step = (times[-1] - times[0]) / (len(times) - 1) if len(times) > 1 else wall / STEPS
+    rss = [int(x) for x in re.findall(r"^(\d+)$", done.stderr, re.M)]
+    orthogonality = re.findall(r"Mesh non-orthogonality Max: ([0-9.eE+-]+)", log)
+    return ok, per_step, (rss[-1] / 1024 if rss else float("nan")), (float(orthogonality[-1]) if orthogonality else float("nan"))
+
+
+print(f"openfoam_plugin: OpenFOAM {subprocess.run(['dpkg-query', '-W', '-f=${Version}', 'openfoam'], capture_output=True, text=True).stdout},"
+      f" {STEPS} steps to the final angle, load {open('/proc/loadavg').read().split()[0]}")
+print(f"{'case':9} {'motion solver':24} {'options':24} {'largest valid':>13} {'s/step @30':>10} {'MB @30':>7}"
+      f" {'non-orth @30':>12} {'time ratio':>10}")
+lines = []
+for name, spec in CASES.items():
+    rows = []
+    for solver, options, dictionary in SOLVERS:
+        case = os.path.join(work, name, solver + ("_" + options.split()[-1] if options.startswith("method") else ""))
+        largest = 0
+        for angle in ANGLES:
+            write_case(case, spec, angle, dictionary)
+            ok, *_ = run(case)
+            if not ok:
+                break
+            largest = angle
+        write_case(case, spec, REFERENCE, dictionary)
+        ok, per_step, rss, orthogonality = run(case)
+        rows.append(dict(bench="openfoam_plugin", case=name, solver=solver, options=options, largest_valid_deg=largest,
+                         seconds_per_step=per_step, max_rss_mb=rss, non_orthogonality=orthogonality,
+                         valid_at_reference=ok))
+    peer = next(r for r in rows if r["solver"] == "displacementLaplacian")
+    for r in rows:
+        r["time_ratio"] = r["seconds_per_step"] / peer["seconds_per_step"] if peer["seconds_per_step"] > 0 else None
+        print(f"{name:9} {r['solver']:24} {r['options']:24} {r['largest_valid_deg']:>11} deg {r['seconds_per_step']:10.4f}"
+              f" {r['max_rss_mb']:7.0f} {r['non_orthogonality']:12.1f} {r['time_ratio']:10.2f}"
+              + ("" if r["valid_at_reference"] else "  (invalid at 30 deg)"))
+        lines.append(r)
+for line in lines:
+    print(json.dumps(line))
+EOF
