@@ -95,7 +95,7 @@ struct Bridge::Impl {
   Mesh<3> mesh;                                    // serial: what the mover was set up on
   ResolvedBoundary<3> boundary;                    // with the face centres' entries
   std::vector<std::vector<Index>> centre_entries;  // add_face_centres()
-  Points<3> given, moved;                         // with the face centres' entries and nodes
+  Points<3> given, moved;                         // with the face centres' entries and nodes; kept between moves
 #ifdef MESHMOTION_FOAM_PARALLEL
   std::optional<parallel::DistributedRbfMover<3>> distributed;
   parallel::BoundarySolveOptions solve;
@@ -232,9 +232,8 @@ void Bridge::move(const std::vector<double>& boundary_displacements, std::vector
     }
 #ifdef MESHMOTION_FOAM_PARALLEL
     if (m.distributed) {
-      Points<3> moved;
-      m.distributed->move_into(d, moved);
-      out.assign(moved.data(), moved.data() + moved.size());
+      m.distributed->move_into(d, m.moved);
+      out.assign(m.moved.data(), m.moved.data() + m.moved.size());
       return;
     }
 #endif
