@@ -10,6 +10,21 @@
 The design surface is the union of the design groups' nodes, in ascending node order, or in
 the solver's own order after set_surface_order(nodes). Nodes of symmetry groups slide in
 their plane, nodes of fixed groups stay; neither appears in the design surface.
+
+Over MPI (mpi4py), every rank of `comm` builds the Warp together:
+
+    w = Warp("wing.su2", design=["wing"], symmetry=["symmetry"], comm=MPI.COMM_WORLD)
+
+Rank 0 reads the mesh (or takes the Mesh given there; the other ranks may pass None) and
+resolves the groups on the whole mesh; METIS splits the cells over the ranks, or
+`cell_ranks` (one rank per cell, on rank 0) does, as a solver's own partition. Each rank
+then holds its part: `node_ids` gives the global id (node index in the whole mesh) of each
+row of volume_coordinates() (owned nodes first, then ghosts shared with other ranks), and
+the design surface of a rank is the design nodes it owns (`design_nodes`, global ids). Every
+call that moves or differentiates is collective. warp_derivative(dI_dXv) reads the rows of
+owned nodes (a ghost's row belongs to its owner) and returns this rank's rows of dI/dXs: the
+ranks' rows together are the serial gradient. Methods: rbf (with derivatives), le and sle
+(PETSc). The result equals the serial Warp's to round-off (RBF).
 """
 
 import numpy as _np
@@ -18,54 +33,138 @@ from . import _core
 from ._arrays import index_array, real_array
 
 
+def _read(mesh, orientation):
+    if isinstance(mesh, (str, bytes)) or hasattr(mesh, "__fspath__"):
+        mesh = _core.read_mesh(mesh, orientation)
+    if not isinstance(mesh, (_core.Mesh2, _core.Mesh3)):
+        raise _core.InputError("Warp: mesh must be a file name or a meshmotion mesh")
+    return mesh
+
+
+def _boundary_spec(mesh, design, symmetry, fixed):
+    spec = _core.BoundarySpec2() if isinstance(mesh, _core.Mesh2) else _core.BoundarySpec3()
+    for group in design:
+        spec.prescribed(group)
+    for group in symmetry:
+        spec.sliding(group)
+    for group in fixed:
+        spec.fixed(group)
+    return spec
+
+
+def _design_nodes(mesh, design):
+    nodes = set()
+    for group in design:
+        nodes.update(mesh.group_nodes(group))
+    return _np.array(sorted(nodes), dtype=_np.int64)
+
+
 class Warp:
-    def __init__(self, mesh, design, symmetry=(), fixed=(), method="rbf", orientation="fix_reversed", **options):
-        if isinstance(mesh, (str, bytes)) or hasattr(mesh, "__fspath__"):
-            mesh = _core.read_mesh(mesh, orientation)
-        if not isinstance(mesh, (_core.Mesh2, _core.Mesh3)):
-            raise _core.InputError("Warp: mesh must be a file name or a meshmotion mesh")
+    def __init__(self, mesh, design, symmetry=(), fixed=(), method="rbf", orientation="fix_reversed", comm=None,
+                 cell_ranks=None, **options):
+        self._comm = comm
         if not design:
             raise _core.InputError("Warp: give at least one design group")
-        self._dim = 2 if isinstance(mesh, _core.Mesh2) else 3
-        self._mesh = mesh
-        self._reference = _np.array(mesh.points, copy=True)
-        spec = _core.BoundarySpec2() if self._dim == 2 else _core.BoundarySpec3()
-        for group in design:
-            spec.prescribed(group)
-        for group in symmetry:
-            spec.sliding(group)
-        for group in fixed:
-            spec.fixed(group)
-        self._boundary = spec.resolve(mesh)
-        nodes = set()
-        for group in design:
-            nodes.update(mesh.group_nodes(group))
-        self._design = _np.array(sorted(nodes), dtype=_np.int64)
-        self._columns = _np.array([self._boundary.column(int(v)) for v in self._design], dtype=_np.int64)
+        if comm is None:
+            mesh = _read(mesh, orientation)
+            boundary = _boundary_spec(mesh, design, symmetry, fixed).resolve(mesh)
+            self._dim = 2 if isinstance(mesh, _core.Mesh2) else 3
+            self._mesh = mesh
+            self._ids = _np.arange(mesh.points.shape[0], dtype=_np.int64)
+            self._num_owned = len(self._ids)
+            self._design = _design_nodes(mesh, design)
+            self._mover = (_core.Mover2 if self._dim == 2 else _core.Mover3)(method, **options)
+            self._mover.setup(mesh, boundary)
+        else:
+            boundary = self._partition(mesh, design, symmetry, fixed, orientation, cell_ranks)
+            self._mover = (_core.DistributedMover2 if self._dim == 2 else _core.DistributedMover3)(method, **options)
+            self._mover.setup(self._part, boundary)
+        self._boundary = boundary
+        self._reference = _np.array(self._mesh.points, copy=True)
+        self._columns = _np.array([boundary.column(int(v)) for v in self._design], dtype=_np.int64)
         self._order = _np.arange(len(self._design))  # user position -> design position
-        self._mover = (_core.Mover2 if self._dim == 2 else _core.Mover3)(method, **options)
-        self._mover.setup(mesh, self._boundary)
         if not self._mover.has_derivatives:
-            self._derivative_note = f"method {method} has no derivatives"
+            self._derivative_note = f"method {method} has no derivatives" + (" over MPI" if comm is not None else "")
         else:
             self._derivative_note = None
         self._surface = self._reference[self._design].copy()
+        self._input = _np.zeros((boundary.size, self._dim))
+        self._displacement = _np.zeros_like(self._reference)
         self._volume = self._reference.copy()
-        self._input = _np.zeros((self._boundary.size, self._dim))
+        self._volume_view = self._volume.view()
+        self._volume_view.flags.writeable = False
+
+    def _partition(self, mesh, design, symmetry, fixed, orientation, cell_ranks):
+        """Rank 0 reads and resolves; every rank gets its part, its boundary entries and its
+        owned design nodes. Returns this rank's boundary."""
+        comm = self._comm
+        if not (hasattr(comm, "py2f") and hasattr(comm, "bcast")):
+            raise _core.InputError(f"Warp: comm must be an mpi4py communicator (got {type(comm).__name__})")
+        if not getattr(_core, "have_mpi", False):
+            raise _core.InputError("Warp: comm given but the module has no MPI: " + _core.mpi_missing)
+        root = comm.Get_rank() == 0
+        whole = whole_boundary = design_ids = None
+        failure = None
+        if root:
+            try:
+                whole = _read(mesh, orientation)
+                whole_boundary = _boundary_spec(whole, design, symmetry, fixed).resolve(whole)
+                design_ids = _design_nodes(whole, design)
+                if cell_ranks is not None:
+                    cell_ranks = index_array(cell_ranks, "Warp: cell_ranks").astype(_np.int32).tolist()
+            except Exception as error:  # every rank raises what rank 0 found
+                failure = (type(error).__name__, str(error))
+        _raise_everywhere(comm, failure)
+        self._dim = comm.bcast(2 if isinstance(whole, _core.Mesh2) else 3, root=0)
+        self._whole = whole  # rank 0 writes the moved mesh from it
+        Part = _core.DistributedMesh2 if self._dim == 2 else _core.DistributedMesh3
+        self._part = Part.partition(comm, whole, cell_ranks if root else None)
+        self._mesh = self._part.local
+        self._ids = _np.array(self._part.global_ids)
+        self._num_owned = self._part.num_owned
+        boundary = self._part.distribute_boundary(whole_boundary)
+        design_ids = comm.bcast(design_ids, root=0)
+        owned = self._ids[:self._num_owned]
+        where = _np.searchsorted(owned, design_ids)
+        mine = where < len(owned)
+        mine[mine] = owned[where[mine]] == design_ids[mine]
+        self._design = where[mine]  # owned local nodes, by ascending global id
+        return boundary
 
     @property
     def dim(self):
         return self._dim
 
     @property
+    def comm(self):
+        return self._comm
+
+    @property
     def design_nodes(self):
-        """Node indices of the design surface, in the order of surface_coordinates()."""
-        return self._design[self._order].copy()
+        """Node indices (over MPI: global ids of this rank's owned nodes) of the design surface, in
+        the order of surface_coordinates()."""
+        return self._ids[self._design[self._order]]
+
+    @property
+    def node_ids(self):
+        """Per row of volume_coordinates(): the node's index in the whole mesh (a copy)."""
+        return self._ids.copy()
+
+    @property
+    def num_owned(self):
+        """Rows 0..num_owned-1 of volume_coordinates() are nodes this rank owns, the others ghosts
+        (all of them without MPI)."""
+        return self._num_owned
+
+    @property
+    def mesh(self):
+        """The mesh moved (over MPI: this rank's part), in its reference position."""
+        return self._mesh
 
     def set_surface_order(self, nodes):
-        """Use the solver's own order of the design nodes (each design node exactly once)."""
+        """Use the solver's own order of the design nodes (each of design_nodes exactly once)."""
         nodes = index_array(nodes, "set_surface_order")
-        position = {int(v): k for k, v in enumerate(self._design)}
+        position = {int(v): k for k, v in enumerate(self._ids[self._design])}
         if len(nodes) != len(self._design) or len(set(nodes.tolist())) != len(nodes):
             raise _core.InputError(
                 f"set_surface_order: expected each of the {len(self._design)} design nodes once (got {len(nodes)} nodes)")
@@ -89,15 +188,40 @@ class Warp:
         self._surface[self._order] = X
 
     def warp(self):
-        """Moves the volume from the reference mesh to the current surface (setup reused)."""
-        self._input[:] = 0.0
+        """Moves the volume from the reference mesh to the current surface (setup reused) and
+        returns the coordinates (n_nodes, dim) as a read-only view of the Warp's state: the next
+        warp() overwrites it (volume_coordinates() or .copy() keeps one). No array of the
+        volume's size is allocated per call."""
         self._input[self._columns] = self._surface - self._reference[self._design]
-        self._volume = self._reference + self._mover.move(self._input)
-        return self._volume
+        self._mover.move_into(self._input, self._displacement)
+        _np.add(self._reference, self._displacement, out=self._volume)
+        return self._volume_view
 
     def volume_coordinates(self):
-        """Coordinates of every node after the last warp(), (n_nodes, dim)."""
+        """Coordinates of every node after the last warp(), (n_nodes, dim), a copy."""
         return self._volume.copy()
+
+    def write_mesh(self, file):
+        """Writes the mesh at the last warp() (format by extension). Over MPI, collective: rank 0
+        gathers the owned nodes and writes the whole mesh in its numbering."""
+        from . import write_mesh as _write
+        if self._comm is None:
+            mesh = self._mesh.copy()
+            mesh.points[:] = self._volume
+            _write(file, mesh)
+            return
+        whole = self._part.gather_owned(self._volume)
+        failure = None
+        if whole is not None:
+            saved = _np.array(self._whole.points, copy=True)
+            try:
+                self._whole.points[:] = whole
+                _write(file, self._whole)
+            except Exception as error:
+                failure = (type(error).__name__, str(error))
+            finally:
+                self._whole.points[:] = saved
+        _raise_everywhere(self._comm, failure)
 
     def warp_derivative(self, dI_dXv):
         """dI/dXs for dI/dXv (n_nodes, dim): one row per design node, in surface order."""
@@ -112,22 +236,43 @@ class Warp:
     def verify_derivative(self, h=1e-6, seed=0, verbose=True):
         """Compares warp_derivative with central finite differences of I = <dI_dXv, Xv> along a
         random surface direction; prints and returns the relative error."""
-        rng = _np.random.default_rng(seed)
+        rng = _np.random.default_rng(seed + (self._comm.Get_rank() if self._comm is not None else 0))
         v = rng.standard_normal(self._reference.shape)
         direction = rng.standard_normal((len(self._design), self._dim))
         saved = self._surface.copy()
         base = self.surface_coordinates()
-        scale = max(1.0, float(_np.abs(base).max()))
+        scale = max(1.0, float(_np.abs(base).max()) if base.size else 0.0)
+        if self._comm is not None:
+            scale = self._comm.allreduce(scale, op=_max())
         self.set_surface_coordinates(base + h * scale * direction)
-        plus = float(_np.sum(v * self.warp()))
+        plus = self._sum(v * self.warp())
         self.set_surface_coordinates(base - h * scale * direction)
-        minus = float(_np.sum(v * self.warp()))
+        minus = self._sum(v * self.warp())
         self._surface = saved
         self.warp()
         finite_difference = (plus - minus) / (2.0 * h * scale)
-        adjoint = float(_np.sum(self.warp_derivative(v) * direction))
+        adjoint = self._sum(self.warp_derivative(v) * direction, owned_only=False)
         error = abs(adjoint - finite_difference) / max(abs(finite_difference), 1e-300)
-        if verbose:
+        if verbose and (self._comm is None or self._comm.Get_rank() == 0):
             print(f"verify_derivative: adjoint {adjoint:.12e}, finite difference {finite_difference:.12e}, "
                   f"relative error {error:.3e}")
         return error
+
+    def _sum(self, terms, owned_only=True):
+        """Σ of terms over the nodes (rows) each rank owns, over every rank."""
+        local = float(_np.sum(terms[:self._num_owned] if owned_only else terms))
+        return local if self._comm is None else self._comm.allreduce(local)
+
+
+def _raise_everywhere(comm, failure):
+    """Raises on every rank the error rank 0 caught, (class name, message), so that no rank goes
+    on to a collective call the others never reach."""
+    failure = comm.bcast(failure, root=0)
+    if failure is not None:
+        kind = getattr(_core, failure[0], None)
+        raise (kind if isinstance(kind, type) and issubclass(kind, Exception) else RuntimeError)(failure[1])
+
+
+def _max():
+    from mpi4py import MPI
+    return MPI.MAX

@@ -163,6 +163,47 @@ inline py::array_t<Index> connectivity_view(ElementBlock& b, const py::object& o
   return view;
 }
 
+// What every mover class of the module offers (the serial AnyMover and the distributed one):
+// move, move into the caller's array, the reverse derivative, its figures. Inputs are read in
+// place and the GIL is released while the library works.
+template <int Dim, class A, class... Extra>
+void bind_move_calls(py::class_<A, Extra...>& c) {
+  c.def("move",
+        [](A& a, const py::array& d) {
+          const Eigen::Map<const Points<Dim>> in = rows_of<Dim>(d, "move: displacements");
+          Points<Dim> out;
+          {
+            py::gil_scoped_release release;
+            a.move_into(in, out);
+          }
+          return to_rows<Dim>(std::move(out));
+        },
+        py::arg("displacements"), "node displacements (n, dim) for boundary displacements (boundary size, dim)")
+      .def("move_into",
+           [](A& a, const py::array& d, py::array& out) {
+             const Eigen::Map<const Points<Dim>> in = rows_of<Dim>(d, "move_into: displacements");
+             (void)rows_of<Dim>(out, "move_into: out");
+             if (!out.writeable()) throw InputError("move_into: out is read-only");
+             Eigen::Map<Points<Dim>> target(static_cast<double*>(out.mutable_data()), Dim, static_cast<Index>(out.shape(0)));
+             py::gil_scoped_release release;
+             a.move_into(in, target);
+           },
+           py::arg("displacements"), py::arg("out"), "move() into a caller's (n, dim) C-contiguous float64 array")
+      .def_property_readonly("stats", [](const A& a) { return to_py(a.stats()); })
+      .def_property_readonly("has_derivatives", &A::has_derivatives)
+      .def("derivative_reverse",
+           [](A& a, const py::array& v) {
+             const Eigen::Map<const Points<Dim>> seed = rows_of<Dim>(v, "derivative_reverse: v");
+             Points<Dim> out;
+             {
+               py::gil_scoped_release release;
+               out = a.derivative_reverse(seed);
+             }
+             return to_rows<Dim>(std::move(out));
+           },
+           py::arg("v"), "Jᵀ v: the gradient (boundary size, dim) of <v, move(d)> for v (n, dim)");
+}
+
 /// Runs f.template operator()<Dim>() for Dim 2 and 3: each class and function is bound once
 /// per dimension, with the dimension in its Python name (Mesh2, Mesh3).
 template <class F>
@@ -179,5 +220,7 @@ void bind_boundary(py::module_& m);
 void bind_movers(py::module_& m);
 void bind_quality(py::module_& m);
 void bind_curving(py::module_& m);
+// Where the parallel layer is built (MESHMOTION_PYTHON_PARALLEL); otherwise parallel.cpp says why not.
+void bind_parallel(py::module_& m);
 
 }  // namespace meshmotion::python

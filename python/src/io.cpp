@@ -22,14 +22,17 @@ void bind_io(py::module_& m) {
         else if (orientation == "require_positive") o.orientation = ReadOrientation::require_positive;
         else if (orientation != "keep")
           throw InputError("read_mesh: orientation must be keep, fix_reversed or require_positive (got '" + orientation + "')");
-        AnyMesh mesh = read_mesh(file, o);
+        AnyMesh mesh = [&] {
+          py::gil_scoped_release release;
+          return read_mesh(file, o);
+        }();
         if (auto* m2 = std::get_if<Mesh<2>>(&mesh)) return py::cast(std::move(*m2));
         return py::cast(std::move(std::get<Mesh<3>>(mesh)));
       },
       py::arg("file"), py::arg("orientation") = "keep");
   for_each_dimension([&]<int Dim>() {
     m.def("write_mesh", [](const std::filesystem::path& file, const Mesh<Dim>& mesh) { write_mesh(file, mesh); },
-          py::arg("file"), py::arg("mesh"));
+          py::arg("file"), py::arg("mesh"), py::call_guard<py::gil_scoped_release>());
   });
 }
 

@@ -23,4 +23,5 @@ PYBIND11_MODULE(_core, m) {
   bind_movers(m);
   bind_quality(m);
   bind_curving(m);
+  bind_parallel(m);
 }

@@ -2,7 +2,7 @@
 
 #include "bindings.hpp"
 
-#include "meshmotion/movers/mover_options.hpp"
+#include "mover_keywords.hpp"
 
 #include <string>
 #include <vector>
@@ -15,42 +15,13 @@ void bind_movers(py::module_& m) {
     using M = Mesh<Dim>;
     using B = ResolvedBoundary<Dim>;
     using A = AnyMover<Dim>;
-    py::class_<A>(m, ("Mover" + suffix).c_str())
-        .def(py::init([](const std::string& method, const py::kwargs& options) {
-               MoverConfig<Dim> c = mover_config<Dim>(method);
-               const std::vector<OptionDoc> docs = c.docs();
-               for (const auto& [key, value] : options) {
-                 const std::string k = key.template cast<std::string>();
-                 c.set(k, option_text(docs, k, value));
-               }
-               return make_mover(c);
+    py::class_<A> c(m, ("Mover" + suffix).c_str());
+    c.def(py::init([](const std::string& method, const py::kwargs& options) {
+               return make_mover(mover_config_from<Dim>(method, options));
              }),
              py::arg("method"))
         .def("setup", [](A& a, const M& mesh, const B& b) { a.setup(mesh, b); }, py::arg("mesh"), py::arg("boundary"),
              py::call_guard<py::gil_scoped_release>())
-        .def("move",
-             [](A& a, const py::array& d) {
-               const Eigen::Map<const Points<Dim>> in = rows_of<Dim>(d, "move: displacements");  // read in place
-               Points<Dim> out;
-               {
-                 py::gil_scoped_release release;
-                 a.move_into(in, out);
-               }
-               return to_rows<Dim>(std::move(out));
-             },
-             py::arg("displacements"), "node displacements (n, dim) for boundary displacements (boundary size, dim)")
-        .def("move_into",
-             [](A& a, const py::array& d, py::array& out) {
-               const Eigen::Map<const Points<Dim>> in = rows_of<Dim>(d, "move_into: displacements");
-               (void)rows_of<Dim>(out, "move_into: out");
-               if (!out.writeable()) throw InputError("move_into: out is read-only");
-               Eigen::Map<Points<Dim>> target(static_cast<double*>(out.mutable_data()), Dim, static_cast<Index>(out.shape(0)));
-               py::gil_scoped_release release;
-               a.move_into(in, target);
-             },
-             py::arg("displacements"), py::arg("out"), "move() into a caller's (n, dim) C-contiguous float64 array")
-        .def_property_readonly("stats", [](const A& a) { return to_py(a.stats()); })
-        .def_property_readonly("has_derivatives", &A::has_derivatives)
         .def("derivative_forward",
              [](A& a, const py::array& w) {
                const Eigen::Map<const Points<Dim>> in = rows_of<Dim>(w, "derivative_forward: w");
@@ -61,19 +32,8 @@ void bind_movers(py::module_& m) {
                }
                return to_rows<Dim>(std::move(out));
              },
-             py::arg("w"), "J w: node displacement changes (n, dim) for boundary changes w (boundary size, dim)")
-        .def("derivative_reverse",
-             [](A& a, const py::array& v) {
-               // v is read in place (no copy of the (n, dim) seed).
-               const Eigen::Map<const Points<Dim>> seed = rows_of<Dim>(v, "derivative_reverse: v");
-               Points<Dim> out;
-               {
-                 py::gil_scoped_release release;
-                 out = a.derivative_reverse(seed);
-               }
-               return to_rows<Dim>(std::move(out));
-             },
-             py::arg("v"), "Jᵀ v: the gradient (boundary size, dim) of <v, move(d)> for v (n, dim)");
+             py::arg("w"), "J w: node displacement changes (n, dim) for boundary changes w (boundary size, dim)");
+    bind_move_calls<Dim>(c);
   });
   m.def("mover_methods", [] {
     std::vector<std::string> out;

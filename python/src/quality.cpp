@@ -13,8 +13,14 @@ namespace meshmotion::python {
 // The per-cell values and validity (cell order) beside the report's summary.
 template <int Dim>
 py::dict quality_dict(const Mesh<Dim>& mesh, Metric metric) {
-  const std::vector<CellQuality> cells = evaluate_cells(mesh, metric);
-  py::dict d(to_py(make_report(mesh, metric, cells)));
+  std::vector<CellQuality> cells;
+  QualityReport report;
+  {
+    py::gil_scoped_release release;
+    cells = evaluate_cells(mesh, metric);
+    report = make_report(mesh, metric, cells);
+  }
+  py::dict d(to_py(report));
   py::array_t<double> values(static_cast<py::ssize_t>(cells.size()));
   py::array_t<bool> valid(static_cast<py::ssize_t>(cells.size()));
   auto v = values.mutable_unchecked<1>();

@@ -238,6 +238,27 @@ def test_warp_in_an_optimization_loop():
         w.set_surface_coordinates(bump[:-1])
 
 
+def test_warp_returns_a_read_only_view_and_allocates_no_volume_array():
+    import tracemalloc
+
+    mesh = grid(60, 40)
+    w = mm.Warp(mesh, design=["bottom"], fixed=["top", "left", "right"], support_radius=0.6)
+    xs = w.surface_coordinates()
+    xs[:, 1] += 0.01 * np.sin(np.pi * xs[:, 0])
+    w.set_surface_coordinates(xs)
+    result = w.warp()
+    with pytest.raises(ValueError):
+        result[0, 0] = 5.0  # the Warp's state, not the caller's to edit
+    kept = w.volume_coordinates()
+    kept[0, 0] = 5.0  # a copy: the Warp does not see it
+    assert w.volume_coordinates()[0, 0] == 0.0
+    tracemalloc.start()
+    w.warp()
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    assert peak < mesh.num_nodes * 2 * 8 // 4, f"warp() allocated {peak} bytes in Python for {mesh.num_nodes} nodes"
+
+
 def test_errors_map_to_python_exceptions():
     with pytest.raises(OSError):
         mm.read_mesh("/no/such/mesh.msh")

@@ -1,0 +1,159 @@
+"""Warp over MPI, run by ctest under mpiexec at 1 to 4 ranks: each rank's part of the warped mesh
+and of the gradient equals the serial Warp's on the same mesh, which every rank also builds; the
+solver's own partition gives the same; errors reach every rank."""
+
+import os
+import pathlib
+
+import numpy as np
+import pytest
+
+mm = pytest.importorskip("meshmotion", reason="the meshmotion module was not built")
+MPI = pytest.importorskip("mpi4py.MPI", reason="mpi4py is not installed (python3-mpi4py)")
+if not mm._core.have_mpi:
+    pytest.skip("the module was built without MPI: " + mm._core.mpi_missing, allow_module_level=True)
+
+comm = MPI.COMM_WORLD
+
+
+def box(nx=7, ny=5, nz=4):
+    """Tetrahedra filling [0, 1.4] x [0, 1] x [0, 0.8], six per hexahedron; groups wall (z = 0,
+    the design surface), symmetry (y = 0), farfield (the other four sides)."""
+    xs, ys, zs = np.linspace(0, 1.4, nx + 1), np.linspace(0, 1.0, ny + 1), np.linspace(0, 0.8, nz + 1)
+    X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
+    points = np.column_stack([X.ravel(), Y.ravel(), Z.ravel()])
+    node = lambda i, j, k: (i * (ny + 1) + j) * (nz + 1) + k  # noqa: E731
+    tets = []
+    for i in range(nx):
+        for j in range(ny):
+            for k in range(nz):
+                c = [node(i + a, j + b, k + d) for d in (0, 1) for b in (0, 1) for a in (0, 1)]
+                # The Kuhn split of the cube along its 0-7 diagonal: six positive tetrahedra.
+                for p, q in ((1, 3), (3, 2), (2, 6), (6, 4), (4, 5), (5, 1)):
+                    tets.append([c[0], c[p], c[q], c[7]])
+    tets = np.array(tets)
+    # Orient each tetrahedron positively.
+    e = points[tets[:, 1:]] - points[tets[:, :1]]
+    negative = np.einsum("ij,ij->i", np.cross(e[:, 0], e[:, 1]), e[:, 2]) < 0
+    tets[negative, 1], tets[negative, 2] = tets[negative, 2].copy(), tets[negative, 1].copy()
+    faces = np.sort(np.concatenate([tets[:, [0, 1, 2]], tets[:, [0, 1, 3]], tets[:, [0, 2, 3]], tets[:, [1, 2, 3]]]), axis=1)
+    unique, counts = np.unique(faces, axis=0, return_counts=True)
+    outer = unique[counts == 1]
+    centre = points[outer].mean(axis=1)
+    groups = {
+        "wall": ("tri3", outer[np.isclose(centre[:, 2], 0.0)]),
+        "symmetry": ("tri3", outer[np.isclose(centre[:, 1], 0.0)]),
+        "farfield": ("tri3", outer[~np.isclose(centre[:, 2], 0.0) & ~np.isclose(centre[:, 1], 0.0)]),
+    }
+    return mm.from_arrays(points, {"tet4": tets}, groups)
+
+
+def bump(xs):
+    """The design surface's new position: a bump on the wall, a function of position only, so
+    that every rank moves its own nodes as the serial Warp moves all of them."""
+    out = xs.copy()
+    out[:, 2] += 0.05 * np.sin(np.pi * xs[:, 0] / 1.4) * np.sin(np.pi * xs[:, 1])
+    out[:, 0] += 0.02 * xs[:, 1]
+    return out
+
+
+def seed(ids):
+    """dI/dXv as a function of the global node id, the same on every rank."""
+    return np.column_stack([np.sin(ids), np.cos(0.7 * ids), np.sin(1.3 * ids + 0.2)])
+
+
+def pair(method="rbf", cell_ranks=None, **options):
+    mesh = box()
+    serial = mm.Warp(mesh, design=["wall"], symmetry=["symmetry"], fixed=["farfield"], method=method, **options)
+    ranks = cell_ranks(mesh) if cell_ranks is not None and comm.rank == 0 else None
+    parallel = mm.Warp(mesh if comm.rank == 0 else None, design=["wall"], symmetry=["symmetry"], fixed=["farfield"],
+                       method=method, comm=comm, cell_ranks=ranks, **options)
+    return serial, parallel
+
+
+def warp_both(serial, parallel):
+    serial.set_surface_coordinates(bump(serial.surface_coordinates()))
+    parallel.set_surface_coordinates(bump(parallel.surface_coordinates()))
+    return serial.warp(), parallel.warp()
+
+
+def test_rbf_warp_and_gradient_equal_the_serial_ones():
+    serial, parallel = pair(support_radius=0.7)
+    ids = parallel.node_ids
+    assert len(ids) == parallel.mesh.num_nodes and 0 < parallel.num_owned <= len(ids)
+    # The design surface is split: each design node on exactly one rank.
+    mine = parallel.design_nodes
+    everyone = np.sort(np.concatenate(comm.allgather(mine)))
+    np.testing.assert_array_equal(everyone, np.sort(serial.design_nodes))
+    whole, part = warp_both(serial, parallel)
+    moved = np.abs(whole - serial.mesh.points).max()
+    assert moved > 0.01
+    np.testing.assert_allclose(part, whole[ids], rtol=0, atol=1e-12 * moved)
+    # Symmetry nodes stayed in their plane y = 0.
+    symmetry = [i for i, g in enumerate(ids) if g in set(serial.mesh.group_nodes("symmetry"))]
+    np.testing.assert_allclose(part[symmetry, 1], 0.0, atol=1e-15)
+    # Gradient: this rank's rows are the serial gradient's rows of its design nodes.
+    g_serial = serial.warp_derivative(seed(serial.node_ids))
+    g_part = parallel.warp_derivative(seed(ids))
+    row = {int(v): k for k, v in enumerate(serial.design_nodes)}
+    expected = g_serial[[row[int(v)] for v in mine]] if len(mine) else np.zeros((0, 3))
+    scale = np.abs(g_serial).max()
+    np.testing.assert_allclose(g_part, expected, rtol=0, atol=1e-12 * scale)
+    # Ghost rows of dI/dXv belong to their owners: changing them changes nothing.
+    poked = seed(ids)
+    poked[parallel.num_owned:] += 1.0
+    np.testing.assert_array_equal(parallel.warp_derivative(poked), g_part)
+    assert parallel.verify_derivative(verbose=False) < 1e-6
+
+
+def test_warp_returns_a_read_only_view_of_local_coordinates():
+    _, parallel = pair(support_radius=0.7)
+    parallel.set_surface_coordinates(bump(parallel.surface_coordinates()))
+    result = parallel.warp()
+    with pytest.raises(ValueError):
+        result[0, 0] = 1.0
+    np.testing.assert_array_equal(parallel.volume_coordinates(), result)
+
+
+def test_a_solvers_own_partition_gives_the_same_mesh():
+    # Cells by slabs of x, ranks in reverse order: not what METIS would do.
+    def slabs(mesh):
+        cells = np.asarray(mesh.cells[0][1])
+        x = np.asarray(mesh.points)[cells].mean(axis=1)[:, 0]
+        return (comm.size - 1 - np.minimum((x / 1.4 * comm.size).astype(int), comm.size - 1)).astype(np.int64)
+
+    serial, parallel = pair(support_radius=0.7, cell_ranks=slabs)
+    whole, part = warp_both(serial, parallel)
+    np.testing.assert_allclose(part, whole[parallel.node_ids], rtol=0, atol=1e-12)
+
+
+def test_elasticity_over_petsc_agrees_with_the_serial_solve():
+    serial, parallel = pair(method="sle")
+    whole, part = warp_both(serial, parallel)
+    moved = np.abs(whole - serial.mesh.points).max()
+    np.testing.assert_allclose(part, whole[parallel.node_ids], rtol=0, atol=1e-5 * moved)
+    with pytest.raises(mm.InputError, match="no derivatives over MPI"):
+        parallel.warp_derivative(seed(parallel.node_ids))
+
+
+def test_write_mesh_gathers_the_whole_mesh_on_rank_0():
+    serial, parallel = pair(support_radius=0.7)
+    whole, _ = warp_both(serial, parallel)
+    folder = pathlib.Path(os.environ.get("MESHMOTION_TEST_TMP_DIR", "/tmp")) / f"warp_mpi_{comm.size}"
+    if comm.rank == 0:
+        folder.mkdir(parents=True, exist_ok=True)
+    comm.Barrier()
+    parallel.write_mesh(folder / "moved.msh")
+    if comm.rank == 0:
+        back = mm.read_mesh(str(folder / "moved.msh"))
+        np.testing.assert_allclose(back.points, whole, rtol=0, atol=1e-12)
+
+
+def test_every_rank_raises_what_rank_0_finds():
+    mesh = box(3, 3, 2)
+    with pytest.raises(mm.InputError, match="nowhere"):
+        mm.Warp(mesh if comm.rank == 0 else None, design=["nowhere"], comm=comm)
+    with pytest.raises(mm.InputError, match="no distributed mover"):
+        mm.Warp(mesh if comm.rank == 0 else None, design=["wall"], fixed=["farfield"], method="spring", comm=comm)
+    with pytest.raises(mm.InputError, match="an mpi4py communicator"):
+        mm.Warp(mesh, design=["wall"], comm="world")

@@ -1,0 +1,204 @@
+// MPI from Python, where the parallel layer is built: a mesh read on one rank partitioned over
+// an mpi4py communicator, and the distributed movers (RBF with its reverse derivative,
+// elasticity through PETSc) on each rank's part. Warp(comm=...) is built on them.
+//
+// An mpi4py Comm reaches the library by its Fortran handle (Comm.py2f), which the MPI this
+// module links converts back: no mpi4py header is needed, only the MPI mpi4py runs on
+// (Debian's Open MPI for both).
+
+#include "bindings.hpp"
+
+#ifdef MESHMOTION_PYTHON_PARALLEL
+
+#include "mover_keywords.hpp"
+
+#include "meshmotion/parallel.hpp"
+
+#include <petscsys.h>
+
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace meshmotion::python {
+
+namespace {
+
+MPI_Comm communicator(const py::object& comm) {
+  int initialized = 0;
+  MPI_Initialized(&initialized);
+  if (!initialized) throw InputError("MPI is not initialized: import mpi4py.MPI before passing a communicator");
+  if (!py::hasattr(comm, "py2f"))
+    throw InputError("expected an mpi4py communicator (got " + py::repr(py::type::of(comm)).cast<std::string>() + ")");
+  const MPI_Comm c = MPI_Comm_f2c(comm.attr("py2f")().cast<MPI_Fint>());
+  if (c == MPI_COMM_NULL) throw InputError("the communicator is MPI.COMM_NULL");
+  return c;
+}
+
+// PETSc starts on the MPI that mpi4py started, on first need, and stops at the interpreter's
+// exit before mpi4py finalizes MPI (atexit handlers run before the Py_AtExit one mpi4py
+// registers). PETSc started by someone else (petsc4py) is theirs to stop. Python keeps its own
+// signal handling.
+void ensure_petsc() {
+  PetscBool initialized = PETSC_FALSE;
+  parallel::detail::petsc_check(PetscInitialized(&initialized), "meshmotion", "PetscInitialized");
+  if (initialized) return;
+  parallel::detail::petsc_check(PetscOptionsSetValue(nullptr, "-no_signal_handler", nullptr), "meshmotion", "PetscOptionsSetValue");
+  parallel::detail::petsc_check(PetscInitializeNoArguments(), "meshmotion", "PetscInitializeNoArguments");
+  py::module_::import("atexit").attr("register")(py::cpp_function([] { PetscFinalize(); }));
+}
+
+template <class T>
+py::array_t<T> read_only_view(const std::vector<T>& values, const py::object& owner) {
+  py::array_t<T> view(static_cast<py::ssize_t>(values.size()), values.data(), owner);
+  view.attr("setflags")(py::arg("write") = false);
+  return view;
+}
+
+// A distributed mover chosen by method name: rbf (DistributedRbfMover), le or sle
+// (DistributedElasticityMover), with the calls bind_move_calls binds.
+template <int Dim>
+class DistributedMover {
+ public:
+  DistributedMover(const std::string& method, const py::kwargs& options) {
+    parallel::BoundarySolveOptions solve;
+    parallel::DistributedElasticityOptions elasticity;
+    std::vector<OptionDoc> docs = option_docs(solve);
+    for (const OptionDoc& d : option_docs(elasticity)) docs.push_back(d);
+    const MoverConfig<Dim> config =
+        mover_config_from<Dim>(method, options, docs, [&](const std::string& key, const std::string& text) {
+          return set_option(solve, key, text) || set_option(elasticity, key, text);
+        });
+    if (const auto* rbf = std::get_if<RbfOptions>(&config.options)) {
+      mover_ = std::make_unique<parallel::DistributedRbfMover<Dim>>(*rbf, solve);
+    } else if (const auto* e = std::get_if<ElasticityOptions>(&config.options)) {
+      elasticity.elasticity = *e;
+      mover_ = std::make_unique<parallel::DistributedElasticityMover<Dim>>(elasticity);
+    } else {
+      throw InputError("method '" + config.method + "' has no distributed mover (expected rbf, le or sle)");
+    }
+  }
+
+  void setup(const parallel::DistributedMesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) {
+    if (has_derivatives()) {
+      // PETSc solves the RBF boundary system only when BoundarySolveOptions chooses it.
+      std::get<Rbf>(mover_)->setup(mesh.view(), boundary);
+    } else {
+      std::get<Elasticity>(mover_)->setup(mesh, boundary);
+    }
+  }
+  void move_into(PointsView<Dim> d, Points<Dim>& out) {
+    std::visit([&](auto& m) { m->move_into(d, out); }, mover_);
+  }
+  void move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) {
+    move_into(d, out_);
+    if (out_.cols() != out.cols())
+      throw InputError("move_into: out has " + std::to_string(out.cols()) + " rows (expected " +
+                       std::to_string(out_.cols()) + ", one per local node)");
+    out = out_;
+  }
+  [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) {
+    if (!has_derivatives()) throw InputError("derivative_reverse: the distributed elasticity mover has no derivatives");
+    return std::get<Rbf>(mover_)->derivative_reverse(v);
+  }
+  [[nodiscard]] bool has_derivatives() const { return std::holds_alternative<Rbf>(mover_); }
+  [[nodiscard]] MoverStats stats() const {
+    return std::visit([](const auto& m) { return m->stats(); }, mover_);
+  }
+  /// The RBF boundary system is solved through PETSc (false for elasticity, which always is).
+  [[nodiscard]] bool petsc_solve() const { return has_derivatives() && std::get<Rbf>(mover_)->petsc_solve(); }
+
+ private:
+  using Rbf = std::unique_ptr<parallel::DistributedRbfMover<Dim>>;
+  using Elasticity = std::unique_ptr<parallel::DistributedElasticityMover<Dim>>;
+  std::variant<Rbf, Elasticity> mover_;
+  Points<Dim> out_;  ///< move_into's result before it is copied to the caller's array
+};
+
+}  // namespace
+
+void bind_parallel(py::module_& m) {
+  m.attr("have_mpi") = true;
+  for_each_dimension([&]<int Dim>() {
+    const std::string suffix = std::to_string(Dim);
+    using M = Mesh<Dim>;
+    using D = parallel::DistributedMesh<Dim>;
+    using B = ResolvedBoundary<Dim>;
+    py::class_<D>(m, ("DistributedMesh" + suffix).c_str(),
+                  "a rank's part of a mesh: local nodes (owned first, then ghosts, each by ascending global id), cells, "
+                  "facets and groups")
+        .def_static(
+            "partition",
+            [](const py::object& comm, const M* whole, std::optional<std::vector<int>> cell_ranks) {
+              const MPI_Comm c = communicator(comm);
+              const M empty;
+              const std::vector<int> ranks = cell_ranks.value_or(std::vector<int>{});
+              py::gil_scoped_release release;
+              return parallel::partition_mesh(c, whole != nullptr ? *whole : empty, std::span<const int>(ranks));
+            },
+            py::arg("comm"), py::arg("mesh") = nullptr, py::arg("cell_ranks") = std::nullopt, py::keep_alive<0, 1>(),
+            "collective: split the mesh given on rank 0 (None elsewhere) by METIS, or by cell_ranks (rank per cell, on "
+            "rank 0)")
+        .def_property_readonly("local", [](D& d) -> M& { return d.local; }, py::return_value_policy::reference_internal)
+        .def_property_readonly("global_ids", [](const py::object& self) { return read_only_view(self.cast<const D&>().global_ids, self); })
+        .def_property_readonly("owner", [](const py::object& self) { return read_only_view(self.cast<const D&>().owner, self); })
+        .def_property_readonly("num_owned", [](const D& d) { return d.num_owned; })
+        .def_property_readonly("num_global_nodes", [](const D& d) { return d.num_global_nodes; })
+        .def("local_index", &D::local_index, py::arg("global_id"), "the local index of a global node (-1: not on this rank)")
+        .def(
+            "distribute_boundary",
+            [](const D& d, const B* whole) {
+              const B empty;
+              py::gil_scoped_release release;
+              return parallel::distribute_boundary(d, whole != nullptr ? *whole : empty);
+            },
+            py::arg("boundary") = nullptr,
+            "collective: the entries of this rank's nodes of a boundary resolved on the whole mesh on rank 0")
+        .def(
+            "gather_owned",
+            [](const D& d, const py::array& field) -> py::object {
+              const Points<Dim> local(rows_of<Dim>(field, "gather_owned: field", static_cast<Index>(d.global_ids.size())));
+              Points<Dim> whole;
+              {
+                py::gil_scoped_release release;
+                whole = parallel::gather_owned(d.view(), local, d.num_global_nodes);
+              }
+              if (parallel::rank_of(d.comm) != 0) return py::none();
+              return to_rows<Dim>(std::move(whole));
+            },
+            py::arg("field"), "collective: a node field (n_local, dim) of every rank as (n_global, dim) on rank 0, None elsewhere");
+
+    using A = DistributedMover<Dim>;
+    py::class_<A> c(m, ("DistributedMover" + suffix).c_str());
+    c.def(py::init([](const std::string& method, const py::kwargs& options) { return std::make_unique<A>(method, options); }),
+          py::arg("method"))
+        .def(
+            "setup",
+            [](A& a, const D& mesh, const B& boundary) {
+              ensure_petsc();  // elasticity always, RBF when its setup chooses PETSc
+              py::gil_scoped_release release;
+              a.setup(mesh, boundary);
+            },
+            py::arg("mesh"), py::arg("boundary"), "collective: set up on each rank's part and its boundary entries")
+        .def_property_readonly("petsc_solve", &A::petsc_solve);
+    bind_move_calls<Dim>(c);
+  });
+}
+
+}  // namespace meshmotion::python
+
+#else
+
+namespace meshmotion::python {
+
+void bind_parallel(py::module_& m) {
+  m.attr("have_mpi") = false;
+  m.attr("mpi_missing") = MESHMOTION_PYTHON_PARALLEL_MISSING;
+}
+
+}  // namespace meshmotion::python
+
+#endif
