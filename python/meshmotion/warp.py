@@ -201,6 +201,13 @@ class Warp:
         """Coordinates of every node after the last warp(), (n_nodes, dim), a copy."""
         return self._volume.copy()
 
+    def gather_volume_coordinates(self):
+        """Coordinates of the whole mesh after the last warp(), in its node order: over MPI on
+        rank 0 (None on the others; collective), else a copy."""
+        if self._comm is None:
+            return self._volume.copy()
+        return self._part.gather_owned(self._volume)
+
     def write_mesh(self, file):
         """Writes the mesh at the last warp() (format by extension). Over MPI, collective: rank 0
         gathers the owned nodes and writes the whole mesh in its numbering."""
@@ -210,7 +217,7 @@ class Warp:
             mesh.points[:] = self._volume
             _write(file, mesh)
             return
-        whole = self._part.gather_owned(self._volume)
+        whole = self.gather_volume_coordinates()
         failure = None
         if whole is not None:
             saved = _np.array(self._whole.points, copy=True)
@@ -232,6 +239,22 @@ class Warp:
             raise _core.InputError(f"warp_derivative: expected shape {self._reference.shape} (got {v.shape})")
         g = self._mover.derivative_reverse(v)
         return g[self._columns][self._order]
+
+    def warp_derivative_forward(self, dXs):
+        """dXv for a change dXs (n_design, dim, surface order) of the design surface: J dXs,
+        (n_nodes, dim). Over MPI, collective; the distributed RBF is linear in the surface, so
+        its forward derivative is a move of dXs."""
+        if self._derivative_note:
+            raise _core.InputError("warp_derivative_forward: " + self._derivative_note)
+        w = real_array(dXs, "warp_derivative_forward")
+        if w.shape != (len(self._design), self._dim):
+            raise _core.InputError(
+                f"warp_derivative_forward: expected shape ({len(self._design)}, {self._dim}) (got {w.shape})")
+        seed = _np.zeros_like(self._input)
+        seed[self._columns[self._order]] = w
+        if self._comm is None:
+            return self._mover.derivative_forward(seed)
+        return self._mover.move(seed)
 
     def verify_derivative(self, h=1e-6, seed=0, verbose=True):
         """Compares warp_derivative with central finite differences of I = <dI_dXv, Xv> along a

@@ -13,53 +13,9 @@ MPI = pytest.importorskip("mpi4py.MPI", reason="mpi4py is not installed (python3
 if not mm._core.have_mpi:
     pytest.skip("the module was built without MPI: " + mm._core.mpi_missing, allow_module_level=True)
 
+from meshes import box, bump, seed  # noqa: E402  (beside this file)
+
 comm = MPI.COMM_WORLD
-
-
-def box(nx=7, ny=5, nz=4):
-    """Tetrahedra filling [0, 1.4] x [0, 1] x [0, 0.8], six per hexahedron; groups wall (z = 0,
-    the design surface), symmetry (y = 0), farfield (the other four sides)."""
-    xs, ys, zs = np.linspace(0, 1.4, nx + 1), np.linspace(0, 1.0, ny + 1), np.linspace(0, 0.8, nz + 1)
-    X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
-    points = np.column_stack([X.ravel(), Y.ravel(), Z.ravel()])
-    node = lambda i, j, k: (i * (ny + 1) + j) * (nz + 1) + k  # noqa: E731
-    tets = []
-    for i in range(nx):
-        for j in range(ny):
-            for k in range(nz):
-                c = [node(i + a, j + b, k + d) for d in (0, 1) for b in (0, 1) for a in (0, 1)]
-                # The Kuhn split of the cube along its 0-7 diagonal: six positive tetrahedra.
-                for p, q in ((1, 3), (3, 2), (2, 6), (6, 4), (4, 5), (5, 1)):
-                    tets.append([c[0], c[p], c[q], c[7]])
-    tets = np.array(tets)
-    # Orient each tetrahedron positively.
-    e = points[tets[:, 1:]] - points[tets[:, :1]]
-    negative = np.einsum("ij,ij->i", np.cross(e[:, 0], e[:, 1]), e[:, 2]) < 0
-    tets[negative, 1], tets[negative, 2] = tets[negative, 2].copy(), tets[negative, 1].copy()
-    faces = np.sort(np.concatenate([tets[:, [0, 1, 2]], tets[:, [0, 1, 3]], tets[:, [0, 2, 3]], tets[:, [1, 2, 3]]]), axis=1)
-    unique, counts = np.unique(faces, axis=0, return_counts=True)
-    outer = unique[counts == 1]
-    centre = points[outer].mean(axis=1)
-    groups = {
-        "wall": ("tri3", outer[np.isclose(centre[:, 2], 0.0)]),
-        "symmetry": ("tri3", outer[np.isclose(centre[:, 1], 0.0)]),
-        "farfield": ("tri3", outer[~np.isclose(centre[:, 2], 0.0) & ~np.isclose(centre[:, 1], 0.0)]),
-    }
-    return mm.from_arrays(points, {"tet4": tets}, groups)
-
-
-def bump(xs):
-    """The design surface's new position: a bump on the wall, a function of position only, so
-    that every rank moves its own nodes as the serial Warp moves all of them."""
-    out = xs.copy()
-    out[:, 2] += 0.05 * np.sin(np.pi * xs[:, 0] / 1.4) * np.sin(np.pi * xs[:, 1])
-    out[:, 0] += 0.02 * xs[:, 1]
-    return out
-
-
-def seed(ids):
-    """dI/dXv as a function of the global node id, the same on every rank."""
-    return np.column_stack([np.sin(ids), np.cos(0.7 * ids), np.sin(1.3 * ids + 0.2)])
 
 
 def pair(method="rbf", cell_ranks=None, **options):

@@ -1,0 +1,151 @@
+"""meshmotion.idwarp.USMesh under mpiexec at 1 to 4 ranks: IDWarp's call sequence on a 3D mesh
+with a symmetry plane, the solver holding its nodes in its own partition (not the warp's), gives
+the serial Warp's grid, a gradient that central differences confirm, and IDWarp's shapes."""
+
+import os
+import pathlib
+import warnings
+
+import numpy as np
+import pytest
+
+mm = pytest.importorskip("meshmotion", reason="the meshmotion module was not built")
+MPI = pytest.importorskip("mpi4py.MPI", reason="mpi4py is not installed (python3-mpi4py)")
+pytest.importorskip("scipy", reason="setSurfaceDefinition matches points with scipy (python3-scipy)")
+if not mm._core.have_mpi:
+    pytest.skip("the module was built without MPI: " + mm._core.mpi_missing, allow_module_level=True)
+
+from meshmotion.idwarp import USMesh  # noqa: E402
+from meshes import box, bump  # noqa: E402  (beside this file)
+
+comm = MPI.COMM_WORLD
+
+
+@pytest.fixture(scope="module")
+def grid_file():
+    folder = pathlib.Path(os.environ.get("MESHMOTION_TEST_TMP_DIR", "/tmp")) / f"idwarp_{comm.size}"
+    path = folder / "box.su2"
+    if comm.rank == 0:
+        folder.mkdir(parents=True, exist_ok=True)
+        mm.write_mesh(path, box())
+    comm.Barrier()
+    return path
+
+
+def options(grid_file, **more):
+    o = {"gridFile": str(grid_file), "fileType": "SU2", "specifiedSurfaces": ["wall"], "symmetrySurfaces": ["symmetry"],
+         "meshmotion": {"support_radius": 0.7}}
+    o.update(more)
+    return o
+
+
+def solver_indices(n):
+    """A solver's partition unlike METIS's: every comm.size-th node, and a few of the next
+    rank's as ghosts (a node on two ranks)."""
+    mine = np.arange(comm.rank, n, comm.size)
+    return np.concatenate([mine, (mine[:3] + 1) % n])
+
+
+def serial_warp(grid_file):
+    w = mm.Warp(str(grid_file), design=["wall"], symmetry=["symmetry"], support_radius=0.7)
+    w.set_surface_coordinates(bump(w.surface_coordinates()))
+    return w, w.warp().copy()
+
+
+def test_idwarps_call_sequence_gives_the_serial_grid_and_gradient(grid_file):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        mesh = USMesh(options=options(grid_file, LdefFact=100.0, aExp=3.0), comm=comm)
+    if comm.rank == 0:
+        assert any("LdefFact" in str(w.message) for w in caught)
+    serial, expected = serial_warp(grid_file)
+    n = serial.mesh.num_nodes
+    ind = solver_indices(n)
+    mesh.setExternalMeshIndices(ind)
+    xs = mesh.getSurfaceCoordinates()
+    assert xs.ndim == 2 and xs.shape[1] == 3
+    # The internal surface: every design node on rank 0, with its triangles.
+    assert len(xs) == (len(serial.design_nodes) if comm.rank == 0 else 0)
+    conn, sizes = mesh.getSurfaceConnectivity()
+    assert sizes.sum() == len(conn) and (comm.rank > 0 or (len(sizes) > 0 and conn.max() < len(xs)))
+    mesh.setSurfaceCoordinates(bump(xs))
+    mesh.warpMesh()
+    grid = mesh.getSolverGrid()
+    assert grid.shape == (3 * len(ind),)
+    np.testing.assert_allclose(grid.reshape(-1, 3), expected[ind], rtol=0, atol=1e-12)
+    # warpDeriv then getdXs: rank 0's rows are the serial gradient for dI/dXv summed over the
+    # solver's ranks (a node on two ranks counts twice).
+    dXv = np.sin(np.arange(3 * len(ind)) + 0.1 * comm.rank)
+    mesh.warpDeriv(dXv)
+    dXs = mesh.getdXs()
+    assert dXs.shape == xs.shape
+    whole = np.zeros((n, 3))
+    for index, values in comm.allgather((ind, dXv.reshape(-1, 3))):
+        np.add.at(whole, index, values)
+    if comm.rank == 0:
+        g = serial.warp_derivative(whole)
+        np.testing.assert_allclose(dXs, g, rtol=0, atol=1e-12 * np.abs(g).max())
+    assert mesh.verifyWarpDeriv(h=1e-6) < 1e-6
+    # Forward: J dXs against the difference of two warps (the RBF warp is linear in the surface).
+    direction = np.cos(np.arange(xs.size)).reshape(xs.shape)
+    forward = mesh.warpDerivFwd(direction)
+    base = mesh.getSolverGrid()
+    mesh.setSurfaceCoordinates(bump(xs) + 1e-3 * direction)
+    mesh.warpMesh()
+    np.testing.assert_allclose(forward, (mesh.getSolverGrid() - base) / 1e-3, rtol=0, atol=1e-9)
+
+
+def test_a_solvers_surface_with_repeated_points(grid_file):
+    mesh = USMesh(options=options(grid_file), comm=comm)
+    serial, expected = serial_warp(grid_file)
+    design = serial.mesh.points[serial.design_nodes]
+    # Each rank gives every other design node, the ranks overlapping: most points are on two ranks.
+    pts = design[(np.arange(len(design)) + comm.rank) % 2 == 0]
+    if comm.rank == 0:
+        pts = np.concatenate([pts, design[1::2]])  # every node on some rank
+    mesh.setSurfaceDefinition(pts, np.zeros(0, dtype=int), np.zeros(0, dtype=int))
+    np.testing.assert_allclose(mesh.getSurfaceCoordinates(), pts, rtol=0, atol=0)
+    mesh.setExternalMeshIndices(np.arange(serial.mesh.num_nodes))
+    mesh.setSurfaceCoordinates(bump(pts))
+    mesh.warpMesh()
+    np.testing.assert_allclose(mesh.getSolverGrid().reshape(-1, 3), expected, rtol=0, atol=1e-12)
+    assert mesh.verifyWarpDeriv(solverVec=False) < 1e-6
+    with pytest.raises(mm.InputError, match="nearest node of the specified surfaces"):
+        mesh.setSurfaceDefinition(pts + 0.01, np.zeros(0, dtype=int), np.zeros(0, dtype=int))
+
+
+def test_write_grid_and_the_options_refused(grid_file):
+    mesh = USMesh(options=options(grid_file), comm=comm)
+    mesh.setSurfaceCoordinates(bump(mesh.getSurfaceCoordinates()))
+    mesh.warpMesh()
+    with pytest.raises(mm.InputError, match="is the grid file"):
+        mesh.writeGrid(str(grid_file))
+    out = grid_file.with_name("warped.su2")
+    mesh.writeGrid(str(out))
+    common = mesh.getCommonGrid()  # collective
+    if comm.rank == 0:
+        _, expected = serial_warp(grid_file)
+        np.testing.assert_allclose(mm.read_mesh(str(out)).points, expected, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(common.reshape(-1, 3), expected, rtol=0, atol=1e-12)
+    else:
+        assert common is None
+    with pytest.raises(mm.InputError, match="restartFile"):
+        USMesh(options=options(grid_file, restartFile="r.dat"), comm=comm)
+    with pytest.raises(mm.InputError, match="PLOT3D"):
+        USMesh(options=options(grid_file, fileType="PLOT3D"), comm=comm)
+    with pytest.raises(mm.InputError, match="unknown option 'warpType'"):
+        USMesh(options=options(grid_file, warpType="x"), comm=comm)
+    with pytest.raises(mm.InputError, match="setExternalMeshIndices first"):
+        USMesh(options=options(grid_file), comm=comm).getSolverGrid()
+
+
+def test_symmetry_planes_find_their_groups(grid_file):
+    by_plane = USMesh(options=options(grid_file, symmetrySurfaces=None, symmetryPlanes=[[[0, 0, 0], [0, 1, 0]]]), comm=comm)
+    by_plane.setSurfaceCoordinates(bump(by_plane.getSurfaceCoordinates()))
+    by_plane.warpMesh()
+    _, expected = serial_warp(grid_file)
+    whole = by_plane.getCommonGrid()
+    if comm.rank == 0:
+        np.testing.assert_allclose(whole.reshape(-1, 3), expected, rtol=0, atol=1e-12)
+    with pytest.raises(mm.InputError, match="no group lies in the symmetry plane"):
+        USMesh(options=options(grid_file, symmetrySurfaces=None, symmetryPlanes=[[[0, 0.5, 0], [0, 1, 0]]]), comm=comm)
