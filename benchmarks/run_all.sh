@@ -95,7 +95,7 @@ for name in "${order[@]}"; do
   [[ -f "$here/$name.cpp" ]] && [[ -z "$only" || "$only" == *",$name,"* ]] && benches+=("$name")
 done
 targets=("${benches[@]}" curve_mesh)
-[[ $peers == 1 && -z "$only" ]] && targets+=(motion_peer_bench python_overhead_peer meshmotion_python)
+[[ $peers == 1 && -z "$only" ]] && targets+=(motion_peer_bench python_overhead_peer python_mpi_overhead_peer meshmotion_python)
 # The parallel layer's benchmark exists when MPI, PETSc and METIS were found at configure time.
 mpi_targets=(mpi_bench)
 

@@ -69,6 +69,15 @@ def plugin_against_laplacian(rows, build):
     return min(ratios) if ratios else None
 
 
+def python_mpi_overhead(rows, build):
+    """The worst Python / C++ ratio per call of python_overhead.py's MPI rows (moves and reverse
+    derivatives, every rank count)."""
+    ratios = [row["ratio"] for row in rows
+              if row.get("build", "current") == build and row.get("benchmark") == "python_overhead"
+              and row.get("case") in ("mpi_move_into", "mpi_derivative_reverse")]
+    return max(ratios) if ratios else None
+
+
 # (name, rows' fields to match or a function of (rows, build), field, "<=" or ">=", limit, unit)
 TARGETS = [
     ("P1->P2 30P30N quads (median)", {"bench": "conversion", "case": "30p30n-quads"}, "median_s", "<=", 0.015, "s"),
@@ -91,6 +100,8 @@ TARGETS = [
     ("defaults' time / hand-set's, worst case", defaults_against_tuned("time_ratio", max), None, "<=", 1.5, "x"),
     ("OpenFOAM plugin defaults' largest valid angle / displacementLaplacian's, worst case", plugin_against_laplacian,
      None, ">=", 1.0, "x"),
+    ("Python over MPI / the C++ distributed mover, per call, worst rank count", python_mpi_overhead, None, "<=", 1.05,
+     "x"),
     ("PU RBF, 1M centres and 10M nodes: peak", {"bench": "pu_rbf", "mesh": "flat-707", "method": "pu"}, "peak_mb",
      "<=", 24576, "MB"),
 ]
