@@ -50,3 +50,49 @@ def bump(xs):
 def seed(ids):
     """dI/dXv as a function of the global node id, the same on every rank."""
     return np.column_stack([np.sin(ids), np.cos(0.7 * ids), np.sin(1.3 * ids + 0.2)])
+
+
+def structured_cgns(path):
+    """Writes the box of box() as two structured CGNS blocks meeting at x = 0.7 (4 x 6 x 5
+    vertices each), with vertex-range BCs wall (k = 1) and symmetry (j = 1) on both, through
+    the CGNS library itself (ctypes), as a multiblock grid generator would. Returns False when
+    the library cannot be loaded."""
+    import ctypes
+    import ctypes.util
+
+    name = ctypes.util.find_library("cgns")
+    if name is None:
+        return False
+    try:
+        cg = ctypes.CDLL(name)
+    except OSError:
+        return False
+    size_t = ctypes.c_int  # cgsize_t: Debian builds CGNS without 64-bit sizes (cgnstypes.h)
+    mode_write, structured, real_double, bc_wall, bc_symmetry, point_range = 1, 2, 4, 20, 16, 4
+    fn, base = ctypes.c_int(), ctypes.c_int()
+
+    def ok(code, what):
+        if code != 0:
+            raise RuntimeError(f"CGNS {what} failed ({code})")
+
+    ok(cg.cg_open(str(path).encode(), mode_write, ctypes.byref(fn)), "cg_open")
+    ok(cg.cg_base_write(fn, b"Base", 3, 3, ctypes.byref(base)), "cg_base_write")
+    n = (4, 6, 5)
+    for block, x0 in ((b"upstream", 0.0), (b"downstream", 0.7)):
+        size = (size_t * 9)(*n, *(v - 1 for v in n), 0, 0, 0)
+        zone = ctypes.c_int()
+        ok(cg.cg_zone_write(fn, base, block, size, structured, ctypes.byref(zone)), "cg_zone_write")
+        k, j, i = np.meshgrid(np.linspace(0, 0.8, n[2]), np.linspace(0, 1.0, n[1]), np.linspace(x0, x0 + 0.7, n[0]),
+                              indexing="ij")
+        for coordinate, values in ((b"CoordinateX", i), (b"CoordinateY", j), (b"CoordinateZ", k)):
+            data = np.ascontiguousarray(values.ravel(), dtype=np.float64)  # i fastest
+            index = ctypes.c_int()
+            ok(cg.cg_coord_write(fn, base, zone, real_double, coordinate, data.ctypes.data_as(ctypes.c_void_p),
+                                 ctypes.byref(index)), "cg_coord_write")
+        for bc, kind, corners in ((b"wall", bc_wall, (1, 1, 1, n[0], n[1], 1)),
+                                  (b"symmetry", bc_symmetry, (1, 1, 1, n[0], 1, n[2]))):
+            points = (size_t * 6)(*corners)
+            index = ctypes.c_int()
+            ok(cg.cg_boco_write(fn, base, zone, bc, kind, point_range, 2, points, ctypes.byref(index)), "cg_boco_write")
+    ok(cg.cg_close(fn), "cg_close")
+    return True

@@ -16,7 +16,7 @@ if not mm._core.have_mpi:
     pytest.skip("the module was built without MPI: " + mm._core.mpi_missing, allow_module_level=True)
 
 from meshmotion.idwarp import USMesh  # noqa: E402
-from meshes import box, bump  # noqa: E402  (beside this file)
+from meshes import box, bump, structured_cgns  # noqa: E402  (beside this file)
 
 comm = MPI.COMM_WORLD
 
@@ -149,3 +149,32 @@ def test_symmetry_planes_find_their_groups(grid_file):
         np.testing.assert_allclose(whole.reshape(-1, 3), expected, rtol=0, atol=1e-12)
     with pytest.raises(mm.InputError, match="no group lies in the symmetry plane"):
         USMesh(options=options(grid_file, symmetrySurfaces=None, symmetryPlanes=[[[0, 0.5, 0], [0, 1, 0]]]), comm=comm)
+
+
+def test_a_structured_multiblock_cgns_grid():
+    if not mm.have_cgns:
+        pytest.skip("the module was built without CGNS (libcgns-dev)")
+    folder = pathlib.Path(os.environ.get("MESHMOTION_TEST_TMP_DIR", "/tmp")) / f"idwarp_structured_{comm.size}"
+    path = folder / "blocks.cgns"
+    written = None
+    if comm.rank == 0:
+        folder.mkdir(parents=True, exist_ok=True)
+        written = structured_cgns(path)
+    if not comm.bcast(written, root=0):
+        pytest.skip("the CGNS library could not be loaded to write the structured grid")
+    mesh = USMesh(options={"gridFile": str(path), "fileType": "CGNS", "specifiedSurfaces": ["wall"],
+                           "symmetrySurfaces": ["symmetry"], "meshmotion": {"support_radius": 0.7}}, comm=comm)
+    serial = mm.Warp(str(path), design=["wall"], symmetry=["symmetry"], support_radius=0.7)
+    assert serial.mesh.num_nodes == 7 * 6 * 5  # the blocks' shared face read once
+    assert serial.mesh.num_cells == 2 * 3 * 5 * 4
+    serial.set_surface_coordinates(bump(serial.surface_coordinates()))
+    expected = serial.warp()
+    ind = solver_indices(serial.mesh.num_nodes)
+    mesh.setExternalMeshIndices(ind)
+    mesh.setSurfaceCoordinates(bump(mesh.getSurfaceCoordinates()))
+    mesh.warpMesh()
+    np.testing.assert_allclose(mesh.getSolverGrid().reshape(-1, 3), expected[ind], rtol=0, atol=1e-12)
+    assert mesh.verifyWarpDeriv() < 1e-6
+    mesh.writeGrid(str(folder / "warped.cgns"))
+    if comm.rank == 0:
+        np.testing.assert_allclose(mm.read_mesh(str(folder / "warped.cgns")).points, expected, rtol=0, atol=1e-12)

@@ -7,6 +7,7 @@
 #include "meshmotion/core/orientation.hpp"
 #include "meshmotion/curving/p2_conversion.hpp"
 #include "meshmotion/io.hpp"
+#include "meshmotion/quality/quality_report.hpp"
 
 #include "io_support.hpp"
 #include "messages.hpp"
@@ -107,6 +108,30 @@ class CgnsBuilder {
     }
     return z;
   }
+  /// A structured block of ni × nj [× nk] vertices (nk 0 in 2D) on a unit grid from x = x0,
+  /// i fastest.
+  int structured_zone(const char* name, int ni, int nj, int nk, double x0) {
+    const bool three = nk > 0;
+    cgsize_t size[9] = {};
+    const std::array<int, 3> n{ni, nj, three ? nk : 1};
+    const int index_dim = three ? 3 : 2;
+    for (int d = 0; d < index_dim; ++d) {
+      size[d] = n[static_cast<std::size_t>(d)];
+      size[index_dim + d] = n[static_cast<std::size_t>(d)] - 1;
+    }
+    int z = 0;
+    REQUIRE(cg_zone_write(fn_, base_, name, size, CGNS_ENUMV(Structured), &z) == CG_OK);
+    static constexpr const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
+    for (int d = 0; d < phys_dim_; ++d) {
+      std::vector<double> c;
+      for (int k = 0; k < n[2]; ++k)
+        for (int j = 0; j < nj; ++j)
+          for (int i = 0; i < ni; ++i) c.push_back(d == 0 ? x0 + i : d == 1 ? j : k);
+      int C = 0;
+      REQUIRE(cg_coord_write(fn_, base_, z, CGNS_ENUMV(RealDouble), names[d], c.data(), &C) == CG_OK);
+    }
+    return z;
+  }
   void section(int z, const char* name, CGNS_ENUMT(ElementType_t) type, cgsize_t start, cgsize_t end,
                const std::vector<cgsize_t>& nodes) {
     int S = 0;
@@ -117,11 +142,12 @@ class CgnsBuilder {
     int S = 0;
     REQUIRE(cg_poly_section_write(fn_, base_, z, name, CGNS_ENUMV(MIXED), start, end, 0, data.data(), offsets.data(), &S) == CG_OK);
   }
+  /// `index_dim`: numbers per point (i, j, k of a structured zone's vertex; 1 otherwise).
   int boco(int z, const char* name, CGNS_ENUMT(PointSetType_t) set, const std::vector<cgsize_t>& points,
-           CGNS_ENUMT(GridLocation_t) location = CGNS_ENUMV(Vertex)) {
+           CGNS_ENUMT(GridLocation_t) location = CGNS_ENUMV(Vertex), int index_dim = 1) {
     int bc = 0;
-    REQUIRE(cg_boco_write(fn_, base_, z, name, CGNS_ENUMV(BCWall), set, static_cast<cgsize_t>(points.size()), points.data(), &bc) ==
-            CG_OK);
+    REQUIRE(cg_boco_write(fn_, base_, z, name, CGNS_ENUMV(BCWall), set, static_cast<cgsize_t>(points.size()) / index_dim,
+                          points.data(), &bc) == CG_OK);
     if (location != CGNS_ENUMV(Vertex)) REQUIRE(cg_boco_gridlocation_write(fn_, base_, z, bc, location) == CG_OK);
     return bc;
   }
@@ -369,6 +395,74 @@ TEST_CASE("CGNS written by other programs: MIXED sections, vertex BCs, families,
   }
 }
 
+TEST_CASE("CGNS structured zones read as hexahedra and quadrilaterals, blocks joined, BCs on their faces", "[io][cgns]") {
+  SECTION("3D: two blocks meeting at x = 2, BCs as vertex ranges and a list, one in a family") {
+    const fs::path file = test::scratch_path("structured_blocks.cgns");
+    {
+      CgnsBuilder f(file, 3, 3);
+      for (const int b : {0, 1}) {
+        const int z = f.structured_zone(b == 0 ? "upstream" : "downstream", 3, 3, 3, 2.0 * b);
+        f.boco(z, "wall", CGNS_ENUMV(PointRange), {1, 1, 1, 3, 3, 1}, CGNS_ENUMV(Vertex), 3);  // k = 1
+        if (b == 0) {
+          std::vector<cgsize_t> inlet;  // i = 1, every vertex listed
+          for (cgsize_t k = 1; k <= 3; ++k)
+            for (cgsize_t j = 1; j <= 3; ++j) inlet.insert(inlet.end(), {1, j, k});
+          f.boco(z, "inlet", CGNS_ENUMV(PointList), inlet, CGNS_ENUMV(Vertex), 3);
+        } else {
+          const int sym = f.boco(z, "side", CGNS_ENUMV(PointRange), {3, 1, 3, 1, 1, 1}, CGNS_ENUMV(Vertex), 3);  // j = 1, corners swapped
+          f.family(z, sym, "SYMMETRY");
+        }
+      }
+    }
+    const Mesh<3> mesh = read_mesh_as<3>(file);
+    CHECK(mesh.num_nodes() == 5 * 3 * 3);  // the x = 2 face is shared
+    CHECK(mesh.num_cells() == 16);
+    CHECK(mesh.cells.front().type == ElementType::hex8);
+    CHECK(test::group_size(mesh, "upstream") == 8);
+    CHECK(test::group_size(mesh, "downstream") == 8);
+    CHECK(test::group_size(mesh, "wall") == 8);
+    CHECK(test::group_size(mesh, "inlet") == 4);
+    CHECK(test::group_size(mesh, "SYMMETRY") == 4);
+    for (const Index v : mesh.group_nodes("wall")) CHECK(mesh.points(2, v) == 0.0);
+    for (const Index v : mesh.group_nodes("inlet")) CHECK(mesh.points(0, v) == 0.0);
+    for (const Index v : mesh.group_nodes("SYMMETRY")) CHECK((mesh.points(1, v) == 0.0 && mesh.points(0, v) >= 2.0));
+    CHECK(orientation_report(mesh).num_negative == 0);
+    CHECK(quality_report(mesh, Metric::scaled_jacobian).min > 0.99);  // unit cubes
+  }
+  SECTION("2D: one block of quadrilaterals, a BC along j = 1") {
+    const fs::path file = test::scratch_path("structured_2d.cgns");
+    {
+      CgnsBuilder f(file);
+      const int z = f.structured_zone("plate", 4, 3, 0, 0.0);
+      f.boco(z, "bottom", CGNS_ENUMV(PointRange), {1, 1, 4, 1}, CGNS_ENUMV(Vertex), 2);
+    }
+    const Mesh<2> mesh = read_mesh_as<2>(file);
+    CHECK(mesh.num_nodes() == 12);
+    CHECK(mesh.num_cells() == 6);
+    CHECK(test::group_size(mesh, "bottom") == 3);
+    CHECK(mesh.group_nodes("bottom") == std::vector<Index>{0, 1, 2, 3});
+    CHECK(orientation_report(mesh).num_negative == 0);
+  }
+  SECTION("refused: a BC on faces, an index outside the block") {
+    const auto refused = [&](const std::string& stem, auto&& build, const std::vector<std::string>& parts) {
+      const fs::path file = test::scratch_path(stem + ".cgns");
+      {
+        CgnsBuilder f(file, 3, 3);
+        build(f);
+      }
+      require_input_error([&] { (void)read_mesh(file); }, parts);
+    };
+    refused("structured_face_bc", [](CgnsBuilder& f) {
+      const int z = f.structured_zone("blk", 3, 3, 3, 0.0);
+      f.boco(z, "wall", CGNS_ENUMV(PointRange), {1, 1, 1, 2, 2, 1}, CGNS_ENUMV(FaceCenter), 3);
+    }, {"/Base/blk/ZoneBC/wall", "structured zone's BC on faces"});
+    refused("structured_range", [](CgnsBuilder& f) {
+      const int z = f.structured_zone("blk", 3, 3, 3, 0.0);
+      f.boco(z, "wall", CGNS_ENUMV(PointRange), {1, 1, 1, 4, 3, 1}, CGNS_ENUMV(Vertex), 3);
+    }, {"/Base/blk/ZoneBC/wall", "index 1 is 4", "3 vertices along it"});
+  }
+}
+
 TEST_CASE("CGNS: each kind of bad file gets a clear error naming the node path", "[io][cgns]") {
   const fs::path dir = test::scratch_path("cgns_bad");
   fs::remove_all(dir);
@@ -387,7 +481,7 @@ TEST_CASE("CGNS: each kind of bad file gets a clear error naming the node path",
       int z = 0;
       REQUIRE(cg_zone_write(f.id(), f.base(), "blk", size, CGNS_ENUMV(Structured), &z) == CG_OK);
     }
-    require_input_error([&] { (void)read_mesh(file); }, {"structured.cgns", "/Base", "no unstructured zone", "blk"});
+    require_input_error([&] { (void)read_mesh(file); }, {"structured.cgns", "/Base/blk/GridCoordinates", "no CoordinateX"});
   }
   const auto one_quad = [&](const std::string& stem, auto&& add) {
     const fs::path file = dir / (stem + ".cgns");

@@ -5,7 +5,7 @@
 /// on first use (io/detail/cgns_library.hpp); without it read_cgns() and write_cgns() throw
 /// InputError saying so, and have_cgns is false.
 ///
-/// Reading (one base; unstructured zones):
+/// Reading (one base; unstructured and structured zones):
 /// - Element sections of every type of the catalogue (linear and quadratic, MIXED sections
 ///   too) in CGNS's node order. Elements take a group named after their section (none when
 ///   the section is named after its element type, "TRI_3", "MIXED", ...); with several zones
@@ -18,11 +18,16 @@
 /// - Several zones read as one mesh: a node of a later zone at exactly the coordinates of a
 ///   node of an earlier zone is that node (conforming zone interfaces), and element numbers
 ///   continue from one zone to the next.
-/// - Refused with the CGNS node path: several bases, no unstructured zone, polyhedral
+/// - A structured zone (the multiblock grids of ADflow and IDWarp) reads as quadrilaterals or
+///   hexahedra, i fastest; its BCs (vertex PointRange or PointList of i, j[, k]) as the facet
+///   groups of the block faces they cover; block interfaces join by their coordinates, as the
+///   zones of an unstructured file do. Nodes repeated within one block (a C-grid's wake cut)
+///   stay apart.
+/// - Refused with the CGNS node path: several bases, no zone, polyhedral
 ///   (NGON_n/NFACE_n) or order ≥ 3 sections, a node or element number out of range, an element
 ///   in two BCs, coordinates other than CoordinateX/Y/Z.
 ///
-/// Writing: one base and one unstructured zone, double coordinates, the cells, facets and
+/// Writing: one base and one unstructured zone (a structured file is written unstructured), double coordinates, the cells, facets and
 /// lower-dimensional elements ordered by their element ids (file order for a mesh that was
 /// read) and numbered 1..n in that order, one section per run of consecutive elements of one
 /// group and type (MIXED where types alternate), named after the group (after the CGNS type

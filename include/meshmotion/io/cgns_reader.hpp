@@ -118,25 +118,18 @@ class CgnsReader {
 
     int nzones = 0;
     cgns_.check(cgns_api().cg_nzones(fn, 1, &nzones), base_);
-    std::vector<int> zones;
-    std::string structured;
+    if (nzones == 0) cgns_.fail(base_, "no zone");
+    multi_zone_ = nzones > 1;
     for (int z = 1; z <= nzones; ++z) {
       CGNS_ENUMT(ZoneType_t) type{};
       cgns_.check(cgns_api().cg_zone_type(fn, 1, z, &type), base_);
-      if (type == CGNS_ENUMV(Unstructured)) {
-        zones.push_back(z);
-      } else {
-        cgsize_t size[9] = {};
-        cgns_.check(cgns_api().cg_zone_read(fn, 1, z, name, size), base_);
-        structured += (structured.empty() ? "" : ", ") + std::string(name);
-      }
+      if (type == CGNS_ENUMV(Structured))
+        read_structured_zone(z);
+      else if (type == CGNS_ENUMV(Unstructured))
+        read_zone(z);
+      else
+        cgns_.fail(base_, "zone " + std::to_string(z) + " is neither structured nor unstructured");
     }
-    if (zones.empty())
-      cgns_.fail(base_, "no unstructured zone" + (structured.empty() ? std::string() : " (structured zones: " + structured + ")"));
-    if (!structured.empty())
-      cgns_.fail(base_, "structured zones (" + structured + ") beside unstructured ones: meshmotion reads unstructured meshes");
-    multi_zone_ = zones.size() > 1;
-    for (const int z : zones) read_zone(z);
     return std::move(raw_);
   }
 
@@ -149,7 +142,7 @@ class CgnsReader {
     zone_name_ = name;
     zone_ = base_ + "/" + zone_name_;
     const auto num_vertices = static_cast<std::int64_t>(size[0]);
-    const std::vector<Index> node_of_vertex = read_coordinates(z, num_vertices);
+    const std::vector<Index> node_of_vertex = read_coordinates(z, {num_vertices});
 
     int nsections = 0;
     cgns_.check(cgns_api().cg_nsections(fn, 1, z, &nsections), zone_);
@@ -181,8 +174,63 @@ class CgnsReader {
     element_offset_ += largest;
   }
 
-  /// Reads the zone's coordinates; returns the mesh node of each CGNS vertex (0-based).
-  [[nodiscard]] std::vector<Index> read_coordinates(int z, std::int64_t num_vertices) {
+  /// A structured zone (ni × nj [× nk] vertices, i fastest): its cells as quadrilaterals or
+  /// hexahedra, its BCs (vertex ranges or lists of i, j, k) as facet groups on the block's faces;
+  /// block interfaces join as the nodes of several zones do, by their coordinates.
+  void read_structured_zone(int z) {
+    const int fn = cgns_.id();
+    char name[33] = {};
+    cgsize_t size[9] = {};
+    cgns_.check(cgns_api().cg_zone_read(fn, 1, z, name, size), base_);
+    zone_name_ = name;
+    zone_ = base_ + "/" + zone_name_;
+    std::vector<std::int64_t> n(static_cast<std::size_t>(cell_dim_));
+    for (int d = 0; d < cell_dim_; ++d) {
+      n[static_cast<std::size_t>(d)] = static_cast<std::int64_t>(size[d]);
+      if (n[static_cast<std::size_t>(d)] < 2)
+        cgns_.fail(zone_, "structured zone of " + std::to_string(n[static_cast<std::size_t>(d)]) + " vertices along index " +
+                              std::to_string(d + 1) + " (expected at least 2)");
+    }
+    const std::vector<Index> node_of_vertex = read_coordinates(z, n);
+    const std::int64_t ni = n[0], nj = n[1], nk = cell_dim_ == 3 ? n[2] : 2;
+    const auto vertex = [&](std::int64_t i, std::int64_t j, std::int64_t k) { return i + ni * (j + nj * k); };
+    const ElementType type = cell_dim_ == 3 ? ElementType::hex8 : ElementType::quad4;
+    ElementBlock& block = raw_.block(type);
+    const auto block_index = static_cast<std::size_t>(&block - raw_.blocks.data());
+    const int tag = multi_zone_ ? group_tag(zone_name_, cell_dim_) : 0;
+    CgnsSections cells;
+    cells.add({zone_, 1, (ni - 1) * (nj - 1) * std::max<std::int64_t>(nk - 1, 1), block_index, block.size(), {}});
+    std::int64_t number = 0;
+    for (std::int64_t k = 0; k + 1 < nk; ++k)
+      for (std::int64_t j = 0; j + 1 < nj; ++j)
+        for (std::int64_t i = 0; i + 1 < ni; ++i) {
+          std::array<Index, 8> nodes{};
+          const std::array<std::int64_t, 8> corners{vertex(i, j, k),         vertex(i + 1, j, k),         vertex(i + 1, j + 1, k),
+                                                    vertex(i, j + 1, k),     vertex(i, j, k + 1),         vertex(i + 1, j, k + 1),
+                                                    vertex(i + 1, j + 1, k + 1), vertex(i, j + 1, k + 1)};
+          const int count = num_nodes(type);
+          for (int c = 0; c < count; ++c)
+            nodes[static_cast<std::size_t>(c)] = node_of_vertex[static_cast<std::size_t>(corners[static_cast<std::size_t>(c)])];
+          block.add(std::span<const Index>(nodes.data(), static_cast<std::size_t>(count)), tag);
+          block.ids.push_back(element_offset_ + ++number);
+        }
+    read_bocos(z, cells, node_of_vertex, false, n);
+    for (ElementBlock& src : boundary_)
+      for (Index e = 0; e < src.size(); ++e)
+        if (const int t = src.tags[static_cast<std::size_t>(e)]; t != 0) {
+          ElementBlock& dst = raw_.block(src.type);
+          dst.add(src.element(e), t);
+          dst.ids.push_back(element_offset_ + ++number);
+        }
+    boundary_.clear();
+    element_offset_ += number;
+  }
+
+  /// Reads the zone's coordinates (`size`: its vertices, or per index of a structured zone);
+  /// returns the mesh node of each CGNS vertex (0-based, i fastest).
+  [[nodiscard]] std::vector<Index> read_coordinates(int z, const std::vector<std::int64_t>& size) {
+    std::int64_t num_vertices = 1;
+    for (const std::int64_t extent : size) num_vertices *= extent;
     const int fn = cgns_.id();
     const std::string path = zone_ + "/GridCoordinates";
     int ncoords = 0;
@@ -204,9 +252,11 @@ class CgnsReader {
         cgns_.fail(path, std::string("no ") + names[d] + " (has: " + (have.empty() ? "none" : have) +
                              "; meshmotion reads Cartesian coordinates)");
       }
-      cgsize_t lo = 1, hi = static_cast<cgsize_t>(num_vertices);
+      std::array<cgsize_t, 3> lo{1, 1, 1}, hi{};
+      for (std::size_t i = 0; i < size.size(); ++i) hi[i] = static_cast<cgsize_t>(size[i]);
       if (num_vertices > 0)
-        cgns_.check(cgns_api().cg_coord_read(fn, 1, z, names[d], CGNS_ENUMV(RealDouble), &lo, &hi, column.data()), path + "/" + names[d]);
+        cgns_.check(cgns_api().cg_coord_read(fn, 1, z, names[d], CGNS_ENUMV(RealDouble), lo.data(), hi.data(), column.data()),
+                    path + "/" + names[d]);
       for (std::int64_t i = 0; i < num_vertices; ++i) xyz[static_cast<std::size_t>(3 * i + d)] = column[static_cast<std::size_t>(i)];
     }
     std::vector<Index> node(static_cast<std::size_t>(num_vertices));
@@ -331,7 +381,10 @@ class CgnsReader {
     return end;
   }
 
-  void read_bocos(int z, const CgnsSections& sections, const std::vector<Index>& node_of_vertex, bool has_facets) {
+  /// The zone's BCs as facet groups. `structured`: the vertices per index of a structured zone,
+  /// whose BCs are vertex ranges or lists of (i, j[, k]); empty for an unstructured one.
+  void read_bocos(int z, const CgnsSections& sections, const std::vector<Index>& node_of_vertex, bool has_facets,
+                  const std::vector<std::int64_t>& structured = {}) {
     const int fn = cgns_.id();
     int nbocos = 0;
     cgns_.check(cgns_api().cg_nbocos(fn, 1, z, &nbocos), zone_ + "/ZoneBC");
@@ -348,7 +401,8 @@ class CgnsReader {
       const std::string path = zone_ + "/ZoneBC/" + name;
       CGNS_ENUMT(GridLocation_t) location = CGNS_ENUMV(Vertex);
       cgns_.check(cgns_api().cg_boco_gridlocation_read(fn, 1, z, bc, &location), path);
-      std::vector<cgsize_t> points(static_cast<std::size_t>(std::max<cgsize_t>(npnts, 0)));
+      const auto index_dim = structured.empty() ? std::size_t{1} : structured.size();
+      std::vector<cgsize_t> points(index_dim * static_cast<std::size_t>(std::max<cgsize_t>(npnts, 0)));
       if (npnts > 0) cgns_.check(cgns_api().cg_boco_read(fn, 1, z, bc, points.data(), nullptr), path);
       std::string group = name;
       char family[33] = {};
@@ -360,7 +414,14 @@ class CgnsReader {
       const bool list = ptset == CGNS_ENUMV(PointList) || ptset == CGNS_ENUMV(ElementList);
       if (!range && !list) cgns_.fail(path, "point set type " + std::to_string(static_cast<int>(ptset)) +
                                                 " (expected PointList, PointRange, ElementList or ElementRange)");
-      if (range && points.size() != 2) cgns_.fail(path, "a range needs 2 numbers (got " + std::to_string(points.size()) + ")");
+      if (range && points.size() != 2 * index_dim)
+        cgns_.fail(path, "a range needs " + std::to_string(2 * index_dim) + " numbers (got " + std::to_string(points.size()) + ")");
+      if (!structured.empty()) {
+        if (location != CGNS_ENUMV(Vertex) || ptset == CGNS_ENUMV(ElementRange) || ptset == CGNS_ENUMV(ElementList))
+          cgns_.fail(path, "a structured zone's BC on faces or elements (meshmotion reads its BCs as vertex ranges or lists)");
+        tag_facets_on_vertices(structured_bc_vertices(points, range, structured, path), node_of_vertex, tag, path, false, sections);
+        continue;
+      }
       const bool elements = ptset == CGNS_ENUMV(ElementRange) || ptset == CGNS_ENUMV(ElementList) ||
                             location != CGNS_ENUMV(Vertex);
       const auto for_each_number = [&](auto&& f) {
@@ -387,6 +448,45 @@ class CgnsReader {
         tag_facets_on_vertices(in_bc, node_of_vertex, tag, path, has_facets, sections);
       }
     }
+  }
+
+  /// The vertices (flags, i fastest) of a structured BC: the box between a range's two
+  /// corners, or the listed (i, j[, k]), each index within the zone.
+  std::vector<char> structured_bc_vertices(const std::vector<cgsize_t>& points, bool range, const std::vector<std::int64_t>& n,
+                                           const std::string& path) const {
+    const std::size_t dim = n.size();
+    std::int64_t total = 1;
+    for (const std::int64_t extent : n) total *= extent;
+    std::vector<char> in_bc(static_cast<std::size_t>(total), 0);
+    const auto check = [&](std::size_t d, std::int64_t v) {
+      if (v < 1 || v > n[d])
+        cgns_.fail(path, "index " + std::to_string(d + 1) + " is " + std::to_string(v) + " (the zone has " + std::to_string(n[d]) +
+                             " vertices along it, numbered from 1)");
+    };
+    const auto flag = [&](const std::array<std::int64_t, 3>& ijk) {
+      std::int64_t at = 0;
+      for (std::size_t d = dim; d-- > 0;) at = at * n[d] + ijk[d] - 1;
+      in_bc[static_cast<std::size_t>(at)] = 1;
+    };
+    if (!range) {
+      for (std::size_t p = 0; p + dim <= points.size(); p += dim) {
+        std::array<std::int64_t, 3> ijk{1, 1, 1};
+        for (std::size_t d = 0; d < dim; ++d) check(d, ijk[d] = points[p + d]);
+        flag(ijk);
+      }
+      return in_bc;
+    }
+    std::array<std::int64_t, 3> lo{1, 1, 1}, hi{1, 1, 1};
+    for (std::size_t d = 0; d < dim; ++d) {
+      check(d, points[d]);
+      check(d, points[dim + d]);
+      lo[d] = std::min<std::int64_t>(points[d], points[dim + d]);
+      hi[d] = std::max<std::int64_t>(points[d], points[dim + d]);
+    }
+    for (std::int64_t k = lo[2]; k <= hi[2]; ++k)
+      for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
+        for (std::int64_t i = lo[0]; i <= hi[0]; ++i) flag({i, j, k});
+    return in_bc;
   }
 
   /// A vertex BC: the zone's facets whose vertices the BC all holds; its boundary facets when
