@@ -220,13 +220,15 @@ class USMesh:
         return None if whole is None else whole.ravel()
 
     def writeGrid(self, fileName=None):
-        """Writes the warped grid (collective; format by extension). The grid file itself is
-        not overwritten."""
+        """Writes the warped grid (collective). A .cgns grid file is written again with the new
+        coordinates (structured blocks, BCs and solutions kept); other names by extension. The
+        grid file itself is not overwritten."""
         if fileName is None:
             raise _core.InputError("writeGrid: give a file name (the grid file itself is not overwritten)")
         if os.path.abspath(str(fileName)) == os.path.abspath(str(self.gridFile)):
             raise _core.InputError(f"writeGrid: {fileName} is the grid file (write the warped grid elsewhere)")
-        self._warp.write_mesh(fileName)
+        same_format = str(self.gridFile).endswith(".cgns") and str(fileName).endswith(".cgns")
+        self._warp.write_mesh(fileName, like=self.gridFile if same_format else None)
 
     # Derivatives -----------------------------------------------------------------------------
     def warpDeriv(self, dXv, solverVec=True):

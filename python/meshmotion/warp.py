@@ -208,10 +208,19 @@ class Warp:
             return self._volume.copy()
         return self._part.gather_owned(self._volume)
 
-    def write_mesh(self, file):
+    def write_mesh(self, file, like=None):
         """Writes the mesh at the last warp() (format by extension). Over MPI, collective: rank 0
-        gathers the owned nodes and writes the whole mesh in its numbering."""
-        from . import write_mesh as _write
+        gathers the owned nodes and writes the whole mesh in its numbering. like: the CGNS file
+        the mesh was read from, written again with the new coordinates (its structured blocks,
+        BCs and solutions kept)."""
+        from . import write_mesh as _write_mesh
+
+        def _write(target, mesh):
+            if like is None:
+                _write_mesh(target, mesh)
+            else:
+                _core.write_cgns_coordinates(str(like), str(target), mesh)
+
         if self._comm is None:
             mesh = self._mesh.copy()
             mesh.points[:] = self._volume

@@ -96,3 +96,23 @@ def structured_cgns(path):
             ok(cg.cg_boco_write(fn, base, zone, bc, kind, point_range, 2, points, ctypes.byref(index)), "cg_boco_write")
     ok(cg.cg_close(fn), "cg_close")
     return True
+
+
+def cgns_zone_types(path):
+    """The type of each zone of a CGNS file ("Structured", "Unstructured"), read through the CGNS
+    library (ctypes)."""
+    import ctypes
+    import ctypes.util
+
+    cg = ctypes.CDLL(ctypes.util.find_library("cgns"))
+    fn, count = ctypes.c_int(), ctypes.c_int()
+    if cg.cg_open(str(path).encode(), 0, ctypes.byref(fn)) != 0:
+        raise RuntimeError(f"cg_open {path} failed")
+    cg.cg_nzones(fn, 1, ctypes.byref(count))
+    types = []
+    for zone in range(1, count.value + 1):
+        kind = ctypes.c_int()
+        cg.cg_zone_type(fn, 1, zone, ctypes.byref(kind))
+        types.append({2: "Structured", 3: "Unstructured"}.get(kind.value, str(kind.value)))
+    cg.cg_close(fn)
+    return types

@@ -16,7 +16,7 @@ if not mm._core.have_mpi:
     pytest.skip("the module was built without MPI: " + mm._core.mpi_missing, allow_module_level=True)
 
 from meshmotion.idwarp import USMesh  # noqa: E402
-from meshes import box, bump, structured_cgns  # noqa: E402  (beside this file)
+from meshes import box, bump, cgns_zone_types, structured_cgns  # noqa: E402  (beside this file)
 
 comm = MPI.COMM_WORLD
 
@@ -175,6 +175,7 @@ def test_a_structured_multiblock_cgns_grid():
     mesh.warpMesh()
     np.testing.assert_allclose(mesh.getSolverGrid().reshape(-1, 3), expected[ind], rtol=0, atol=1e-12)
     assert mesh.verifyWarpDeriv() < 1e-6
-    mesh.writeGrid(str(folder / "warped.cgns"))
+    mesh.writeGrid(str(folder / "warped.cgns"))  # the grid file again, its blocks kept
     if comm.rank == 0:
+        assert cgns_zone_types(folder / "warped.cgns") == ["Structured", "Structured"]
         np.testing.assert_allclose(mm.read_mesh(str(folder / "warped.cgns")).points, expected, rtol=0, atol=1e-12)

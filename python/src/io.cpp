@@ -33,6 +33,12 @@ void bind_io(py::module_& m) {
   for_each_dimension([&]<int Dim>() {
     m.def("write_mesh", [](const std::filesystem::path& file, const Mesh<Dim>& mesh) { write_mesh(file, mesh); },
           py::arg("file"), py::arg("mesh"), py::call_guard<py::gil_scoped_release>());
+    m.def("write_cgns_coordinates",
+          [](const std::filesystem::path& source, const std::filesystem::path& file, const Mesh<Dim>& mesh) {
+            write_cgns_coordinates(source, file, mesh);
+          },
+          py::arg("source"), py::arg("file"), py::arg("mesh"), py::call_guard<py::gil_scoped_release>(),
+          "the CGNS file source again as file, with the mesh's coordinates (structured zones stay blocks)");
   });
 }
 

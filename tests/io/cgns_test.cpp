@@ -428,6 +428,29 @@ TEST_CASE("CGNS structured zones read as hexahedra and quadrilaterals, blocks jo
     for (const Index v : mesh.group_nodes("SYMMETRY")) CHECK((mesh.points(1, v) == 0.0 && mesh.points(0, v) >= 2.0));
     CHECK(orientation_report(mesh).num_negative == 0);
     CHECK(quality_report(mesh, Metric::scaled_jacobian).min > 0.99);  // unit cubes
+
+    // Written back with new coordinates: the same structured blocks and BCs.
+    Mesh<3> moved = mesh;
+    for (Index v = 0; v < moved.num_nodes(); ++v) moved.points(2, v) += 0.1 * moved.points(0, v) * moved.points(1, v);
+    const fs::path out = test::scratch_path("structured_blocks_moved.cgns");
+    write_cgns_coordinates(file, out, moved);
+    int fn = 0, nzones = 0;
+    REQUIRE(cg_open(out.c_str(), CG_MODE_READ, &fn) == CG_OK);
+    REQUIRE(cg_nzones(fn, 1, &nzones) == CG_OK);
+    CHECK(nzones == 2);
+    for (int z = 1; z <= nzones; ++z) {
+      CGNS_ENUMT(ZoneType_t) type{};
+      REQUIRE(cg_zone_type(fn, 1, z, &type) == CG_OK);
+      CHECK(type == CGNS_ENUMV(Structured));
+    }
+    cg_close(fn);
+    const Mesh<3> back = read_mesh_as<3>(out);
+    CHECK(back.points == moved.points);
+    CHECK(back.group_nodes("wall") == mesh.group_nodes("wall"));
+    CHECK(back.group_nodes("SYMMETRY") == mesh.group_nodes("SYMMETRY"));
+    Mesh<3> fewer = mesh;
+    fewer.points.conservativeResize(3, mesh.num_nodes() - 1);
+    require_input_error([&] { write_cgns_coordinates(file, out, fewer); }, {"45 nodes", "3D with 44"});
   }
   SECTION("2D: one block of quadrilaterals, a BC along j = 1") {
     const fs::path file = test::scratch_path("structured_2d.cgns");

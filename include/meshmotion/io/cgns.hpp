@@ -27,7 +27,8 @@
 ///   (NGON_n/NFACE_n) or order ≥ 3 sections, a node or element number out of range, an element
 ///   in two BCs, coordinates other than CoordinateX/Y/Z.
 ///
-/// Writing: one base and one unstructured zone (a structured file is written unstructured), double coordinates, the cells, facets and
+/// write_cgns_coordinates() writes a file that was read again with new coordinates (structured
+/// zones stay blocks). write_cgns(), for any mesh: one base and one unstructured zone, double coordinates, the cells, facets and
 /// lower-dimensional elements ordered by their element ids (file order for a mesh that was
 /// read) and numbered 1..n in that order, one section per run of consecutive elements of one
 /// group and type (MIXED where types alternate), named after the group (after the CGNS type

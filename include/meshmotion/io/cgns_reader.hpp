@@ -91,6 +91,10 @@ class CgnsReader {
  public:
   explicit CgnsReader(const std::filesystem::path& file) : file_(file), cgns_(file, CG_MODE_READ) {}
 
+  /// After read(): the mesh node of each vertex of each zone (file order; 0-based, a structured
+  /// zone's i fastest).
+  [[nodiscard]] const std::vector<std::vector<Index>>& zone_nodes() const noexcept { return zone_nodes_; }
+
   [[nodiscard]] RawMesh read() {
     const int fn = cgns_.id();
     int nbases = 0;
@@ -142,7 +146,7 @@ class CgnsReader {
     zone_name_ = name;
     zone_ = base_ + "/" + zone_name_;
     const auto num_vertices = static_cast<std::int64_t>(size[0]);
-    const std::vector<Index> node_of_vertex = read_coordinates(z, {num_vertices});
+    const std::vector<Index>& node_of_vertex = zone_nodes_.emplace_back(read_coordinates(z, {num_vertices}));
 
     int nsections = 0;
     cgns_.check(cgns_api().cg_nsections(fn, 1, z, &nsections), zone_);
@@ -161,17 +165,21 @@ class CgnsReader {
       if (t == 0) t = tag;
     }
     section_tags_.clear();
-    // Boundary facets made for vertex BCs join the mesh (those a BC holds), numbered after
-    // the zone's elements.
+    finish_zone(largest);
+  }
+
+  /// Boundary facets made for vertex BCs join the mesh (those a BC holds), numbered after the
+  /// zone's `last` element; the next zone's numbers follow.
+  void finish_zone(std::int64_t last) {
     for (ElementBlock& src : boundary_)
       for (Index e = 0; e < src.size(); ++e)
         if (const int t = src.tags[static_cast<std::size_t>(e)]; t != 0) {
           ElementBlock& dst = raw_.block(src.type);
           dst.add(src.element(e), t);
-          dst.ids.push_back(element_offset_ + ++largest);
+          dst.ids.push_back(element_offset_ + ++last);
         }
     boundary_.clear();
-    element_offset_ += largest;
+    element_offset_ += last;
   }
 
   /// A structured zone (ni × nj [× nk] vertices, i fastest): its cells as quadrilaterals or
@@ -191,7 +199,7 @@ class CgnsReader {
         cgns_.fail(zone_, "structured zone of " + std::to_string(n[static_cast<std::size_t>(d)]) + " vertices along index " +
                               std::to_string(d + 1) + " (expected at least 2)");
     }
-    const std::vector<Index> node_of_vertex = read_coordinates(z, n);
+    const std::vector<Index>& node_of_vertex = zone_nodes_.emplace_back(read_coordinates(z, n));
     const std::int64_t ni = n[0], nj = n[1], nk = cell_dim_ == 3 ? n[2] : 2;
     const auto vertex = [&](std::int64_t i, std::int64_t j, std::int64_t k) { return i + ni * (j + nj * k); };
     const ElementType type = cell_dim_ == 3 ? ElementType::hex8 : ElementType::quad4;
@@ -215,15 +223,7 @@ class CgnsReader {
           block.ids.push_back(element_offset_ + ++number);
         }
     read_bocos(z, cells, node_of_vertex, false, n);
-    for (ElementBlock& src : boundary_)
-      for (Index e = 0; e < src.size(); ++e)
-        if (const int t = src.tags[static_cast<std::size_t>(e)]; t != 0) {
-          ElementBlock& dst = raw_.block(src.type);
-          dst.add(src.element(e), t);
-          dst.ids.push_back(element_offset_ + ++number);
-        }
-    boundary_.clear();
-    element_offset_ += number;
+    finish_zone(number);
   }
 
   /// Reads the zone's coordinates (`size`: its vertices, or per index of a structured zone);
@@ -590,6 +590,7 @@ class CgnsReader {
   std::vector<SectionTag> section_tags_;
   std::unordered_map<Key, Index, KeyHash> node_at_;
   std::vector<ElementBlock> boundary_;
+  std::vector<std::vector<Index>> zone_nodes_;
 };
 
 }  // namespace detail

@@ -8,6 +8,7 @@
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/topology.hpp"
 #include "meshmotion/core/detail/atomic_file.hpp"
+#include "meshmotion/io/cgns_reader.hpp"
 #include "meshmotion/io/detail/cgns_file.hpp"
 
 #include <algorithm>
@@ -233,6 +234,47 @@ void write_cgns(const std::filesystem::path& file, const Mesh<Dim>& mesh) {
   detail::CgnsWriter<Dim> writer(mesh);
   detail::write_through_temporary(file, [&](const std::filesystem::path& tmp) { writer.write(tmp); });
 #else
+  (void)mesh;
+  throw InputError(file.string() + ": writing CGNS needs the CGNS library (meshmotion was built without it: install "
+                   "libcgns-dev and reconfigure)");
+#endif
+}
+
+/// Writes the CGNS file `source` again as `file` with every zone's coordinates replaced by the
+/// mesh's, whose nodes are numbered as read_cgns(source) numbers them (the mesh is the file's,
+/// moved): structured zones stay the same blocks, and the sections, BCs, families, block
+/// connectivity and solutions are the source's. Through a temporary file and a rename. Throws
+/// InputError when the mesh's dimension or node count is not the file's, or a coordinate is
+/// not finite (nothing is written); IoError when the library fails.
+template <int Dim>
+void write_cgns_coordinates(const std::filesystem::path& source, const std::filesystem::path& file, const Mesh<Dim>& mesh) {
+#ifdef MESHMOTION_HAVE_CGNS
+  detail::CgnsReader reader(source);
+  const detail::RawMesh raw = reader.read();
+  if (raw.dim != Dim || raw.num_nodes() != mesh.num_nodes())
+    throw InputError("write_cgns_coordinates: " + source.string() + " holds a " + std::to_string(raw.dim) + "D mesh of " +
+                     std::to_string(raw.num_nodes()) + " nodes (the mesh given is " + std::to_string(Dim) + "D with " +
+                     std::to_string(mesh.num_nodes()) + ")");
+  if (!mesh.points.allFinite()) throw InputError("write_cgns_coordinates: a coordinate of the mesh is not finite");
+  detail::write_through_temporary(file, [&](const std::filesystem::path& tmp) {
+    std::filesystem::copy_file(source, tmp, std::filesystem::copy_options::overwrite_existing);
+    detail::CgnsFile cgns(tmp, CG_MODE_MODIFY);
+    static constexpr const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
+    const std::vector<std::vector<Index>>& zones = reader.zone_nodes();
+    for (std::size_t z = 0; z < zones.size(); ++z) {
+      std::vector<double> column(zones[z].size());
+      for (int d = 0; d < Dim; ++d) {
+        for (std::size_t v = 0; v < column.size(); ++v) column[v] = mesh.points(d, zones[z][v]);
+        int index = 0;
+        cgns.check(detail::cgns_api().cg_coord_write(cgns.id(), 1, static_cast<int>(z) + 1, CGNS_ENUMV(RealDouble), names[d],
+                                                     column.data(), &index),
+                   "zone " + std::to_string(z + 1) + "/GridCoordinates/" + names[d]);
+      }
+    }
+    cgns.close();
+  });
+#else
+  (void)source;
   (void)mesh;
   throw InputError(file.string() + ": writing CGNS needs the CGNS library (meshmotion was built without it: install "
                    "libcgns-dev and reconfigure)");
