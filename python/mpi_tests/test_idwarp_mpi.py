@@ -24,7 +24,7 @@ comm = MPI.COMM_WORLD
 @pytest.fixture(scope="module")
 def grid_file():
     folder = pathlib.Path(os.environ.get("MESHMOTION_TEST_TMP_DIR", "/tmp")) / f"idwarp_{comm.size}"
-    path = folder / "box.su2"
+    path = folder / ("box.cgns" if mm.have_cgns else "box.su2")  # unstructured CGNS, as ADflow's grids
     if comm.rank == 0:
         folder.mkdir(parents=True, exist_ok=True)
         mm.write_mesh(path, box())
@@ -33,7 +33,8 @@ def grid_file():
 
 
 def options(grid_file, **more):
-    o = {"gridFile": str(grid_file), "fileType": "SU2", "specifiedSurfaces": ["wall"], "symmetrySurfaces": ["symmetry"],
+    o = {"gridFile": str(grid_file), "fileType": "CGNS" if grid_file.suffix == ".cgns" else "SU2",
+         "specifiedSurfaces": ["wall"], "symmetrySurfaces": ["symmetry"],
          "meshmotion": {"support_radius": 0.7}}
     o.update(more)
     return o
@@ -120,7 +121,7 @@ def test_write_grid_and_the_options_refused(grid_file):
     mesh.warpMesh()
     with pytest.raises(mm.InputError, match="is the grid file"):
         mesh.writeGrid(str(grid_file))
-    out = grid_file.with_name("warped.su2")
+    out = grid_file.with_name("warped" + grid_file.suffix)
     mesh.writeGrid(str(out))
     common = mesh.getCommonGrid()  # collective
     if comm.rank == 0:
