@@ -89,6 +89,41 @@ TEST_CASE("boundary layer: thickness of a generated O-mesh layer is the one buil
   }
 }
 
+TEST_CASE("wall distance: the closest point within a reach is the closest point, found by one pruned search", "[curving]") {
+  // A wall of 64 segments on the unit circle; queries inside, on and outside it.
+  constexpr Index n = 64;
+  Points<2> points(2, n);
+  std::vector<detail::WallFacet> facets;
+  for (Index i = 0; i < n; ++i) {
+    const double a = 2.0 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(n);
+    points.col(i) = Vec<2>(std::cos(a), std::sin(a));
+    facets.push_back({ElementType::line2, {i, (i + 1) % n}});
+  }
+  const detail::WallDistance<2> wall(points, facets);
+  const double reach = 0.3;
+  for (int k = 0; k < 200; ++k) {
+    const double r = 0.5 + 0.005 * k, a = 0.37 * k;
+    const Vec<2> x(r * std::cos(a), r * std::sin(a));
+    // Brute force: the nearest vertex decides "within", every facet the closest point.
+    double vertex = std::numeric_limits<double>::infinity(), facet = vertex;
+    for (Index i = 0; i < n; ++i) {
+      vertex = std::min(vertex, (points.col(i) - x).norm());
+      const Vec<2> a0 = points.col(i), a1 = points.col((i + 1) % n);
+      const double t = std::clamp((x - a0).dot(a1 - a0) / (a1 - a0).squaredNorm(), 0.0, 1.0);
+      facet = std::min(facet, (a0 + t * (a1 - a0) - x).norm());
+    }
+    const auto within = wall.closest_within(x, reach);
+    REQUIRE(within.has_value() == (vertex < reach));
+    CHECK(wall.closest(x).distance == Approx(facet).margin(1e-14));
+    if (within) {
+      CHECK(within->distance == Approx(facet).margin(1e-14));
+      CHECK(within->facet == wall.closest(x).facet);
+    }
+  }
+  CHECK_THROWS_AS(detail::WallDistance<2>(points, facets, 0), InputError);
+  CHECK_THROWS_AS(detail::WallDistance<2>(points, facets, 17), InputError);
+}
+
 TEST_CASE("blend mover: a wall translation is blended by the C2 weight of the wall distance", "[curving]") {
   OMeshOptions o;
   o.n_around = 32;

@@ -3,8 +3,10 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
+#include <span>
 #include <type_traits>
 #include <utility>
 
@@ -51,6 +53,15 @@ void check_against_brute_force(Index n) {
     REQUIRE(within.has_value() == (all[0].first < radius * radius));
     if (within) CHECK(within->first == all[0].second);
     if (within) CHECK(within->second == Approx(all[0].first));
+    // The k nearest within the radius: the front of the sorted distances below it.
+    std::array<Neighbor, 5> near{};
+    const Index count = tree.nearest_within(query, radius, std::span<Neighbor>(near));
+    const auto inside = static_cast<Index>(std::count_if(all.begin(), all.end(), [&](const auto& a) { return a.first < radius * radius; }));
+    REQUIRE(count == std::min<Index>(5, inside));
+    for (Index k = 0; k < count; ++k) {
+      CHECK(near[static_cast<std::size_t>(k)].first == all[static_cast<std::size_t>(k)].second);
+      CHECK(near[static_cast<std::size_t>(k)].second == Approx(all[static_cast<std::size_t>(k)].first));
+    }
   }
 }
 
@@ -94,6 +105,9 @@ TEST_CASE("k-d tree reads the matrix in place and handles edge cases", "[spatial
   const KdTree<2> ring(circle);
   CHECK_FALSE(ring.nearest_within(Vec<2>(0.0, 0.0), 0.99).has_value());
   CHECK(ring.nearest_within(Vec<2>(0.9, 0.0), 0.2)->first == 0);
+  std::array<Neighbor, KdTree<2>::max_within + 1> too_many{};
+  CHECK_THROWS_WITH(ring.nearest_within(Vec<2>(0.0, 0.0), 2.0, std::span<Neighbor>(too_many)), Catch::Contains("17 neighbours asked"));
+  CHECK(ring.nearest_within(Vec<2>(0.0, 0.0), 2.0, std::span<Neighbor>(too_many.data(), KdTree<2>::max_within)) == 16);
   CHECK(tree.nearest(Vec<2>(5.0, 0.0), 10).size() == 3);
   points(0, 1) = std::numeric_limits<double>::quiet_NaN();
   CHECK_THROWS_AS(KdTree<2>(points), InputError);

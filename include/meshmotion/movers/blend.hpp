@@ -158,8 +158,9 @@ class BlendMover {
           bool any = false;
           for (const std::size_t b : active) {
             phi[b] = 0.0;
-            if (!distance[b].vertex_within(x, reach[b])) continue;
-            closest[b] = distance[b].closest(x);
+            const std::optional<detail::WallPoint<Dim>> near = distance[b].closest_within(x, reach[b]);
+            if (!near) continue;
+            closest[b] = *near;
             const double length = length_at(b, closest[b].facet);
             phi[b] = length > 0.0 ? rbf_value(RbfKernel::wendland2, closest[b].distance, length) : 0.0;
             any = any || phi[b] > 0.0;

@@ -10,11 +10,13 @@
 #include <nanoflann.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -141,19 +143,33 @@ class KdTree {
     return out;
   }
 
-  /// The nearest point strictly closer than `radius` to `query`, or none: the search is pruned
-  /// by the radius from its start. Points at about one distance all around the query (a
-  /// farfield circle seen from inside it) make nearest() visit nearly every one of them.
-  [[nodiscard]] std::optional<Neighbor> nearest_within(const Vec<Dim>& query, double radius) const {
-    if (size() == 0 || box_squared_distance(query) >= radius * radius) return std::nullopt;
-    std::size_t index = 0;
-    double distance = 0.0;
-    nanoflann::KNNResultSet<double, std::size_t, std::size_t> result(1);
-    result.init(&index, &distance);
-    distance = radius * radius;  // the worst distance the search accepts
+  /// Most neighbours one nearest_within() call returns.
+  static constexpr std::size_t max_within = 16;
+
+  /// The out.size() (at most max_within) nearest points strictly closer than `radius` to
+  /// `query`, nearest first, written to the front of `out`; returns their number. The search is
+  /// pruned by the radius from its start and allocates nothing: points at about one distance
+  /// all around the query (a farfield circle seen from inside it) make an unpruned search visit
+  /// nearly every one of them. An infinite radius gives the plain k nearest.
+  Index nearest_within(const Vec<Dim>& query, double radius, std::span<Neighbor> out) const {
+    if (out.size() > max_within)
+      throw InputError("KdTree::nearest_within: " + std::to_string(out.size()) + " neighbours asked (at most " +
+                       std::to_string(max_within) + ")");
+    if (out.empty() || size() == 0 || box_squared_distance(query) >= radius * radius) return 0;
+    std::array<std::size_t, max_within> indices{};
+    std::array<double, max_within> distances{};
+    nanoflann::KNNResultSet<double, std::size_t, std::size_t> result(out.size());
+    result.init(indices.data(), distances.data());
+    distances[out.size() - 1] = radius * radius;  // the worst distance the search accepts
     tree_->findNeighbors(result, query.data(), detail::RadiusSearchParameters{});
-    if (result.size() == 0) return std::nullopt;
-    return Neighbor{index, distance};
+    for (std::size_t i = 0; i < result.size(); ++i) out[i] = Neighbor{indices[i], distances[i]};
+    return static_cast<Index>(result.size());
+  }
+  /// The nearest point strictly closer than `radius` to `query`, or none.
+  [[nodiscard]] std::optional<Neighbor> nearest_within(const Vec<Dim>& query, double radius) const {
+    Neighbor found{};
+    if (nearest_within(query, radius, std::span<Neighbor>(&found, 1)) == 0) return std::nullopt;
+    return found;
   }
 
   /// The nearest point to `query` as (index, squared distance). Throws InputError on an empty tree.

@@ -22,6 +22,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <tuple>
@@ -132,6 +133,9 @@ class WallDistance {
   /// whose incident facets are searched. Throws InputError for a facet node out of range.
   WallDistance(const Points<Dim>& points, std::vector<WallFacet> facets, Index candidates = 4)
       : points_(&points), facets_(std::move(facets)), candidates_(candidates) {
+    if (candidates < 1 || static_cast<std::size_t>(candidates) > KdTree<Dim>::max_within)
+      throw InputError("WallDistance: " + std::to_string(candidates) + " candidate vertices (expected 1 to " +
+                       std::to_string(KdTree<Dim>::max_within) + ")");
     for (const WallFacet& f : facets_)
       for (int k = 0; k < num_nodes(f.type); ++k) {
         const Index v = f.nodes[static_cast<std::size_t>(k)];
@@ -165,10 +169,6 @@ class WallDistance {
   /// Sorted unique wall vertices.
   [[nodiscard]] const std::vector<Index>& vertices() const noexcept { return vertices_; }
 
-  /// Whether a wall vertex lies strictly closer than `radius` to p: far from the wall much
-  /// cheaper than nearest_vertex() (KdTree::nearest_within()).
-  [[nodiscard]] bool vertex_within(const Vec<Dim>& p, double radius) const { return tree_.nearest_within(p, radius).has_value(); }
-
   /// The wall vertex nearest to p (a mesh node index) and its distance.
   [[nodiscard]] std::pair<Index, double> nearest_vertex(const Vec<Dim>& p) const {
     const Neighbor n = tree_.nearest(p);
@@ -178,13 +178,25 @@ class WallDistance {
   /// Closest point of the wall to p. Throws InputError when the wall has no facet.
   [[nodiscard]] WallPoint<Dim> closest(const Vec<Dim>& p) const {
     if (facets_.empty()) throw InputError("WallDistance::closest: the wall has no facet");
+    return *closest_within(p, std::numeric_limits<double>::infinity());
+  }
+
+  /// closest(p) when a wall vertex lies strictly closer than `reach` to p, none otherwise: one
+  /// search pruned by the reach, far from the wall much cheaper than closest(). Candidate
+  /// vertices beyond the reach are left out, so a facet with a point within (reach − its
+  /// length) of p is always among those searched.
+  [[nodiscard]] std::optional<WallPoint<Dim>> closest_within(const Vec<Dim>& p, double reach) const {
+    std::array<Neighbor, KdTree<Dim>::max_within> near{};
+    const Index found = tree_.nearest_within(p, reach, std::span<Neighbor>(near.data(), static_cast<std::size_t>(candidates_)));
+    if (found == 0) return std::nullopt;
     WallPoint<Dim> best;
-    for (const Neighbor& n : tree_.nearest(p, candidates_))
-      for (Index k = offsets_[n.first]; k < offsets_[n.first + 1]; ++k) {
-        const Index f = incident_[static_cast<std::size_t>(k)];
-        const WallPoint<Dim> c = closest_on_facet(p, f);
+    for (Index i = 0; i < found; ++i) {
+      const std::size_t vertex = near[static_cast<std::size_t>(i)].first;
+      for (Index k = offsets_[vertex]; k < offsets_[vertex + 1]; ++k) {
+        const WallPoint<Dim> c = closest_on_facet(p, incident_[static_cast<std::size_t>(k)]);
         if (c.distance < best.distance) best = c;
       }
+    }
     return best;
   }
 
