@@ -208,6 +208,25 @@ TEST_CASE("every real mesh round-trips through all msh variants and SU2", "[io]"
   }
 }
 
+TEST_CASE("msh text formatted by several threads is the text of one thread", "[io]") {
+  // Over 3 × 2048 nodes and cells: records go to the threads in blocks, the last one partial;
+  // one parametric node splits the node runs (4.1) or makes the nodes $ParametricNodes (2.2).
+  Mesh<2> mesh = rectangle_mesh({.nx = 97, .ny = 83, .cells = RectangleCells::tri_quad});
+  mesh.node_params.assign(static_cast<std::size_t>(mesh.num_nodes()), NodeParametrization{2, 1, 0.0, 0.0});
+  mesh.node_params[5000] = NodeParametrization{1, 3, 0.25, 0.0};
+  for (const auto& options : msh_variants) {
+    const GmshWriteOptions gmsh{options.msh_version, options.binary};
+    set_num_threads(1);
+    const std::string one = format_gmsh(mesh, gmsh);
+    set_num_threads(3);
+    CHECK(format_gmsh(mesh, gmsh) == one);
+    const auto out = test::scratch_path("threads.msh");
+    write_mesh(out, mesh, options);
+    require_same_mesh(mesh, read_mesh_as<2>(out));
+  }
+  set_num_threads(0);
+}
+
 TEST_CASE("elements of every type and order round-trip with non-contiguous ids", "[io]") {
   for (const int element_order : {1, 2, 3, 4}) {
     for (const auto& options : msh_variants) {

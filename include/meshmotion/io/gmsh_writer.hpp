@@ -11,6 +11,7 @@
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/threads.hpp"
 #include "meshmotion/core/detail/atomic_file.hpp"
 #include "meshmotion/io/detail/number_format.hpp"
 
@@ -62,6 +63,50 @@ class GmshFormatter {
     output_.spill();
   }
 
+  // record(formatter, i) for i in [first, last), each ended as a line. ASCII records are
+  // formatted by the threads in blocks, each into its own reused buffer, and written in order:
+  // number formatting was the larger part of writing a curved mesh's file (the 30P30N's 257k P2
+  // nodes and 64k cells, 17 MB, 47 ms on one thread).
+  template <class Record>
+  void records(Index first, Index last, const Record& record) {
+    constexpr Index block = 4096;  // a P2 mesh's lines: about 200 kB of text per block
+    const int threads = binary_ ? 1 : static_cast<int>(std::min<Index>(num_threads(), (last - first) / block));
+    if (threads <= 1) {
+      for (Index i = first; i < last; ++i) {
+        record(*this, i);
+        end_of_record();
+      }
+      return;
+    }
+    // A cache line each: the threads update their buffer's size at every number.
+    struct alignas(64) Piece {
+      TextOutput output;
+    };
+    std::vector<Piece> pieces(static_cast<std::size_t>(threads));
+    RegionErrors errors;
+    for (Index start = first; start < last; start += threads * block) {
+#pragma omp parallel for num_threads(threads) schedule(static, 1)
+      for (int t = 0; t < threads; ++t)
+        errors.run([&] {
+          TextOutput& piece = pieces[static_cast<std::size_t>(t)].output;
+          piece.text.clear();
+          GmshFormatter local(piece, false);
+          for (Index i = start + t * block; i < std::min(last, start + (t + 1) * block); ++i) {
+            record(local, i);
+            local.end_of_record();
+          }
+        });
+      errors.rethrow();
+      for (const Piece& piece : pieces) {
+        const std::string& text = piece.output.text;
+        for (std::size_t at = 0; at < text.size(); at += TextOutput::chunk / 2) {
+          out.append(text, at, TextOutput::chunk / 2);
+          output_.spill();
+        }
+      }
+    }
+  }
+
  private:
   TextOutput& output_;
   bool binary_;
@@ -85,18 +130,17 @@ void format_gmsh_v2(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
   f.text(parametric ? "$ParametricNodes\n" : "$Nodes\n");
   f.ascii(mesh.num_nodes());
   f.text("\n");
-  for (Index i = 0; i < mesh.num_nodes(); ++i) {
-    f.value<std::int32_t>(msh_node_id(mesh, i));
-    for (int d = 0; d < 3; ++d) f.value<double>(d < Dim ? mesh.points(d, i) : 0.0);
+  f.records(0, mesh.num_nodes(), [&](GmshFormatter& g, Index i) {
+    g.value<std::int32_t>(msh_node_id(mesh, i));
+    for (int d = 0; d < 3; ++d) g.value<double>(d < Dim ? mesh.points(d, i) : 0.0);
     if (parametric) {
       const auto& p = mesh.node_params[static_cast<std::size_t>(i)];
-      f.value<int>(p.entity_dim);
-      f.value<int>(p.entity_tag);
-      if (p.entity_dim >= 1 && p.entity_dim <= 2) f.value<double>(p.u);
-      if (p.entity_dim == 2) f.value<double>(p.v);
+      g.value<int>(p.entity_dim);
+      g.value<int>(p.entity_tag);
+      if (p.entity_dim >= 1 && p.entity_dim <= 2) g.value<double>(p.u);
+      if (p.entity_dim == 2) g.value<double>(p.v);
     }
-    f.end_of_record();
-  }
+  });
   f.text(binary ? "\n" : "");
   f.text(parametric ? "$EndParametricNodes\n" : "$EndNodes\n");
   Index total = 0;
@@ -241,16 +285,12 @@ void format_gmsh_v4(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
     f.value<std::int32_t>(tag);
     f.value<std::int32_t>(num_params > 0 ? 1 : 0);
     size(static_cast<std::uint64_t>(last - first), '\n');
-    for (Index i = first; i < last; ++i) {
-      size(static_cast<std::uint64_t>(msh_node_id(mesh, i)), '\n');
-      f.end_of_record();
-    }
-    for (Index i = first; i < last; ++i) {
-      for (int d = 0; d < 3; ++d) f.value<double>(d < Dim ? mesh.points(d, i) : 0.0);
-      if (num_params > 0) f.value<double>(mesh.node_params[static_cast<std::size_t>(i)].u);
-      if (num_params > 1) f.value<double>(mesh.node_params[static_cast<std::size_t>(i)].v);
-      f.end_of_record();
-    }
+    f.records(first, last, [&](GmshFormatter& g, Index i) { g.value<std::uint64_t>(static_cast<std::uint64_t>(msh_node_id(mesh, i)), '\n'); });
+    f.records(first, last, [&](GmshFormatter& g, Index i) {
+      for (int d = 0; d < 3; ++d) g.value<double>(d < Dim ? mesh.points(d, i) : 0.0);
+      if (num_params > 0) g.value<double>(mesh.node_params[static_cast<std::size_t>(i)].u);
+      if (num_params > 1) g.value<double>(mesh.node_params[static_cast<std::size_t>(i)].v);
+    });
   }
   f.text(binary ? "\n" : "");
   f.text("$EndNodes\n");
@@ -293,11 +333,10 @@ void format_gmsh_v4(GmshFormatter& f, const Mesh<Dim>& mesh, bool binary) {
     f.value<std::int32_t>(run.entity);
     f.value<std::int32_t>(element_info(run.block->type).gmsh_id);
     size(static_cast<std::uint64_t>(run.last - run.first), '\n');
-    for (Index e = run.first; e < run.last; ++e) {
-      size(static_cast<std::uint64_t>(element_id(*run.block, e, block_start + e)));
-      for (const Index v : run.block->element(e)) size(static_cast<std::uint64_t>(msh_node_id(mesh, v)));
-      f.end_of_record();
-    }
+    f.records(run.first, run.last, [&](GmshFormatter& g, Index e) {
+      g.value<std::uint64_t>(static_cast<std::uint64_t>(element_id(*run.block, e, block_start + e)));
+      for (const Index v : run.block->element(e)) g.value<std::uint64_t>(static_cast<std::uint64_t>(msh_node_id(mesh, v)));
+    });
     position = block_start + run.last;
   }
   f.text(binary ? "\n" : "");

@@ -14,7 +14,9 @@ template <class T>
 void append_number(std::string& out, T value) {
   char buffer[32];
   const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  out.append(buffer, result.ptr);
+  // (pointer, count): the (first, last) overload goes through replace(), a fifth of the time
+  // of formatting a mesh's coordinates.
+  out.append(buffer, static_cast<std::size_t>(result.ptr - buffer));
 }
 
 /// Appends the bytes of a trivially copyable value (native byte order) to a binary buffer.
