@@ -10,6 +10,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <tuple>
 #include <vector>
 
 using namespace meshmotion;
@@ -168,7 +169,7 @@ TEST_CASE("walls without a layer: the blend follows the wall where it bulges int
   CHECK(curved.quality.min > curve_mesh(linear, snap_only).quality.min);
 }
 
-TEST_CASE("walls without a layer: the RBF radius of each wall node is twice its facets' node spacing", "[curving]") {
+TEST_CASE("walls without a layer: the RBF radius of a wall node is twice its facets' node spacing, half where they bulge away", "[curving]") {
   const Mesh<2> linear = isotropic_gap();
   for (const int p : {2, 3}) {
     INFO("order " << p);
@@ -180,9 +181,10 @@ TEST_CASE("walls without a layer: the RBF radius of each wall node is twice its 
     const CurveResult<2> curved = curve_mesh(linear, options);
     CHECK(curved.invalid() == 0);
     REQUIRE(curved.wall_support_radii.size() == 2);
-    // 32 facets around each circle: chord 2 r sin(pi / 32), split into p node spacings.
-    for (const auto& [w, r] : {std::pair{0, 0.5}, std::pair{1, 1.5}})
-      CHECK(curved.wall_support_radii[static_cast<std::size_t>(w)] == Approx(2.0 * 2.0 * r * std::sin(std::numbers::pi / 32) / p));
+    // 32 facets around each circle: chord 2 r sin(pi / 32), split into p node spacings. The
+    // shaft's facets bulge into the gap's cells, the housing's away from them.
+    for (const auto& [w, r, spacings] : {std::tuple{0, 0.5, 2.0}, std::tuple{1, 1.5, 0.5}})
+      CHECK(curved.wall_support_radii[static_cast<std::size_t>(w)] == Approx(spacings * 2.0 * r * std::sin(std::numbers::pi / 32) / p));
   }
 }
 

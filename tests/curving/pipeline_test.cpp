@@ -387,11 +387,12 @@ TEST_CASE("pipeline: boundary-layer mesh (aspect ratio >= 1000) needs the regula
     CHECK(curved.layers[0].thickness > 100 * o.first_height);
     CHECK(curved.layers[1].thickness == 0.0);
     if (method != "rbf") continue;
-    // The wall's radius follows its layer; the farfield, without one, gets 2 of its node
-    // spacings (the wall of inner_nodes_test.cpp checks the value).
+    // The wall's radius follows its layer; the farfield, without one and snapped away from its
+    // cells, gets half its node spacing (half the chord of 128 facets on R = 20 at P2).
     REQUIRE(curved.wall_support_radii.size() == 2);
     CHECK(curved.wall_support_radii[0] == options.support_radius_factor * curved.layers[0].thickness);
-    CHECK(curved.wall_support_radii[1] > 5 * curved.wall_support_radii[0]);
+    CHECK(curved.wall_support_radii[1] == Approx(0.5 * 20.0 * std::sin(std::numbers::pi / 128.0)));
+    REQUIRE(curved.wall_support_radii[1] > curved.wall_support_radii[0]);
     CHECK(curved.support_radius == curved.wall_support_radii[1]);
   }
 }
@@ -445,6 +446,33 @@ TEST_CASE("pipeline: each wall's RBF support follows its own boundary layer", "[
     between += from_shaft > r_inner && from_shaft < r_outer ? 1 : 0;
   }
   CHECK(between > 0);
+}
+
+TEST_CASE("pipeline: under the RBF a farfield snapped outward moves only its own nodes", "[curving]") {
+  // An O-mesh: a wall with a layer, and a farfield circle (R = 20, no layer) whose facets bulge
+  // away from their cells when snapped. Its centres get half a node spacing, which reaches no
+  // other node; at 2 spacings the 30P30N's farfield made the RBF system 0.91M nonzeros.
+  const Mesh<2> linear = o_mesh({.n_around = 64, .n_radial = 24});
+  CurveOptions<2> options;
+  options.method = "rbf";
+  options.geometry.emplace("wall", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 0.5)));
+  options.geometry.emplace("farfield", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 20.0)));
+  options.untangle.enabled = false;  // its rounds raise the worst cells anywhere
+  const CurveResult<2> curved = curve_mesh(linear, options);
+  REQUIRE(curved.layers.size() == 2);
+  REQUIRE(curved.layers[1].thickness == 0.0);
+  REQUIRE(curved.wall_support_radii.size() == 2);
+  const double chord = 2.0 * 20.0 * std::sin(std::numbers::pi / 64.0);
+  CHECK(curved.wall_support_radii[1] == Approx(0.5 * chord / 2.0));
+  CHECK(curved.invalid() == 0);
+  Index stayed = 0;
+  for (Index v = 0; v < linear.num_nodes(); ++v) {
+    const double r = linear.points.col(v).norm();
+    if (r <= 0.5 + curved.wall_support_radii[0] || r > 20.0 - 1e-9) continue;
+    CHECK(curved.curved.points.col(v) == linear.points.col(v));
+    ++stayed;
+  }
+  CHECK(stayed > 64 * 4);
 }
 
 TEST_CASE("pipeline: each wall's RBF support follows its own layer in 3D (two cylinders)", "[curving]") {

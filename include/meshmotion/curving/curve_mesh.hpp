@@ -41,6 +41,7 @@
 #include "meshmotion/movers/any_mover.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/boundary_layer.hpp"
+#include "meshmotion/movers/detail/wall_distance.hpp"
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/movers/mover_options.hpp"
 #include "meshmotion/movers/rbf.hpp"
@@ -97,7 +98,8 @@ struct CurveOptions {
   /// 4 in 2D, 1 in 3D (a larger 3D support multiplies the factorization's cost).
   double support_radius_factor = Dim == 2 ? 4.0 : 1.0;
   /// With the default radius, each curved wall's centres get the radius of its own layer
-  /// (walls without a layer: each node 2 node spacings of its own facets,
+  /// (walls without a layer: each node 2 node spacings of its own facets, half one where a
+  /// facet is snapped away from its cell,
   /// local_spacing_radii()), and the other boundary centres the radius of the nearest moving
   /// wall node, so a thin layer is not overrun by the support of a thick one. false: the
   /// thickest layer's radius everywhere (the thesis's one radius). Differing radii make the
@@ -553,27 +555,42 @@ struct DefaultRadii {
   bool limited = false;          ///< some wall's layer radius was shrunk to max_support_nodes
 };
 
-/// For the nodes of the facets tagged `tag`: `factor` × the node spacing of the largest facet
-/// holding the node (its mean vertex-to-vertex edge length over the order), written into
-/// `radii` (num_nodes entries). A wall without a boundary layer has nothing else to size its
-/// motion by, and its spacing varies: on the RAE2822 the leading edge's cells are 0.007 wide
-/// where the wall's median spacing gives a radius of 0.058, which spreads the leading edge's
-/// displacement over many cells and lowers the snapped quality (0.79 to 0.61 at P2). With
-/// factor 2 the RBF raises it instead at orders 2 to 4; 1 leaves it as snapped, 4 lowers it
+/// For the nodes of the facets tagged `tag`: 2 × the node spacing of the largest facet holding
+/// the node (its mean vertex-to-vertex edge length over the order), written into `radii`
+/// (num_nodes entries). A wall without a boundary layer has nothing else to size its motion
+/// by, and its spacing varies: on the RAE2822 the leading edge's cells are 0.007 wide where
+/// the wall's median spacing gives a radius of 0.058, which spreads the leading edge's
+/// displacement over many cells and lowers the snapped quality (0.79 to 0.61 at P2). With 2
+/// the RBF raises it instead at orders 2 to 4; 1 leaves it as snapped, 4 lowers it
 /// (docs/curving.md, "A radius per node on walls without a layer").
+/// A facet snapped away from its cell (detail::bulging_away(): a farfield circle) only enlarges
+/// it, and one that hardly moves has nothing to spread: they get half their spacing, which
+/// reaches no other node, so their motion stays on them, as the blend leaves the first. At 2 spacings the 30P30N's farfield nodes took a radius of 1.03 and the RBF
+/// system 0.91M nonzeros (2.0 s) for the minimum that 0.0022 gives in 0.2 s.
 template <int Dim>
-void local_spacing_radii(const Mesh<Dim>& mesh, int tag, double factor, std::vector<double>& radii) {
-  for (const auto& block : mesh.facets) {
-    const auto sides = edges(block.type);
-    const int p = order(block.type);
-    for (Index e = 0; e < block.size(); ++e) {
-      if (block.tags[static_cast<std::size_t>(e)] != tag) continue;
-      const auto el = block.element(e);
-      double length = 0.0;
-      for (const auto& side : sides)
-        length += (mesh.points.col(el[static_cast<std::size_t>(side[0])]) - mesh.points.col(el[static_cast<std::size_t>(side[1])])).norm();
-      const double radius = factor * length / static_cast<double>(sides.size() * static_cast<std::size_t>(p));
-      for (const Index v : el) radii[static_cast<std::size_t>(v)] = std::max(radii[static_cast<std::size_t>(v)], radius);
+void local_spacing_radii(const Mesh<Dim>& mesh, int tag, const SnappedBoundary<Dim>& snapped, std::vector<double>& radii) {
+  const std::vector<WallFacet> wall = wall_facets(mesh, std::span<const int>(&tag, 1));
+  const auto displacement = [&](Index v) -> Vec<Dim> {
+    const auto it = std::lower_bound(snapped.nodes.begin(), snapped.nodes.end(), v);
+    if (it == snapped.nodes.end() || *it != v) return Vec<Dim>::Zero();
+    return snapped.displacements.col(static_cast<Index>(it - snapped.nodes.begin()));
+  };
+  const std::vector<char> away = bulging_away(mesh, wall, displacement);
+  for (std::size_t i = 0; i < wall.size(); ++i) {
+    const WallFacet& f = wall[i];
+    const auto sides = edges(f.type);
+    double length = 0.0;
+    for (const auto& side : sides)
+      length += (mesh.points.col(f.nodes[static_cast<std::size_t>(side[0])]) - mesh.points.col(f.nodes[static_cast<std::size_t>(side[1])])).norm();
+    const double spacing = length / static_cast<double>(sides.size() * static_cast<std::size_t>(order(f.type)));
+    // A facet moved by at most 2% of its spacing dents its cell by as little: the 30P30N
+    // farfield's flat side has 49 such facets bulging inward where the spline meets its arc.
+    const auto nodes = std::span<const Index>(f.nodes.data(), static_cast<std::size_t>(num_nodes(f.type)));
+    const bool slight = std::all_of(nodes.begin(), nodes.end(), [&](Index v) { return displacement(v).norm() <= 0.02 * spacing; });
+    const double radius = (away[i] != 0 || slight ? 0.5 : 2.0) * spacing;
+    for (int k = 0; k < num_nodes(f.type); ++k) {
+      double& r = radii[static_cast<std::size_t>(f.nodes[static_cast<std::size_t>(k)])];
+      r = std::max(r, radius);
     }
   }
 }
@@ -601,7 +618,7 @@ template <int Dim, class Keep>
 
 /// The default radii of the curved `walls` (wall_of: wall_of_nodes()): support_radius_factor ×
 /// each wall's layer thickness, limited to max_support_nodes boundary nodes per support around
-/// the wall's moving nodes; a wall without a layer gets a radius per node, 2 × its facets' node
+/// the wall's moving nodes; a wall without a layer gets a radius per node from its facets' node
 /// spacing (local_spacing_radii(); per_wall: the largest of them).
 /// The uniform radius is the largest layer radius, or spacing_radius() of every snapped node
 /// when no wall has a layer.
@@ -628,7 +645,7 @@ template <int Dim>
   for (std::size_t w = 0; w < layers.size(); ++w)
     if (!(out.per_wall[w] > 0.0)) {
       if (out.per_node.empty()) out.per_node.assign(static_cast<std::size_t>(mesh.num_nodes()), 0.0);
-      local_spacing_radii(mesh, layers[w].tag, 2.0, out.per_node);
+      local_spacing_radii(mesh, layers[w].tag, snapped, out.per_node);
       for (const Index v : moving[w]) out.per_wall[w] = std::max(out.per_wall[w], out.per_node[static_cast<std::size_t>(v)]);
       if (!(out.per_wall[w] > 0.0)) out.per_wall[w] = out.uniform;
     }

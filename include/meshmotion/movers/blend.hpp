@@ -49,7 +49,6 @@
 #include <span>
 #include <utility>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 namespace meshmotion {
@@ -304,62 +303,22 @@ class BlendMover {
     for (std::size_t b = 0; b < walls.size(); ++b) {
       lengths[b] = options_.blending_factor * thickness[b];
       if (lengths[b] > 0.0) continue;
-      const std::vector<Vec<Dim>> inward = inward_directions(mesh, walls[b]);
+      // A facet bulging away from its cell is left alone (the NACA0012's farfield circle:
+      // 0.9964 as snapped, 0.978 blended over one facet).
+      const std::vector<char> away = detail::bulging_away(mesh, walls[b], [&](Index v) {
+        return boundary_.displacements.col(slot_[static_cast<std::size_t>(v)]);
+      });
       for (std::size_t i = 0; i < walls[b].size(); ++i) {
         const detail::WallFacet& f = walls[b][i];
         const auto sides = edges(f.type);
         double size = 0.0;
         for (const auto& side : sides)
           size += (mesh.points.col(f.nodes[static_cast<std::size_t>(side[0])]) - mesh.points.col(f.nodes[static_cast<std::size_t>(side[1])])).norm();
-        // A facet bulging away from its cell only enlarges it: the snapped cell, its inside
-        // nodes placed from its edges, is better left alone than sheared by a blend (the
-        // NACA0012's farfield circle: 0.9964 alone, 0.978 blended over one facet).
-        Vec<Dim> bulge = Vec<Dim>::Zero();
-        for (int j = num_vertices(f.type); j < num_nodes(f.type); ++j)
-          bulge += boundary_.displacements.col(slot_[static_cast<std::size_t>(f.nodes[static_cast<std::size_t>(j)])]);
-        const bool away = bulge.dot(inward[i]) < 0.0;
-        facet_lengths_[b].push_back(!away ? options_.fallback_spacings * size / static_cast<double>(sides.size()) : 0.0);
+        facet_lengths_[b].push_back(!away[i] ? options_.fallback_spacings * size / static_cast<double>(sides.size()) : 0.0);
         lengths[b] = std::max(lengths[b], facet_lengths_[b].back());
       }
     }
     return lengths;
-  }
-
-  // For each facet of a wall, the direction from its centroid to that of the cell holding it
-  // (zero when no cell holds it).
-  [[nodiscard]] static std::vector<Vec<Dim>> inward_directions(const Mesh<Dim>& mesh, const std::vector<detail::WallFacet>& wall) {
-    std::unordered_map<Index, std::vector<std::pair<std::size_t, Index>>> cells_at;  // wall vertex -> (block, cell)
-    for (const auto& f : wall)
-      for (int j = 0; j < num_vertices(f.type); ++j) cells_at.try_emplace(f.nodes[static_cast<std::size_t>(j)]);
-    for (std::size_t blk = 0; blk < mesh.cells.size(); ++blk) {
-      const ElementBlock& block = mesh.cells[blk];
-      for (Index c = 0; c < block.size(); ++c) {
-        const auto el = block.element(c);
-        for (int j = 0; j < num_vertices(block.type); ++j)
-          if (const auto it = cells_at.find(el[static_cast<std::size_t>(j)]); it != cells_at.end()) it->second.emplace_back(blk, c);
-      }
-    }
-    const auto centroid = [&](const ElementType type, const auto& nodes) {
-      Vec<Dim> x = Vec<Dim>::Zero();
-      for (int j = 0; j < num_vertices(type); ++j) x += mesh.points.col(nodes[static_cast<std::size_t>(j)]);
-      return Vec<Dim>(x / num_vertices(type));
-    };
-    std::vector<Vec<Dim>> out(wall.size(), Vec<Dim>::Zero());
-    for (std::size_t i = 0; i < wall.size(); ++i) {
-      const detail::WallFacet& f = wall[i];
-      for (const auto& [blk, c] : cells_at[f.nodes[0]]) {
-        const auto el = mesh.cells[blk].element(c);
-        const int nv = num_vertices(mesh.cells[blk].type);
-        const bool holds = std::all_of(f.nodes.begin(), f.nodes.begin() + num_vertices(f.type), [&](Index v) {
-          return std::find(el.begin(), el.begin() + nv, v) != el.begin() + nv;
-        });
-        if (holds) {
-          out[i] = centroid(mesh.cells[blk].type, el) - centroid(f.type, f.nodes);
-          break;
-        }
-      }
-    }
-    return out;
   }
 
   BlendOptions options_;

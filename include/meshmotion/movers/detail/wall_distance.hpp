@@ -26,6 +26,7 @@
 #include <span>
 #include <string>
 #include <tuple>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -50,6 +51,61 @@ template <int Dim>
       out.push_back(f);
     }
   return out;
+}
+
+/// For each facet of a wall, the direction from its centroid to that of the cell holding it
+/// (zero when no cell holds it).
+template <int Dim>
+[[nodiscard]] std::vector<Vec<Dim>> inward_directions(const Mesh<Dim>& mesh, const std::vector<WallFacet>& wall) {
+  std::unordered_map<Index, std::vector<std::pair<std::size_t, Index>>> cells_at;  // wall vertex -> (block, cell)
+  for (const auto& f : wall)
+    for (int j = 0; j < num_vertices(f.type); ++j) cells_at.try_emplace(f.nodes[static_cast<std::size_t>(j)]);
+  for (std::size_t blk = 0; blk < mesh.cells.size(); ++blk) {
+    const ElementBlock& block = mesh.cells[blk];
+    for (Index c = 0; c < block.size(); ++c) {
+      const auto el = block.element(c);
+      for (int j = 0; j < num_vertices(block.type); ++j)
+        if (const auto it = cells_at.find(el[static_cast<std::size_t>(j)]); it != cells_at.end()) it->second.emplace_back(blk, c);
+    }
+  }
+  const auto centroid = [&](const ElementType type, const auto& nodes) {
+    Vec<Dim> x = Vec<Dim>::Zero();
+    for (int j = 0; j < num_vertices(type); ++j) x += mesh.points.col(nodes[static_cast<std::size_t>(j)]);
+    return Vec<Dim>(x / num_vertices(type));
+  };
+  std::vector<Vec<Dim>> out(wall.size(), Vec<Dim>::Zero());
+  for (std::size_t i = 0; i < wall.size(); ++i) {
+    const WallFacet& f = wall[i];
+    for (const auto& [blk, c] : cells_at[f.nodes[0]]) {
+      const auto el = mesh.cells[blk].element(c);
+      const int nv = num_vertices(mesh.cells[blk].type);
+      const bool holds = std::all_of(f.nodes.begin(), f.nodes.begin() + num_vertices(f.type), [&](Index v) {
+        return std::find(el.begin(), el.begin() + nv, v) != el.begin() + nv;
+      });
+      if (holds) {
+        out[i] = centroid(mesh.cells[blk].type, el) - centroid(f.type, f.nodes);
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+/// Whether each facet bulges away from the cell holding it: the displacements of its nodes
+/// beyond its vertices (displacement(node), a Dim-vector) point, summed, against the facet's
+/// inward direction. Such a facet only enlarges its cell (a farfield circle snapped outward):
+/// the snapped cell is better left alone than its motion spread into the interior.
+template <int Dim, class Displacement>
+[[nodiscard]] std::vector<char> bulging_away(const Mesh<Dim>& mesh, const std::vector<WallFacet>& wall, const Displacement& displacement) {
+  const std::vector<Vec<Dim>> inward = inward_directions(mesh, wall);
+  std::vector<char> away(wall.size(), 0);
+  for (std::size_t i = 0; i < wall.size(); ++i) {
+    const WallFacet& f = wall[i];
+    Vec<Dim> bulge = Vec<Dim>::Zero();
+    for (int j = num_vertices(f.type); j < num_nodes(f.type); ++j) bulge += displacement(f.nodes[static_cast<std::size_t>(j)]);
+    away[i] = bulge.dot(inward[i]) < 0.0 ? 1 : 0;
+  }
+  return away;
 }
 
 /// Closest point on a wall: facet index, reference coordinates there, point and distance.
