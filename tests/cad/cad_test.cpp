@@ -491,6 +491,39 @@ TEST_CASE("CAD: the local search from nearby parameters finds the face's closest
   CHECK_THROWS_WITH(sphere.closest_point_near(2, sphere.num_faces() + 1, Vec<3>::Zero(), 0.0, 0.0), Catch::Contains("no face"));
 }
 
+TEST_CASE("CAD: points on a B-spline face and just off it project along the normal", "[cad]") {
+  // The sphere's faces are B-splines: a point on one, or pushed a little along the sphere's
+  // normal, has that surface point as its closest (found from the face's sample grid, or
+  // by the global search farther off, alike).
+  MESHMOTION_REQUIRE_DATA(sphere_mesh, "meshopt_sphere_symmetry_linear_tet.msh");
+  MESHMOTION_REQUIRE_DATA(sphere_step, "meshopt_Sphere25CSymmetry.stp");
+  const CadModel sphere = CadModel::read(sphere_step);
+  const auto match = match_cad_groups(read_mesh_as<3>(sphere_mesh), sphere, 0.0, {"7"}).front();
+  REQUIRE(match.located.size() > 20);
+  // The sphere's centre and radius, fitted: |x|² = 2 c·x + (R² − |c|²) is linear in c and R².
+  Eigen::MatrixXd a(static_cast<Index>(match.located.size()), 4);
+  Eigen::VectorXd b(a.rows());
+  for (Index i = 0; i < a.rows(); ++i) {
+    const Vec<3>& x = match.located[static_cast<std::size_t>(i)].second.point;
+    a.row(i) << 2.0 * x.transpose(), 1.0;
+    b(i) = x.squaredNorm();
+  }
+  const Eigen::Vector4d fit = a.colPivHouseholderQr().solve(b);
+  const Vec<3> centre = fit.head<3>();
+  const double radius = std::sqrt(fit(3) + centre.squaredNorm());
+  const double scale = sphere.diagonal();
+  for (const double push : {0.0, 1e-5, -1e-5, 0.02}) {
+    CAPTURE(push);
+    for (const auto& [x, on] : match.located) {
+      const Vec<3> normal = (on.point - centre).normalized();
+      const CadPoint c = sphere.closest_point(2, on.index, on.point + push * scale * normal);
+      CHECK((c.point - on.point).norm() < 1e-6 * scale);
+      CHECK(c.distance == Approx(std::abs(push) * scale).margin(1e-6 * scale));
+      CHECK(std::abs((c.point - centre).norm() - radius) < 1e-5 * radius);
+    }
+  }
+}
+
 TEST_CASE("CAD: arc lengths along a face's isolines, across its seams, in every format", "[cad]") {
   // On the torus of radii 1 and 0.3, an isoline is a circle: the point at a fraction of the
   // arc length between two points is at that fraction of the angle between them, whatever
