@@ -27,6 +27,8 @@ ranks' rows together are the serial gradient. Methods: rbf (with derivatives), l
 (PETSc). The result equals the serial Warp's to round-off (RBF).
 """
 
+import warnings as _warnings
+
 import numpy as _np
 
 from . import _core
@@ -93,6 +95,11 @@ class Warp:
         self._volume = self._reference.copy()
         self._volume_view = self._volume.view()
         self._volume_view.flags.writeable = False
+        if self.condition > CONDITION_WARNING and (comm is None or comm.Get_rank() == 0):
+            _warnings.warn(f"Warp: the RBF system's condition number is at least {self.condition:.1e}: warp_derivative "
+                           f"may carry relative rounding errors up to {self.condition * 2.2e-16:.0e} (a smaller "
+                           "support_radius, or centres less close together, conditions it better)",
+                           RuntimeWarning, stacklevel=2)
 
     def _partition(self, mesh, design, symmetry, fixed, orientation, cell_ranks):
         """Rank 0 reads and resolves; every rank gets its part, its boundary entries and its
@@ -130,6 +137,12 @@ class Warp:
         mine[mine] = owned[where[mine]] == design_ids[mine]
         self._design = where[mine]  # owned local nodes, by ascending global id
         return boundary
+
+    @property
+    def condition(self):
+        """A lower bound of the interpolation system's condition number (RBF; 0 for methods
+        without one): rounding in warp_derivative grows by up to this factor."""
+        return float(self._mover.stats["condition"])
 
     @property
     def dim(self):
@@ -287,13 +300,18 @@ class Warp:
         error = abs(adjoint - finite_difference) / max(abs(finite_difference), 1e-300)
         if verbose and (self._comm is None or self._comm.Get_rank() == 0):
             print(f"verify_derivative: adjoint {adjoint:.12e}, finite difference {finite_difference:.12e}, "
-                  f"relative error {error:.3e}")
+                  f"relative error {error:.3e}, condition >= {self.condition:.1e}")
         return error
 
     def _sum(self, terms, owned_only=True):
         """Σ of terms over the nodes (rows) each rank owns, over every rank."""
         local = float(_np.sum(terms[:self._num_owned] if owned_only else terms))
         return local if self._comm is None else self._comm.allreduce(local)
+
+
+#: Warp warns when the RBF system's condition estimate exceeds this: warp_derivative's
+#: rounding may then reach 1e-4 of its values.
+CONDITION_WARNING = 1e12
 
 
 def _raise_everywhere(comm, failure):

@@ -4,6 +4,7 @@ differences, the Warp class, errors mapped to Python exceptions."""
 
 import os
 import pathlib
+import warnings
 
 import numpy as np
 import pytest
@@ -236,6 +237,20 @@ def test_warp_in_an_optimization_loop():
         w.set_surface_order(np.concatenate([order[:-1], [mesh.groups["top"][3]]]))
     with pytest.raises(ValueError, match="shape"):
         w.set_surface_coordinates(bump[:-1])
+
+
+def test_warp_reports_its_conditioning_and_warns_when_gradients_lose_digits():
+    mesh = grid()
+    conditions = []
+    for radius in (0.6, 3.0):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # a well-conditioned Warp warns of nothing
+            conditions.append(mm.Warp(mesh, design=["bottom"], fixed=["top"], support_radius=radius).condition)
+    assert 1.0 <= conditions[0] < conditions[1]
+    with pytest.warns(RuntimeWarning, match="condition number is at least"):
+        w = mm.Warp(mesh, design=["bottom"], fixed=["top"], support_radius=2000.0)
+    assert w.condition > mm.warp.CONDITION_WARNING
+    assert mm.Warp(mesh, design=["bottom"], fixed=["top"], method="le").condition == 0.0
 
 
 def test_warp_returns_a_read_only_view_and_allocates_no_volume_array():

@@ -2,8 +2,10 @@
 
 #include "random_field.hpp"
 
+#include <Eigen/SVD>
 #include <catch2/catch.hpp>
 
+#include <numbers>
 #include <random>
 
 using namespace meshmotion;
@@ -339,6 +341,88 @@ TEST_CASE("a support radius per boundary entry: interpolation, reach of each cen
     options.support_radii[5] = 0.0;
     CHECK_THROWS_WITH(RbfMover<2>(options).setup(g.mesh, boundary), Catch::Contains("boundary entry 5 (node"));
   }
+}
+
+TEST_CASE("radii differing only between centres out of each other's reach keep the RBF system symmetric", "[movers]") {
+  // Two rings of 32 centres (spacing 0.196), each with its own radius; a ring's radius reaches
+  // its own neighbours, and the other ring only when the rings are moved close.
+  const auto rings = [](double gap) {
+    Points<2> c(2, 64);
+    for (Index i = 0; i < 32; ++i) {
+      const double t = 2.0 * std::numbers::pi * double(i) / 32.0;
+      c.col(i) = Vec<2>(std::cos(t), std::sin(t));
+      c.col(32 + i) = Vec<2>(2.0 + gap + std::cos(t), std::sin(t));
+    }
+    return c;
+  };
+  detail::RbfKernelSettings kernel;
+  for (Index i = 0; i < 64; ++i) kernel.radii.push_back(i < 32 ? 0.5 : 0.8);
+  kernel.radius = 0.8;
+  for (const double gap : {8.0, 0.3}) {
+    CAPTURE(gap);
+    const Points<2> c = rings(gap);
+    detail::RbfSystem<2> system;
+    system.setup(c, kernel, SolverOptions{}, DenseSolverKind::partial_piv_lu, 4000);
+    CHECK(system.symmetric() == (gap > 1.0));
+    const Points<2> values = random_displacements<2>(64, 11, 1.0);
+    Eigen::MatrixXd alpha;
+    detail::RbfPolynomial<2>::Coefficients beta;
+    system.solve(values.transpose(), alpha, beta);
+    // Interpolation: Σ_j α_j φ(|c_i − c_j| / ρ_j) = values_i, summed here over every centre.
+    Eigen::MatrixXd a(64, 64);
+    for (Index i = 0; i < 64; ++i)
+      for (Index j = 0; j < 64; ++j) a(i, j) = rbf_value(kernel.kernel, (c.col(i) - c.col(j)).norm(), kernel.radius_of(j));
+    CHECK((a * alpha - values.transpose()).norm() < 1e-12 * values.norm());
+    // The transposed solve (the reverse derivative) is Aᵀ's, from the factorization kept
+    // (symmetric) or from Aᵀ's own.
+    const Eigen::MatrixXd bar = random_displacements<2>(64, 12, 1.0).transpose();
+    Eigen::MatrixXd values_bar;
+    system.solve_transpose(bar, detail::RbfPolynomial<2>::Coefficients::Zero(), values_bar);
+    CHECK((a.transpose() * values_bar - bar).norm() < 1e-12 * bar.norm());
+  }
+}
+
+TEST_CASE("the RBF condition estimate is a close lower bound, and an ill-conditioned system still sets up", "[movers]") {
+  // A ring of 48 centres and one more 1e-5 from the first, as a blunt trailing edge's two
+  // sides: the condition grows with the radius, past 1e11.
+  Points<2> c(2, 49);
+  for (Index i = 0; i < 48; ++i) {
+    const double t = 2.0 * std::numbers::pi * double(i) / 48.0;
+    c.col(i) = Vec<2>(std::cos(t), std::sin(t));
+  }
+  c.col(48) = c.col(0) + Vec<2>(0.0, 1e-5);
+  double previous = 0.0;
+  for (const double radius : {0.2, 0.5, 2.0}) {
+    CAPTURE(radius);
+    detail::RbfKernelSettings kernel;
+    kernel.radius = radius;
+    detail::RbfSystem<2> system;
+    system.setup(c, kernel, SolverOptions{}, DenseSolverKind::partial_piv_lu, 4000);
+    Eigen::MatrixXd a(49, 49);
+    for (Index i = 0; i < 49; ++i)
+      for (Index j = 0; j < 49; ++j) a(i, j) = rbf_value(kernel.kernel, (c.col(i) - c.col(j)).norm(), radius);
+    const Eigen::VectorXd sigma = Eigen::JacobiSVD<Eigen::MatrixXd>(a).singularValues();
+    const double exact = sigma(0) / sigma(sigma.size() - 1);
+    CHECK(system.condition() <= exact * (1.0 + 1e-6));
+    CHECK(system.condition() >= exact / 2.0);
+    CHECK(system.condition() > previous);
+    previous = system.condition();
+  }
+  CHECK(previous > 1e11);
+  // The mover reports it, largest over its systems.
+  const Grid<2> g = grid<2>(12);
+  BoundarySpec<2> spec;
+  spec.fixed("outer");
+  const auto boundary = spec.resolve(g.mesh.points, with_outer<2>(g.groups));
+  RbfOptions options;
+  options.support_radius = 0.3;
+  RbfMover<2> small(options);
+  small.setup(g.mesh, boundary);
+  options.support_radius = 3.0;
+  RbfMover<2> large(options);
+  large.setup(g.mesh, boundary);
+  CHECK(small.stats().condition >= 1.0);
+  CHECK(large.stats().condition > 100.0 * small.stats().condition);
 }
 
 TEST_CASE("global kernels refuse large systems and suggest a compact kernel", "[movers]") {

@@ -24,6 +24,9 @@ struct MoverStats {
   Index boundary_nodes = 0;    ///< constrained nodes after merging coincident ones
   Index evaluated_nodes = 0;   ///< nodes whose displacement the mover computes (others stay put)
   Index nonzeros = 0;          ///< stored nonzeros of the system and evaluation operators
+  /// A lower bound of the interpolation system's 2-norm condition number (RBF: the largest
+  /// over its systems or patches); 0 where the mover has none or does not estimate it.
+  double condition = 0.0;
 };
 
 template <class F>
@@ -38,6 +41,7 @@ void visit_fields(const MoverStats& s, F&& f) {
   f("boundary_nodes", s.boundary_nodes, "constrained nodes after merging coincident ones");
   f("evaluated_nodes", s.evaluated_nodes, "nodes whose displacement the mover computes");
   f("nonzeros", s.nonzeros, "stored nonzeros of the system and evaluation operators");
+  f("condition", s.condition, "lower bound of the RBF system's condition number (0: not estimated)");
 }
 
 /// A mesh mover in Dim = M::dim dimensions.

@@ -72,8 +72,9 @@ struct RbfOptions {
   /// A radius per boundary entry (in the order of the boundary given to setup), replacing
   /// support_radius; empty: support_radius everywhere. Coincident nodes share the radius of
   /// the one that gives their value. Lets each wall's support follow its own boundary layer.
-  /// Differing radii make the interpolation matrix nonsymmetric: it is factorized by sparse LU
-  /// whatever `solver` says (BiCGSTAB is kept).
+  /// Radii that differ between centres within each other's support make the interpolation
+  /// matrix nonsymmetric: it is then factorized by sparse LU whatever `solver` says (BiCGSTAB
+  /// is kept). Walls whose supports do not meet keep it symmetric, and `solver` applies.
   std::vector<double> support_radii{};
   /// Add a linear polynomial (reproduces affine motions exactly). Always on for the kernels
   /// that need it (needs_polynomial(): tps, multiquadric; without it a rotation moved by tps
@@ -556,6 +557,8 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   build_evaluation(kernel);
   stats_.factorizations = with_all([](auto& system) { return system.report().factorizations; }) +
                           (n_centres_ > n_constrained_ ? with_constrained([](auto& system) { return system.report().factorizations; }) : 0);
+  stats_.condition = std::max(with_all([](auto& system) { return system.condition(); }),
+                              n_centres_ > n_constrained_ ? with_constrained([](auto& system) { return system.condition(); }) : 0.0);
   ready_ = true;
   stats_.setup_seconds = watch.seconds();
 }

@@ -87,6 +87,11 @@ struct SolverOptions {
 
 /// What a solver did, accumulated since it was created (seconds, factorizations) or for the
 /// latest solve (iterations, residual).
+/// Whether a solve refuses a result whose relative residual exceeds the solver's limit. Off
+/// only for solves whose right-hand side is chosen to be hard (a condition estimate's), where
+/// the residual measures the matrix rather than the solve.
+enum class ResidualCheck { enforced, off };
+
 struct SolverReport {
   Index iterations = 0;      ///< largest iteration count over the right-hand sides of the last solve
   double residual = 0.0;     ///< largest relative residual ||A x - b|| / ||b|| of the last solve (of the scaled system under diagonal_scaling)

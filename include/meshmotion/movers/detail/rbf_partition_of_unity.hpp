@@ -115,7 +115,9 @@ class PartitionOfUnityRbf {
     patch_tree_.build(patch_centre_);
     report_ = SolverReport{};
     nonzeros_ = 0;
+    condition_ = 1.0;
     for (const auto& s : systems_) {
+      condition_ = std::max(condition_, s.condition());
       report_.factorizations += s.report().factorizations;
       report_.analyses += s.report().analyses;
       report_.seconds += s.report().seconds;
@@ -135,6 +137,8 @@ class PartitionOfUnityRbf {
   }
   [[nodiscard]] Index nonzeros() const noexcept { return nonzeros_; }
   [[nodiscard]] const SolverReport& report() const noexcept { return report_; }
+  /// The largest of the patch systems' condition estimates (RbfSystem::condition()).
+  [[nodiscard]] double condition() const noexcept { return condition_; }
 
   /// The stacked local coefficients (num_coefficients() × Dim) interpolating `values`
   /// (k × Dim) at the centres; β is zero (no polynomial).
@@ -293,6 +297,7 @@ class PartitionOfUnityRbf {
   std::vector<RbfSystem<Dim>> systems_;
   SolverReport report_;
   Index nonzeros_ = 0;
+  double condition_ = 1.0;
 };
 
 }  // namespace meshmotion::detail
