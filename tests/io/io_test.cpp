@@ -773,6 +773,39 @@ TEST_CASE("a failing write leaves no output and no temporary file, and never tou
   CHECK(fs::file_size(input) == size_before);
 }
 
+TEST_CASE("writing over an existing output replaces it whole, as a rename would", "[io]") {
+  const auto dir = test::scratch_path("replace");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto read_text = [](const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const auto small = all_types_mesh<2>(1);
+  const auto large = all_types_mesh<2>(3);
+  write_mesh(dir / "out.msh", large);
+  fs::create_hard_link(dir / "out.msh", dir / "earlier.msh");  // another name of the old file
+  const std::string old_text = read_text(dir / "out.msh");
+  write_mesh(dir / "out.msh", small);
+  CHECK(read_mesh_as<2>(dir / "out.msh").num_nodes() == small.num_nodes());
+  CHECK(small.num_nodes() != large.num_nodes());
+  CHECK(read_text(dir / "earlier.msh") == old_text);  // the old file is unlinked, not rewritten
+  CHECK(fs::hard_link_count(dir / "out.msh") == 1);
+  CHECK(files_in(dir).size() == 2);  // no temporary left
+
+  // a symbolic link is replaced by the file, its target kept (rename's behaviour)
+  fs::create_symlink(dir / "earlier.msh", dir / "link.msh");
+  write_mesh(dir / "link.msh", small);
+  CHECK(!fs::is_symlink(dir / "link.msh"));
+  CHECK(read_text(dir / "earlier.msh") == old_text);
+
+  // a folder is not replaced
+  fs::create_directories(dir / "folder.msh");
+  CHECK_THROWS_AS(write_mesh(dir / "folder.msh", small), IoError);
+  CHECK(fs::is_directory(dir / "folder.msh"));
+  CHECK(files_in(dir).size() == 4);
+}
+
 TEST_CASE("a killed run's temporaries are removed once an hour old, anyone else's never", "[io]") {
   const auto dir = test::scratch_path("stale");
   fs::remove_all(dir);

@@ -14,6 +14,11 @@
 #include <string_view>
 #include <system_error>
 
+#if defined(__linux__)
+#include <fcntl.h>  // AT_FDCWD
+#include <stdio.h>  // renameat2, RENAME_EXCHANGE (glibc 2.28, _GNU_SOURCE)
+#endif
+
 namespace meshmotion::detail {
 
 /// A name for the temporary file beside `file` (same folder, so rename is atomic).
@@ -27,7 +32,23 @@ namespace meshmotion::detail {
 
 /// Moves the complete temporary file `tmp` onto `file`; removes `tmp` and throws IoError when
 /// the rename fails.
+///
+/// An existing regular file is exchanged with `tmp` (renameat2's RENAME_EXCHANGE, atomic like a
+/// rename) and then removed: ext4 writes a file renamed over another out to disk before the
+/// rename returns (its auto_da_alloc heuristic for programs that never fsync), 15-25 ms for the
+/// 30P30N's 17 MB .msh, which a loop writing one output again and again paid every time. The
+/// output is as durable as a file written in place; neither way syncs it.
 inline void rename_into_place(const std::filesystem::path& tmp, const std::filesystem::path& file) {
+#if defined(__linux__) && defined(RENAME_EXCHANGE)
+  std::error_code status_error;
+  if (std::filesystem::symlink_status(file, status_error).type() == std::filesystem::file_type::regular &&
+      ::renameat2(AT_FDCWD, tmp.c_str(), AT_FDCWD, file.c_str(), RENAME_EXCHANGE) == 0) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);  // the former file, now under the temporary name
+    return;
+  }
+  // A file system without the exchange (EINVAL) or a file just removed takes the plain rename.
+#endif
   std::error_code ec;
   std::filesystem::rename(tmp, file, ec);
   if (ec) {
