@@ -112,3 +112,76 @@ TEST_CASE("k-d tree reads the matrix in place and handles edge cases", "[spatial
   points(0, 1) = std::numeric_limits<double>::quiet_NaN();
   CHECK_THROWS_AS(KdTree<2>(points), InputError);
 }
+
+namespace {
+
+// Every point in a ball is covered; most points outside every ball by more than a cell are not.
+template <int Dim>
+void check_ball_cover(const std::vector<double>& radius_spread) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const Index n = 300;
+  Points<Dim> centres(Dim, n);
+  std::vector<double> radii(static_cast<std::size_t>(n));
+  for (Index i = 0; i < n; ++i) {
+    for (int d = 0; d < Dim; ++d) centres(d, i) = d == 0 ? u(rng) : 0.1 * u(rng);  // a thin wall-like strip
+    radii[static_cast<std::size_t>(i)] = 0.002 * radius_spread[static_cast<std::size_t>(i) % radius_spread.size()];
+  }
+  radii[5] = 0.0;  // no ball
+  const BallCover<Dim> cover(centres, radii);
+  const auto inside = [&](const Vec<Dim>& p, double grow) {
+    for (Index i = 0; i < n; ++i)
+      if (radii[static_cast<std::size_t>(i)] > 0.0 && (p - centres.col(i)).norm() <= radii[static_cast<std::size_t>(i)] + grow) return true;
+    return false;
+  };
+  Index covered_far = 0, far = 0;
+  for (int q = 0; q < 4000; ++q) {
+    // points near a centre (inside its ball or just outside) and anywhere around the strip
+    Vec<Dim> p;
+    if (q % 2 == 0) {
+      const Index i = static_cast<Index>(q / 2) % n;
+      Vec<Dim> direction;
+      for (int d = 0; d < Dim; ++d) direction[d] = u(rng) - 0.5;
+      p = centres.col(i) + direction.normalized() * radii[static_cast<std::size_t>(i)] * 1.2 * u(rng);
+    } else {
+      for (int d = 0; d < Dim; ++d) p[d] = 1.4 * u(rng) - 0.2;
+    }
+    if (inside(p, 0.0)) {
+      REQUIRE(cover.contains(p));
+    } else if (!inside(p, 0.05)) {
+      ++far;
+      covered_far += cover.contains(p) ? 1 : 0;
+    }
+  }
+  CHECK(far > 500);
+  CHECK(covered_far == 0);
+  CHECK(!cover.contains(Vec<Dim>::Constant(5.0)));
+}
+
+}  // namespace
+
+TEST_CASE("BallCover: every point of a ball is covered, points far from all balls are not", "[spatial]") {
+  check_ball_cover<2>({1.0});
+  check_ball_cover<3>({1.0});
+  check_ball_cover<2>({0.5, 1.0, 3.0, 14.0});  // the 30P30N's spread of facet sizes
+  check_ball_cover<3>({0.5, 1.0, 3.0, 14.0});
+}
+
+TEST_CASE("BallCover: no ball covers nothing, bad input is refused", "[spatial]") {
+  const Points<2> centres = Points<2>::Zero(2, 2);
+  const std::vector<double> none{0.0, -1.0};
+  CHECK(!BallCover<2>(centres, none).contains(Vec<2>::Zero()));
+  CHECK(!BallCover<2>().contains(Vec<2>::Zero()));
+  const std::vector<double> one{1.0};
+  CHECK_THROWS_WITH(BallCover<2>(centres, one), Catch::Contains("1 radii for 2 centres"));
+  const std::vector<double> nan{1.0, std::nan("")};
+  CHECK_THROWS_WITH(BallCover<2>(centres, nan), Catch::Contains("ball 1"));
+  // radii over many orders of magnitude: the cover keeps the box and is still never wrong
+  Points<2> spread(2, 3);
+  spread << 0.0, 1.0, 1000.0, 0.0, 0.0, 0.0;
+  const std::vector<double> radii{1e-6, 1e-6, 500.0};
+  const BallCover<2> coarse(spread, radii);
+  CHECK(coarse.contains(Vec<2>(1.0, 0.0)));
+  CHECK(coarse.contains(Vec<2>(700.0, 10.0)));
+  CHECK(!coarse.contains(Vec<2>(0.0, 600.0)));
+}
