@@ -14,9 +14,11 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <span>
 #include <string>
@@ -72,12 +74,17 @@ inline void encode_base64(std::string& out, const unsigned char* bytes, std::siz
   out.resize(start + (n + 2) / 3 * 4);
   char* o = out.data() + start;
   std::size_t i = 0;
+  // Two characters per lookup of 12 bits: half the lookups of one per 6 bits (the .vtu of the
+  // 30P30N's P2 mesh encodes 11 MB).
+  static const std::array<std::array<char, 2>, 4096> pairs = [] {
+    std::array<std::array<char, 2>, 4096> table{};
+    for (unsigned k = 0; k < 4096; ++k) table[k] = {alphabet[k >> 6], alphabet[k & 63u]};
+    return table;
+  }();
   for (; i + 3 <= n; i += 3, o += 4) {
     const unsigned v = (unsigned{bytes[i]} << 16) | (unsigned{bytes[i + 1]} << 8) | bytes[i + 2];
-    o[0] = alphabet[(v >> 18) & 63u];
-    o[1] = alphabet[(v >> 12) & 63u];
-    o[2] = alphabet[(v >> 6) & 63u];
-    o[3] = alphabet[v & 63u];
+    std::memcpy(o, pairs[v >> 12].data(), 2);
+    std::memcpy(o + 2, pairs[v & 4095u].data(), 2);
   }
   if (i == n) return;
   const unsigned v = (unsigned{bytes[i]} << 16) | (i + 1 < n ? unsigned{bytes[i + 1]} << 8 : 0u);

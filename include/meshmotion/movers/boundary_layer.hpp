@@ -202,6 +202,14 @@ template <int Dim>
     return longest >= options.aspect_ratio_threshold * (farthest - nearest);
   };
 
+  // The wall vertex nearest to each vertex, computed when first needed: a vertex is met once
+  // per cell around it.
+  std::vector<Index> nearest(static_cast<std::size_t>(mesh.num_nodes()), -1);
+  const auto nearest_slot = [&](Index v) {
+    Index& s = nearest[static_cast<std::size_t>(v)];
+    if (s < 0) s = static_cast<Index>(slot(wall.nearest_vertex(Vec<Dim>(mesh.points.col(v))).first));
+    return static_cast<std::size_t>(s);
+  };
   std::vector<char> is_wall(static_cast<std::size_t>(mesh.num_nodes()), 0);
   for (const Index v : out.wall_nodes) is_wall[static_cast<std::size_t>(v)] = 1;
   std::vector<char> reached(aspect.size(), 0);
@@ -235,8 +243,7 @@ template <int Dim>
     std::size_t credited = out.walls.size();
     for (int k = 0; k < num_vertices(type); ++k) {
       const Index v = nodes[static_cast<std::size_t>(k)];
-      const Vec<Dim> p = mesh.points.col(v);
-      const std::size_t s = slot(wall.nearest_vertex(p).first);
+      const std::size_t s = nearest_slot(v);
       credited = std::min(credited, owner[s]);
       if (measured[static_cast<std::size_t>(v)] || is_wall[static_cast<std::size_t>(v)]) continue;
       measured[static_cast<std::size_t>(v)] = 1;
