@@ -1,4 +1,7 @@
+#include "meshmotion/core/generators.hpp"
+#include "meshmotion/curving/p2_conversion.hpp"
 #include "meshmotion/movers.hpp"
+#include "meshmotion/quality.hpp"
 
 #include "random_field.hpp"
 
@@ -787,4 +790,40 @@ TEST_CASE("rbf: the memory is estimated before assembly, a default radius shrink
   options.max_memory_bytes = -1.0;
   RbfMover<3> negative(options);
   CHECK_THROWS_AS(negative.setup(g.mesh, boundary), InputError);
+}
+
+TEST_CASE("a mesh whose whole boundary turns 56 degrees, stretches and swirls stays valid with the default RBF",
+          "[movers]") {
+  // Nothing holds the mesh: the default radius (5 × the largest displacement) reaches across
+  // the whole ring, so the interior follows the boundary instead of staying behind (with a
+  // radius of 1, the old Python default, 688 and 396 cells here are invalid). A ring with
+  // boundary-layer cells on its inner circle, at P1 and P2.
+  const Mesh<2> ring = annulus_mesh();
+  const auto map = [](const Vec<2>& x) {
+    const double turn = (56.0 + 20.0 * x.squaredNorm() / 2.25) * std::numbers::pi / 180.0;  // swirl: more turn outside
+    return Vec<2>(Eigen::Rotation2Dd(turn) * Vec<2>(1.3 * x[0], 0.8 * x[1]));
+  };
+  for (const Mesh<2>& mesh : {ring, convert_to_quadratic(ring).mesh}) {
+    CAPTURE(mesh.num_nodes());
+    ResolvedBoundary<2> boundary;
+    for (const auto& block : boundary_facets(mesh)) boundary.nodes.insert(boundary.nodes.end(), block.connectivity.begin(), block.connectivity.end());
+    std::sort(boundary.nodes.begin(), boundary.nodes.end());
+    boundary.nodes.erase(std::unique(boundary.nodes.begin(), boundary.nodes.end()), boundary.nodes.end());
+    const auto m = static_cast<Index>(boundary.nodes.size());
+    boundary.kinds.assign(boundary.nodes.size(), BoundaryKind::prescribed);
+    boundary.displacements.resize(2, m);
+    boundary.normals = boundary.directions = Points<2>::Zero(2, m);
+    for (Index k = 0; k < m; ++k) {
+      const Vec<2> x = mesh.points.col(boundary.nodes[static_cast<std::size_t>(k)]);
+      boundary.displacements.col(k) = map(x) - x;
+    }
+    RbfMover<2> mover;
+    mover.setup(mesh, boundary);
+    Mesh<2> moved = mesh;
+    moved.points += mover.move(boundary.displacements);
+    CHECK(mover.support_radius() > 3.0);  // the ring is 3 across
+    const QualityReport q = quality_report(moved, Metric::scaled_jacobian);
+    CHECK(q.num_invalid == 0);
+    CHECK(q.min > 0.8);  // 0.959 and 0.970 measured
+  }
 }
