@@ -10,6 +10,7 @@ run skips the full sizes; ../shared/data may be absent) is listed as "not run".
 """
 import argparse
 import json
+import statistics
 import sys
 
 from plot_results import read_rows
@@ -30,17 +31,15 @@ def per_cell_growth(small, large):
 
 def distributed_setup_growth(ranks):
     """The distributed RBF's setup on the box (automatic boundary solve) at `ranks` ranks over
-    one rank's, in the same run (1 = no growth with the ranks)."""
+    one rank's (1 = no growth with the ranks): run_all.sh runs 1, 2 and 4 ranks in rounds, and
+    the k-th run at `ranks` is paired with the k-th at 1 rank; the median of the rounds' ratios."""
     def value(rows, build):
-        def setup(r):
-            found = None
-            for row in rows:
-                if (row.get("build", "current") == build and row.get("method") == "rbf" and row.get("ranks") == r
-                        and str(row.get("case", "")).startswith("box") and "setup_seconds" in row):
-                    found = row["setup_seconds"]
-            return found
-        one, many = setup(1), setup(ranks)
-        return None if one is None or many is None else many / one
+        def setups(r):
+            return [row["setup_seconds"] for row in rows
+                    if row.get("build", "current") == build and row.get("method") == "rbf" and row.get("ranks") == r
+                    and str(row.get("case", "")).startswith("box") and "setup_seconds" in row]
+        ratios = [many / one for one, many in zip(setups(1), setups(ranks))]
+        return statistics.median(ratios) if ratios else None
     return value
 
 
