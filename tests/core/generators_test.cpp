@@ -1,3 +1,4 @@
+#include "meshmotion/core/extrusion.hpp"
 #include "meshmotion/core/generators.hpp"
 
 #include <Eigen/Geometry>
@@ -230,4 +231,67 @@ TEST_CASE("facet tags without a group get one named by their number", "[core]") 
   for (const Index v : m.group_nodes(std::to_string(left.tag))) CHECK(m.points(0, v) == 0.0);
   CHECK(m.group("top").name == "top");
   CHECK(name_unnamed_facet_groups(m) == 0);  // idempotent
+}
+
+TEST_CASE("a mesh one cell thick between two planes gives back its 2D section; other meshes give none", "[core]") {
+  const Mesh<2> flat = rectangle_mesh({.nx = 4, .ny = 3, .x_max = 2.0, .cells = RectangleCells::tri_quad});
+  const Index n = flat.num_nodes();
+  const Mesh<3> slab = extrude_mesh(flat, {.layers = 1, .height = 0.1});
+  const auto same_section = [&](const Extrusion& ext) {
+    CHECK(ext.section.points == flat.points);
+    for (const auto t : {ElementType::tri3, ElementType::quad4}) {
+      REQUIRE(ext.section.find_block(t));
+      CHECK(ext.section.find_block(t)->connectivity == flat.find_block(t)->connectivity);
+    }
+    for (const auto& g : flat.groups) {
+      INFO(g.name);
+      CHECK(ext.section.group(g.name).tag == g.tag);
+      CHECK(ext.section.group(g.name).dim == 1);
+      CHECK(ext.section.group_nodes(g.name) == flat.group_nodes(g.name));
+    }
+    CHECK(ext.plane_groups == std::vector<std::string>{"z_min", "z_max"});
+  };
+  {
+    const auto ext = find_extrusion(slab);
+    REQUIRE(ext);
+    CHECK(ext->axis == 2);
+    CHECK(ext->front == 0.0);
+    CHECK(ext->back == 0.1);
+    same_section(*ext);
+    for (Index s = 0; s < n; ++s) {
+      CHECK(ext->front_nodes[static_cast<std::size_t>(s)] == s);
+      CHECK(ext->back_nodes[static_cast<std::size_t>(s)] == s + n);
+    }
+    CHECK(ext->section.node_ids[3] == slab.node_id(3));
+  }
+  {
+    // Thick along x: the section's coordinates are (y, z), in cyclic order.
+    Mesh<3> along_x = slab;
+    along_x.points.row(0) = slab.points.row(2);
+    along_x.points.row(1) = slab.points.row(0);
+    along_x.points.row(2) = slab.points.row(1);
+    const auto ext = find_extrusion(along_x);
+    REQUIRE(ext);
+    CHECK(ext->axis == 0);
+    same_section(*ext);
+  }
+  {
+    // Mirrored: the front face of every cell turns clockwise and is reversed.
+    Mesh<3> mirrored = slab;
+    mirrored.points.row(1) *= -1.0;
+    const auto ext = find_extrusion(mirrored);
+    REQUIRE(ext);
+    CHECK(min_measure(ext->section) > 0.0);
+  }
+  CHECK_FALSE(find_extrusion(extrude_mesh(flat, {.layers = 2, .height = 0.1})));
+  Mesh<3> off_plane = slab;
+  off_plane.points(2, 5) += 1e-6;
+  CHECK_FALSE(find_extrusion(off_plane));
+  Mesh<3> sheared = slab;
+  sheared.points(0, n + 5) += 1e-6;  // a back node no longer behind its front node
+  CHECK_FALSE(find_extrusion(sheared));
+  CHECK_FALSE(find_extrusion(box_mesh({.nx = 3, .ny = 3, .nz = 1, .cells = BoxCells::tet4})));
+  // One hexahedron thick along both y and z: no one plane.
+  CHECK_FALSE(find_extrusion(box_mesh({.nx = 3, .ny = 1, .nz = 1})));
+  CHECK(find_extrusion(box_mesh({.nx = 3, .ny = 4, .nz = 1, .cells = BoxCells::hex_prism})));
 }
