@@ -3,6 +3,7 @@
 // rotation, translation or displacement file, the fixed and sliding groups, and the support
 // radius of the methods that take one (a heuristic from the boundary when not given).
 
+#include "meshmotion/core/extrusion.hpp"
 #include "meshmotion/core/option_text.hpp"
 #include "meshmotion/io/detail/read_file.hpp"
 #include "meshmotion/movers.hpp"
@@ -135,6 +136,30 @@ std::pair<std::string, std::optional<Vec<Dim>>> sliding_entry(const std::string&
   return {entry.substr(0, colon), vec<Dim>(normal, "sliding NAME:normal")};
 }
 
+/// The arguments for a 2D case stored in 3D (`ext`), in 3D: a centre X,Y and a translation
+/// DX,DY in the section's coordinates (x, y for a case one cell thick along z), the rotation
+/// about the axis when none is given, and a group holding the front and the back sliding in
+/// planes normal to the axis when no normal is given.
+inline MotionArguments section_motion(MotionArguments a, const Extrusion& ext) {
+  const auto lift = [&](std::vector<double>& v, double along) {
+    if (v.size() != 2) return;
+    Vec<3> x = ext.lift(Vec<2>(v[0], v[1]));
+    x(ext.axis) = along;
+    v.assign(x.data(), x.data() + 3);
+  };
+  lift(a.center, ext.front);
+  lift(a.translate, 0.0);
+  if (a.rotate && a.axis.empty()) {
+    a.axis.assign(3, 0.0);
+    a.axis[static_cast<std::size_t>(ext.axis)] = 1.0;
+  }
+  for (auto& entry : a.sliding)
+    if (!sliding_entry<3>(entry).second &&
+        std::find(ext.plane_groups.begin(), ext.plane_groups.end(), entry) != ext.plane_groups.end())
+      entry += ext.axis == 0 ? ":1,0,0" : ext.axis == 1 ? ":0,1,0" : ":0,0,1";
+  return a;
+}
+
 /// The boundary conditions the arguments give, on `mesh`.
 template <int Dim>
 BoundarySpec<Dim> boundary_spec(const MotionArguments& a, const Mesh<Dim>& mesh) {
@@ -158,11 +183,11 @@ BoundarySpec<Dim> boundary_spec(const MotionArguments& a, const Mesh<Dim>& mesh)
 }
 
 /// Sets the support radius of a method that takes one: --support-radius, else an option
-/// given, else the heuristic on the resolved boundary. Returns the radius (none for methods
-/// without one); refuses --support-radius for those.
-template <int Dim>
+/// given, else the heuristic on the boundary `resolve()` gives on `points`. Returns the radius
+/// (none for methods without one); refuses --support-radius for those.
+template <int Dim, std::invocable Resolve>
 std::optional<double> set_support_radius(MoverConfig<Dim>& config, const MotionArguments& a, const KeyValues& given,
-                                         const BoundarySpec<Dim>& spec, const Mesh<Dim>& mesh) {
+                                         const Points<Dim>& points, Resolve&& resolve) {
   std::optional<double> radius;
   std::visit(
       [&]<class O>(O& o) {
@@ -170,10 +195,10 @@ std::optional<double> set_support_radius(MoverConfig<Dim>& config, const MotionA
           if (a.support_radius) {
             parse_option_value("support_radius", *a.support_radius, o.support_radius);
           } else if (std::none_of(given.begin(), given.end(), [](const auto& kv) { return kv.first == "support_radius"; })) {
-            const ResolvedBoundary<Dim> b = spec.resolve(mesh);
+            const ResolvedBoundary<Dim> b = resolve();
             if constexpr (std::same_as<O, RbfOptions>) {
               // The mover's own default, within its memory budget (RbfOptions::max_memory_bytes).
-              const DefaultSupportRadius fitted = default_support_radius(mesh.points, b, o);
+              const DefaultSupportRadius fitted = default_support_radius(points, b, o);
               o.support_radius = fitted.radius;
               if (fitted.reduced)
                 std::cerr << "note: support radius reduced to " << format_option_value(fitted.radius)
@@ -181,7 +206,7 @@ std::optional<double> set_support_radius(MoverConfig<Dim>& config, const MotionA
                              "(RbfOptions::max_memory_bytes; docs/interpolation.md)\n";
             } else {
               Points<Dim> at(Dim, b.size());
-              for (Index k = 0; k < b.size(); ++k) at.col(k) = mesh.points.col(b.nodes[static_cast<std::size_t>(k)]);
+              for (Index k = 0; k < b.size(); ++k) at.col(k) = points.col(b.nodes[static_cast<std::size_t>(k)]);
               o.support_radius = suggest_support_radius(at, b.displacements);
             }
           }

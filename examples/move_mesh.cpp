@@ -8,9 +8,11 @@
 // Exit codes: 0 moved and valid, 1 error (nothing written), 2 written with invalid cells
 // (the last line says so) or refused by --strict.
 
+#include "meshmotion/core/extrusion.hpp"
 #include "meshmotion/core/fields.hpp"
 #include "meshmotion/io.hpp"
 #include "meshmotion/movers.hpp"
+#include "meshmotion/movers/section_mover.hpp"
 #include "meshmotion/quality.hpp"
 
 #include "motion_arguments.hpp"
@@ -20,6 +22,11 @@
 #include <CLI/CLI.hpp>
 
 #include <iostream>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 using namespace meshmotion;
 
@@ -29,32 +36,49 @@ struct Arguments {
   std::string input, output;
   examples::MotionArguments motion;
   int steps = 1;
-  bool json = false, strict = false, overwrite = false, keep_orientation = false;
+  bool json = false, strict = false, overwrite = false, keep_orientation = false, keep_3d = false;
   examples::MoverArguments mover;
 };
 
-template <int Dim>
-int run(const Arguments& a, Mesh<Dim> mesh) {
-  int order = 1;
-  for (const auto& b : mesh.cells) order = std::max(order, meshmotion::order(b.type));
-  check_mesh_output(a.output, order);
-  examples::handle_orientation(mesh, a.input, a.keep_orientation);
-  // Files without physical names: `--group 3` addresses the facets tagged 3.
-  name_unnamed_facet_groups(mesh);
-  const BoundarySpec<Dim> spec = examples::boundary_spec<Dim>(a.motion, mesh);
+// DGRBF2 rotates about the centre (and axis) of the rigid motion given here: in the section's
+// coordinates when a 2D case stored in 3D moves as its section.
+template <int MoverDim>
+KeyValues mover_options(const Arguments& a, const examples::MotionArguments& motion, const Extrusion* section) {
   KeyValues given = examples::given_options(a.mover);
-  // DGRBF2 rotates about the centre (and axis) of the rigid motion given here.
-  if (a.mover.method == "dgrbf2") {
-    if (!a.motion.center.empty()) given.emplace(given.begin(), "center", format_option_value(std::vector<double>(a.motion.center)));
-    if (Dim == 3 && !a.motion.axis.empty())
-      given.emplace(given.begin(), "axis", format_option_value(std::vector<double>(a.motion.axis)));
+  if (a.mover.method != "dgrbf2") return given;
+  std::vector<double> center = motion.center;
+  if (section != nullptr && center.size() == 3) {
+    const Vec<2> uv = section->project(Vec<3>(center[0], center[1], center[2]));
+    center = {uv(0), uv(1)};
   }
-  MoverConfig<Dim> config = mover_config<Dim>(a.mover.method, given);
-  const std::optional<double> radius = examples::set_support_radius(config, a.motion, given, spec, mesh);
-  AnyMover<Dim> mover = make_mover(config);
+  if (!center.empty()) given.emplace(given.begin(), "center", format_option_value(center));
+  if (MoverDim == 3 && !motion.axis.empty()) given.emplace(given.begin(), "axis", format_option_value(motion.axis));
+  return given;
+}
+
+template <int Dim>
+int move_and_write(const Arguments& a, const Mesh<Dim>& mesh, const examples::MotionArguments& motion,
+                   const BoundarySpec<Dim>& spec, const Extrusion* section) {
+  std::optional<double> radius;
+  KeyValues values;
+  const auto make = [&]<int MoverDim>(const Points<MoverDim>& points, auto&& resolve) {
+    const KeyValues given = mover_options<MoverDim>(a, motion, section);
+    MoverConfig<MoverDim> config = mover_config<MoverDim>(a.mover.method, given);
+    radius = examples::set_support_radius(config, motion, given, points, resolve);
+    for (const auto& kv : config.values()) values.emplace_back(kv);
+    return make_mover(config);
+  };
+  std::optional<AnyMover<Dim>> mover;
+  if constexpr (Dim == 3) {
+    if (section != nullptr)
+      mover.emplace(SectionMover(make.template operator()<2>(section->section.points, [&] {
+        return section_boundary(*section, mesh, spec.resolve(mesh)).boundary;
+      })));
+  }
+  if (!mover) mover.emplace(make.template operator()<Dim>(mesh.points, [&] { return spec.resolve(mesh); }));
   examples::set_stage("moving " + a.input + " with " + a.mover.method);
   const QualityReport before = quality_report(mesh, Metric::skew);
-  const StepResult<Dim> result = run_steps(mover, mesh, spec, StepOptions{a.steps, Metric::skew});
+  const StepResult<Dim> result = run_steps(*mover, mesh, spec, StepOptions{a.steps, Metric::skew});
   const MoveReport report = move_report(a.mover.method, before, result);
   const QualityReport& after = report.after;
   const bool invalid = after.num_invalid > 0;
@@ -66,8 +90,9 @@ int run(const Arguments& a, Mesh<Dim> mesh) {
     JsonWriter w(std::cout);
     w.begin_object().key("input").value(a.input).key("output").value(a.output);
     if (radius) w.key("support_radius").value(*radius);
+    if (section != nullptr) w.key("section_axis").value(std::string(1, section->axis_name()));
     w.key("options").begin_object();
-    for (const auto& [k, v] : config.values()) w.key(k).value(v);
+    for (const auto& [k, v] : values) w.key(k).value(v);
     w.end_object();
     write_json_fields(w, report);
     w.end_object();
@@ -75,6 +100,8 @@ int run(const Arguments& a, Mesh<Dim> mesh) {
   } else {
     std::cout << "moved " << mesh.num_nodes() << " nodes with " << a.mover.method;
     if (radius) std::cout << " (support radius " << format_option_value(*radius) << ")";
+    if (section != nullptr)
+      std::cout << " as a 2D case: one cell thick along " << section->axis_name() << ", moved in its section (--keep-3d moves it in 3D)";
     std::cout << "\n";
     write_text(std::cout, report, 2);
   }
@@ -84,6 +111,33 @@ int run(const Arguments& a, Mesh<Dim> mesh) {
   }
   if (!a.json) std::cout << "wrote " << a.output << "\n";
   return examples::exit_ok;
+}
+
+template <int Dim>
+int run(const Arguments& a, Mesh<Dim> mesh) {
+  int order = 1;
+  for (const auto& b : mesh.cells) order = std::max(order, meshmotion::order(b.type));
+  check_mesh_output(a.output, order);
+  examples::handle_orientation(mesh, a.input, a.keep_orientation);
+  // Files without physical names: `--group 3` addresses the facets tagged 3.
+  name_unnamed_facet_groups(mesh);
+  if constexpr (Dim == 3) {
+    // A 2D case stored in 3D moves as its section, so that every method keeps it 2D; a motion
+    // that is not in its plane moves it in 3D.
+    if (std::optional<Extrusion> section = a.keep_3d ? std::nullopt : find_extrusion(mesh)) {
+      const examples::MotionArguments motion = examples::section_motion(a.motion, *section);
+      const BoundarySpec<3> spec = examples::boundary_spec<3>(motion, mesh);
+      bool planar = true;
+      try {
+        (void)section_boundary(*section, mesh, spec.resolve(mesh));
+      } catch (const NotTwoDimensional& e) {
+        std::cerr << "note: moving in 3D: " << std::string(e.what()).substr(std::string_view("meshmotion: ").size()) << "\n";
+        planar = false;
+      }
+      return move_and_write<3>(a, mesh, motion, spec, planar ? &*section : nullptr);
+    }
+  }
+  return move_and_write<Dim>(a, mesh, a.motion, examples::boundary_spec<Dim>(a.motion, mesh), nullptr);
 }
 
 }  // namespace
@@ -103,6 +157,8 @@ int main(int argc, char** argv) {
   app.add_flag("--overwrite", a.overwrite, "allow the output to be the input file");
   app.add_flag("--keep-orientation", a.keep_orientation,
                "refuse a mesh whose cells are all negatively oriented instead of reorienting it");
+  app.add_flag("--keep-3d", a.keep_3d,
+               "move a mesh one cell thick between two planes (a 2D case stored in 3D) in 3D, not as its 2D section");
   app.add_flag("--json", a.json, "Print one JSON object");
   if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv)) return *rc;
   return examples::guarded(a.json, [&] {

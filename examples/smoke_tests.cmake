@@ -398,6 +398,24 @@ smoke_test(NAME move_mesh.sliding_normal_of_two_values.json EXPECT_RC 1 KEYS err
            COMMAND move_mesh "${smoke_dir}/two_hexes_front_back.su2" -o "${smoke_dir}/front_back_refused.vtu" --group top
                    --translate 0.05,0,0 --fixed bottom --sliding frontAndBack:0,1 --json)
 
+# A 2D case stored in 3D: four hexahedra one cell thick along z, front and back one group.
+# It moves as its 2D section (every method keeps front and back alike and in their planes),
+# takes a centre X,Y, and the front and back slide without a normal given; --keep-3d and a
+# motion along z move it in 3D.
+file(WRITE "${smoke_dir}/slab_2d.su2" "NDIME= 3\nNELEM= 4\n12 0 1 4 3 9 10 13 12 0\n12 1 2 5 4 10 11 14 13 1\n12 3 4 7 6 12 13 16 15 2\n12 4 5 8 7 13 14 17 16 3\nNPOIN= 18\n0 0 0 0\n1 0 0 1\n2 0 0 2\n0 1 0 3\n1 1 0 4\n2 1 0 5\n0 2 0 6\n1 2 0 7\n2 2 0 8\n0 0 0.1 9\n1 0 0.1 10\n2 0 0.1 11\n0 1 0.1 12\n1 1 0.1 13\n2 1 0.1 14\n0 2 0.1 15\n1 2 0.1 16\n2 2 0.1 17\nNMARK= 3\nMARKER_TAG= bottom\nMARKER_ELEMS= 2\n9 0 1 10 9\n9 1 2 11 10\nMARKER_TAG= top\nMARKER_ELEMS= 2\n9 7 6 15 16\n9 8 7 16 17\nMARKER_TAG= frontAndBack\nMARKER_ELEMS= 8\n9 0 3 4 1\n9 9 10 13 12\n9 1 4 5 2\n9 10 11 14 13\n9 3 6 7 4\n9 12 13 16 15\n9 4 7 8 5\n9 13 14 17 16\n")
+smoke_test(NAME move_mesh.section_2d_elasticity.json KEYS output VALUES section_axis=z,after/invalid=0
+           COMMAND move_mesh "${smoke_dir}/slab_2d.su2" -o "${smoke_dir}/slab_2d_le.su2" --group top --rotate 5
+                   --center 1,1 --fixed bottom --method le --json)
+smoke_test(NAME move_mesh.section_2d_sliding_front_and_back.json KEYS output VALUES section_axis=z,after/invalid=0
+           COMMAND move_mesh "${smoke_dir}/slab_2d.su2" -o "${smoke_dir}/slab_2d_dgrbf.su2" --group top --rotate 5
+                   --center 1,1 --fixed bottom --sliding frontAndBack --method dgrbf --json)
+smoke_test(NAME move_mesh.section_2d_keep_3d.json KEYS output,options VALUES after/invalid=0
+           COMMAND move_mesh "${smoke_dir}/slab_2d.su2" -o "${smoke_dir}/slab_2d_3d.su2" --group top --rotate 5
+                   --center 1,1,0 --fixed bottom --keep-3d --json)
+smoke_test(NAME move_mesh.section_2d_motion_along_axis.json KEYS output VALUES after/invalid=0
+           COMMAND move_mesh "${smoke_dir}/slab_2d.su2" -o "${smoke_dir}/slab_2d_z.su2" --group top
+                   --translate 0.05,0,0.01 --fixed bottom --json)
+
 # move_mesh_mpi: the same mesh as move_mesh's, byte for byte, from 3 ranks with the boundary
 # system replicated (the serial mover's factorization); through PETSc on request; elasticity
 # through PETSc; an unknown group or boundary solve refused by every rank with rank 0's message.

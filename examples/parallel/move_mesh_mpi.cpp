@@ -101,7 +101,7 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
     examples::handle_orientation(*whole, a.input, a.keep_orientation);
     name_unnamed_facet_groups(*whole);
     const BoundarySpec<Dim> spec = examples::boundary_spec<Dim>(a.motion, *whole);
-    if (const auto r = examples::set_support_radius(config, a.motion, given, spec, *whole)) radius = *r;
+    if (const auto r = examples::set_support_radius(config, a.motion, given, whole->points, [&] { return spec.resolve(*whole); })) radius = *r;
     boundary = spec.resolve(*whole);
     before = quality_report(*whole, Metric::skew);
   });

@@ -13,6 +13,7 @@ from ._core import (  # noqa: F401  (re-exported)
     SolverError,
     __version__,
     element_types,
+    find_extrusion,
     have_cgns,
     curve_options,
     mover_methods,
@@ -71,14 +72,24 @@ def Boundary(dim):
     return _core.BoundarySpec2() if dim == 2 else _core.BoundarySpec3()
 
 
-def Mover(method, dim, **options):
+def Mover(method, dim, section=False, **options):
     """The mover `method` ("rbf", "sle", ...) in `dim` dimensions with typed keyword options.
 
     An unknown keyword raises InputError (a ValueError) naming the method's keys;
     mover_options(method) lists them with their defaults.
+
+    section=True (dim 3): for a 2D case stored in 3D (one cell thick between two planes normal
+    to a coordinate axis, as find_extrusion(mesh) tells), the method moves the 2D section and
+    the front and the back take its displacement, with none along the axis, whatever the
+    method; setup refuses another mesh, and conditions or displacements that are not
+    two-dimensional.
     """
     if dim not in (2, 3):
         raise InputError(f"Mover: dim must be 2 or 3 (got {dim})")
+    if section:
+        if dim != 3:
+            raise InputError("Mover: section=True moves a 2D case stored in 3D (give dim=3)")
+        return _core._section_mover(method, **options)
     return (_core.Mover2 if dim == 2 else _core.Mover3)(method, **options)
 
 

@@ -4,6 +4,10 @@
 
 #include "mover_keywords.hpp"
 
+#include "meshmotion/core/extrusion.hpp"
+#include "meshmotion/movers/section_mover.hpp"
+
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,6 +39,22 @@ void bind_movers(py::module_& m) {
              py::arg("w"), "J w: node displacement changes (n, dim) for boundary changes w (boundary size, dim)");
     bind_move_calls<Dim>(c);
   });
+  // A 2D case stored in 3D moved as its section (movers/section_mover.hpp): a Mover3.
+  m.def("_section_mover", [](const std::string& method, const py::kwargs& options) {
+    return AnyMover<3>(SectionMover(make_mover(mover_config_from<2>(method, options))));
+  }, py::arg("method"));
+  m.def("find_extrusion", [](const Mesh<3>& mesh) -> py::object {
+    const std::optional<Extrusion> ext = find_extrusion(mesh);
+    if (!ext) return py::none();
+    py::dict out;
+    out["axis"] = ext->axis;
+    out["front"] = ext->front;
+    out["back"] = ext->back;
+    out["plane_groups"] = ext->plane_groups;
+    return out;
+  }, py::arg("mesh"),
+        "None, or the axis (0, 1, 2), the two planes' coordinates and the groups lying in them of a mesh one cell thick "
+        "between two planes normal to a coordinate axis (a 2D case stored in 3D)");
   m.def("mover_methods", [] {
     std::vector<std::string> out;
     for (const auto& method : mover_methods<3>()) out.emplace_back(method.name);

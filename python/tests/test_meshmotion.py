@@ -116,6 +116,50 @@ def test_the_default_radius_follows_the_mesh_scale():
     np.testing.assert_allclose(moved[1], moved[0], rtol=0, atol=1e-12)
 
 
+def slab(nx=8, ny=6, thickness=0.05):
+    """grid() extruded one cell thick along z: hexahedra, the lateral groups as quadrilaterals
+    and the front and back as one group, as an OpenFOAM 2D case stores it."""
+    flat = grid(nx, ny)
+    n = flat.num_nodes
+    points = np.vstack([np.column_stack([flat.points, np.zeros(n)]), np.column_stack([flat.points, np.full(n, thickness)])])
+    node = lambda i, j: i * (ny + 1) + j  # noqa: E731
+    quads = np.array([[node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)] for i in range(nx) for j in range(ny)])
+    lateral = lambda pairs: ("quad4", np.array([[a, b, b + n, a + n] for a, b in pairs]))  # noqa: E731
+    groups = {
+        "bottom": lateral([(node(i, 0), node(i + 1, 0)) for i in range(nx)]),
+        "top": lateral([(node(i, ny), node(i + 1, ny)) for i in range(nx)]),
+        "frontAndBack": ("quad4", np.vstack([quads[:, ::-1], quads + n])),
+    }
+    return mm.from_arrays(points, {"hex8": np.hstack([quads, quads + n])}, groups)
+
+
+def test_a_2d_case_stored_in_3d_moves_as_its_section():
+    mesh = slab()
+    assert mm.find_extrusion(mesh) == {"axis": 2, "front": 0.0, "back": 0.05, "plane_groups": ["frontAndBack"]}
+    tet = mm.from_arrays([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], {"tet4": [[0, 1, 2, 3]]})
+    assert mm.find_extrusion(tet) is None
+    b = mm.Boundary(3).translating("top", [0.1, -0.05, 0.0]).fixed("bottom").resolve(mesh)
+    d = np.zeros((b.size, 3))
+    top = mesh.groups["top"]
+    b.scatter(list(top), np.tile([0.1, -0.05, 0.0], (len(top), 1)), d)
+    n = mesh.num_nodes // 2
+    for method in ("le", "dgrbf", "rbf"):
+        mover = mm.Mover(method, 3, section=True)
+        mover.setup(mesh, b)
+        u = mover.move(d)
+        assert np.all(u[:, 2] == 0.0), method
+        np.testing.assert_array_equal(u[:n], u[n:])
+    # The 3D elasticity moves the front and back off their planes.
+    mover = mm.Mover("le", 3)
+    mover.setup(mesh, b)
+    assert np.abs(mover.move(d)[:, 2]).max() > 1e-6
+    with pytest.raises(mm.InputError, match="not two-dimensional"):
+        mover = mm.Mover("le", 3, section=True)
+        mover.setup(mesh, mm.Boundary(3).translating("top", [0.1, 0.0, 0.01]).fixed("bottom").resolve(mesh))
+    with pytest.raises(mm.InputError, match="give dim=3"):
+        mm.Mover("le", 2, section=True)
+
+
 def test_tps_gets_the_polynomial_it_needs():
     # Without the polynomial the thin plate spline's system is ill-posed: a rotated boundary
     # gave a scaled Jacobian of -230 and no error. It is always added: the rotation is exact.
