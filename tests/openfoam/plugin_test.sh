@@ -7,8 +7,9 @@
 # decomposed on 2 ranks (`-parallel`) giving the serial points to 1e-12, with the points two
 # ranks share identical; pimpleFoam running a 2D channel whose wall turns, serially and on 2
 # ranks; stiffened elasticity through the cube's hexahedra and through the polyhedra of its
-# dual mesh; an unknown option refused with its name, and a method that needs cells refused on
-# a decomposed case.
+# dual mesh; a sphere cut out of a box by snappyHexMesh, translated and swung, serially and on
+# 2 ranks; an unknown option refused with its name, and a method that needs cells refused on a
+# decomposed case.
 #
 #   plugin_test.sh LIBMESHMOTIONFOAM WORK_DIR [MPIEXEC [FLAGS...]]
 #
@@ -198,6 +199,76 @@ grep -q "polyhedra: *300" log.check || { echo "FAIL: the dual mesh has not the e
 sed -i 's/(4 (0.02 0 -0.1))/(4 (0.01 0 -0.05))/' 0/pointDisplacement
 move "method sle;" "sle set up on .* boundary points of 2052"
 cube_check 0.25
+# A 3D body from snappyHexMesh: a sphere (OpenFOAM's analytic searchableSphere, no surface
+# file) cut out of a blockMesh box, 288 polyhedra where the castellated cells were split. The
+# sphere translates by a uniformFixedValue table, then swings about an axis beside its centre
+# by angularOscillatingDisplacement; the box stays. Checks: the sphere's points where the
+# patch field puts them, the box's still, every step's mesh valid, 2 ranks as serial.
+make_case "$work/sphere" "(-1 -1 -1) (1 -1 -1) (1 1 -1) (-1 1 -1) (-1 -1 1) (1 -1 1) (1 1 1) (-1 1 1)" "(12 12 12)" \
+  "box { type wall; faces ((4 5 6 7) (0 3 2 1) (0 4 7 3) (1 2 6 5) (3 7 6 2) (0 1 5 4)); }" \
+  "sphere { type uniformFixedValue; uniformValue table ((0 (0 0 0)) (4 (0.2 0.08 0))); }
+   box { type fixedValue; value uniform (0 0 0); }"
+cat > system/snappyHexMeshDict <<EOD
+$header snappyHexMeshDict; }
+castellatedMesh true; snap true; addLayers false;
+geometry { sphere { type searchableSphere; centre (0 0 0); radius 0.3; } }
+castellatedMeshControls { maxLocalCells 100000; maxGlobalCells 2000000; minRefinementCells 0; maxLoadUnbalance 0.1;
+  nCellsBetweenLevels 2; features (); resolveFeatureAngle 30; refinementRegions {};
+  refinementSurfaces { sphere { level (1 1); patchInfo { type wall; } } }
+  locationInMesh (0.71 0.73 0.69); allowFreeStandingZoneFaces true; }
+snapControls { nSmoothPatch 3; tolerance 2.0; nSolveIter 30; nRelaxIter 5; nFeatureSnapIter 10;
+  implicitFeatureSnap false; explicitFeatureSnap false; multiRegionFeatureSnap false; }
+addLayersControls { relativeSizes true; layers {}; expansionRatio 1; finalLayerThickness 0.3; minThickness 0.1;
+  nGrow 0; featureAngle 60; nRelaxIter 3; nSmoothSurfaceNormals 1; nSmoothNormals 3; nSmoothThickness 10;
+  maxFaceThicknessRatio 0.5; maxThicknessToMedialRatio 0.3; minMedialAxisAngle 90; nBufferCellsNoExtrude 0;
+  nLayerIter 50; }
+meshQualityControls { maxNonOrtho 65; maxBoundarySkewness 20; maxInternalSkewness 4; maxConcave 80; minVol 1e-13;
+  minTetQuality 1e-15; minArea -1; minTwist 0.02; minDeterminant 0.001; minFaceWeight 0.05; minVolRatio 0.01;
+  minTriangleTwist -1; nSmoothScale 4; errorReduction 0.75; relaxed { maxNonOrtho 75; } }
+mergeTolerance 1e-6;
+EOD
+snappyHexMesh -overwrite > log.snappy 2>&1 || { tail -20 log.snappy; exit 1; }
+checkMesh > log.check 2>&1 || { tail -20 log.check; exit 1; }
+grep -q "polyhedra: *[1-9]" log.check || { echo "FAIL: snappyHexMesh made no polyhedra"; grep -A8 "cells:" log.check; exit 1; }
+# The sphere's points where the patch field puts them at each step ($1: "translate" or
+# "swing"), the box's still, the interior moved.
+sphere_check() {
+  MOTION=$1 /usr/bin/python3 - <<'EOD'
+import math, os, re
+def points(path):
+    return [tuple(map(float, p)) for p in re.findall(r"\(([-0-9.e+]+) ([-0-9.e+]+) ([-0-9.e+]+)\)", open(path).read())]
+def patch_points(name):
+    boundary = open("constant/polyMesh/boundary").read()
+    block = re.search(name + r"\s*\{([^}]*)\}", boundary).group(1)
+    start, count = (int(re.search(key + r"\s+(\d+)", block).group(1)) for key in ("startFace", "nFaces"))
+    faces = re.findall(r"\d+\(([\d ]+)\)", open("constant/polyMesh/faces").read())
+    return {int(v) for f in faces[start:start + count] for v in f.split()}
+p0 = points("constant/polyMesh/points")
+sphere, box = patch_points("sphere"), patch_points("box")
+assert sphere and box
+for t in (1, 2, 3, 4):
+    p = points(f"{t}/polyMesh/points")
+    if os.environ["MOTION"] == "translate":
+        target = lambda a: (a[0] + 0.05 * t, a[1] + 0.02 * t, a[2])
+    else:
+        angle = 0.3 * math.sin(0.39269908169872414 * t)
+        c, s = math.cos(angle), math.sin(angle)
+        target = lambda a: (0.1 + c * (a[0] - 0.1) - s * a[1], s * (a[0] - 0.1) + c * a[1], a[2])
+    on_sphere = max(max(abs(x - y) for x, y in zip(p[v], target(p0[v]))) for v in sphere)
+    on_box = max(max(abs(x - y) for x, y in zip(p[v], p0[v])) for v in box)
+    moved = sum(1 for v in range(len(p0)) if v not in sphere and v not in box and p[v] != p0[v])
+    assert on_sphere < 1e-12 and on_box == 0.0 and moved > 0, (t, on_sphere, on_box, moved)
+print(f"sphere ({len(sphere)} points) on its {os.environ['MOTION']}, box ({len(box)} points) still")
+EOD
+}
+move "method rbf;" "rbf set up on"
+sphere_check translate
+rm -rf 1 2 3 4
+sed -i 's/sphere { type uniformFixedValue; uniformValue table ((0 (0 0 0)) (4 (0.2 0.08 0))); }/sphere { type angularOscillatingDisplacement; axis (0 0 1); origin (0.1 0 0); angle0 0; amplitude 0.3; omega 0.39269908169872414; value uniform (0 0 0); }/' 0/pointDisplacement
+grep -q angularOscillating 0/pointDisplacement || { echo "FAIL: the swing was not set"; exit 1; }
+move "method rbf;" "rbf set up on"
+sphere_check swing
+parallel_equals_serial moveDynamicMesh
 # A 2D case (one cell thick, front and back `empty`) whose bottom wall turns by
 # angularOscillatingDisplacement: the bottom's points where the rotation puts them, the mesh
 # still 2D with front and back moved alike, only the walls' points as the mover's boundary.
