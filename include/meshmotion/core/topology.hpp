@@ -156,9 +156,9 @@ template <MeshLike M>
 /// 2D, tri3/quad4 and their quadratic kinds in 3D, as facet_type() gives), all nodes
 /// included and oriented outward as facets(type) lists them. Each element is tagged `tag`.
 /// Blocks appear in the order their types are first met; elements in the order of facet ids.
+/// `topo` is unique_facets(mesh), for a caller that has it already.
 template <MeshLike M>
-[[nodiscard]] std::vector<ElementBlock> boundary_facets(const M& mesh, int tag = 0) {
-  const FacetTopology topo = unique_facets(mesh);
+[[nodiscard]] std::vector<ElementBlock> boundary_facets(const M& mesh, const FacetTopology& topo, int tag = 0) {
   return detail::with_cell_source(mesh, [&](const auto& source) {
     std::vector<Index> cell_block;  // block of each cell, by cell order
     cell_block.reserve(static_cast<std::size_t>(topo.element_facets.ids.size()));
@@ -190,6 +190,12 @@ template <MeshLike M>
     }
     return out;
   });
+}
+
+/// boundary_facets() of `mesh`, its facets numbered here.
+template <MeshLike M>
+[[nodiscard]] std::vector<ElementBlock> boundary_facets(const M& mesh, int tag = 0) {
+  return boundary_facets(mesh, unique_facets(mesh), tag);
 }
 
 /// Compressed sparse rows: row i holds targets[offsets[i] .. offsets[i+1]).

@@ -133,12 +133,14 @@ template <class Walls>
 
 /// Layer thickness of walls given as straight facet lists (`walls[w]`: the facets of wall
 /// w, P1 or P2; only vertices are used) in a mesh of any cells. WallLayer::group and tag are
-/// left empty. A vertex shared by two walls belongs to the first. Throws InputError for a
+/// left empty. A vertex shared by two walls belongs to the first. `topology`, when given, is
+/// unique_facets(mesh) made by the caller (numbered here otherwise). Throws InputError for a
 /// threshold below 1 or a facet node out of range.
 template <int Dim>
 [[nodiscard]] BoundaryLayerEstimate estimate_boundary_layer(const Mesh<Dim>& mesh,
                                                             const std::vector<std::vector<detail::WallFacet>>& walls,
-                                                            const BoundaryLayerOptions& options = {}) {
+                                                            const BoundaryLayerOptions& options = {},
+                                                            const FacetTopology* topology = nullptr) {
   if (!(options.aspect_ratio_threshold >= 1.0))
     throw InputError("estimate_boundary_layer: aspect_ratio_threshold " + std::to_string(options.aspect_ratio_threshold) +
                      " (expected >= 1)");
@@ -234,7 +236,8 @@ template <int Dim>
       queue.push_back(cell);
     }
   }
-  const FacetTopology topo = unique_facets(mesh);
+  const FacetTopology numbered = topology != nullptr ? FacetTopology{} : unique_facets(mesh);
+  const FacetTopology& topo = topology != nullptr ? *topology : numbered;
   std::vector<char> measured(static_cast<std::size_t>(mesh.num_nodes()), 0);
   while (!queue.empty()) {
     const Index cell = queue.front();
@@ -270,13 +273,14 @@ template <int Dim>
 }
 
 /// Estimates the boundary-layer thickness of each of `wall_groups` (groups of dimension
-/// Dim - 1) of a linear or quadratic mesh (only vertices are used). Throws InputError for an
-/// empty group list, an unknown group or one that is not a facet group, and a threshold
-/// below 1.
+/// Dim - 1) of a linear or quadratic mesh (only vertices are used); `topology` as above.
+/// Throws InputError for an empty group list, an unknown group or one that is not a facet
+/// group, and a threshold below 1.
 template <int Dim>
 [[nodiscard]] BoundaryLayerEstimate estimate_boundary_layer(const Mesh<Dim>& mesh,
                                                             std::span<const std::string> wall_groups,
-                                                            const BoundaryLayerOptions& options = {}) {
+                                                            const BoundaryLayerOptions& options = {},
+                                                            const FacetTopology* topology = nullptr) {
   if (wall_groups.empty()) throw InputError("estimate_boundary_layer: no wall group given (expected at least one)");
   std::vector<std::vector<detail::WallFacet>> walls;
   for (const auto& name : wall_groups) {
@@ -287,7 +291,7 @@ template <int Dim>
     const int tag = g.tag;
     walls.push_back(detail::wall_facets(mesh, std::span<const int>(&tag, 1)));
   }
-  BoundaryLayerEstimate out = estimate_boundary_layer(mesh, walls, options);
+  BoundaryLayerEstimate out = estimate_boundary_layer(mesh, walls, options, topology);
   for (std::size_t w = 0; w < wall_groups.size(); ++w) {
     out.walls[w].group = wall_groups[w];
     out.walls[w].tag = mesh.group(wall_groups[w]).tag;
