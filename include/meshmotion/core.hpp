@@ -5,6 +5,7 @@
 
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
+#include "meshmotion/core/extrusion.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/core/json.hpp"
 #include "meshmotion/core/mesh.hpp"

@@ -22,6 +22,7 @@
 #include "meshmotion/movers/nonlinear_elasticity.hpp"
 #include "meshmotion/movers/rbf.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
+#include "meshmotion/movers/section_mover.hpp"
 #include "meshmotion/movers/spring.hpp"
 #include "meshmotion/movers/step_driver.hpp"
 #include "meshmotion/movers/support_radius.hpp"
