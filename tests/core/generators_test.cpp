@@ -233,7 +233,7 @@ TEST_CASE("facet tags without a group get one named by their number", "[core]") 
   CHECK(name_unnamed_facet_groups(m) == 0);  // idempotent
 }
 
-TEST_CASE("a mesh one cell thick between two planes gives back its 2D section; other meshes give none", "[core]") {
+TEST_CASE("a mesh one cell thick between two planes gives back its 2D section, other meshes none", "[core]") {
   const Mesh<2> flat = rectangle_mesh({.nx = 4, .ny = 3, .x_max = 2.0, .cells = RectangleCells::tri_quad});
   const Index n = flat.num_nodes();
   const Mesh<3> slab = extrude_mesh(flat, {.layers = 1, .height = 0.1});
