@@ -18,7 +18,7 @@
 # table shows its figures and the ratios. A benchmark that does not compile against the older
 # library is reported and skipped.
 #
-# --only runs the named benchmarks alone (e.g. --only conversion_bench,io_bench,curve_mesh_program,defaults_bench,openfoam_plugin).
+# --only runs the named benchmarks alone (e.g. --only conversion_bench,io_bench,curve_mesh_program,move_mesh_section,defaults_bench,openfoam_plugin).
 #
 # Programs and benchmarks run with glibc's huge-page heap (GLIBC_TUNABLES, see
 # include/meshmotion/core/process_memory.hpp) for both builds; MESHMOTION_HUGE_PAGES=0 runs
@@ -179,6 +179,34 @@ program_case() {
   printf '{"bench":"program","case":"curve_mesh-30p30n","median_s":%d.%06d}\n' $((median / 1000000)) $((median % 1000000))
 }
 
+# move_mesh on the airFoil2D case (one cell thick, OpenFOAM's 2D), walls turned 15 degrees with
+# linear elasticity: as its 2D section (the default) and in 3D (--keep-3d), in turn, 3 runs
+# each; the medians and the median of the paired ratios, as one JSON line.
+section_case() {
+  local program="$1" data="$source_dir/../shared/data/openfoam_airFoil2D_polyMesh" work section=() in_3d=() ratios=()
+  if [[ ! -d "$data" ]]; then echo "section_case: $data not found, skipped"; return 0; fi
+  work="$(mktemp -d)"
+  local flags=(--group walls --rotate 15 --fixed inlet --fixed outlet --method le)
+  for _ in 1 2 3; do
+    local start=$(date +%s%N) t2 t3
+    "$program" "$data" -o "$work/moved.vtu" "${flags[@]}" --center 0.25,0 > /dev/null || { rm -rf "$work"; return 1; }
+    t2=$(( ($(date +%s%N) - start) / 1000 ))
+    start=$(date +%s%N)
+    "$program" "$data" -o "$work/moved.vtu" "${flags[@]}" --center 0.25,0,0 --keep-3d > /dev/null || { rm -rf "$work"; return 1; }
+    t3=$(( ($(date +%s%N) - start) / 1000 ))
+    section+=("$t2"); in_3d+=("$t3"); ratios+=("$(( t2 * 1000000 / t3 ))")
+  done
+  rm -rf "$work"
+  local s3 d3 r
+  s3=$(printf '%s\n' "${section[@]}" | sort -n | sed -n 2p)
+  d3=$(printf '%s\n' "${in_3d[@]}" | sort -n | sed -n 2p)
+  r=$(printf '%s\n' "${ratios[@]}" | sort -n | sed -n 2p)
+  printf 'move_mesh airFoil2D le 15 deg: as its 2D section %d.%06d s, in 3D %d.%06d s, ratio 0.%06d\n' \
+    $((s3 / 1000000)) $((s3 % 1000000)) $((d3 / 1000000)) $((d3 % 1000000)) "$r"
+  printf '{"bench":"program","case":"move_mesh-airfoil2d-le","section_s":%d.%06d,"in_3d_s":%d.%06d,"ratio":%d.%06d}\n' \
+    $((s3 / 1000000)) $((s3 % 1000000)) $((d3 / 1000000)) $((d3 % 1000000)) $((r / 1000000)) $((r % 1000000))
+}
+
 for name in "${benches[@]}"; do
   if [[ $full == 1 ]]; then args="${full_args[$name]}"; else args="${quick_args[$name]}"; fi
   if [[ ! -x "$build_dir/benchmarks/$name" ]]; then
@@ -197,6 +225,9 @@ if [[ -x "$build_dir/examples/curve_mesh" && ( -z "$only" || "$only" == *",curve
   run curve_mesh_program program_case "$build_dir/examples/curve_mesh"
   [[ -n "$baseline" && -x "$baseline_dir/examples/curve_mesh" ]] \
     && run "baseline:curve_mesh_program" program_case "$baseline_dir/examples/curve_mesh"
+fi
+if [[ -x "$build_dir/examples/move_mesh" && ( -z "$only" || "$only" == *",move_mesh_section,"* ) ]]; then
+  run move_mesh_section section_case "$build_dir/examples/move_mesh"
 fi
 # The programs' defaults beside the options the benchmarks set by hand, on the same cases
 # (this build only: the comparison is within it).
