@@ -7,11 +7,13 @@
 #include "meshmotion/movers/rbf.hpp"
 #include "meshmotion/movers/support_radius.hpp"
 #ifdef MESHMOTION_FOAM_PARALLEL
+#include "meshmotion/parallel/distributed_elasticity.hpp"
 #include "meshmotion/parallel/distributed_rbf.hpp"
 #endif
 
 #include <algorithm>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -21,13 +23,77 @@ namespace meshmotion::foam {
 #ifdef MESHMOTION_FOAM_PARALLEL
 namespace {
 
-// The options of the boundary system's place on a decomposed case (BoundarySolveOptions) are
-// taken out of the method's: a case's dictionary runs alike serially, where they do nothing.
-KeyValues take_options(KeyValues& given, parallel::BoundarySolveOptions& solve) {
+// The options of a decomposed case's solves (the RBF's boundary system, BoundarySolveOptions;
+// the elasticity's PETSc solver, DistributedElasticityOptions) are taken out of the method's:
+// a case's dictionary runs alike serially, where they do nothing.
+KeyValues take_options(KeyValues& given, parallel::BoundarySolveOptions& solve, parallel::DistributedElasticityOptions& cells) {
   KeyValues rest;
   for (auto& [key, text] : given)
-    if (!set_option(solve, key, text)) rest.emplace_back(std::move(key), std::move(text));
+    if (!set_option(solve, key, text) && !set_option(cells, key, text)) rest.emplace_back(std::move(key), std::move(text));
   return rest;
+}
+
+// Global ids and owners of a decomposed case's auxiliary nodes (to_mesh(): the centres of the
+// faces of more than three points, then of the cells), after the points' own in `ids` and
+// `owners`. A cell's centre, and the centre of a face no other rank holds, is this rank's,
+// numbered after the case's points and the shared centres, rank after rank. The centre of a
+// face between two ranks (`coupled`) is held by both: the sorted global ids of the face's
+// points name it alike on both, and the lower rank owns it. Collective.
+void number_auxiliary_nodes(const PolyMesh& poly, Index nodes, const std::vector<char>& coupled,
+                            std::vector<std::int64_t>& ids, std::vector<int>& owners) {
+  const MPI_Comm comm = MPI_COMM_WORLD;
+  const Index np = poly.points.cols();
+  std::int64_t points_total = 0;
+  for (const std::int64_t g : ids) points_total = std::max(points_total, g + 1);
+  MPI_Allreduce(MPI_IN_PLACE, &points_total, 1, MPI_INT64_T, MPI_MAX, comm);
+  // This rank's shared centres, each as its key: the point count, then the sorted ids.
+  std::vector<std::int64_t> keys;
+  std::vector<Index> shared;
+  Index centre = np;
+  for (Index f = 0; f < poly.num_faces(); ++f) {
+    const auto v = poly.face(f);
+    if (v.size() <= 3) continue;
+    const Index node = centre++;
+    if (!coupled[static_cast<std::size_t>(f)]) continue;
+    keys.push_back(static_cast<std::int64_t>(v.size()));
+    const auto first = keys.size();
+    for (const Index p : v) keys.push_back(ids[static_cast<std::size_t>(p)]);
+    std::sort(keys.begin() + static_cast<std::ptrdiff_t>(first), keys.end());
+    shared.push_back(node);
+  }
+  const auto key_at = [](const std::vector<std::int64_t>& list, std::size_t at) {
+    const auto begin = list.begin() + static_cast<std::ptrdiff_t>(at) + 1;
+    return std::vector<std::int64_t>(begin, begin + list[at]);
+  };
+  std::vector<int> counts;
+  const std::vector<std::int64_t> every = parallel::all_gather(comm, keys, &counts);
+  struct Holder {
+    int owner;
+    std::int64_t id;
+  };
+  std::map<std::vector<std::int64_t>, Holder> holders;  // emplace keeps the lowest rank
+  std::size_t at = 0;
+  for (std::size_t r = 0; r < counts.size(); ++r)
+    for (const std::size_t end = at + static_cast<std::size_t>(counts[r]); at < end; at += 1 + static_cast<std::size_t>(every[at]))
+      holders.emplace(key_at(every, at), Holder{static_cast<int>(r), 0});
+  std::int64_t next = points_total;
+  for (auto& [key, holder] : holders) holder.id = next++;
+  const auto n_own = static_cast<std::int64_t>(nodes - np) - static_cast<std::int64_t>(shared.size());
+  std::int64_t first_own = 0;
+  MPI_Exscan(&n_own, &first_own, 1, MPI_INT64_T, MPI_SUM, comm);
+  if (parallel::rank_of(comm) == 0) first_own = 0;
+  ids.resize(static_cast<std::size_t>(nodes), -1);
+  owners.resize(static_cast<std::size_t>(nodes), parallel::rank_of(comm));
+  at = 0;
+  for (const Index node : shared) {
+    const Holder& holder = holders.at(key_at(keys, at));
+    ids[static_cast<std::size_t>(node)] = holder.id;
+    owners[static_cast<std::size_t>(node)] = holder.owner;
+    at += 1 + static_cast<std::size_t>(keys[at]);
+  }
+  std::int64_t own = next + first_own;
+  for (std::size_t i = static_cast<std::size_t>(np); i < ids.size(); ++i)
+    if (ids[i] < 0) ids[i] = own++;
 }
 
 }  // namespace
@@ -37,9 +103,11 @@ KeyValues take_options(KeyValues& given, parallel::BoundarySolveOptions& solve) 
 // their faces of more than three points (to_mesh()). A boundary face's centre is on the
 // boundary, so it joins the mover's boundary: prescribed when all the face's points are, by
 // their mean displacement (exact for a rigid motion, the centre being their mean), else
-// sliding in the face's plane. Its entries come after the points'; per entry, the entries of
-// its face's points (empty: sliding).
-std::vector<std::vector<Index>> add_face_centres(const PolyMesh& poly, const Mesh<3>& mesh, ResolvedBoundary<3>& b) {
+// sliding in the face's plane. A face between ranks (`coupled`, empty: none) is interior.
+// Its entries come after the points'; per entry, the entries of its face's points (empty:
+// sliding).
+std::vector<std::vector<Index>> add_face_centres(const PolyMesh& poly, const Mesh<3>& mesh, const std::vector<char>& coupled,
+                                                 ResolvedBoundary<3>& b) {
   std::vector<std::vector<Index>> out;
   if (mesh.num_auxiliary_nodes == 0) return out;
   const Index np = poly.points.cols();
@@ -52,7 +120,7 @@ std::vector<std::vector<Index>> add_face_centres(const PolyMesh& poly, const Mes
     const auto v = poly.face(f);
     if (v.size() <= 3) continue;
     const Index node = centre++;
-    if (f < poly.num_internal_faces()) continue;
+    if (f < poly.num_internal_faces() || (!coupled.empty() && coupled[static_cast<std::size_t>(f)])) continue;
     std::vector<Index> entries;
     bool all_prescribed = true;
     for (const Index p : v) {
@@ -98,9 +166,11 @@ struct Bridge::Impl {
   Points<3> given, moved;                         // with the face centres' entries and nodes; kept between moves
 #ifdef MESHMOTION_FOAM_PARALLEL
   std::optional<parallel::DistributedRbfMover<3>> distributed;
+  std::optional<parallel::DistributedElasticityMover<3>> distributed_cells;  // le, sle
   parallel::BoundarySolveOptions solve;
-  Points<3> points;  // the distributed mover's view of them must outlive its setup
-  std::vector<std::int64_t> global_ids;
+  parallel::DistributedElasticityOptions cells;
+  Points<3> points;  // the distributed RBF's view of them must outlive its setup
+  std::vector<std::int64_t> global_ids;  // with the auxiliary nodes' where the cells are moved
   std::vector<int> owners;
 #endif
   Index points_count = 0, entries = 0;
@@ -113,6 +183,14 @@ struct Bridge::Impl {
   bool set_up(const Points<3>& d) {
     boundary.displacements.leftCols(d.cols()) = d;
 #ifdef MESHMOTION_FOAM_PARALLEL
+    if (!global_ids.empty() && needs_cells(config.method)) {
+      parallel::DistributedElasticityOptions options = cells;
+      options.elasticity = std::get<ElasticityOptions>(config.options);
+      distributed_cells.emplace(options);
+      distributed_cells->setup(parallel::PartitionView<3>{MPI_COMM_WORLD, mesh.points, global_ids, owners}, mesh, boundary);
+      ++setups;
+      return true;
+    }
     if (!global_ids.empty()) {
       const double before = radius;
       distributed.emplace(std::get<RbfOptions>(config.options), solve);
@@ -145,14 +223,23 @@ struct Bridge::Impl {
 #endif
     return out;
   }
+
+  // The cells' mover: the serial one, or on a decomposed case the distributed elasticity.
+  void move_cells() {
+#ifdef MESHMOTION_FOAM_PARALLEL
+    if (distributed_cells) {
+      distributed_cells->move_into(given, moved);
+      return;
+    }
+#endif
+    mover->move_into(given, moved);
+  }
 };
 
 bool needs_cells(const std::string& method) { return method != "rbf"; }
 
 Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
   try {
-    if (!input.global_ids.empty() && needs_cells(input.method))
-      throw InputError("method '" + input.method + "' moves a decomposed case's cells, which this plugin does not pass between ranks yet; use method rbf");
     const auto n = static_cast<Index>(input.points.size() / 3), nb = static_cast<Index>(input.boundary.size());
     auto impl = std::make_unique<Impl>();
     ResolvedBoundary<3>& b = impl->boundary;
@@ -172,13 +259,16 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
     impl->entries = nb;
     const Eigen::Map<const Points<3>> points(input.points.data(), 3, n);
 #ifdef MESHMOTION_FOAM_PARALLEL
-    const KeyValues rest = take_options(given, impl->solve);
+    const KeyValues rest = take_options(given, impl->solve, impl->cells);
 #else
     if (!input.global_ids.empty())
       throw InputError("this plugin was built without meshmotion's parallel layer (MPI, PETSc, METIS): run the motion serially");
     const KeyValues& rest = given;
 #endif
     impl->config = mover_config<3>(input.method, rest);
+    if (!input.global_ids.empty() && needs_cells(input.method) && impl->config.method != "le" && impl->config.method != "sle")
+      throw InputError("method '" + input.method + "' has no mover for a decomposed case (expected rbf, le or sle; "
+                       "or run the case serially)");
     if (const auto* rbf = std::get_if<RbfOptions>(&impl->config.options))
       impl->growing_radius = rbf->support_radius == 0.0 && rbf->support_radii.empty();
 #ifdef MESHMOTION_FOAM_PARALLEL
@@ -193,6 +283,11 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
     }
 #endif
     if (needs_cells(input.method)) {
+      std::vector<char> coupled;
+      if (!input.coupled_faces.empty()) {
+        coupled.assign(input.face_offsets.size() - 1, 0);
+        for (const long f : input.coupled_faces) coupled[static_cast<std::size_t>(f)] = 1;
+      }
       PolyMesh poly;
       poly.points = points;
       poly.face_offsets.assign(input.face_offsets.begin(), input.face_offsets.end());
@@ -203,7 +298,16 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
       const Index internal = poly.num_internal_faces();
       poly.patches = {{"boundary", "patch", internal, poly.num_faces() - internal}};
       impl->mesh = to_mesh(poly);
-      impl->centre_entries = add_face_centres(poly, impl->mesh, b);
+#ifdef MESHMOTION_FOAM_PARALLEL
+      if (!input.global_ids.empty()) {
+        // Every rank cuts its cells into tetrahedra when any rank must, as the serial run does.
+        int cut = impl->mesh.num_auxiliary_nodes > 0 ? 1 : 0;
+        MPI_Allreduce(MPI_IN_PLACE, &cut, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+        if (cut == 1 && impl->mesh.num_auxiliary_nodes == 0) impl->mesh = to_mesh(poly, true);
+        number_auxiliary_nodes(poly, impl->mesh.num_nodes(), coupled, impl->global_ids, impl->owners);
+      }
+#endif
+      impl->centre_entries = add_face_centres(poly, impl->mesh, coupled, b);
     } else if (input.global_ids.empty()) {
       impl->mesh.points = points;
     }
@@ -244,7 +348,7 @@ void Bridge::move(const std::vector<double>& boundary_displacements, std::vector
       for (const Index e : face) mean += d.col(e);
       m.given.col(m.entries + static_cast<Index>(k)) = face.empty() ? mean : Vec<3>(mean / static_cast<double>(face.size()));
     }
-    m.mover->move_into(m.given, m.moved);
+    m.move_cells();
     out.assign(m.moved.data(), m.moved.data() + 3 * m.points_count);
   } catch (const std::exception& e) {
     throw std::runtime_error(e.what());

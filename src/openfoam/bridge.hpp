@@ -29,9 +29,13 @@ struct BridgeInput {
   /// each internal face's neighbour (internal faces first), and the number of cells.
   std::vector<long> face_offsets, face_points, owner, neighbour;
   long cells = 0;
+  /// A decomposed case's faces between ranks (on processor patches) and on cyclic patches:
+  /// interior to the mover, whatever their points are.
+  std::vector<long> coupled_faces;
 };
 
-/// Whether `method` moves the interior through the mesh's cells (every method but rbf).
+/// Whether `method` moves the interior through the mesh's cells (every method but rbf). On a
+/// decomposed case le and sle do (PETSc's distributed elasticity), the others are refused.
 bool needs_cells(const std::string& method);
 
 class Bridge {

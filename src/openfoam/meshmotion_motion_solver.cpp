@@ -199,7 +199,7 @@ void meshmotionMotionSolver::setup()
     {
         for (direction d = 0; d < 3; ++d) input.points[3 * i + d] = p0[i][d];
     }
-    if (meshmotion::foam::needs_cells(input.method) && !Pstream::parRun())
+    if (meshmotion::foam::needs_cells(input.method))
     {
         const faceList& faces = m.faces();
         input.face_offsets.reserve(faces.size() + 1);
@@ -212,6 +212,12 @@ void meshmotionMotionSolver::setup()
         input.owner.assign(m.faceOwner().begin(), m.faceOwner().end());
         input.neighbour.assign(m.faceNeighbour().begin(), m.faceNeighbour().end());
         input.cells = m.nCells();
+        forAll(m.boundaryMesh(), patchi)
+        {
+            const polyPatch& patch = m.boundaryMesh()[patchi];
+            if (!patch.coupled()) continue;
+            for (label f = patch.start(); f < patch.start() + patch.size(); ++f) input.coupled_faces.push_back(f);
+        }
     }
     if (Pstream::parRun())
     {

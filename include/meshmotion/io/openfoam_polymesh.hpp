@@ -118,7 +118,9 @@ struct SmallCell {
 /// they all are, else every cell cut into tetrahedra around auxiliary centre nodes; patches as
 /// facet groups. See the file comment. The auxiliary nodes are, in this order, the centres of
 /// the faces of more than three points, in face order, then every cell's centre, in cell order.
-[[nodiscard]] inline Mesh<3> to_mesh(const PolyMesh& poly) {
+/// `cut_every_cell` cuts them even when every cell has a standard shape: a rank of a decomposed
+/// case must cut its cells as the whole case is cut, whatever shapes the rank itself holds.
+[[nodiscard]] inline Mesh<3> to_mesh(const PolyMesh& poly, bool cut_every_cell = false) {
   const Index nc = poly.num_cells, nf = poly.num_faces(), np = poly.points.cols();
   // Cell -> faces (CSR), each face oriented out of the cell.
   std::vector<Index> start(static_cast<std::size_t>(nc) + 1, 0);
@@ -149,7 +151,7 @@ struct SmallCell {
   mesh.first_node_id = 0;  // OpenFOAM's point labels
   std::vector<ElementType> types(static_cast<std::size_t>(nc));
   std::vector<std::array<Index, 8>> matched(static_cast<std::size_t>(nc));
-  bool all_matched = true;
+  bool all_matched = !cut_every_cell;
   for (Index c = 0; c < nc && all_matched; ++c) {
     detail::SmallCell cell;
     for (Index k = start[static_cast<std::size_t>(c)]; k < start[static_cast<std::size_t>(c) + 1] && all_matched; ++k) {
