@@ -23,8 +23,9 @@ row of volume_coordinates() (owned nodes first, then ghosts shared with other ra
 the design surface of a rank is the design nodes it owns (`design_nodes`, global ids). Every
 call that moves or differentiates is collective. warp_derivative(dI_dXv) reads the rows of
 owned nodes (a ghost's row belongs to its owner) and returns this rank's rows of dI/dXs: the
-ranks' rows together are the serial gradient. Methods: rbf (with derivatives), le and sle
-(PETSc). The result equals the serial Warp's to round-off (RBF).
+ranks' rows together are the serial gradient. Methods: rbf, le and sle (PETSc), each with
+its reverse derivative. The result equals the serial Warp's to round-off (RBF), to the PETSc
+solve's tolerance (le, sle).
 """
 
 import warnings as _warnings

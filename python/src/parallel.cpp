@@ -83,7 +83,7 @@ class DistributedMover {
   }
 
   void setup(const parallel::DistributedMesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) {
-    if (has_derivatives()) {
+    if (std::holds_alternative<Rbf>(mover_)) {
       // PETSc solves the RBF boundary system only when BoundarySolveOptions chooses it.
       std::get<Rbf>(mover_)->setup(mesh.view(), boundary);
     } else {
@@ -101,15 +101,15 @@ class DistributedMover {
     out = out_;
   }
   [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) {
-    if (!has_derivatives()) throw InputError("derivative_reverse: the distributed elasticity mover has no derivatives");
-    return std::get<Rbf>(mover_)->derivative_reverse(v);
+    return std::visit([&](auto& m) { return m->derivative_reverse(v); }, mover_);
   }
-  [[nodiscard]] bool has_derivatives() const { return std::holds_alternative<Rbf>(mover_); }
+  /// Both movers are linear in the displacements and give their reverse derivative.
+  [[nodiscard]] bool has_derivatives() const { return true; }
   [[nodiscard]] MoverStats stats() const {
     return std::visit([](const auto& m) { return m->stats(); }, mover_);
   }
   /// The RBF boundary system is solved through PETSc (false for elasticity, which always is).
-  [[nodiscard]] bool petsc_solve() const { return has_derivatives() && std::get<Rbf>(mover_)->petsc_solve(); }
+  [[nodiscard]] bool petsc_solve() const { return std::holds_alternative<Rbf>(mover_) && std::get<Rbf>(mover_)->petsc_solve(); }
 
  private:
   using Rbf = std::unique_ptr<parallel::DistributedRbfMover<Dim>>;

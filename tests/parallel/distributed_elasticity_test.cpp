@@ -8,6 +8,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <utility>
 
@@ -79,6 +81,58 @@ TEST_CASE("distributed elasticity: an empty rank and a rank without boundary nod
   DistributedElasticityOptions options;
   options.tolerance = 1e-12;
   CHECK(relative_error(mesh, spec, options, ranks) <= 1e-9);
+}
+
+TEST_CASE("distributed elasticity derivatives: the ranks' reverse gradients add up to the serial one, a dot test holds",
+          "[parallel][elasticity][derivatives]") {
+  const Mesh<2> whole = rectangle_mesh({.nx = 20, .ny = 12, .cells = RectangleCells::tri_quad});
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Rotation2D{{0.5, 0.0}, radians(4.0)}).fixed("top").sliding("left").sliding("right");
+  const ResolvedBoundary<2> b = spec.resolve(whole);
+  DistributedElasticityOptions options;
+  options.elasticity.stiffening_exponent = 1.0;
+  options.tolerance = 1e-13;
+  ElasticityMover<2> serial(options.elasticity);
+  serial.setup(whole, b);
+  // One seed per node of the whole mesh, the same on every rank.
+  Points<2> v(2, whole.num_nodes());
+  for (Index i = 0; i < whole.num_nodes(); ++i) v.col(i) << std::sin(3.0 * i), std::cos(5.0 * i);
+  const Points<2> expected = serial.derivative_reverse(v);
+
+  const DistributedMesh<2> part = partition_mesh(world(), whole);
+  const ResolvedBoundary<2> local_b = distribute_boundary(part, b);
+  DistributedElasticityMover<2> mover(options);
+  mover.setup(part, local_b);
+  Points<2> local_v(2, part.local.num_nodes());
+  for (Index i = 0; i < part.local.num_nodes(); ++i) local_v.col(i) = v.col(part.global_ids[static_cast<std::size_t>(i)]);
+  const Points<2> local_gradient = mover.derivative_reverse(local_v);
+  Points<2> gradient = Points<2>::Zero(2, b.size());
+  for (Index k = 0; k < local_b.size(); ++k)
+    gradient.col(b.column(part.global_ids[static_cast<std::size_t>(local_b.nodes[static_cast<std::size_t>(k)])])) += local_gradient.col(k);
+  MPI_Allreduce(MPI_IN_PLACE, gradient.data(), static_cast<int>(gradient.size()), MPI_DOUBLE, MPI_SUM, world());
+  // The prescribed entries' rows (a fixed entry's displacement is zero by contract: the
+  // distributed mover reads none and gives it no gradient, the serial one reads it).
+  double worst = 0.0, largest = 0.0;
+  for (Index k = 0; k < b.size(); ++k) {
+    if (b.kinds[static_cast<std::size_t>(k)] != BoundaryKind::prescribed) continue;
+    worst = std::max(worst, (gradient.col(k) - expected.col(k)).cwiseAbs().maxCoeff());
+    largest = std::max(largest, expected.col(k).cwiseAbs().maxCoeff());
+  }
+  CHECK(worst <= 1e-9 * largest);
+  CHECK(largest > 0.0);
+
+  // ⟨v, J w⟩ over the owned nodes equals Σ ⟨Jᵀ v, w⟩ over the ranks' entries.
+  Points<2> w = Points<2>::Zero(2, local_b.size());
+  for (Index k = 0; k < local_b.size(); ++k) {
+    const auto g = static_cast<double>(part.global_ids[static_cast<std::size_t>(local_b.nodes[static_cast<std::size_t>(k)])]);
+    w.col(k) << std::cos(0.7 * g), std::sin(1.3 * g);
+  }
+  const Points<2> jw = mover.derivative_forward(w);
+  double sums[2] = {0.0, 0.0};
+  for (Index i = 0; i < part.num_owned; ++i) sums[0] += local_v.col(i).dot(jw.col(i));
+  for (Index k = 0; k < local_b.size(); ++k) sums[1] += local_gradient.col(k).dot(w.col(k));
+  MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, world());
+  CHECK(sums[0] == Approx(sums[1]).epsilon(1e-9));
 }
 
 TEST_CASE("distributed elasticity: a solver failure raises on every rank, or falls back when asked", "[parallel][elasticity]") {

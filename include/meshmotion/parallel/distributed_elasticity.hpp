@@ -137,6 +137,17 @@ class DistributedElasticityMover {
     return out;
   }
 
+  /// Collective. Forward derivative: the displacement change (Dim × part.size()) for a change
+  /// `w` of the boundary entries' displacements. The mover is linear, so this is move(w).
+  [[nodiscard]] Points<Dim> derivative_forward(PointsView<Dim> w) { return move(w); }
+
+  /// Collective. For v (Dim × part.size()), the gradient of Σ over ranks of ⟨v, move(d)⟩ on
+  /// owned nodes with respect to this rank's boundary entries (Dim × boundary.size()): owned
+  /// prescribed entries carry it, ghost, fixed and sliding entries are zero, so the ranks'
+  /// gradients add up to the serial one. One solve of the symmetric system (x̄ = seed in the
+  /// nodes' frames, y = K_FF⁻¹ x̄_F, gradient = x̄_D − (K y)_D), to the solver's tolerance.
+  [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v);
+
  private:
   using Frame = Eigen::Matrix<double, Dim, Dim>;
   enum Condition : int { free_node = -1, prescribed = 0, fixed = 1, sliding = 2 };
@@ -152,6 +163,9 @@ class DistributedElasticityMover {
   using OwnedVec = detail::OwnedVec;
 
   void build_solver(OwnedKsp& ksp, PetscSolverKind kind, const char* where);
+  /// Solves the scaled system for b_ into x_ (MUMPS again when CG fails and fallback_to_direct
+  /// is set); the iterations and the relative residual into stats_.
+  void solve_scaled(const char* where);
   void release() {
     ksp_.reset();
     direct_.reset();
@@ -493,32 +507,7 @@ void DistributedElasticityMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& 
   for (std::size_t r = 0; r < held.size(); ++r) b[dirichlet_[r] - first_row_] = held[r];
   petsc_check(VecRestoreArray(b_.get(), &b), where, "VecRestoreArray");
   petsc_check(VecPointwiseMult(b_.get(), b_.get(), scale_.get()), where, "VecPointwiseMult");
-  PetscReal rhs_norm = 0.0;
-  petsc_check(VecNorm(b_.get(), NORM_2, &rhs_norm), where, "VecNorm");
-
-  petsc_check(KSPSolve(ksp_.get(), b_.get(), x_.get()), where, "KSPSolve");
-  KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
-  petsc_check(KSPGetConvergedReason(ksp_.get(), &reason), where, "KSPGetConvergedReason");
-  PetscInt iterations = 0;
-  petsc_check(KSPGetIterationNumber(ksp_.get(), &iterations), where, "KSPGetIterationNumber");
-  stats_.fell_back = false;
-  // The reason is the same on every rank, so every rank raises or falls back alike.
-  if (reason < 0) {
-    if (!options_.fallback_to_direct) {
-      throw SolverError("DistributedElasticityMover::move: CG did not converge (PETSc reason " + std::to_string(static_cast<int>(reason)) +
-                        " after " + std::to_string(iterations) + " iterations; tolerance " + std::to_string(options_.tolerance) +
-                        "); set fallback_to_direct or another solver");
-    }
-    if (!direct_) build_solver(direct_, PetscSolverKind::direct_mumps, where);
-    petsc_check(KSPSolve(direct_.get(), b_.get(), x_.get()), where, "KSPSolve");
-    stats_.fell_back = true;
-  }
-  OwnedVec residual;
-  petsc_check(VecDuplicate(b_.get(), residual.out()), where, "VecDuplicate");
-  petsc_check(MatMult(a_.get(), x_.get(), residual.get()), where, "MatMult");
-  petsc_check(VecAYPX(residual.get(), -1.0, b_.get()), where, "VecAYPX");
-  PetscReal residual_norm = 0.0;
-  petsc_check(VecNorm(residual.get(), NORM_2, &residual_norm), where, "VecNorm");
+  solve_scaled(where);
   petsc_check(VecPointwiseMult(x_.get(), x_.get(), scale_.get()), where, "VecPointwiseMult");
   // Dirichlet values exactly, whatever the Krylov iterate left there.
   PetscScalar* x = nullptr;
@@ -540,9 +529,84 @@ void DistributedElasticityMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& 
   }
   petsc_check(VecRestoreArrayRead(ghosts_.get(), &g), where, "VecRestoreArrayRead");
   ++stats_.moves;
+  stats_.move_seconds = watch.seconds();
+}
+
+template <int Dim>
+Points<Dim> DistributedElasticityMover<Dim>::derivative_reverse(PointsView<Dim> v) {
+  using detail::petsc_check;
+  constexpr const char* where = "DistributedElasticityMover::derivative_reverse";
+  collective(comm_, [&] {
+    if (!ready_) throw InputError("DistributedElasticityMover::derivative_reverse: setup() was not called");
+    meshmotion::detail::check_node_field<Dim>(where, v, n_local_);
+  });
+  // x̄: the owned nodes' seeds in their frames (a ghost's term is its owner's).
+  PetscScalar* seed = nullptr;
+  petsc_check(VecGetArray(values_.get(), &seed), where, "VecGetArray");
+  for (std::size_t j = 0; j < owned_nodes_.size(); ++j) {
+    const Index i = owned_nodes_[j];
+    Eigen::Map<Vec<Dim>>(seed + j * Dim) = conditions_[static_cast<std::size_t>(i)].frame.transpose() * v.col(i);
+  }
+  petsc_check(VecRestoreArray(values_.get(), &seed), where, "VecRestoreArray");
+  // y = K_FF⁻¹ x̄_F through the scaled system: b = S x̄ with zero Dirichlet rows, y = S x.
+  petsc_check(VecPointwiseMult(b_.get(), values_.get(), scale_.get()), where, "VecPointwiseMult");
+  PetscScalar* b = nullptr;
+  petsc_check(VecGetArray(b_.get(), &b), where, "VecGetArray");
+  for (const PetscInt row : dirichlet_) b[row - first_row_] = 0.0;
+  petsc_check(VecRestoreArray(b_.get(), &b), where, "VecRestoreArray");
+  solve_scaled(where);
+  petsc_check(VecPointwiseMult(x_.get(), x_.get(), scale_.get()), where, "VecPointwiseMult");
+  PetscScalar* x = nullptr;
+  petsc_check(VecGetArray(x_.get(), &x), where, "VecGetArray");
+  for (const PetscInt row : dirichlet_) x[row - first_row_] = 0.0;
+  petsc_check(VecRestoreArray(x_.get(), &x), where, "VecRestoreArray");
+  petsc_check(MatMult(k_.get(), x_.get(), b_.get()), where, "MatMult");
+  // A prescribed node's rows are its own (no frame): its gradient is x̄ − K y there.
+  Points<Dim> gradient = Points<Dim>::Zero(Dim, boundary_size_);
+  const PetscScalar* x_bar = nullptr;
+  petsc_check(VecGetArrayRead(values_.get(), &x_bar), where, "VecGetArrayRead");
+  const PetscScalar* ky = nullptr;
+  petsc_check(VecGetArrayRead(b_.get(), &ky), where, "VecGetArrayRead");
+  for (std::size_t e = 0; e < owned_entries_.size(); ++e) {
+    if (conditions_[static_cast<std::size_t>(entry_nodes_[e])].kind != prescribed) continue;
+    const std::size_t at = static_cast<std::size_t>(entry_rows_[e]) * Dim;
+    for (int a = 0; a < Dim; ++a) gradient(a, owned_entries_[e]) = x_bar[at + static_cast<std::size_t>(a)] - ky[at + static_cast<std::size_t>(a)];
+  }
+  petsc_check(VecRestoreArrayRead(b_.get(), &ky), where, "VecRestoreArrayRead");
+  petsc_check(VecRestoreArrayRead(values_.get(), &x_bar), where, "VecRestoreArrayRead");
+  return gradient;
+}
+
+template <int Dim>
+void DistributedElasticityMover<Dim>::solve_scaled(const char* where) {
+  using detail::petsc_check;
+  PetscReal rhs_norm = 0.0;
+  petsc_check(VecNorm(b_.get(), NORM_2, &rhs_norm), where, "VecNorm");
+  petsc_check(KSPSolve(ksp_.get(), b_.get(), x_.get()), where, "KSPSolve");
+  KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
+  petsc_check(KSPGetConvergedReason(ksp_.get(), &reason), where, "KSPGetConvergedReason");
+  PetscInt iterations = 0;
+  petsc_check(KSPGetIterationNumber(ksp_.get(), &iterations), where, "KSPGetIterationNumber");
+  stats_.fell_back = false;
+  // The reason is the same on every rank, so every rank raises or falls back alike.
+  if (reason < 0) {
+    if (!options_.fallback_to_direct) {
+      throw SolverError(std::string(where) + ": CG did not converge (PETSc reason " + std::to_string(static_cast<int>(reason)) +
+                        " after " + std::to_string(iterations) + " iterations; tolerance " + std::to_string(options_.tolerance) +
+                        "); set fallback_to_direct or another solver");
+    }
+    if (!direct_) build_solver(direct_, PetscSolverKind::direct_mumps, where);
+    petsc_check(KSPSolve(direct_.get(), b_.get(), x_.get()), where, "KSPSolve");
+    stats_.fell_back = true;
+  }
+  OwnedVec residual;
+  petsc_check(VecDuplicate(b_.get(), residual.out()), where, "VecDuplicate");
+  petsc_check(MatMult(a_.get(), x_.get(), residual.get()), where, "MatMult");
+  petsc_check(VecAYPX(residual.get(), -1.0, b_.get()), where, "VecAYPX");
+  PetscReal residual_norm = 0.0;
+  petsc_check(VecNorm(residual.get(), NORM_2, &residual_norm), where, "VecNorm");
   stats_.iterations = iterations;
   stats_.residual = rhs_norm > 0.0 ? residual_norm / rhs_norm : 0.0;
-  stats_.move_seconds = watch.seconds();
 }
 
 }  // namespace meshmotion::parallel
