@@ -123,4 +123,11 @@ TEST_CASE("a motion that is not two-dimensional is refused on the section, namin
   const Mesh<3> thick = extrude_mesh(flat, {.layers = 2});
   CHECK_THAT(test::message_of<InputError>([&] { mover.setup(thick, BoundarySpec<3>{}.fixed("bottom").resolve(thick)); }),
              Catch::Contains("not one cell thick"));
+  // Given the extrusion the caller found, the mover moves as when it finds it, and refuses a
+  // mesh it was not found on.
+  SectionMover given(make_mover(mover_config<2>("rbf")), *ext);
+  given.setup(slab, b);
+  CHECK(given.move(b.displacements) == mover.move(b.displacements));
+  CHECK_THAT(test::message_of<InputError>([&] { given.setup(thick, BoundarySpec<3>{}.fixed("bottom").resolve(thick)); }),
+             Catch::Contains("the given extrusion pairs"));
 }

@@ -138,15 +138,24 @@ class SectionMover {
   static constexpr int dim = 3;
 
   explicit SectionMover(AnyMover<2> mover) : mover_(std::move(mover)) {}
+  /// With the extrusion of the mesh that setup will be given, as find_extrusion() gave it to
+  /// the caller: setup does not look for it again (a case moved step after step keeps it).
+  SectionMover(AnyMover<2> mover, Extrusion ext) : mover_(std::move(mover)), ext_(std::move(ext)), known_(true) {}
 
   void setup(const Mesh<3>& mesh, const ResolvedBoundary<3>& boundary) {
-    std::optional<Extrusion> ext = find_extrusion(mesh);
-    if (!ext)
-      throw InputError("SectionMover::setup: the mesh is not one cell thick between two parallel coordinate planes "
-                       "(every node on one of them, every cell a linear prism or hexahedron joining them)");
-    SectionBoundary b = section_boundary(*ext, mesh, boundary);
-    mover_.setup(ext->section, b.boundary);
-    ext_ = std::move(*ext);
+    if (!known_) {
+      std::optional<Extrusion> ext = find_extrusion(mesh);
+      if (!ext)
+        throw InputError("SectionMover::setup: the mesh is not one cell thick between two parallel coordinate planes "
+                         "(every node on one of them, every cell a linear prism or hexahedron joining them)");
+      ext_ = std::move(*ext);
+    } else if (static_cast<Index>(2 * ext_.front_nodes.size()) != mesh.num_nodes()) {
+      throw InputError("SectionMover::setup: the mesh has " + std::to_string(mesh.num_nodes()) +
+                       " nodes but the given extrusion pairs " + std::to_string(2 * ext_.front_nodes.size()) +
+                       " (expected the mesh it was found on)");
+    }
+    SectionBoundary b = section_boundary(ext_, mesh, boundary);
+    mover_.setup(ext_.section, b.boundary);
     section_ = std::move(b);
     num_nodes_ = mesh.num_nodes();
     num_columns_ = boundary.size();
@@ -188,6 +197,7 @@ class SectionMover {
  private:
   AnyMover<2> mover_;
   Extrusion ext_;
+  bool known_ = false;  ///< ext_ was given: setup keeps it
   SectionBoundary section_;
   Index num_nodes_ = 0, num_columns_ = 0;
   Points<2> d2_, out2_;
