@@ -10,6 +10,7 @@
 #include "meshmotion/core/json.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/mesh_like.hpp"
+#include "meshmotion/core/name_pattern.hpp"
 #include "meshmotion/core/option_text.hpp"
 #include "meshmotion/core/orientation.hpp"
 #include "meshmotion/core/shape_functions.hpp"

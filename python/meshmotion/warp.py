@@ -55,11 +55,11 @@ def _boundary_spec(mesh, design, symmetry, fixed):
     return spec
 
 
-def _design_nodes(mesh, design):
-    nodes = set()
-    for group in design:
-        nodes.update(mesh.group_nodes(group))
-    return _np.array(sorted(nodes), dtype=_np.int64)
+def _design_nodes(boundary):
+    # The prescribed entries are the design groups' nodes (a node shared with a symmetry or
+    # fixed group included: prescribed wins), however the groups were named (a patch group, a
+    # pattern).
+    return _np.array([v for v, kind in zip(boundary.nodes, boundary.kinds) if kind == "prescribed"], dtype=_np.int64)
 
 
 class Warp:
@@ -75,7 +75,7 @@ class Warp:
             self._mesh = mesh
             self._ids = _np.arange(mesh.points.shape[0], dtype=_np.int64)
             self._num_owned = len(self._ids)
-            self._design = _design_nodes(mesh, design)
+            self._design = _design_nodes(boundary)
             self._mover = (_core.Mover2 if self._dim == 2 else _core.Mover3)(method, **options)
             self._mover.setup(mesh, boundary)
         else:
@@ -117,7 +117,7 @@ class Warp:
             try:
                 whole = _read(mesh, orientation)
                 whole_boundary = _boundary_spec(whole, design, symmetry, fixed).resolve(whole)
-                design_ids = _design_nodes(whole, design)
+                design_ids = _design_nodes(whole_boundary)
                 if cell_ranks is not None:
                     cell_ranks = index_array(cell_ranks, "Warp: cell_ranks").astype(_np.int32).tolist()
             except Exception as error:  # every rank raises what rank 0 found

@@ -283,6 +283,20 @@ def test_warp_in_an_optimization_loop():
         w.set_surface_coordinates(bump[:-1])
 
 
+def test_warp_takes_groups_named_by_patterns_as_openfoam_names_patches():
+    mesh = grid()
+    by_name = mm.Warp(mesh, design=["bottom"], symmetry=["left", "right"], fixed=["top"], support_radius=0.6)
+    by_pattern = mm.Warp(mesh, design=["bot.*"], symmetry=["(left|right)"], fixed=["t[o]p"], support_radius=0.6)
+    np.testing.assert_array_equal(by_pattern.design_nodes, by_name.design_nodes)
+    bump = by_name.surface_coordinates().copy()
+    bump[:, 1] += 0.02 * np.sin(np.pi * bump[:, 0])
+    by_name.set_surface_coordinates(bump)
+    by_pattern.set_surface_coordinates(bump)
+    np.testing.assert_array_equal(by_pattern.warp(), by_name.warp())
+    with pytest.raises(ValueError, match="no group named 'inlet.[*]'"):
+        mm.Warp(mesh, design=["inlet.*"], fixed=["top"])
+
+
 def test_warp_reports_its_conditioning_and_warns_when_gradients_lose_digits():
     mesh = grid()
     conditions = []

@@ -20,6 +20,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -135,6 +136,17 @@ void require_checkmesh_values(const FoamQuality& q, const std::string& report) {
   const bool errors = report.find("non-orthogonality errors") != std::string::npos;
   CHECK(errors == (q.num_non_orthogonality_errors > 0));
   if (errors) CHECK(q.num_non_orthogonality_errors == static_cast<Index>(reported(report, "Number of non-orthogonality errors: ")));
+  // " ***Error in face pyramids: N faces are incorrectly oriented."
+  const bool pyramids = report.find("Error in face pyramids: ") != std::string::npos;
+  CHECK(pyramids == (q.num_wrong_face_pyramids > 0));
+  if (pyramids) CHECK(q.num_wrong_face_pyramids == static_cast<Index>(reported(report, "Error in face pyramids: ")));
+  // The verdict over the geometric checks: each failed one prints a "***" line after
+  // "Checking geometry..." (the topological ones before it are not ours).
+  const std::size_t geometry = report.find("Checking geometry...");
+  REQUIRE(geometry != std::string::npos);
+  int failed = 0;
+  for (std::size_t at = report.find("***", geometry); at != std::string::npos; at = report.find("***", at + 3)) ++failed;
+  CHECK(q.failed_checks == failed);
 }
 
 double total_volume(const Mesh<3>& mesh) {
@@ -205,6 +217,45 @@ TEST_CASE("OpenFOAM: a polyhedral cell is cut into tetrahedra around auxiliary c
   CHECK_THAT(report, Catch::Contains("cells:            3") && Catch::Contains("polyhedra:     1") && Catch::Contains("Mesh OK."));
 }
 
+TEST_CASE("OpenFOAM: patch groups and types name sets of patches, as in OpenFOAM's dictionaries", "[io][openfoam]") {
+  PolyMesh c = hanging_node_case();
+  c.patches[0].groups = {"body"};
+  const fs::path dir = test::scratch_path("foam_groups");
+  write_case(dir, c);
+  const PolyMesh poly = read_polymesh(dir);
+  CHECK(poly.patches[0].groups == std::vector<std::string>{"body"});
+  CHECK(poly.patches[1].groups.empty());
+  const Mesh<3> mesh = read_openfoam(dir);
+  // The type joins the set as OpenFOAM adds it; the generic `patch` does not.
+  CHECK(mesh.group("wall").in_groups == std::vector<std::string>{"body", "wall"});
+  CHECK(mesh.group("outlet").in_groups.empty());
+  CHECK(mesh.group("frontAndBack").in_groups == std::vector<std::string>{"empty"});
+  const ResolvedBoundary<3> by_set = BoundarySpec<3>{}.fixed("body").resolve(mesh);
+  CHECK(by_set.nodes == mesh.group_nodes("wall"));
+  const ResolvedBoundary<3> by_pattern = BoundarySpec<3>{}.fixed("(wall|outlet)").resolve(mesh);
+  const ResolvedBoundary<3> by_names = BoundarySpec<3>{}.fixed("wall").fixed("outlet").resolve(mesh);
+  CHECK(by_pattern.nodes == by_names.nodes);
+}
+
+TEST_CASE("OpenFOAM: cells of standard shapes are cut into tetrahedra on request, as polyhedra are", "[io][openfoam]") {
+  // A rank of a decomposed case holding only hexahedra cuts them when another rank holds
+  // polyhedra (the plugin's distributed elasticity), so both must give the same volume.
+  const PolyMesh poly = to_polymesh(box_mesh({.nx = 3, .ny = 2, .nz = 2}));
+  const Mesh<3> kept = to_mesh(poly);
+  CHECK(kept.num_auxiliary_nodes == 0);
+  REQUIRE(kept.cells.size() == 1);
+  CHECK(kept.cells.front().type == ElementType::hex8);
+  const Mesh<3> cut = to_mesh(poly, true);
+  // A centre per face (every face a quadrilateral) and per cell; 4 tetrahedra per face of a cell.
+  CHECK(cut.num_auxiliary_nodes == poly.num_faces() + 12);
+  REQUIRE(cut.cells.size() == 1);
+  CHECK(cut.cells.front().type == ElementType::tet4);
+  CHECK(cut.cells.front().size() == 12 * 6 * 4);
+  CHECK(orientation_report(cut).num_negative == 0);
+  CHECK(total_volume(cut) == Approx(total_volume(kept)).epsilon(1e-12));
+  CHECK(cut.points.leftCols(poly.points.cols()) == poly.points);
+}
+
 TEST_CASE("OpenFOAM: moved points go into the case or a time folder, in the case's format", "[io][openfoam]") {
   const PolyMesh c = hanging_node_case();
   for (const auto format : formats()) {
@@ -225,6 +276,14 @@ TEST_CASE("OpenFOAM: moved points go into the case or a time folder, in the case
     const Points<3> at_time = detail::read_foam_points(dir / "0.5" / "polyMesh" / "points");
     CHECK(at_time == mesh.points.leftCols(16));  // every digit kept
     CHECK(detail::read_foam_file(dir / "0.5" / "polyMesh" / "points").find("\"0.5/polyMesh\"") != std::string::npos);
+    // Read back from the time folder, as OpenFOAM's -time 0.5: those points on the constant
+    // faces; a time folder without points gives the constant ones.
+    const Mesh<3> at_half = read_openfoam(dir / "0.5");
+    CHECK(at_half.points.leftCols(16) == mesh.points.leftCols(16));
+    CHECK(at_half.cells.front().connectivity == mesh.cells.front().connectivity);
+    fs::create_directories(dir / "0.25");
+    CHECK(read_polymesh(dir / "0.25").points == c.points);
+    CHECK_THROWS_AS(read_polymesh(dir / "0.125"), IoError);  // no such time
 
     // In place: only the points change.
     write_mesh(dir, mesh);
@@ -241,6 +300,31 @@ TEST_CASE("OpenFOAM: moved points go into the case or a time folder, in the case
       if (!report.empty()) CHECK_THAT(report, Catch::Contains("Mesh OK."));
     }
   }
+}
+
+TEST_CASE("OpenFOAM: moved points are written with the case's writePrecision, as OpenFOAM writes them", "[io][openfoam]") {
+  const PolyMesh c = hanging_node_case();
+  const fs::path dir = test::scratch_path("foam_precision");
+  write_case(dir, c);
+  Mesh<3> mesh = read_openfoam(dir);
+  for (Index i = 0; i < mesh.num_nodes(); ++i) mesh.points.col(i) += Vec<3>(0.1, 1.0 / 3.0, 0.0) * (1.0 + mesh.points(0, i));
+  fs::create_directories(dir / "system");
+  {
+    // A writePrecision inside a sub-dictionary (a function object's) is not the case's.
+    std::ofstream out(dir / "system" / "controlDict");
+    out << "FoamFile { version 2.0; format ascii; class dictionary; object controlDict; }\n"
+           "functions { probes { writePrecision 12; } }\n// writePrecision 3;\nwritePrecision 6;\n";
+  }
+  write_mesh(dir / "0.5", mesh);
+  const std::string text = detail::read_foam_file(dir / "0.5" / "polyMesh" / "points");
+  CHECK(text.find("(0.1 0.333333 0)") != std::string::npos);  // point 0 moved, six digits
+  const Points<3> back = detail::read_foam_points(dir / "0.5" / "polyMesh" / "points");
+  CHECK((back - mesh.points.leftCols(16)).cwiseAbs().maxCoeff() < 5e-6 * mesh.points.cwiseAbs().maxCoeff());
+  CHECK(back != mesh.points.leftCols(16));
+  // Without a writePrecision every digit is kept.
+  fs::remove(dir / "system" / "controlDict");
+  write_mesh(dir / "0.5", mesh);
+  CHECK(detail::read_foam_points(dir / "0.5" / "polyMesh" / "points") == mesh.points.leftCols(16));
 }
 
 TEST_CASE("OpenFOAM: each kind of bad case gets a clear error and nothing is written", "[io][openfoam]") {
@@ -383,6 +467,9 @@ TEST_CASE("OpenFOAM: checkMesh's measures agree with checkMesh on the shared cas
   CHECK(h.max_volume == Approx(2.0).epsilon(1e-14));
   CHECK(h.total_volume == Approx(4.0).epsilon(1e-14));
   CHECK(h.num_nonpositive_volumes == 0);
+  CHECK(h.num_wrong_face_pyramids == 0);
+  CHECK(h.num_invalid_cells == 0);
+  CHECK(h.failed_checks == 0);
   // mesh_quality's "checkmesh" object and text come from the description: every field in both.
   std::ostringstream json, text;
   JsonWriter w(json);
@@ -438,8 +525,35 @@ TEST_CASE("OpenFOAM: checkMesh's measures agree with checkMesh on the shared cas
   CHECK(moved.num_non_orthogonality_errors > 0);
   CHECK(moved.num_nonpositive_volumes > 0);
   CHECK(moved.num_highly_skewed > 0);
+  CHECK(moved.num_wrong_face_pyramids > 0);
+  CHECK(moved.num_invalid_cells >= moved.num_nonpositive_volumes);
+  CHECK(moved.failed_checks >= 4);
   write_case(dir, poly);
   if (const std::string report = check_mesh(dir); !report.empty()) require_checkmesh_values(moved, report);
+}
+
+TEST_CASE("OpenFOAM: a wedge case's aspect ratio is taken in its geometric directions, as checkMesh takes it",
+          "[io][openfoam][quality]") {
+  // An axisymmetric wedge of 5 degrees about the x axis: a 2D grid in x, y (y the radius),
+  // its front and back at z = -/+ y tan(2.5 degrees).
+  Mesh<3> box = box_mesh({.nx = 6, .ny = 4, .nz = 1, .y_min = 0.1, .z_min = -1.0, .z_max = 1.0});
+  for (Index i = 0; i < box.num_nodes(); ++i) box.points(2, i) *= box.points(1, i) * std::tan(2.5 * std::numbers::pi / 180.0);
+  PolyMesh wedge = to_polymesh(box);
+  for (auto& p : wedge.patches)
+    if (p.name == "bottom" || p.name == "top") p.type = "wedge";
+  const FoamQuality q = foam_quality(wedge);
+  CHECK(q.solution_directions == 3);
+  CHECK(q.geometric_directions == 2);
+  PolyMesh flat = wedge;
+  for (auto& p : flat.patches) p.type = "patch";
+  const FoamQuality in_3d = foam_quality(flat);
+  CHECK(in_3d.geometric_directions == 3);
+  CHECK(q.max_aspect_ratio < in_3d.max_aspect_ratio);  // the thin direction no longer counts
+  const fs::path dir = test::scratch_path("foam_wedge");
+  fs::remove_all(dir);
+  write_case(dir, wedge);
+  if (const std::string report = check_mesh(dir); !report.empty()) require_checkmesh_values(q, report);
+  else WARN("checkMesh not installed (Debian openfoam): the wedge case was not compared");
 }
 
 TEST_CASE("OpenFOAM: a mixed mesh written as a new case reads back cell by cell and passes checkMesh", "[io][openfoam]") {

@@ -207,3 +207,32 @@ TEST_CASE("file node ids map to node indices", "[movers][boundary]") {
         std::vector<Index>{0, 1, mesh.num_nodes() - 1});
   CHECK_THAT(input_error_of([&] { (void)mesh.node_indices(std::vector<std::int64_t>{999}); }), Catch::Contains("999"));
 }
+
+TEST_CASE("a name of several groups, an OpenFOAM patch group or a pattern, gives each group its condition", "[movers][boundary]") {
+  Mesh<2> mesh = rectangle_mesh({});
+  for (auto& g : mesh.groups)
+    if (g.name == "left" || g.name == "right") g.in_groups = {"sides"};
+  // Each side slides on its own line: taken as one group, the two sides are not one line.
+  const ResolvedBoundary<2> expected =
+      BoundarySpec<2>{}.moving("top", Translation<2>{{0.1, 0.0}}).fixed("bottom").sliding("left").sliding("right").resolve(mesh);
+  for (const std::string sides : {"sides", "(left|right)", "[lr].*t"}) {
+    INFO(sides);
+    const BoundarySpec<2> spec = BoundarySpec<2>{}.moving("top", Translation<2>{{0.1, 0.0}}).fixed("bottom").sliding(sides);
+    const ResolvedBoundary<2> b = spec.resolve(mesh);
+    CHECK(b.nodes == expected.nodes);
+    CHECK(b.kinds == expected.kinds);
+    CHECK(b.normals == expected.normals);
+    CHECK(b.displacements == expected.displacements);
+    CHECK(spec.overlaps(mesh).size() == 4);  // each corner: top or bottom over a side
+  }
+  CHECK_THAT(input_error_of([&] { (void)BoundarySpec<2>{}.moving("(top|bottom)", Points<2>::Zero(2, 11)).resolve(mesh); }),
+             Catch::Contains("'(top|bottom)' names 2 groups but is given one displacement array"));
+  CHECK_THAT(input_error_of([&] { (void)BoundarySpec<2>{}.fixed("(top|bottom").resolve(mesh); }),
+             Catch::Contains("'(' is not closed"));
+  CHECK_THAT(input_error_of([&] { (void)BoundarySpec<2>{}.fixed("inlet.*").resolve(mesh); }),
+             Catch::Contains("no group named 'inlet.*'"));
+  // A pattern naming a group twice over is the same group given twice.
+  CHECK_THAT(input_error_of([&] { (void)BoundarySpec<2>{}.fixed("(top|bottom)").sliding("top").resolve(mesh); }),
+             Catch::Contains("group 'top' is given twice"));
+}
+

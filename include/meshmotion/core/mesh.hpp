@@ -62,12 +62,16 @@ struct ElementBlock {
   }
 };
 
-/// A named physical group (Gmsh physical group, SU2 marker): elements carrying `tag` in
-/// blocks of dimension `dim` belong to it.
+/// A named physical group (Gmsh physical group, SU2 marker, OpenFOAM patch): elements carrying
+/// `tag` in blocks of dimension `dim` belong to it.
 struct PhysicalGroup {
   int dim = 0;
   int tag = 0;
   std::string name;
+  /// Names of the sets of groups it belongs to, by which a boundary condition can name them
+  /// all: an OpenFOAM patch's `inGroups` and its type when not the generic `patch` (`wall`,
+  /// `empty`, `symmetryPlane`, ... as OpenFOAM adds them).
+  std::vector<std::string> in_groups{};
 };
 
 /// CAD parametrization of a node, as Gmsh's $ParametricNodes gives it: the model entity the

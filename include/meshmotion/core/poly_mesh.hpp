@@ -22,6 +22,7 @@ struct PolyMesh {
     std::string type;  ///< patch, wall, empty, symmetryPlane, ...
     Index start = 0;   ///< first face
     Index size = 0;    ///< number of faces
+    std::vector<std::string> groups{};  ///< the boundary file's inGroups
   };
   Points<3> points;
   std::vector<Index> face_offsets{0};  ///< face f: face_nodes[face_offsets[f] .. face_offsets[f+1])

@@ -161,7 +161,13 @@ struct SmallCell {
     all_matched = all_matched && cell.count > 0 &&
                   detail::match_cell(cell, types[static_cast<std::size_t>(c)], matched[static_cast<std::size_t>(c)]);
   }
-  for (std::size_t p = 0; p < poly.patches.size(); ++p) mesh.groups.push_back({2, static_cast<int>(p) + 1, poly.patches[p].name});
+  for (std::size_t p = 0; p < poly.patches.size(); ++p) {
+    const PolyMesh::Patch& patch = poly.patches[p];
+    PhysicalGroup g{2, static_cast<int>(p) + 1, patch.name, patch.groups};
+    if (!patch.type.empty() && patch.type != "patch" && std::find(g.in_groups.begin(), g.in_groups.end(), patch.type) == g.in_groups.end())
+      g.in_groups.push_back(patch.type);
+    mesh.groups.push_back(std::move(g));
+  }
   const auto patch_tag = [&](Index f) {
     for (std::size_t p = 0; p < poly.patches.size(); ++p)
       if (f >= poly.patches[p].start && f < poly.patches[p].start + poly.patches[p].size) return static_cast<int>(p) + 1;

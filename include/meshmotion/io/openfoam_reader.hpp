@@ -19,6 +19,7 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -129,6 +130,8 @@ inline void read_foam_faces(const std::filesystem::path& file, PolyMesh& mesh) {
           if (t == "(" || t == "{") ++depth;
           if (t == ")" || t == "}") --depth;
           if (key == "type") value += std::string(t);
+          // "inGroups List<word> 1(wall);": the words inside the parentheses.
+          if (key == "inGroups" && depth == 1 && t != "(") patch.groups.emplace_back(t);
         }
         if (key == "type") patch.type = value;
       }
@@ -188,15 +191,24 @@ void check_closed_cells(const PolyMesh& mesh, Fail&& fail) {
 
 }  // namespace detail
 
-/// Reads an OpenFOAM polyMesh from a case folder (its constant/polyMesh) or a polyMesh folder.
-/// Throws IoError for a missing file, ParseError for malformed content (file and line or byte
-/// offset), InputError for lists that do not fit together (naming the list and the entry).
+/// Reads an OpenFOAM polyMesh from a case folder (its constant/polyMesh), a polyMesh folder, or
+/// a time folder of a case (`case/0.3`, as OpenFOAM's tools read `-time 0.3`: the points of
+/// `case/0.3/polyMesh/points` where the case moved, else the constant ones, on the constant
+/// faces). Throws IoError for a missing file, ParseError for malformed content (file and line
+/// or byte offset), InputError for lists that do not fit together (naming the list and the entry).
 [[nodiscard]] inline PolyMesh read_polymesh(const std::filesystem::path& path) {
-  const std::filesystem::path dir = detail::polymesh_folder(path);
+  std::filesystem::path dir = detail::polymesh_folder(path), points = dir / "points";
+  std::error_code ec;
+  if (const auto time = dir.empty() && std::filesystem::is_directory(path, ec) ? detail::foam_time_folder(path) : std::nullopt) {
+    dir = time->constant;
+    const bool moved = std::filesystem::exists(time->points(), ec) || std::filesystem::exists(time->points().string() + ".gz", ec);
+    points = moved ? time->points() : dir / "points";
+  }
   if (dir.empty())
-    throw IoError(path.string() + ": not an OpenFOAM case or polyMesh folder (no constant/polyMesh/faces nor faces in it)");
+    throw IoError(path.string() + ": not an OpenFOAM case, polyMesh folder or time folder of a case (no constant/polyMesh/faces "
+                                  "nor faces in it)");
   PolyMesh mesh;
-  mesh.points = detail::read_foam_points(dir / "points");
+  mesh.points = detail::read_foam_points(points);
   detail::read_foam_faces(dir / "faces", mesh);
   // Uniform lists hold at most one entry per face.
   mesh.owner = detail::read_foam_labels(dir / "owner", "owner", mesh.num_faces());

@@ -26,8 +26,10 @@
 namespace meshmotion {
 namespace detail {
 
-/// Appends a points list ("N ( (x y z) ... )" or its binary form) to `out`.
-inline void append_foam_points(std::string& out, const Eigen::Ref<const Points<3>>& points, const FoamHeader& h) {
+/// Appends a points list ("N ( (x y z) ... )" or its binary form) to `out`: ASCII numbers with
+/// `precision` significant digits, or (0) in their shortest exact form.
+inline void append_foam_points(std::string& out, const Eigen::Ref<const Points<3>>& points, const FoamHeader& h,
+                               int precision = 0) {
   const Index n = points.cols();
   out += "\n\n\n";
   append_number(out, n);
@@ -50,15 +52,40 @@ inline void append_foam_points(std::string& out, const Eigen::Ref<const Points<3
     return;
   }
   out += '\n';
+  char buffer[32];
   for (Index i = 0; i < n; ++i) {
     out += '(';
     for (int d = 0; d < 3; ++d) {
       if (d > 0) out += ' ';
-      append_number(out, points(d, i));
+      if (precision > 0) {
+        const auto r = std::to_chars(buffer, buffer + sizeof(buffer), points(d, i), std::chars_format::general, precision);
+        out.append(buffer, static_cast<std::size_t>(r.ptr - buffer));
+      } else {
+        append_number(out, points(d, i));
+      }
     }
     out += ")\n";
   }
   out += ")\n";
+}
+
+/// The `writePrecision` of `case_dir`'s system/controlDict (the significant digits OpenFOAM
+/// writes the case's fields and moved points with), or 0 when there is none.
+[[nodiscard]] inline int foam_write_precision(const std::filesystem::path& case_dir) {
+  const std::filesystem::path file = case_dir / "system" / "controlDict";
+  std::error_code ec;
+  if (case_dir.empty() || !std::filesystem::is_regular_file(file, ec)) return 0;
+  const std::string text = read_foam_file(file);
+  FoamCursor in(text, file);
+  int depth = 0;
+  while (!in.at_end()) {
+    const std::string_view t = in.token("a controlDict entry");
+    if (t == "{") ++depth;
+    if (t == "}") --depth;
+    // More digits than a double holds write the same numbers.
+    if (depth == 0 && t == "writePrecision") return std::min(17, in.integer<int>("writePrecision", 1, 1000));
+  }
+  return 0;
 }
 
 /// Writes `text` to `file` (or `file`.gz, compressed) through a temporary file and a rename.
@@ -93,19 +120,20 @@ inline void write_foam_file(const std::filesystem::path& file, const std::string
 struct FoamPointsTarget {
   std::filesystem::path points;     ///< the file to write (without .gz)
   std::filesystem::path reference;  ///< the case's existing points file (without .gz)
+  std::filesystem::path case_dir;   ///< the case holding them, where known
 };
 
 [[nodiscard]] inline FoamPointsTarget foam_points_target(const std::filesystem::path& target) {
   std::filesystem::path dir = polymesh_folder(target);
-  if (!dir.empty()) return {dir / "points", dir / "points"};
-  // A time folder of a case: "<case>/<number>".
-  const std::filesystem::path case_dir = target.has_filename() ? target.parent_path() : target.parent_path().parent_path();
-  const std::string time = (target.has_filename() ? target : target.parent_path()).filename().string();
-  double t = 0;
-  const auto [ptr, ec] = std::from_chars(time.data(), time.data() + time.size(), t);
-  const std::filesystem::path constant = polymesh_folder(case_dir.empty() ? std::filesystem::path(".") : case_dir);
-  if (ec == std::errc() && ptr == time.data() + time.size() && !constant.empty())
-    return {(case_dir.empty() ? std::filesystem::path(".") : case_dir) / time / "polyMesh" / "points", constant / "points"};
+  if (!dir.empty()) {
+    // <case>/constant/polyMesh, or a region's <case>/constant/<region>/polyMesh.
+    std::filesystem::path case_dir;
+    for (const auto& up : {dir.parent_path(), dir.parent_path().parent_path()})
+      if (case_dir.empty() && up.filename() == "constant")
+        case_dir = up.parent_path().empty() ? std::filesystem::path(".") : up.parent_path();
+    return {dir / "points", dir / "points", case_dir};
+  }
+  if (const auto time = foam_time_folder(target)) return {time->points(), time->constant / "points", time->case_dir};
   return {};
 }
 
@@ -158,7 +186,7 @@ inline void write_polymesh_points(const std::filesystem::path& target, const Mes
     }
   }
   std::string out = header;
-  detail::append_foam_points(out, mesh.points.leftCols(n), h);
+  detail::append_foam_points(out, mesh.points.leftCols(n), h, detail::foam_write_precision(where.case_dir));
   out += "\n\n// ************************************************************************* //\n";
   std::error_code ec;
   std::filesystem::create_directories(where.points.parent_path(), ec);
@@ -264,10 +292,16 @@ inline void write_polymesh(const std::filesystem::path& case_dir, const PolyMesh
   labels(neighbour, mesh.neighbour);
   detail::write_foam_file(dir / "neighbour", neighbour + end, options.compressed);
   std::string boundary = header("polyBoundaryMesh", "boundary", false) + "\n" + std::to_string(mesh.patches.size()) + "\n(\n";
-  for (const auto& p : mesh.patches)
-    boundary += "    " + p.name + "\n    {\n        type            " + (p.type.empty() ? std::string("patch") : p.type) +
-                ";\n        nFaces          " + std::to_string(p.size) + ";\n        startFace       " + std::to_string(p.start) +
+  for (const auto& p : mesh.patches) {
+    boundary += "    " + p.name + "\n    {\n        type            " + (p.type.empty() ? std::string("patch") : p.type) + ";\n";
+    if (!p.groups.empty()) {
+      boundary += "        inGroups        List<word> " + std::to_string(p.groups.size()) + "(";
+      for (std::size_t g = 0; g < p.groups.size(); ++g) boundary += (g == 0 ? "" : " ") + p.groups[g];
+      boundary += ");\n";
+    }
+    boundary += "        nFaces          " + std::to_string(p.size) + ";\n        startFace       " + std::to_string(p.start) +
                 ";\n    }\n";
+  }
   detail::write_foam_file(dir / "boundary", boundary + ")\n" + end, options.compressed);
 }
 

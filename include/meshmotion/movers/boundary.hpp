@@ -15,6 +15,7 @@
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/name_pattern.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/motion.hpp"
 
@@ -305,9 +306,10 @@ class BoundarySpec {
   };
   [[nodiscard]] std::vector<Overlap> overlaps(const Mesh<Dim>& mesh) const {
     std::vector<Overlap> out;
-    for (std::size_t i = 0; i < groups_.size(); ++i)
-      for (std::size_t j = i + 1; j < groups_.size(); ++j) {
-        const Group *a = &groups_[i], *b = &groups_[j];
+    const std::vector<Group> groups = expand(mesh);
+    for (std::size_t i = 0; i < groups.size(); ++i)
+      for (std::size_t j = i + 1; j < groups.size(); ++j) {
+        const Group *a = &groups[i], *b = &groups[j];
         if (a->kind == b->kind) continue;
         if (static_cast<int>(b->kind) < static_cast<int>(a->kind)) std::swap(a, b);
         const std::vector<Index> na = mesh.group_nodes(a->name), nb = mesh.group_nodes(b->name);
@@ -320,14 +322,19 @@ class BoundarySpec {
 
   /// Resolves against a Mesh<Dim> (groups by name, reference positions mesh.points).
   /// Displacements are those between fractions `from` and `to` of the motions (arrays scale
-  /// linearly), so a driver can split the motion into steps. Throws InputError for an unknown
-  /// group (listing the known ones), a wrong-sized or non-finite displacement array, or a
-  /// non-planar sliding group.
+  /// linearly), so a driver can split the motion into steps. A name that is not a group's
+  /// names, as in OpenFOAM, every facet group of that set (PhysicalGroup::in_groups: `wall`,
+  /// an `inGroups` entry) or, when it is a pattern (core/name_pattern.hpp: `"(inlet|outlet)"`),
+  /// every facet group whose name or set matches it: each takes the condition on its own (each
+  /// sliding group its own plane). Throws InputError for an unknown group (listing the known
+  /// ones), a malformed pattern, a displacement array given to a name of several groups, a
+  /// wrong-sized or non-finite displacement array, or a non-planar sliding group.
   /// Messages name a node by its index and, where the file numbers it otherwise, its id there.
   [[nodiscard]] ResolvedBoundary<Dim> resolve(const Mesh<Dim>& mesh, double to = 1.0, double from = 0.0) const {
+    const std::vector<Group> groups = expand(mesh);
     GroupNodes nodes;
-    for (const auto& g : groups_) nodes.emplace(g.name, mesh.group_nodes(g.name));
-    return resolve_nodes(mesh.points, nodes, to, from, &mesh);
+    for (const auto& g : groups) nodes.emplace(g.name, mesh.group_nodes(g.name));
+    return resolve_nodes(groups, mesh.points, nodes, to, from, &mesh);
   }
 
   /// Resolves with explicit node lists per group name (for MeshLike meshes without groups).
@@ -335,7 +342,7 @@ class BoundarySpec {
   /// node indices outside [0, n_nodes).
   [[nodiscard]] ResolvedBoundary<Dim> resolve(const Points<Dim>& points, const GroupNodes& group_nodes,
                                               double to = 1.0, double from = 0.0) const {
-    return resolve_nodes(points, group_nodes, to, from, nullptr);
+    return resolve_nodes(groups_, points, group_nodes, to, from, nullptr);
   }
 
  private:
@@ -356,16 +363,50 @@ class BoundarySpec {
     [[nodiscard]] std::string operator()(Index v) const { return mesh ? mesh->describe_node(v) : "node " + std::to_string(v); }
   };
 
-  [[nodiscard]] ResolvedBoundary<Dim> resolve_nodes(const Points<Dim>& points, const GroupNodes& group_nodes, double to,
-                                                    double from, const Mesh<Dim>* mesh) const {
+  /// The conditions with each name that is not one of the mesh's groups replaced by the facet
+  /// groups it names (see resolve()); an unmatched name stays, for resolve's message.
+  [[nodiscard]] std::vector<Group> expand(const Mesh<Dim>& mesh) const {
+    std::vector<Group> out;
+    for (const Group& g : groups_) {
+      if (mesh.find_group(g.name) != nullptr) {
+        out.push_back(g);
+        continue;
+      }
+      const auto in_set = [&](const PhysicalGroup& m, auto&& named) {
+        return std::any_of(m.in_groups.begin(), m.in_groups.end(), named);
+      };
+      std::vector<std::string> names;
+      for (const PhysicalGroup& m : mesh.groups)
+        if (m.dim == Dim - 1 && in_set(m, [&](const std::string& s) { return s == g.name; })) names.push_back(m.name);
+      if (names.empty() && NamePattern::is_pattern(g.name)) {
+        const NamePattern pattern(g.name);
+        const auto match = [&](const std::string& s) { return pattern.matches(s); };
+        for (const PhysicalGroup& m : mesh.groups)
+          if (m.dim == Dim - 1 && (match(m.name) || in_set(m, match))) names.push_back(m.name);
+      }
+      if (names.size() > 1 && (g.displacements.size() > 0 || !g.node_order.empty()))
+        throw InputError("BoundarySpec::resolve: '" + g.name + "' names " + std::to_string(names.size()) +
+                         " groups but is given one displacement array (give it one group's name)");
+      if (names.empty()) names.push_back(g.name);
+      for (std::string& name : names) {
+        out.push_back(g);
+        out.back().name = std::move(name);
+      }
+    }
+    return out;
+  }
+
+  [[nodiscard]] ResolvedBoundary<Dim> resolve_nodes(const std::vector<Group>& groups, const Points<Dim>& points,
+                                                    const GroupNodes& group_nodes, double to, double from,
+                                                    const Mesh<Dim>* mesh) const {
     const NodeNames node_name{mesh};
     BoundaryCollector<Dim> entries(points.cols());
-    for (auto g = groups_.begin(); g != groups_.end(); ++g)
-      for (auto h = groups_.begin(); h != g; ++h)
+    for (auto g = groups.begin(); g != groups.end(); ++g)
+      for (auto h = groups.begin(); h != g; ++h)
         if (h->name == g->name)
           throw InputError("BoundarySpec::resolve: group '" + g->name + "' is given twice (" + std::string(name(h->kind)) + " and " +
                            std::string(name(g->kind)) + "): give each group one condition");
-    for (const auto& g : groups_) {
+    for (const auto& g : groups) {
       const auto found = group_nodes.find(g.name);
       if (found == group_nodes.end()) {
         std::string known;

@@ -12,9 +12,16 @@
 ///   (the face normal through the owner's centre on boundary faces) crosses the face, over a
 ///   face size in that direction; high above 4;
 /// - aspect ratio: the largest over the smallest Cartesian component of the cell's summed
-///   absolute face areas, in the mesh's solution directions (`empty` patches remove theirs),
-///   and in 3D at least the area-to-volume ratio of a cube; high above 1000;
-/// - cell volumes: smallest, largest, total, and the cells of zero or negative volume.
+///   absolute face areas, in the mesh's geometric directions (`empty` patches remove the
+///   directions they face, `wedge` patches the direction of their centre normal), and in 3D at
+///   least the area-to-volume ratio of a cube; high above 1000;
+/// - cell volumes: smallest, largest, total, and the cells of zero or negative volume;
+/// - face pyramids: the pyramid of each face on its owner's centre, and on its neighbour's,
+///   must have a positive volume (above -1e-15, checkMesh's bound);
+/// - the verdict: how many of these checks fail as checkMesh counts failures (faces of
+///   non-orthogonality 90 degrees or more, highly skewed faces, cells of high aspect ratio,
+///   cells of non-positive volume, inverted face pyramids). checkMesh's open-cell and
+///   topological checks are not among them.
 /// Validated against checkMesh (Debian `openfoam`) in tests/io/openfoam_test.cpp. Polyhedra: core/poly_mesh.hpp.
 
 #include "meshmotion/core/types.hpp"
@@ -34,6 +41,7 @@ namespace meshmotion {
 /// checkMesh's measures of a polyMesh (see the file comment).
 struct FoamQuality {
   int solution_directions = 3;  ///< 3, or 2 when `empty` patches remove a direction
+  int geometric_directions = 3;  ///< the solution directions, less a `wedge` case's normal one
   double min_volume = 0, max_volume = 0, total_volume = 0;
   Index num_nonpositive_volumes = 0;   ///< cells of volume below 1e-300 (checkMesh's VSMALL)
   double max_non_orthogonality = 0;    ///< degrees
@@ -44,12 +52,16 @@ struct FoamQuality {
   Index num_highly_skewed = 0;  ///< faces above 4
   double max_aspect_ratio = 0;
   Index num_high_aspect_ratio = 0;  ///< cells above 1000
+  Index num_wrong_face_pyramids = 0;  ///< face pyramids on a cell centre of non-positive volume (a face once per cell)
+  Index num_invalid_cells = 0;  ///< cells of non-positive volume or with a face pyramid inverted: what OpenFOAM refuses
+  int failed_checks = 0;        ///< checks failed as checkMesh counts them (see the file comment)
   Index worst_non_orthogonal_face = -1, worst_skewed_face = -1, worst_aspect_ratio_cell = -1, smallest_cell = -1;
 };
 
 template <class F>
 void visit_fields(const FoamQuality& q, F&& f) {
   f("solution_directions", q.solution_directions, "3, or 2 when empty patches remove a direction");
+  f("geometric_directions", q.geometric_directions, "the solution directions, less a wedge case's normal one");
   f("max_non_orthogonality", q.max_non_orthogonality, "degrees, over internal faces");
   f("average_non_orthogonality", q.average_non_orthogonality, "degrees: the angle of the average cosine");
   f("severely_non_orthogonal_faces", q.num_severely_non_orthogonal, "internal faces above 70 degrees and below 90");
@@ -62,6 +74,9 @@ void visit_fields(const FoamQuality& q, F&& f) {
   f("max_volume", q.max_volume, "largest cell volume");
   f("total_volume", q.total_volume, "sum of the cell volumes");
   f("nonpositive_volume_cells", q.num_nonpositive_volumes, "cells of volume below 1e-300");
+  f("wrong_face_pyramids", q.num_wrong_face_pyramids, "face pyramids on a cell centre of non-positive volume, a face once per cell");
+  f("invalid_cells", q.num_invalid_cells, "cells of non-positive volume or with an inverted face pyramid");
+  f("failed_checks", q.failed_checks, "checks failed as checkMesh counts them (0: Mesh OK)");
   f("worst_non_orthogonal_face", q.worst_non_orthogonal_face, "face of the largest non-orthogonality (-1: none)");
   f("worst_skewed_face", q.worst_skewed_face, "face of the largest skewness (-1: none)");
   f("worst_aspect_ratio_cell", q.worst_aspect_ratio_cell, "cell of the largest aspect ratio (-1: none)");
@@ -162,6 +177,22 @@ inline void foam_face_geometry(const PolyMesh& mesh, std::vector<Vec<3>>& centre
     if (v < vsmall) ++q.num_nonpositive_volumes;
   }
 
+  // Face pyramids on the cell centres: a third of the area vector dotted with the height.
+  constexpr double min_pyramid = -1e-15;
+  std::vector<char> invalid(static_cast<std::size_t>(nc), 0);
+  for (Index c = 0; c < nc; ++c) invalid[static_cast<std::size_t>(c)] = volume[static_cast<std::size_t>(c)] < vsmall ? 1 : 0;
+  for (Index f = 0; f < nf; ++f) {
+    const Vec<3>& centre = fc[static_cast<std::size_t>(f)];
+    const Vec<3>& area = fa[static_cast<std::size_t>(f)];
+    const bool owner_wrong = area.dot(centre - cc[own(f)]) / 3.0 < min_pyramid;
+    const bool neighbour_wrong = f < ni && area.dot(cc[nei(f)] - centre) / 3.0 < min_pyramid;
+    // Once per cell, as checkMesh counts "faces incorrectly oriented".
+    q.num_wrong_face_pyramids += static_cast<Index>(owner_wrong) + static_cast<Index>(neighbour_wrong);
+    if (owner_wrong) invalid[own(f)] = 1;
+    if (neighbour_wrong) invalid[nei(f)] = 1;
+  }
+  q.num_invalid_cells = static_cast<Index>(std::count(invalid.begin(), invalid.end(), 1));
+
   // Non-orthogonality of the internal faces.
   const double severe = std::cos(70.0 * std::numbers::pi / 180.0);
   double min_cos = 1.0, sum_cos = 0.0;
@@ -221,6 +252,23 @@ inline void foam_face_geometry(const PolyMesh& mesh, std::vector<Vec<3>>& centre
     for (int d = 0; d < 3; ++d) solved[static_cast<std::size_t>(d)] = !(empty_dir[d] > 1e-6);
   }
   q.solution_directions = static_cast<int>(std::count(solved.begin(), solved.end(), true));
+  // Geometric directions: a wedge patch's centre normal (its first face's normal with each
+  // component's magnitude less a half, kept where positive, as OpenFOAM defines it) removes
+  // the direction it leans on.
+  Vec<3> wedge_dir = Vec<3>::Zero();
+  for (const auto& p : mesh.patches) {
+    if (p.type != "wedge" || p.size == 0) continue;
+    const Vec<3> n = fa[static_cast<std::size_t>(p.start)].normalized();
+    Vec<3> centre_normal;
+    for (int d = 0; d < 3; ++d) centre_normal[d] = std::copysign(std::max(std::abs(n[d]), 0.5) - 0.5, n[d]);
+    if (centre_normal.norm() > 0) wedge_dir += (centre_normal / centre_normal.norm()).cwiseAbs();
+  }
+  std::array<bool, 3> geometric = solved;
+  if (wedge_dir.norm() > 0) {
+    wedge_dir /= wedge_dir.norm();
+    for (int d = 0; d < 3; ++d) geometric[static_cast<std::size_t>(d)] = geometric[static_cast<std::size_t>(d)] && !(wedge_dir[d] > 1e-6);
+  }
+  q.geometric_directions = static_cast<int>(std::count(geometric.begin(), geometric.end(), true));
 
   // Aspect ratio from the summed absolute face areas of each cell.
   std::vector<Vec<3>> summed(static_cast<std::size_t>(nc), Vec<3>::Zero());
@@ -232,12 +280,12 @@ inline void foam_face_geometry(const PolyMesh& mesh, std::vector<Vec<3>>& centre
     const Vec<3>& s = summed[static_cast<std::size_t>(c)];
     double lo = std::numeric_limits<double>::max(), hi = -std::numeric_limits<double>::max();
     for (int d = 0; d < 3; ++d)
-      if (solved[static_cast<std::size_t>(d)]) {
+      if (geometric[static_cast<std::size_t>(d)]) {
         lo = std::min(lo, s[d]);
         hi = std::max(hi, s[d]);
       }
     double ratio = hi / (lo + root_vsmall);
-    if (q.solution_directions == 3) {
+    if (q.geometric_directions == 3) {
       const double v = std::max(root_vsmall, volume[static_cast<std::size_t>(c)]);
       ratio = std::max(ratio, s.sum() / 6.0 / std::pow(v, 2.0 / 3.0));
     }
@@ -247,6 +295,9 @@ inline void foam_face_geometry(const PolyMesh& mesh, std::vector<Vec<3>>& centre
       q.worst_aspect_ratio_cell = c;
     }
   }
+  q.failed_checks = static_cast<int>(q.num_non_orthogonality_errors > 0) + static_cast<int>(q.num_highly_skewed > 0) +
+                    static_cast<int>(q.num_high_aspect_ratio > 0) + static_cast<int>(q.num_nonpositive_volumes > 0) +
+                    static_cast<int>(q.num_wrong_face_pyramids > 0);
   return q;
 }
 

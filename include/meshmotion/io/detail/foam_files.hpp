@@ -16,6 +16,7 @@
 #include <initializer_list>
 #include <limits>
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -289,6 +290,24 @@ inline void check_foam_class(FoamCursor& in, const FoamHeader& h, std::initializ
   if (has_faces(path / "constant" / "polyMesh")) return path / "constant" / "polyMesh";
   if (has_faces(path)) return path;
   return {};
+}
+
+/// A time folder of a case ("<case>/<number>", the case holding a constant/polyMesh): where a
+/// moved mesh's points go (<case>/<time>/polyMesh/points) and OpenFOAM's tools read them from.
+struct FoamTimeFolder {
+  std::filesystem::path case_dir, constant;  ///< the case, and its polyMesh folder
+  std::string time;
+  [[nodiscard]] std::filesystem::path points() const { return case_dir / time / "polyMesh" / "points"; }
+};
+[[nodiscard]] inline std::optional<FoamTimeFolder> foam_time_folder(const std::filesystem::path& path) {
+  const std::filesystem::path parent = path.has_filename() ? path.parent_path() : path.parent_path().parent_path();
+  const std::filesystem::path case_dir = parent.empty() ? std::filesystem::path(".") : parent;
+  std::string time = (path.has_filename() ? path : path.parent_path()).filename().string();
+  double t = 0;
+  const auto [end, ec] = std::from_chars(time.data(), time.data() + time.size(), t);
+  std::filesystem::path constant = polymesh_folder(case_dir);
+  if (ec != std::errc() || end != time.data() + time.size() || constant.empty()) return std::nullopt;
+  return FoamTimeFolder{case_dir, std::move(constant), std::move(time)};
 }
 
 }  // namespace meshmotion::detail
