@@ -1,6 +1,8 @@
 // mesh_info: prints what a mesh file holds (element counts per type, boundary groups,
 // bounding box, edge lengths, orientation), as text or as one JSON object. It shows the file
-// as it is: a reversed or mixed orientation is reported, never changed.
+// as it is: a reversed or mixed orientation is reported, never changed. An OpenFOAM case is
+// also shown as checkMesh shows it: its points, faces and cells, the cells by shape
+// (polyhedra, not the tetrahedra the library cuts them into) and its patches with their types.
 
 #include "meshmotion/core/json.hpp"
 #include "meshmotion/io.hpp"
@@ -9,13 +11,85 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <array>
+#include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <variant>
+#include <vector>
+
+namespace {
+
+using namespace meshmotion;
+
+// checkMesh's cell shapes, by the faces' vertex counts and the cell's vertex count.
+constexpr std::array<const char*, 5> shape_names{"hexahedra", "prisms", "pyramids", "tetrahedra", "polyhedra"};
+
+std::array<Index, 5> cell_shapes(const PolyMesh& poly) {
+  const auto nc = static_cast<std::size_t>(poly.num_cells);
+  std::vector<std::array<int, 3>> faces(nc, {0, 0, 0});  // triangles, quadrilaterals, others
+  std::vector<std::vector<Index>> vertices(nc);
+  const auto add = [&](Index cell, Index f) {
+    const auto v = poly.face(f);
+    auto& count = faces[static_cast<std::size_t>(cell)];
+    ++count[v.size() == 3 ? 0 : v.size() == 4 ? 1 : 2];
+    vertices[static_cast<std::size_t>(cell)].insert(vertices[static_cast<std::size_t>(cell)].end(), v.begin(), v.end());
+  };
+  for (Index f = 0; f < poly.num_faces(); ++f) {
+    add(poly.owner[static_cast<std::size_t>(f)], f);
+    if (f < poly.num_internal_faces()) add(poly.neighbour[static_cast<std::size_t>(f)], f);
+  }
+  std::array<Index, 5> out{};
+  for (std::size_t c = 0; c < nc; ++c) {
+    std::vector<Index>& v = vertices[c];
+    std::sort(v.begin(), v.end());
+    const auto points = std::unique(v.begin(), v.end()) - v.begin();
+    const auto [tris, quads, others] = faces[c];
+    int shape = 4;
+    if (others == 0 && tris == 0 && quads == 6 && points == 8) shape = 0;
+    if (others == 0 && tris == 2 && quads == 3 && points == 6) shape = 1;
+    if (others == 0 && tris == 4 && quads == 1 && points == 5) shape = 2;
+    if (others == 0 && tris == 4 && quads == 0 && points == 4) shape = 3;
+    ++out[static_cast<std::size_t>(shape)];
+  }
+  return out;
+}
+
+void write_case_json(JsonWriter& w, const PolyMesh& poly) {
+  w.key("openfoam").begin_object();
+  w.key("points").value(poly.points.cols()).key("faces").value(poly.num_faces());
+  w.key("internal_faces").value(poly.num_internal_faces()).key("cells").value(poly.num_cells);
+  const std::array<Index, 5> shapes = cell_shapes(poly);
+  w.key("cell_shapes").begin_object();
+  for (std::size_t k = 0; k < shapes.size(); ++k) w.key(shape_names[k]).value(shapes[k]);
+  w.end_object();
+  w.key("patches").begin_array();
+  for (const auto& p : poly.patches) {
+    w.begin_object().key("name").value(p.name).key("type").value(p.type).key("faces").value(p.size);
+    w.key("in_groups").array(p.groups);
+    w.end_object();
+  }
+  w.end_array().end_object();
+}
+
+void write_case_text(std::ostream& out, const PolyMesh& poly) {
+  out << "  OpenFOAM case: " << poly.points.cols() << " points, " << poly.num_faces() << " faces (" << poly.num_internal_faces()
+      << " internal), " << poly.num_cells << " cells\n    cells:";
+  const std::array<Index, 5> shapes = cell_shapes(poly);
+  for (std::size_t k = 0; k < shapes.size(); ++k) out << " " << shape_names[k] << " " << shapes[k] << (k + 1 < shapes.size() ? "," : "\n");
+  for (const auto& p : poly.patches) {
+    out << "    patch " << p.name << ": " << p.type << ", " << p.size << " faces";
+    for (std::size_t g = 0; g < p.groups.size(); ++g) out << (g == 0 ? ", in groups " : " ") << p.groups[g];
+    out << "\n";
+  }
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   meshmotion::tune_process_memory(argc, argv);  // may restart the program once (core/process_memory.hpp)
-  using namespace meshmotion;
   CLI::App app{"Print the contents of a mesh file (.msh, .su2, .cgns or .vtu) or OpenFOAM case"};
   examples::add_version_flag(app);
   std::string file;
@@ -26,15 +100,20 @@ int main(int argc, char** argv) {
   return examples::guarded(json, [&] {
     const AnyMesh mesh = examples::read_input(file);
     const auto summary = std::visit([](const auto& m) { return summarize(m); }, mesh);
+    std::error_code ec;
+    const std::optional<PolyMesh> poly =
+        std::filesystem::is_directory(file, ec) ? std::optional<PolyMesh>(read_polymesh(file)) : std::nullopt;
     if (json) {
       JsonWriter w(std::cout);
       w.begin_object().key("file").value(file).key("mesh");
       write_json(w, summary);
+      if (poly) write_case_json(w, *poly);
       w.end_object();
       std::cout << "\n";
     } else {
       std::cout << file << ":\n";
       write_text(std::cout, summary, 2);
+      if (poly) write_case_text(std::cout, *poly);
     }
     return examples::exit_ok;
   });

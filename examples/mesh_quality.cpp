@@ -94,6 +94,13 @@ int run(Mesh<Dim>& mesh, const Settings& s) {
     if (foam) {
       std::cout << "checkMesh measures:\n";
       write_text(std::cout, *foam, 2);
+      // checkMesh's verdict over these checks (its open-cell and topological ones are not here).
+      const int failed = foam->failed_checks;
+      if (failed == 0)
+        std::cout << "Mesh OK (checkMesh's volume, face pyramid, non-orthogonality, skewness and aspect ratio checks)\n";
+      else
+        std::cout << "Failed " << failed << " mesh check" << (failed == 1 ? "" : "s")
+                  << " (of checkMesh's volume, face pyramid, non-orthogonality, skewness and aspect ratio checks)\n";
     }
   }
   return 0;

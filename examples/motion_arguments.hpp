@@ -160,6 +160,24 @@ inline MotionArguments section_motion(MotionArguments a, const Extrusion& ext) {
   return a;
 }
 
+/// Says on stderr which facet groups no condition reaches (their nodes move with the interior,
+/// as a patch a solver's case leaves out would not): OpenFOAM fixes a patch it is not told to
+/// move, move_mesh lets it deform, so the user must see it. `excluded`: groups that are meant
+/// to be free (a 2D case's front and back, moved as its section).
+template <int Dim>
+void note_unlisted_groups(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary, const std::vector<std::string>& excluded = {}) {
+  std::vector<char> constrained(static_cast<std::size_t>(mesh.num_nodes()), 0);
+  for (const Index v : boundary.nodes) constrained[static_cast<std::size_t>(v)] = 1;
+  for (const PhysicalGroup& g : mesh.groups) {
+    if (g.dim != Dim - 1 || std::find(excluded.begin(), excluded.end(), g.name) != excluded.end()) continue;
+    const std::vector<Index> nodes = mesh.group_nodes(g.tag, g.dim);
+    const auto free = std::count_if(nodes.begin(), nodes.end(), [&](Index v) { return constrained[static_cast<std::size_t>(v)] == 0; });
+    if (free > 0)
+      std::cerr << "note: group '" << g.name << "' has no condition: " << free << " of its " << nodes.size()
+                << " nodes move with the interior (give --fixed " << g.name << " or --sliding " << g.name << " to keep it)\n";
+  }
+}
+
 /// The boundary conditions the arguments give, on `mesh`.
 template <int Dim>
 BoundarySpec<Dim> boundary_spec(const MotionArguments& a, const Mesh<Dim>& mesh) {

@@ -21,6 +21,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -56,13 +57,15 @@ KeyValues mover_options(const Arguments& a, const examples::MotionArguments& mot
   return given;
 }
 
+// `section`: the extrusion of a 2D case stored in 3D, moved as its section, and the section's
+// boundary; null to move the mesh in its own dimension.
 template <int Dim>
 int move_and_write(const Arguments& a, const Mesh<Dim>& mesh, const examples::MotionArguments& motion,
-                   const BoundarySpec<Dim>& spec, const Extrusion* section) {
+                   const BoundarySpec<Dim>& spec, const std::pair<Extrusion, SectionBoundary>* section) {
   std::optional<double> radius;
   KeyValues values;
   const auto make = [&]<int MoverDim>(const Points<MoverDim>& points, auto&& resolve) {
-    const KeyValues given = mover_options<MoverDim>(a, motion, section);
+    const KeyValues given = mover_options<MoverDim>(a, motion, section != nullptr ? &section->first : nullptr);
     MoverConfig<MoverDim> config = mover_config<MoverDim>(a.mover.method, given);
     radius = examples::set_support_radius(config, motion, given, points, resolve);
     for (const auto& kv : config.values()) values.emplace_back(kv);
@@ -71,9 +74,8 @@ int move_and_write(const Arguments& a, const Mesh<Dim>& mesh, const examples::Mo
   std::optional<AnyMover<Dim>> mover;
   if constexpr (Dim == 3) {
     if (section != nullptr)
-      mover.emplace(SectionMover(make.template operator()<2>(section->section.points, [&] {
-        return section_boundary(*section, mesh, spec.resolve(mesh)).boundary;
-      })));
+      mover.emplace(SectionMover(make.template operator()<2>(section->first.section.points, [&] { return section->second.boundary; }),
+                                 section->first));
   }
   if (!mover) mover.emplace(make.template operator()<Dim>(mesh.points, [&] { return spec.resolve(mesh); }));
   examples::set_stage("moving " + a.input + " with " + a.mover.method);
@@ -81,32 +83,55 @@ int move_and_write(const Arguments& a, const Mesh<Dim>& mesh, const examples::Mo
   const StepResult<Dim> result = run_steps(*mover, mesh, spec, StepOptions{a.steps, Metric::skew});
   const MoveReport report = move_report(a.mover.method, before, result);
   const QualityReport& after = report.after;
-  const bool invalid = after.num_invalid > 0;
+  // A polyhedral OpenFOAM case is judged as checkMesh judges it, on its own cells: the
+  // tetrahedra they were cut into are the library's, and one of them may fold inside a cell
+  // that OpenFOAM finds sound (a triangle of a warped face).
+  std::optional<FoamQuality> foam_after;
+  Index invalid_cells = after.num_invalid, cells = after.num_elements;
+  if constexpr (Dim == 3) {
+    std::error_code ec;
+    if (mesh.num_auxiliary_nodes > 0 && std::filesystem::is_directory(a.input, ec)) {
+      PolyMesh poly = read_polymesh(a.input);
+      poly.points = result.mesh.points.leftCols(poly.points.cols());
+      foam_after = foam_quality(poly);
+      invalid_cells = foam_after->num_invalid_cells;
+      cells = poly.num_cells;
+    }
+  }
+  const bool invalid = invalid_cells > 0;
   if (invalid && a.strict)
-    throw InvalidMeshError("move_mesh: " + std::to_string(after.num_invalid) + " of " + std::to_string(after.num_elements) +
+    throw InvalidMeshError("move_mesh: " + std::to_string(invalid_cells) + " of " + std::to_string(cells) +
                            " cells invalid after the motion (--strict: nothing written)");
   examples::write_output(a.output, result.mesh);
   if (a.json) {
     JsonWriter w(std::cout);
     w.begin_object().key("input").value(a.input).key("output").value(a.output);
     if (radius) w.key("support_radius").value(*radius);
-    if (section != nullptr) w.key("section_axis").value(std::string(1, section->axis_name()));
+    if (section != nullptr) w.key("section_axis").value(std::string(1, section->first.axis_name()));
     w.key("options").begin_object();
     for (const auto& [k, v] : values) w.key(k).value(v);
     w.end_object();
     write_json_fields(w, report);
+    if (foam_after) {
+      w.key("checkmesh_after");
+      write_json(w, *foam_after);
+    }
     w.end_object();
     std::cout << "\n";
   } else {
     std::cout << "moved " << mesh.num_nodes() << " nodes with " << a.mover.method;
     if (radius) std::cout << " (support radius " << format_option_value(*radius) << ")";
     if (section != nullptr)
-      std::cout << " as a 2D case: one cell thick along " << section->axis_name() << ", moved in its section (--keep-3d moves it in 3D)";
+      std::cout << " as a 2D case: one cell thick along " << section->first.axis_name() << ", moved in its section (--keep-3d moves it in 3D)";
     std::cout << "\n";
     write_text(std::cout, report, 2);
+    if (foam_after) {
+      std::cout << "  the case's own cells (checkMesh's measures; the validity verdict):\n";
+      write_text(std::cout, *foam_after, 4);
+    }
   }
   if (invalid) {
-    std::cerr << "wrote " << a.output << " WITH " << after.num_invalid << " INVALID CELLS of " << after.num_elements << "\n";
+    std::cerr << "wrote " << a.output << " WITH " << invalid_cells << " INVALID CELLS of " << cells << "\n";
     return examples::exit_invalid;
   }
   if (!a.json) std::cout << "wrote " << a.output << "\n";
@@ -127,17 +152,21 @@ int run(const Arguments& a, Mesh<Dim> mesh) {
     if (std::optional<Extrusion> section = a.keep_3d ? std::nullopt : find_extrusion(mesh)) {
       const examples::MotionArguments motion = examples::section_motion(a.motion, *section);
       const BoundarySpec<3> spec = examples::boundary_spec<3>(motion, mesh);
-      bool planar = true;
+      const ResolvedBoundary<3> resolved = spec.resolve(mesh);
+      std::optional<std::pair<Extrusion, SectionBoundary>> planar;
       try {
-        (void)section_boundary(*section, mesh, spec.resolve(mesh));
+        SectionBoundary boundary = section_boundary(*section, mesh, resolved);
+        planar.emplace(std::move(*section), std::move(boundary));
       } catch (const NotTwoDimensional& e) {
         std::cerr << "note: moving in 3D: " << std::string(e.what()).substr(std::string_view("meshmotion: ").size()) << "\n";
-        planar = false;
       }
-      return move_and_write<3>(a, mesh, motion, spec, planar ? &*section : nullptr);
+      examples::note_unlisted_groups(mesh, resolved, planar ? planar->first.plane_groups : std::vector<std::string>{});
+      return move_and_write<3>(a, mesh, motion, spec, planar ? &*planar : nullptr);
     }
   }
-  return move_and_write<Dim>(a, mesh, a.motion, examples::boundary_spec<Dim>(a.motion, mesh), nullptr);
+  const BoundarySpec<Dim> spec = examples::boundary_spec<Dim>(a.motion, mesh);
+  examples::note_unlisted_groups(mesh, spec.resolve(mesh));
+  return move_and_write<Dim>(a, mesh, a.motion, spec, nullptr);
 }
 
 }  // namespace

@@ -369,18 +369,52 @@ file(REMOVE_RECURSE "${smoke_dir}/foam_case")
 smoke_test(NAME move_mesh.new_openfoam_case.json SETUP examples_foam_case KEYS output VALUES after/invalid=0
            COMMAND move_mesh "${smoke_dir}/two_hexes.su2" -o "${smoke_dir}/foam_case" --group top --translate 0,0,0.1
                    --fixed bottom --json)
-smoke_test(NAME mesh_info.openfoam.json REQUIRES examples_foam_case KEYS mesh/groups VALUES mesh/nodes=12,mesh/cells/hex8=2
+smoke_test(NAME mesh_info.openfoam.json REQUIRES examples_foam_case KEYS mesh/groups,openfoam/patches
+           VALUES mesh/nodes=12,mesh/cells/hex8=2,openfoam/cells=2,openfoam/faces=11,openfoam/cell_shapes/hexahedra=2,openfoam/cell_shapes/polyhedra=0
            COMMAND mesh_info "${smoke_dir}/foam_case" --json)
 smoke_test(NAME mesh_quality.openfoam.json REQUIRES examples_foam_case
            KEYS checkmesh/max_non_orthogonality,checkmesh/max_skewness,checkmesh/max_aspect_ratio
-           VALUES checkmesh/solution_directions=3,checkmesh/highly_skewed_faces=0,checkmesh/nonpositive_volume_cells=0
+           VALUES checkmesh/solution_directions=3,checkmesh/highly_skewed_faces=0,checkmesh/nonpositive_volume_cells=0,checkmesh/failed_checks=0
            COMMAND mesh_quality "${smoke_dir}/foam_case" --json)
-smoke_test(NAME move_mesh.openfoam_time_folder.json REQUIRES examples_foam_case KEYS output VALUES after/invalid=0
+smoke_test(NAME move_mesh.openfoam_time_folder.json REQUIRES examples_foam_case SETUP examples_foam_time KEYS output
+           VALUES after/invalid=0
            COMMAND move_mesh "${smoke_dir}/foam_case" -o "${smoke_dir}/foam_case/0.5" --group top --translate 0.05,0,0
                    --fixed bottom --json)
+# From that time folder (OpenFOAM's -time 0.5) on, groups named by patterns as OpenFOAM's
+# dictionaries name patches; a pattern that names no group is refused.
+smoke_test(NAME move_mesh.openfoam_from_time_folder_by_patterns.json REQUIRES examples_foam_time KEYS output
+           VALUES after/invalid=0,input=${smoke_dir}/foam_case/0.5
+           COMMAND move_mesh "${smoke_dir}/foam_case/0.5" -o "${smoke_dir}/foam_case/0.75" --group "t.p" --translate 0.05,0,0
+                   --fixed "(bottom|inlet)" --json)
+smoke_test(NAME move_mesh.openfoam_pattern_naming_nothing.json REQUIRES examples_foam_case EXPECT_RC 1 KEYS error
+           VALUES kind=input
+           COMMAND move_mesh "${smoke_dir}/foam_case" -o "${smoke_dir}/foam_case/0.9" --group top --translate 0.05,0,0
+                   --fixed "(inlet|outlet)" --json)
 smoke_test(NAME move_mesh.openfoam_in_place_needs_overwrite.json REQUIRES examples_foam_case EXPECT_RC 1 KEYS error
            COMMAND move_mesh "${smoke_dir}/foam_case" -o "${smoke_dir}/foam_case" --group top --translate 0.05,0,0
                    --fixed bottom --json)
+
+# A polyhedral case (a cell with a hanging node beside two hexahedra): moved, it is judged on
+# its own cells by checkMesh's measures, not on the tetrahedra the library cuts it into.
+set(foam_header "FoamFile { version 2.0; format ascii; class")
+file(REMOVE_RECURSE "${smoke_dir}/foam_poly")
+file(WRITE "${smoke_dir}/foam_poly/constant/polyMesh/points" "${foam_header} vectorField; object points; }\n16\n("
+     "(0 0 0) (1 0 0) (2 0 0) (1 1 0) (2 1 0) (0 2 0) (1 2 0) (2 2 0) (0 0 1) (1 0 1) (2 0 1) (1 1 1) (2 1 1) (0 2 1) (1 2 1) (2 2 1))\n")
+file(WRITE "${smoke_dir}/foam_poly/constant/polyMesh/faces" "${foam_header} faceList; object faces; }\n16\n("
+     "4(1 3 11 9) 4(3 6 14 11) 4(3 11 12 4) 4(0 8 13 5) 4(2 4 12 10) 4(4 7 15 12) 4(0 1 9 8) 4(1 2 10 9) 4(5 13 14 6) "
+     "4(6 14 15 7) 5(0 5 6 3 1) 4(1 3 4 2) 4(3 6 7 4) 5(8 9 11 14 13) 4(9 10 12 11) 4(11 12 15 14))\n")
+file(WRITE "${smoke_dir}/foam_poly/constant/polyMesh/owner" "${foam_header} labelList; object owner; }\n16\n(0 0 1 0 1 2 0 1 0 2 0 1 2 0 1 2)\n")
+file(WRITE "${smoke_dir}/foam_poly/constant/polyMesh/neighbour" "${foam_header} labelList; object neighbour; }\n3\n(1 2 2)\n")
+file(WRITE "${smoke_dir}/foam_poly/constant/polyMesh/boundary" "${foam_header} polyBoundaryMesh; object boundary; }\n4\n("
+     "wall { type wall; inGroups List<word> 1(body); nFaces 1; startFace 3; } outlet { type patch; nFaces 2; startFace 4; } "
+     "sides { type patch; nFaces 4; startFace 6; } frontAndBack { type empty; nFaces 6; startFace 10; })\n")
+smoke_test(NAME move_mesh.openfoam_polyhedra_judged_on_cells.json KEYS output,checkmesh_after/max_skewness
+           VALUES after/invalid=0,checkmesh_after/invalid_cells=0,checkmesh_after/failed_checks=0
+           COMMAND move_mesh "${smoke_dir}/foam_poly" -o "${smoke_dir}/foam_poly/0.1" --group body --translate 0.05,0,0
+                   --fixed "(outlet|sides)" --sliding frontAndBack:0,0,1 --method sle --json)
+smoke_test(NAME mesh_info.openfoam_polyhedra.json KEYS openfoam/patches
+           VALUES openfoam/cells=3,openfoam/cell_shapes/hexahedra=2,openfoam/cell_shapes/polyhedra=1,mesh/cells/tet4=78
+           COMMAND mesh_info "${smoke_dir}/foam_poly" --json)
 
 # A 2D case stored in 3D: front (y = 0) and back (y = 1) are one group, two parallel planes.
 # It slides with the normal given (each node in its own plane); without it no plane fits.

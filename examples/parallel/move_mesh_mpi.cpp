@@ -103,6 +103,7 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
     const BoundarySpec<Dim> spec = examples::boundary_spec<Dim>(a.motion, *whole);
     if (const auto r = examples::set_support_radius(config, a.motion, given, whole->points, [&] { return spec.resolve(*whole); })) radius = *r;
     boundary = spec.resolve(*whole);
+    examples::note_unlisted_groups(*whole, boundary);
     before = quality_report(*whole, Metric::skew);
   });
   MPI_Bcast(&radius, 1, MPI_DOUBLE, 0, comm);
