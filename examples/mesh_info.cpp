@@ -17,6 +17,7 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -57,6 +58,14 @@ std::array<Index, 5> cell_shapes(const PolyMesh& poly) {
   return out;
 }
 
+// Cell zones, then face zones, then point zones, as OpenFOAM lists them: f("cellZone", zone).
+template <class F>
+void for_each_zone(const PolyMesh& poly, F&& f) {
+  for (const auto& z : poly.cell_zones) f("cellZone", z);
+  for (const auto& z : poly.face_zones) f("faceZone", z);
+  for (const auto& z : poly.point_zones) f("pointZone", z);
+}
+
 void write_case_json(JsonWriter& w, const PolyMesh& poly) {
   w.key("openfoam").begin_object();
   w.key("points").value(poly.points.cols()).key("faces").value(poly.num_faces());
@@ -71,6 +80,11 @@ void write_case_json(JsonWriter& w, const PolyMesh& poly) {
     w.key("in_groups").array(p.groups);
     w.end_object();
   }
+  w.end_array();
+  w.key("zones").begin_array();
+  for_each_zone(poly, [&](const char* kind, const PolyMesh::Zone& z) {
+    w.begin_object().key("name").value(z.name).key("kind").value(kind).key("size").value(static_cast<Index>(z.labels.size())).end_object();
+  });
   w.end_array().end_object();
 }
 
@@ -84,6 +98,10 @@ void write_case_text(std::ostream& out, const PolyMesh& poly) {
     for (std::size_t g = 0; g < p.groups.size(); ++g) out << (g == 0 ? ", in groups " : " ") << p.groups[g];
     out << "\n";
   }
+  for_each_zone(poly, [&](const char* kind, const PolyMesh::Zone& z) {
+    out << "    " << kind << " " << z.name << ": " << z.labels.size() << " " << std::string_view(kind).substr(0, std::string_view(kind).size() - 4)
+        << (z.labels.size() == 1 ? "" : "s") << "\n";
+  });
 }
 
 }  // namespace
@@ -96,8 +114,11 @@ int main(int argc, char** argv) {
   bool json = false;
   app.add_option("file", file, "mesh file (.msh Gmsh 2.2/4.1, .su2, .cgns) or OpenFOAM case folder")->required();
   app.add_flag("--json", json, "print one JSON object instead of text");
+  examples::FoamSelection foam;
+  examples::add_foam_options(app, foam);
   if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv)) return *rc;
   return examples::guarded(json, [&] {
+    file = examples::foam_input(file, foam).string();
     const AnyMesh mesh = examples::read_input(file);
     const auto summary = std::visit([](const auto& m) { return summarize(m); }, mesh);
     std::error_code ec;

@@ -125,8 +125,11 @@ int main(int argc, char** argv) {
   app.add_option("--worst", s.worst, "how many worst cells to list per metric");
   app.add_flag("--keep-orientation", s.keep_orientation,
                "refuse a mesh whose cells are all negatively oriented instead of reorienting it");
+  examples::FoamSelection foam;
+  examples::add_foam_options(app, foam);
   if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv)) return *rc;
   return examples::guarded(s.json, [&] {
+    s.file = examples::foam_input(s.file, foam).string();
     if (!s.vtu.empty()) examples::check_output(s.file, s.vtu, 2, false);
     AnyMesh mesh = examples::read_input(s.file);
     return std::visit([&](auto& m) { return run(m, s); }, mesh);

@@ -39,6 +39,7 @@ struct Arguments {
   int steps = 1;
   bool json = false, strict = false, overwrite = false, keep_orientation = false, keep_3d = false;
   examples::MoverArguments mover;
+  examples::FoamSelection foam;
 };
 
 // DGRBF2 rotates about the centre (and axis) of the rigid motion given here: in the section's
@@ -102,7 +103,7 @@ int move_and_write(const Arguments& a, const Mesh<Dim>& mesh, const examples::Mo
   if (invalid && a.strict)
     throw InvalidMeshError("move_mesh: " + std::to_string(invalid_cells) + " of " + std::to_string(cells) +
                            " cells invalid after the motion (--strict: nothing written)");
-  examples::write_output(a.output, result.mesh);
+  examples::write_output(a.output, result.mesh, a.input);
   if (a.json) {
     JsonWriter w(std::cout);
     w.begin_object().key("input").value(a.input).key("output").value(a.output);
@@ -177,7 +178,7 @@ int main(int argc, char** argv) {
   examples::add_version_flag(app);
   Arguments a;
   app.add_option("input", a.input, "Input mesh (.msh, .su2, .cgns, .vtu) or OpenFOAM case folder")->check(CLI::ExistingPath);
-  app.add_option("-o,--output", a.output, "Output mesh (.msh, .su2, .cgns, .vtu), or an OpenFOAM case (its points replaced; give --overwrite when it is the input) or a time folder of it (case/0.001: its polyMesh/points)");
+  app.add_option("-o,--output", a.output, "Output mesh (.msh, .su2, .cgns, .vtu), or an OpenFOAM case (its points replaced; give --overwrite when it is the input) or a time folder of it (case/0.001: its polyMesh/points), or a new folder (a new case: the input case's cells, patches and zones, moved)");
   examples::add_motion_options(app, a.motion);
   examples::add_mover_options(app, a.mover, known_methods<3>());
   // More steps than this is a typing slip, not a motion: it would run for days.
@@ -189,11 +190,14 @@ int main(int argc, char** argv) {
   app.add_flag("--keep-3d", a.keep_3d,
                "move a mesh one cell thick between two planes (a 2D case stored in 3D) in 3D, not as its 2D section");
   app.add_flag("--json", a.json, "Print one JSON object");
+  examples::add_foam_options(app, a.foam);
   if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv)) return *rc;
   return examples::guarded(a.json, [&] {
     if (examples::list_options<2>(a.mover)) return examples::exit_ok;
     if (a.input.empty() || a.output.empty()) throw InputError("move_mesh: give an input mesh and -o OUTPUT (see --help)");
     examples::require_motion(a.motion, "move_mesh");
+    a.input = examples::foam_input(a.input, a.foam).string();
+    a.output = examples::foam_output(a.output, a.foam).string();
     examples::check_output(a.input, a.output, 1, a.overwrite);
     return std::visit([&](auto& mesh) { return run(a, std::move(mesh)); }, *std::make_unique<AnyMesh>(examples::read_input(a.input)));
   });

@@ -20,6 +20,7 @@
 #include <exception>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <new>
 #include <optional>
 #include <string>
@@ -132,16 +133,82 @@ int guarded(bool json, Body&& body) {
   }
 }
 
+/// A mesh of an OpenFOAM case chosen as OpenFOAM's tools choose it (-time, -latestTime, -region).
+struct FoamSelection {
+  std::string time{}, region{};
+  bool latest_time = false;
+};
+
+inline void add_foam_options(CLI::App& app, FoamSelection& s) {
+  app.add_option("--time", s.time, "OpenFOAM case: its mesh at this time (the points it moved to), as OpenFOAM's -time");
+  app.add_flag("--latest-time", s.latest_time, "OpenFOAM case: its mesh at the latest time, as OpenFOAM's -latestTime");
+  app.add_option("--region", s.region, "OpenFOAM case: this region's mesh (constant/REGION/polyMesh), as OpenFOAM's -region");
+}
+
+/// The folder that `s` selects in the OpenFOAM case `input` (`input` when nothing is
+/// selected): a region's polyMesh folder, or a time folder (`case/0.3`, `case/0.3/REGION`).
+/// InputError when `input` is no such case or holds no such time.
+[[nodiscard]] inline std::filesystem::path foam_input(const std::filesystem::path& input, const FoamSelection& s) {
+  if (s.time.empty() && !s.latest_time && s.region.empty()) return input;
+  if (!s.time.empty() && s.latest_time) throw InputError("give --time or --latest-time, not both");
+  const std::filesystem::path mesh = s.region.empty() ? input / "constant" / "polyMesh" : input / "constant" / s.region / "polyMesh";
+  std::error_code ec;
+  if (!std::filesystem::exists(mesh / "faces", ec) && !std::filesystem::exists(mesh / "faces.gz", ec))
+    throw InputError(input.string() + ": --time, --latest-time and --region choose in an OpenFOAM case folder, and " + mesh.string() +
+                     " holds no mesh");
+  double wanted = 0;
+  if (!s.time.empty() && !detail::is_foam_time_name(s.time, &wanted)) throw InputError("--time " + s.time + ": not a time");
+  std::string time;
+  double latest = -std::numeric_limits<double>::infinity();
+  std::string times;
+  for (const auto& entry : std::filesystem::directory_iterator(input, ec)) {
+    const std::string name = entry.path().filename().string();
+    double t = 0;
+    if (!entry.is_directory(ec) || !detail::is_foam_time_name(name, &t)) continue;
+    times += (times.empty() ? "" : ", ") + name;
+    if ((s.latest_time && t > latest) || (!s.time.empty() && t == wanted)) {
+      time = name;
+      latest = t;
+    }
+  }
+  if (!s.time.empty() && time.empty())
+    throw InputError(input.string() + ": no time " + s.time + " (times: " + (times.empty() ? std::string("none") : times) + ")");
+  if (time.empty()) return mesh;  // --latest-time in a case that has not run: its constant mesh
+  if (s.region.empty()) return input / time;
+  if (!std::filesystem::is_directory(input / time / s.region, ec))
+    throw InputError(input.string() + ": time " + time + " has no folder for region " + s.region);
+  return input / time / s.region;
+}
+
+/// Where the moved mesh of a selected region goes when `output` is its case or a time folder
+/// of it: that region's mesh there. Any other output as given.
+[[nodiscard]] inline std::filesystem::path foam_output(const std::filesystem::path& output, const FoamSelection& s) {
+  if (s.region.empty()) return output;
+  std::error_code ec;
+  if (std::filesystem::is_directory(output / "constant" / s.region, ec)) return output / "constant" / s.region / "polyMesh";
+  const std::filesystem::path folder = output.has_filename() ? output : output.parent_path();
+  const std::filesystem::path case_dir = folder.parent_path().empty() ? std::filesystem::path(".") : folder.parent_path();
+  if (detail::is_foam_time_name(folder.filename().string()) && std::filesystem::is_directory(case_dir / "constant" / s.region, ec))
+    return folder / s.region;
+  return output;
+}
+
 /// read_mesh() with the stage set.
 [[nodiscard]] inline AnyMesh read_input(const std::filesystem::path& file) {
   set_stage("reading " + file.string());
   return read_mesh(file);
 }
 
-/// write_mesh() with the stage set.
+/// write_mesh() with the stage set; the moved mesh of an OpenFOAM case `input` is written as
+/// that case moved (write_moved_case(): a new case keeps the input's cells, patches and zones).
 template <int Dim>
-void write_output(const std::filesystem::path& file, const Mesh<Dim>& mesh) {
+void write_output(const std::filesystem::path& file, const Mesh<Dim>& mesh, const std::filesystem::path& input = {}) {
   set_stage("writing " + file.string());
+  std::error_code ec;
+  if constexpr (Dim == 3) {
+    if (!input.empty() && std::filesystem::is_directory(input, ec) && (is_openfoam_target(file) || is_new_openfoam_case(file)))
+      return write_moved_case(file, input, mesh);
+  }
   write_mesh(file, mesh);
 }
 

@@ -386,6 +386,11 @@ smoke_test(NAME move_mesh.openfoam_from_time_folder_by_patterns.json REQUIRES ex
            VALUES after/invalid=0,input=${smoke_dir}/foam_case/0.5
            COMMAND move_mesh "${smoke_dir}/foam_case/0.5" -o "${smoke_dir}/foam_case/0.75" --group "t.p" --translate 0.05,0,0
                    --fixed "(bottom|inlet)" --json)
+smoke_test(NAME mesh_info.openfoam_time_option.json REQUIRES examples_foam_time KEYS mesh
+           VALUES file=${smoke_dir}/foam_case/0.5
+           COMMAND mesh_info "${smoke_dir}/foam_case" --time 0.5 --json)
+smoke_test(NAME mesh_info.openfoam_time_option_absent.json REQUIRES examples_foam_time EXPECT_RC 1 KEYS error
+           COMMAND mesh_info "${smoke_dir}/foam_case" --time 0.3 --json)
 smoke_test(NAME move_mesh.openfoam_pattern_naming_nothing.json REQUIRES examples_foam_case EXPECT_RC 1 KEYS error
            VALUES kind=input
            COMMAND move_mesh "${smoke_dir}/foam_case" -o "${smoke_dir}/foam_case/0.9" --group top --translate 0.05,0,0
@@ -408,13 +413,24 @@ file(WRITE "${smoke_dir}/foam_poly/constant/polyMesh/neighbour" "${foam_header} 
 file(WRITE "${smoke_dir}/foam_poly/constant/polyMesh/boundary" "${foam_header} polyBoundaryMesh; object boundary; }\n4\n("
      "wall { type wall; inGroups List<word> 1(body); nFaces 1; startFace 3; } outlet { type patch; nFaces 2; startFace 4; } "
      "sides { type patch; nFaces 4; startFace 6; } frontAndBack { type empty; nFaces 6; startFace 10; })\n")
+file(WRITE "${smoke_dir}/foam_poly/constant/polyMesh/cellZones" "${foam_header} regIOobject; object cellZones; }\n1\n("
+     "hexes { type cellZone; cellLabels List<label> 2(1 2); })\n")
 smoke_test(NAME move_mesh.openfoam_polyhedra_judged_on_cells.json KEYS output,checkmesh_after/max_skewness
            VALUES after/invalid=0,checkmesh_after/invalid_cells=0,checkmesh_after/failed_checks=0
            COMMAND move_mesh "${smoke_dir}/foam_poly" -o "${smoke_dir}/foam_poly/0.1" --group body --translate 0.05,0,0
                    --fixed "(outlet|sides)" --sliding frontAndBack:0,0,1 --method sle --json)
 smoke_test(NAME mesh_info.openfoam_polyhedra.json KEYS openfoam/patches
-           VALUES openfoam/cells=3,openfoam/cell_shapes/hexahedra=2,openfoam/cell_shapes/polyhedra=1,mesh/cells/tet4=78
+           VALUES openfoam/cells=3,openfoam/cell_shapes/hexahedra=2,openfoam/cell_shapes/polyhedra=1,mesh/cells/tet4=78,openfoam/zones/0/name=hexes,openfoam/zones/0/kind=cellZone,openfoam/zones/0/size=2
            COMMAND mesh_info "${smoke_dir}/foam_poly" --json)
+# A cell zone moved as a body, written as a new case: the case's own cells, patches and zone.
+file(REMOVE_RECURSE "${smoke_dir}/foam_poly_moved")
+smoke_test(NAME move_mesh.openfoam_zone_to_new_case.json SETUP examples_foam_poly_moved KEYS output
+           VALUES after/invalid=0,checkmesh_after/invalid_cells=0
+           COMMAND move_mesh "${smoke_dir}/foam_poly" -o "${smoke_dir}/foam_poly_moved" --group hexes --translate 0.05,0,0
+                   --fixed wall --method sle --json)
+smoke_test(NAME mesh_info.openfoam_new_case_keeps_cells.json REQUIRES examples_foam_poly_moved KEYS openfoam/patches
+           VALUES openfoam/cells=3,openfoam/cell_shapes/polyhedra=1,openfoam/patches/0/type=wall,openfoam/patches/3/type=empty,openfoam/zones/0/name=hexes
+           COMMAND mesh_info "${smoke_dir}/foam_poly_moved" --json)
 
 # A 2D case stored in 3D: front (y = 0) and back (y = 1) are one group, two parallel planes.
 # It slides with the normal given (each node in its own plane); without it no plane fits.

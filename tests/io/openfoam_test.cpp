@@ -625,3 +625,124 @@ TEST_CASE("OpenFOAM: a new case appears whole or not at all, and never over a fo
   CHECK(fs::exists(parent / "busy" / "notes.txt"));
   CHECK(std::distance(fs::directory_iterator(parent), fs::directory_iterator{}) == 3);
 }
+
+TEST_CASE("OpenFOAM: cell, face and point zones come back as written and name groups of their nodes", "[io][openfoam]") {
+  PolyMesh c = hanging_node_case();
+  c.cell_zones = {{"body", {0}}, {"right", {1, 2}}};
+  c.face_zones = {{"cut", {1, 2}, {0, 1}}};
+  c.point_zones = {{"wall", {0, 5}}};  // a patch's name: its group is qualified
+  for (const auto format : formats()) {
+    INFO("format " << static_cast<int>(format));
+    const fs::path dir = test::scratch_path("foam_zones");
+    write_case(dir, c, format);
+    const PolyMesh back = read_polymesh(dir);
+    for (const auto& [read, written] : {std::pair{&back.cell_zones, &c.cell_zones}, std::pair{&back.face_zones, &c.face_zones},
+                                        std::pair{&back.point_zones, &c.point_zones}}) {
+      REQUIRE(read->size() == written->size());
+      for (std::size_t z = 0; z < read->size(); ++z) {
+        CHECK((*read)[z].name == (*written)[z].name);
+        CHECK((*read)[z].labels == (*written)[z].labels);
+        CHECK((*read)[z].flip == (*written)[z].flip);
+      }
+    }
+    const Mesh<3> mesh = read_openfoam(dir);
+    for (const char* name : {"body", "right", "cut", "pointZone:wall"}) CHECK(mesh.group(name).dim == 0);
+    CHECK(mesh.group("wall").dim == 2);
+    // Cell 0: its 10 vertices, the centres of its 7 faces (none a triangle) and its own.
+    const std::vector<Index> body = mesh.group_nodes("body");
+    REQUIRE(body.size() == 18);
+    CHECK(body[9] == 14);
+    CHECK(body[10] >= 16);
+    // The faces 1 and 2: 6 vertices and 2 centres; the points as listed.
+    CHECK(mesh.group_nodes("cut").size() == 8);
+    CHECK(mesh.group_nodes("pointZone:wall") == std::vector<Index>{0, 5});
+    // A zone moved as a body: each of its nodes, auxiliary ones included, takes the motion.
+    BoundarySpec<3> spec;
+    spec.moving("right", Translation<3>{Vec<3>(0.0, 0.0, 0.25)}).fixed("wall");
+    const ResolvedBoundary<3> r = spec.resolve(mesh);
+    const std::vector<Index> right = mesh.group_nodes("right");
+    for (const Index v : right) CHECK(r.displacements.col(r.column(v)) == Vec<3>(0.0, 0.0, 0.25));
+    if (format == Format::ascii) {
+      const std::string report = check_mesh(dir);
+      INFO(report);
+      if (!report.empty()) {
+        CHECK_THAT(report, Catch::Contains("Mesh OK."));
+        // OpenFOAM reads the zones as written.
+        CHECK(reported(report, "cell zones:") == 2);
+        CHECK(reported(report, "face zones:") == 1);
+        CHECK(reported(report, "point zones:") == 1);
+      }
+    }
+  }
+}
+
+TEST_CASE("OpenFOAM: a zone file in binary reads as in ASCII", "[io][openfoam]") {
+  const fs::path dir = test::scratch_path("foam_zones_binary");
+  write_case(dir, hanging_node_case());
+  std::string text = "FoamFile\n{\n    version 2.0;\n    format binary;\n    arch \"LSB;label=32;scalar=64\";\n    class regIOobject;\n"
+                     "    object faceZones;\n}\n1\n(\ncut\n{\n    type faceZone;\n    faceLabels List<label> 2(";
+  for (const std::int32_t f : {1, 2}) text.append(reinterpret_cast<const char*>(&f), 4);
+  text += ");\n    flipMap List<bool> 2(";
+  text += std::string("\0\1", 2);
+  text += ");\n}\n)\n";
+  std::ofstream(dir / "constant/polyMesh/faceZones", std::ios::binary) << text;
+  const PolyMesh poly = read_polymesh(dir);
+  REQUIRE(poly.face_zones.size() == 1);
+  CHECK(poly.face_zones[0].labels == std::vector<Index>{1, 2});
+  CHECK(poly.face_zones[0].flip == std::vector<char>{0, 1});
+}
+
+TEST_CASE("OpenFOAM: a zone that names what the mesh lacks, or is malformed, is refused naming the zone", "[io][openfoam]") {
+  const fs::path dir = test::scratch_path("foam_zones_bad");
+  const auto zones_file = [&](const std::string& object, const std::string& body) {
+    write_case(dir, hanging_node_case());
+    std::ofstream(dir / "constant/polyMesh" / object) << "FoamFile { version 2.0; format ascii; class regIOobject; object " << object
+                                                       << "; }\n" << body;
+  };
+  zones_file("cellZones", "1\n(\nbody\n{\n    type cellZone;\n    cellLabels List<label> 2(0 3);\n}\n)\n");
+  CHECK_THAT(test::message_of<InputError>([&] { (void)read_polymesh(dir); }),
+             Catch::Contains("cellZones") && Catch::Contains("cell zone 'body' holds cell 3") && Catch::Contains("3 cells"));
+  zones_file("pointZones", "1\n(\ntip\n{\n    type pointZone;\n    pointLabels List<label> 1(-1);\n}\n)\n");
+  CHECK_THAT(test::message_of<InputError>([&] { (void)read_polymesh(dir); }), Catch::Contains("point zone 'tip' holds point -1"));
+  zones_file("faceZones", "1\n(\ncut\n{\n    type faceZone;\n    flipMap List<bool> 1(0);\n}\n)\n");
+  CHECK_THAT(test::message_of<ParseError>([&] { (void)read_polymesh(dir); }), Catch::Contains("lacks faceLabels"));
+  zones_file("faceZones", "1\n(\ncut\n{\n    type faceZone;\n    faceLabels List<label> 2(1 2);\n    flipMap List<bool> 1(0);\n}\n)\n");
+  CHECK_THAT(test::message_of<ParseError>([&] { (void)read_polymesh(dir); }), Catch::Contains("1 flipMap entries for 2 faces"));
+  // A count no file of this size holds allocates nothing.
+  zones_file("cellZones", "1\n(\nbody\n{\n    type cellZone;\n    cellLabels List<label> 2000000000(0);\n}\n)\n");
+  CHECK_THAT(test::message_of<ParseError>([&] { (void)read_polymesh(dir); }), Catch::Contains("bytes left in the file"));
+  zones_file("faceZones", "1\n(\ncut\n{\n    type faceZone;\n    faceLabels List<label> 1(1);\n    flipMap List<bool> 2000000000{0};\n}\n)\n");
+  CHECK_THAT(test::message_of<ParseError>([&] { (void)read_polymesh(dir); }), Catch::Contains("uniform flipMap of 2000000000 entries"));
+}
+
+TEST_CASE("OpenFOAM: a region's mesh and a time's points are read and written as OpenFOAM's -region and -time address them", "[io][openfoam]") {
+  const fs::path dir = test::scratch_path("foam_region");
+  const PolyMesh fluid = hanging_node_case();
+  write_case(dir, fluid);
+  // A second region: a box, in constant/solid/polyMesh.
+  const PolyMesh solid = to_polymesh(box_mesh({.nx = 2, .ny = 1, .nz = 1}));
+  write_polymesh(dir / "solid_case", solid);
+  fs::create_directories(dir / "constant/solid");
+  fs::rename(dir / "solid_case/constant/polyMesh", dir / "constant/solid/polyMesh");
+  fs::remove_all(dir / "solid_case");
+  CHECK(read_polymesh(dir / "constant/solid/polyMesh").num_cells == solid.num_cells);
+
+  // Moved points of the region at 0.5: in 0.5/solid/polyMesh, located there.
+  Mesh<3> moved = read_openfoam(dir / "constant/solid/polyMesh");
+  moved.points.row(2).array() += 0.125;
+  fs::create_directories(dir / "0.5/solid");
+  CHECK(is_openfoam_target(dir / "0.5/solid"));
+  write_mesh(dir / "0.5/solid", moved);
+  CHECK(detail::read_foam_file(dir / "0.5/solid/polyMesh/points").find("\"0.5/solid/polyMesh\"") != std::string::npos);
+  CHECK(read_openfoam(dir / "0.5/solid").points == moved.points);
+  // Later times that hold no points read the last moved ones; earlier ones the constant ones.
+  fs::create_directories(dir / "0.75/solid");
+  fs::create_directories(dir / "0.25/solid");
+  CHECK(read_polymesh(dir / "0.75/solid").points == moved.points);
+  CHECK(read_polymesh(dir / "0.25/solid").points == solid.points);
+  // The default region did not move.
+  CHECK(read_polymesh(dir / "0.75").points == fluid.points);
+  // A folder in a time folder that is no region of the case is no target.
+  CHECK_FALSE(is_openfoam_target(dir / "0.5/polyMesh"));
+  CHECK_FALSE(is_openfoam_target(dir / "0.5/liquid"));
+}

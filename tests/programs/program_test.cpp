@@ -1,9 +1,14 @@
 // The programs' error reporting (examples/program.hpp): what a user reads when a run fails
-// in a way whose own message names nothing, such as running out of memory.
+// in a way whose own message names nothing, such as running out of memory; and how they choose
+// a mesh in an OpenFOAM case (--time, --latest-time, --region).
 #include "program.hpp"
+
+#include "messages.hpp"
 
 #include <catch2/catch.hpp>
 
+#include <filesystem>
+#include <fstream>
 #include <new>
 #include <sstream>
 #include <stdexcept>
@@ -71,4 +76,41 @@ TEST_CASE("programs: reading and writing set the stage", "[programs]") {
   CHECK_THROWS_AS(examples::write_output(output, Mesh<2>{}), Error);
   CHECK(examples::current_stage() == "writing " + output);
   examples::set_stage("");
+}
+
+TEST_CASE("programs: --time, --latest-time and --region choose in an OpenFOAM case as OpenFOAM's tools do", "[programs]") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(MESHMOTION_TEST_TMP_DIR) / "foam_selection";
+  fs::remove_all(dir);
+  for (const char* mesh : {"constant/polyMesh", "constant/solid/polyMesh"}) {
+    fs::create_directories(dir / mesh);
+    std::ofstream(dir / mesh / "faces") << "";
+  }
+  for (const char* time : {"0", "0.5", "1e-1", "2/solid"}) fs::create_directories(dir / time);
+  fs::create_directories(dir / "system");
+  const auto input = [&](examples::FoamSelection s) { return examples::foam_input(dir, s); };
+  CHECK(input({}) == dir);
+  CHECK(input({.time = "0.5"}) == dir / "0.5");
+  CHECK(input({.time = "0.10"}) == dir / "1e-1");  // by value, as OpenFOAM matches times
+  CHECK(input({.latest_time = true}) == dir / "2");
+  CHECK(input({.region = "solid"}) == dir / "constant/solid/polyMesh");
+  CHECK(input({.time = "2", .region = "solid"}) == dir / "2/solid");
+  const auto refused = [&](examples::FoamSelection s) { return test::message_of<InputError>([&] { (void)input(s); }); };
+  CHECK(refused({.time = "0.3"}).find("no time 0.3 (times: ") != std::string::npos);
+  CHECK(refused({.time = "0.5", .region = "solid"}).find("time 0.5 has no folder for region solid") != std::string::npos);
+  CHECK(refused({.region = "liquid"}).find("constant/liquid/polyMesh holds no mesh") != std::string::npos);
+  CHECK(refused({.time = "x"}).find("--time x: not a time") != std::string::npos);
+  CHECK(refused({.time = "0", .latest_time = true}).find("not both") != std::string::npos);
+  // Without a time folder, the latest time is the constant mesh.
+  fs::remove_all(dir / "0");
+  fs::remove_all(dir / "0.5");
+  fs::remove_all(dir / "1e-1");
+  fs::remove_all(dir / "2");
+  CHECK(input({.latest_time = true}) == dir / "constant/polyMesh");
+  // The region's output: in the case, or in a time folder of it; anything else as given.
+  CHECK(examples::foam_output(dir, {.region = "solid"}) == dir / "constant/solid/polyMesh");
+  CHECK(examples::foam_output(dir / "0.25", {.region = "solid"}) == dir / "0.25/solid");
+  CHECK(examples::foam_output(dir / "0.25", {}) == dir / "0.25");
+  CHECK(examples::foam_output("moved.msh", {.region = "solid"}) == "moved.msh");
+  fs::remove_all(dir);
 }

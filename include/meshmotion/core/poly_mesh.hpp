@@ -24,6 +24,13 @@ struct PolyMesh {
     Index size = 0;    ///< number of faces
     std::vector<std::string> groups{};  ///< the boundary file's inGroups
   };
+  /// A named set of cells, faces or points: OpenFOAM's cellZones, faceZones and pointZones,
+  /// by which a solver (and a motion: a zone moved as a body) addresses part of the mesh.
+  struct Zone {
+    std::string name;
+    std::vector<Index> labels;  ///< cell, face or point labels
+    std::vector<char> flip{};   ///< faceZones: whether each face is turned (flipMap); else empty
+  };
   Points<3> points;
   std::vector<Index> face_offsets{0};  ///< face f: face_nodes[face_offsets[f] .. face_offsets[f+1])
   std::vector<Index> face_nodes;
@@ -31,6 +38,7 @@ struct PolyMesh {
   std::vector<Index> neighbour;  ///< one per internal face
   std::vector<Patch> patches;
   Index num_cells = 0;
+  std::vector<Zone> cell_zones{}, face_zones{}, point_zones{};
 
   [[nodiscard]] Index num_faces() const noexcept { return static_cast<Index>(face_offsets.size()) - 1; }
   [[nodiscard]] Index num_internal_faces() const noexcept { return static_cast<Index>(neighbour.size()); }

@@ -14,7 +14,8 @@
 ///   three vertices around its centre too (as OpenFOAM's own tet decomposition does); those
 ///   centres are appended after the points as auxiliary nodes (Mesh::num_auxiliary_nodes).
 /// Patches become facet groups (tag = patch index + 1) of the boundary faces, oriented out of
-/// the domain as OpenFOAM lists them. Malformed files give the file, the line (ASCII) or byte
+/// the domain as OpenFOAM lists them; cell, face and point zones groups of dimension 0 holding
+/// their nodes, by which a motion can address them (a cell zone moved as a body). Malformed files give the file, the line (ASCII) or byte
 /// offset (binary) and the entry; inconsistent lists (an owner list shorter than the faces, a
 /// face index out of range, patches that do not cover the boundary faces) name the list.
 ///
@@ -23,7 +24,8 @@
 /// case are not touched. It writes the nodes before the auxiliary ones and refuses a mesh whose
 /// node count differs from the case's. Targets: a case folder (its constant/polyMesh), a
 /// polyMesh folder, or a time folder of a case (`case/0.001`: its polyMesh/points, created,
-/// which is where OpenFOAM looks for moved points).
+/// which is where OpenFOAM looks for moved points). write_moved_case() also writes a whole new
+/// case: the source case's own cells, patches and zones with the moved points.
 ///
 /// The pieces: io/openfoam_polymesh.hpp (the model and its conversions),
 /// io/openfoam_reader.hpp, io/openfoam_writer.hpp, io/detail/foam_files.hpp (the files' syntax).
@@ -31,3 +33,27 @@
 #include "meshmotion/io/openfoam_polymesh.hpp"
 #include "meshmotion/io/openfoam_reader.hpp"
 #include "meshmotion/io/openfoam_writer.hpp"
+
+#include <filesystem>
+#include <string>
+
+namespace meshmotion {
+
+/// Writes `moved`, the mesh read from the OpenFOAM case `source` (read_openfoam()) with its
+/// nodes moved: into a case, polyMesh or time folder, its points (write_polymesh_points()); at
+/// a new or empty folder, a whole case holding `source`'s own polyMesh (its cells, not the
+/// tetrahedra a polyhedral case is cut into; its patches with their types and groups; its
+/// zones) with the moved points. Throws as those functions do, and InputError when `moved` does
+/// not have `source`'s point count.
+inline void write_moved_case(const std::filesystem::path& target, const std::filesystem::path& source, const Mesh<3>& moved) {
+  if (!is_new_openfoam_case(target)) return write_polymesh_points(target, moved);
+  PolyMesh poly = read_polymesh(source);
+  const Index n = moved.num_nodes() - moved.num_auxiliary_nodes;
+  if (n != poly.points.cols())
+    throw InputError(target.string() + ": the mesh has " + std::to_string(n) + " points, the case it comes from (" + source.string() +
+                     ") " + std::to_string(poly.points.cols()));
+  poly.points = moved.points.leftCols(n);
+  write_new_polymesh_case(target, poly);
+}
+
+}  // namespace meshmotion

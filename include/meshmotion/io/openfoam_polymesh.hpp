@@ -116,7 +116,10 @@ struct SmallCell {
 
 /// The Mesh<3> of a polyMesh: its cells as tetrahedra, pyramids, prisms and hexahedra when
 /// they all are, else every cell cut into tetrahedra around auxiliary centre nodes; patches as
-/// facet groups. See the file comment. The auxiliary nodes are, in this order, the centres of
+/// facet groups; each cell, face or point zone as a group of dimension 0 holding its nodes
+/// (point elements in `lower`; a cell zone's and a face zone's include the auxiliary nodes
+/// inside them), named as the zone unless a patch or another zone has that name, then
+/// `cellZone:NAME`, `faceZone:NAME` or `pointZone:NAME`. See the file comment. The auxiliary nodes are, in this order, the centres of
 /// the faces of more than three points, in face order, then every cell's centre, in cell order.
 /// `cut_every_cell` cuts them even when every cell has a standard shape: a rank of a decomposed
 /// case must cut its cells as the whole case is cut, whatever shapes the rank itself holds.
@@ -174,6 +177,36 @@ struct SmallCell {
     return 0;
   };
 
+  // Each zone as a group of the nodes it holds: point elements in `lower`, tagged after the
+  // patches; `add_nodes(kind, label, out)` gives a cell's or a face's nodes.
+  const auto add_zones = [&](auto&& add_nodes) {
+    const auto taken = [&](const std::string& name) {
+      return std::count_if(mesh.groups.begin(), mesh.groups.end(), [&](const PhysicalGroup& g) { return g.name == name; }) +
+             std::count_if(poly.cell_zones.begin(), poly.cell_zones.end(), [&](const PolyMesh::Zone& z) { return z.name == name; }) +
+             std::count_if(poly.face_zones.begin(), poly.face_zones.end(), [&](const PolyMesh::Zone& z) { return z.name == name; }) +
+             std::count_if(poly.point_zones.begin(), poly.point_zones.end(), [&](const PolyMesh::Zone& z) { return z.name == name; });
+    };
+    std::vector<std::string> names;  // decided before any zone's group is added
+    for (const auto* zones : {&poly.cell_zones, &poly.face_zones, &poly.point_zones})
+      for (const auto& z : *zones) {
+        const char* kind = zones == &poly.cell_zones ? "cellZone:" : zones == &poly.face_zones ? "faceZone:" : "pointZone:";
+        names.push_back(taken(z.name) > 1 ? kind + z.name : z.name);
+      }
+    std::size_t k = 0;
+    std::vector<Index> nodes;
+    for (const auto* zones : {&poly.cell_zones, &poly.face_zones, &poly.point_zones})
+      for (const auto& z : *zones) {
+        nodes.clear();
+        for (const Index label : z.labels) add_nodes(zones == &poly.cell_zones ? 3 : zones == &poly.face_zones ? 2 : 0, label, nodes);
+        std::sort(nodes.begin(), nodes.end());
+        nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+        const int tag = static_cast<int>(mesh.groups.size()) + 1;
+        mesh.groups.push_back({0, tag, names[k++]});
+        ElementBlock& b = mesh.block(ElementType::point1);
+        for (const Index v : nodes) b.add(std::span<const Index>(&v, 1), tag);
+      }
+  };
+
   if (all_matched) {
     for (Index c = 0; c < nc; ++c) {
       ElementBlock& b = mesh.block(types[static_cast<std::size_t>(c)]);
@@ -186,6 +219,19 @@ struct SmallCell {
       b.add(v, patch_tag(f));
       b.ids.push_back(nc + f + 1);
     }
+    add_zones([&](int kind, Index label, std::vector<Index>& out) {
+      if (kind == 3) {
+        const auto& m = matched[static_cast<std::size_t>(label)];
+        out.insert(out.end(), m.begin(), m.begin() + num_nodes(types[static_cast<std::size_t>(label)]));
+      } else if (kind == 2) {
+        const auto v = poly.face(label);
+        out.insert(out.end(), v.begin(), v.end());
+      } else {
+        out.push_back(label);
+      }
+    });
+    if (ElementBlock* points = mesh.lower.empty() ? nullptr : &mesh.block(ElementType::point1))
+      for (Index e = 0; e < points->size(); ++e) points->ids.push_back(nc + nf + 1 + e);
     return mesh;
   }
 
@@ -201,6 +247,7 @@ struct SmallCell {
     extra.push_back(sum / static_cast<double>(v.size()));
   }
   ElementBlock& tets = mesh.block(ElementType::tet4);
+  std::vector<Index> cell_centre(static_cast<std::size_t>(nc));
   for (Index c = 0; c < nc; ++c) {
     std::vector<Index> vertices;
     for (Index k = start[static_cast<std::size_t>(c)]; k < start[static_cast<std::size_t>(c) + 1]; ++k) {
@@ -213,6 +260,7 @@ struct SmallCell {
     Vec<3> sum = Vec<3>::Zero();
     for (const Index i : vertices) sum += poly.points.col(i);
     const Index centre = np + static_cast<Index>(extra.size());
+    cell_centre[static_cast<std::size_t>(c)] = centre;
     extra.push_back(sum / static_cast<double>(vertices.size()));
     for (Index k = start[static_cast<std::size_t>(c)]; k < start[static_cast<std::size_t>(c) + 1]; ++k) {
       const Index entry = cell_faces[static_cast<std::size_t>(k)];
@@ -234,6 +282,25 @@ struct SmallCell {
     }
     for (std::size_t i = 0; i < v.size(); ++i) tris.add({face_centre[static_cast<std::size_t>(f)], v[i], v[(i + 1) % v.size()]}, patch_tag(f));
   }
+  // A zone holds the auxiliary nodes inside what it holds: moved with it as a body.
+  const auto face_with_centre = [&](Index f, std::vector<Index>& out) {
+    const auto v = poly.face(f);
+    out.insert(out.end(), v.begin(), v.end());
+    if (face_centre[static_cast<std::size_t>(f)] >= 0) out.push_back(face_centre[static_cast<std::size_t>(f)]);
+  };
+  add_zones([&](int kind, Index label, std::vector<Index>& out) {
+    if (kind == 3) {
+      for (Index k = start[static_cast<std::size_t>(label)]; k < start[static_cast<std::size_t>(label) + 1]; ++k) {
+        const Index entry = cell_faces[static_cast<std::size_t>(k)];
+        face_with_centre(entry >= 0 ? entry : -entry - 1, out);
+      }
+      out.push_back(cell_centre[static_cast<std::size_t>(label)]);
+    } else if (kind == 2) {
+      face_with_centre(label, out);
+    } else {
+      out.push_back(label);
+    }
+  });
   mesh.points.conservativeResize(3, np + static_cast<Index>(extra.size()));
   for (std::size_t k = 0; k < extra.size(); ++k) mesh.points.col(np + static_cast<Index>(k)) = extra[k];
   mesh.num_auxiliary_nodes = static_cast<Index>(extra.size());
@@ -243,8 +310,9 @@ struct SmallCell {
 /// The polyMesh of a linear 3D mesh: its nodes as points, its cells as cells (same order), each
 /// face once, oriented out of its owner (the lower-numbered cell), internal faces in upper
 /// triangular order, then one patch per facet group holding the boundary faces its facets
-/// cover (named after the group, type `patch`), and `defaultFaces` for boundary faces no
-/// facet covers. Throws InputError for quadratic elements or a face shared by three cells.
+/// cover (named after the group, in its sets as `inGroups`; type `patch`, or `wall`, `empty`,
+/// `symmetryPlane`, `symmetry` or `wedge` where the group is in that set, as to_mesh() puts an
+/// OpenFOAM patch), and `defaultFaces` for boundary faces no facet covers. Throws InputError for quadratic elements or a face shared by three cells.
 [[nodiscard]] inline PolyMesh to_polymesh(const Mesh<3>& mesh) {
   validate(mesh);
   for (const auto* list : {&mesh.cells, &mesh.facets})
@@ -325,10 +393,17 @@ struct SmallCell {
   Index start = poly.num_internal_faces();
   for (std::size_t p = 0; p < tags.size(); ++p) {
     const Index size = static_cast<Index>(std::count_if(faces.begin(), faces.end(), [&](const Face& f) { return f.patch == static_cast<int>(p); }));
-    std::string patch_name = tags[p] == 0 ? "defaultFaces" : "tag_" + std::to_string(tags[p]);
+    PolyMesh::Patch patch{tags[p] == 0 ? "defaultFaces" : "tag_" + std::to_string(tags[p]), "patch", start, size};
     for (const auto& g : mesh.groups)
-      if (g.dim == 2 && g.tag == tags[p]) patch_name = g.name;
-    poly.patches.push_back({patch_name, "patch", start, size});
+      if (g.dim == 2 && g.tag == tags[p]) {
+        patch.name = g.name;
+        patch.groups = g.in_groups;
+        // The types that need no entry beyond `type` come back from the sets to_mesh() put
+        // them in; a cyclic or processor patch needs its partner, so it stays a patch.
+        for (const char* type : {"wall", "empty", "symmetryPlane", "symmetry", "wedge"})
+          if (std::find(g.in_groups.begin(), g.in_groups.end(), type) != g.in_groups.end()) patch.type = type;
+      }
+    poly.patches.push_back(std::move(patch));
     start += size;
   }
   return poly;

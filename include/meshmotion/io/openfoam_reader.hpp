@@ -1,6 +1,7 @@
 #pragma once
 /// \file
-/// OpenFOAM polyMesh reading (`constant/polyMesh/`: points, faces, owner, neighbour, boundary):
+/// OpenFOAM polyMesh reading (`constant/polyMesh/`: points, faces, owner, neighbour, boundary,
+/// and the cellZones, faceZones and pointZones where the case has them):
 /// ASCII and binary files (FoamFile header; `arch` label and scalar sizes), `faceList` and
 /// `faceCompactList` faces, gzip-compressed files (`points.gz`, ...) when built with zlib.
 /// read_polymesh() gives the face-based mesh as the files hold it, read_openfoam() the Mesh<3>
@@ -143,6 +144,81 @@ inline void read_foam_faces(const std::filesystem::path& file, PolyMesh& mesh) {
   return patches;
 }
 
+/// Reads a zones file (cellZones, faceZones or pointZones: "N ( name { type ...Zone;
+/// <kind>Labels List<label> M(...); flipMap List<bool> M(...); } ... )"); `kind` is "cell",
+/// "face" or "point". Entries other than the labels and the flip map are skipped.
+[[nodiscard]] inline std::vector<PolyMesh::Zone> read_foam_zones(const std::filesystem::path& file, const std::string& kind) {
+  const std::string text = read_foam_file(file);
+  FoamCursor in(text, file);
+  const FoamHeader h = read_foam_header(in);
+  check_foam_class(in, h, {"regIOobject", kind + "ZoneMesh"});
+  const auto n = in.integer<Index>("zone count", 0, 1 << 20);
+  in.expect("(");
+  const std::string labels_key = kind + "Labels";
+  // "List<label> 3(0 1 2)": the type word is optional before the list.
+  const auto list_start = [&](std::string_view type) {
+    if (in.peek() < '0' || in.peek() > '9') {
+      const std::string_view word = in.token(type);
+      if (word != type) in.fail("expected " + std::string(type) + " or a list (got '" + shorten_token(word) + "')");
+    }
+  };
+  std::vector<PolyMesh::Zone> zones;
+  for (Index z = 0; z < n; ++z) {
+    PolyMesh::Zone zone;
+    zone.name = std::string(in.token("a zone name"));
+    in.expect("{");
+    bool have_labels = false;
+    for (;;) {
+      const std::string key(in.token("a zone entry or '}'"));
+      if (key == "}") break;
+      if (key == labels_key) {
+        list_start("List<label>");
+        zone.labels = read_label_list(in, h, labels_key, 0);
+        have_labels = true;
+      } else if (key == "flipMap" && kind == "face") {
+        list_start("List<bool>");
+        const auto m = in.integer<Index>("flipMap count", 0, std::numeric_limits<Index>::max());
+        if (in.peek() == '{') {
+          // Uniform: allocated only for the labels already read.
+          if (!have_labels || m != static_cast<Index>(zone.labels.size()))
+            in.fail("face zone '" + zone.name + "': a uniform flipMap of " + std::to_string(m) + " entries where " +
+                    (have_labels ? std::to_string(zone.labels.size()) + " faceLabels" : std::string("no faceLabels")) + " came before");
+          in.expect("{");
+          zone.flip.assign(static_cast<std::size_t>(m), static_cast<char>(in.integer<int>("a flip (0 or 1)", 0, 1)));
+          in.expect("}");
+        } else {
+          in.expect("(");
+          in.check_count(m, "flipMap", h.binary ? 1 : 2);
+          zone.flip.resize(static_cast<std::size_t>(m));
+          if (h.binary && m > 0) {
+            in.use_byte_offsets();
+            const std::string_view bytes = in.raw(static_cast<std::size_t>(m), "flipMap");
+            for (std::size_t k = 0; k < zone.flip.size(); ++k) zone.flip[k] = bytes[k] != 0 ? 1 : 0;
+          } else {
+            for (auto& f : zone.flip) f = static_cast<char>(in.integer<int>("a flip (0 or 1)", 0, 1));
+          }
+          in.expect(")");
+        }
+      } else {
+        int depth = 0;
+        for (std::string_view t = in.token("';'"); depth > 0 || t != ";"; t = in.token("';'")) {
+          if (t == "(" || t == "{") ++depth;
+          if (t == ")" || t == "}") --depth;
+        }
+        continue;
+      }
+      in.expect(";");
+    }
+    if (!have_labels) in.fail(kind + " zone '" + zone.name + "' lacks " + labels_key);
+    if (!zone.flip.empty() && zone.flip.size() != zone.labels.size())
+      in.fail("face zone '" + zone.name + "' has " + std::to_string(zone.flip.size()) + " flipMap entries for " +
+              std::to_string(zone.labels.size()) + " faces");
+    zones.push_back(std::move(zone));
+  }
+  in.expect(")");
+  return zones;
+}
+
 /// Calls fail(message) for the first cell whose faces, each turned out of the cell, do not close
 /// (OpenFOAM's checkMesh "open cells", with its threshold): a face listed the wrong way round,
 /// or given to the wrong cell. Names the face whose reversal would close the cell when one does.
@@ -191,18 +267,18 @@ void check_closed_cells(const PolyMesh& mesh, Fail&& fail) {
 
 }  // namespace detail
 
-/// Reads an OpenFOAM polyMesh from a case folder (its constant/polyMesh), a polyMesh folder, or
-/// a time folder of a case (`case/0.3`, as OpenFOAM's tools read `-time 0.3`: the points of
-/// `case/0.3/polyMesh/points` where the case moved, else the constant ones, on the constant
-/// faces). Throws IoError for a missing file, ParseError for malformed content (file and line
+/// Reads an OpenFOAM polyMesh from a case folder (its constant/polyMesh), a polyMesh folder
+/// (a region's: `case/constant/solid/polyMesh`), or a time folder of a case (`case/0.3`, or
+/// `case/0.3/solid` for a region, as OpenFOAM's tools read `-time 0.3 [-region solid]`: the
+/// points of the latest time up to 0.3 where the mesh moved, else the constant ones, on the
+/// constant faces). Throws IoError for a missing file, ParseError for malformed content (file and line
 /// or byte offset), InputError for lists that do not fit together (naming the list and the entry).
 [[nodiscard]] inline PolyMesh read_polymesh(const std::filesystem::path& path) {
   std::filesystem::path dir = detail::polymesh_folder(path), points = dir / "points";
   std::error_code ec;
   if (const auto time = dir.empty() && std::filesystem::is_directory(path, ec) ? detail::foam_time_folder(path) : std::nullopt) {
     dir = time->constant;
-    const bool moved = std::filesystem::exists(time->points(), ec) || std::filesystem::exists(time->points().string() + ".gz", ec);
-    points = moved ? time->points() : dir / "points";
+    points = time->current_points();
   }
   if (dir.empty())
     throw IoError(path.string() + ": not an OpenFOAM case, polyMesh folder or time folder of a case (no constant/polyMesh/faces "
@@ -271,6 +347,19 @@ void check_closed_cells(const PolyMesh& mesh, Fail&& fail) {
   }
   if (next != nf)
     fail("boundary", "the patches end at face " + std::to_string(next) + " (the boundary faces run to " + std::to_string(nf) + ")");
+  const auto read_zones = [&](const char* kind, std::vector<PolyMesh::Zone>& zones, Index count, const char* things) {
+    const std::filesystem::path file = dir / (std::string(kind) + "Zones");
+    if (!std::filesystem::exists(file, ec) && !std::filesystem::exists(file.string() + ".gz", ec)) return;
+    zones = detail::read_foam_zones(file, kind);
+    for (const auto& z : zones)
+      for (const Index label : z.labels)
+        if (label < 0 || label >= count)
+          fail(file.filename().string(), std::string(kind) + " zone '" + z.name + "' holds " + kind + " " + std::to_string(label) +
+                                             " (the mesh has " + std::to_string(count) + " " + things + ", numbered from 0)");
+  };
+  read_zones("cell", mesh.cell_zones, mesh.num_cells, "cells");
+  read_zones("face", mesh.face_zones, nf, "faces");
+  read_zones("point", mesh.point_zones, np, "points");
   return mesh;
 }
 

@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <string>
 #include <system_error>
+#include <tuple>
 
 namespace meshmotion {
 namespace detail {
@@ -181,8 +182,8 @@ inline void write_polymesh_points(const std::filesystem::path& target, const Mes
     const std::size_t at = header.find("location");
     if (at != std::string::npos) {
       const std::size_t end = header.find(';', at);
-      const std::string time = where.points.parent_path().parent_path().filename().string();
-      header.replace(at, end - at, "location    \"" + time + "/polyMesh\"");
+      const std::string folder = where.points.parent_path().lexically_relative(where.case_dir).generic_string();
+      header.replace(at, end - at, "location    \"" + folder + "\"");
     }
   }
   std::string out = header;
@@ -200,7 +201,8 @@ struct PolyMeshWriteOptions {
   bool compressed = false;  ///< gzip every file (needs zlib)
 };
 
-/// Writes a whole polyMesh (points, faces, owner, neighbour, boundary) into `case_dir`'s
+/// Writes a whole polyMesh (points, faces, owner, neighbour, boundary, and its zones when it has
+/// any) into `case_dir`'s
 /// constant/polyMesh, each file through a temporary file and a rename. The faces must be
 /// ordered as OpenFOAM requires (internal faces first, then each patch's); InputError otherwise.
 inline void write_polymesh(const std::filesystem::path& case_dir, const PolyMesh& mesh, const PolyMeshWriteOptions& options = {}) {
@@ -215,9 +217,23 @@ inline void write_polymesh(const std::filesystem::path& case_dir, const PolyMesh
     next += p.size;
   }
   if (next != nf) throw InputError("write_polymesh: the patches end at face " + std::to_string(next) + " of " + std::to_string(nf));
-  for (const auto& p : mesh.patches)
-    if (p.name.empty() || p.name.find_first_of(" \t\n\"';{}()/\\") != std::string::npos)
-      throw InputError("write_polymesh: patch name '" + p.name + "' is not an OpenFOAM word (no blanks, quotes, ;, braces, parentheses or slashes)");
+  const auto check_word = [](const std::string& what, const std::string& word) {
+    if (word.empty() || word.find_first_of(" \t\n\"';{}()/\\") != std::string::npos)
+      throw InputError("write_polymesh: " + what + " name '" + word + "' is not an OpenFOAM word (no blanks, quotes, ;, braces, parentheses or slashes)");
+  };
+  for (const auto& p : mesh.patches) check_word("patch", p.name);
+  for (const auto& [list, kind, count] : {std::tuple{&mesh.cell_zones, "cell", mesh.num_cells}, std::tuple{&mesh.face_zones, "face", nf},
+                                          std::tuple{&mesh.point_zones, "point", mesh.points.cols()}})
+    for (const auto& z : *list) {
+      check_word(std::string(kind) + " zone", z.name);
+      for (const Index label : z.labels)
+        if (label < 0 || label >= count)
+          throw InputError("write_polymesh: " + std::string(kind) + " zone '" + z.name + "' holds " + kind + " " + std::to_string(label) +
+                           " (the mesh has " + std::to_string(count) + ")");
+      if (!z.flip.empty() && z.flip.size() != z.labels.size())
+        throw InputError("write_polymesh: face zone '" + z.name + "' has " + std::to_string(z.flip.size()) + " flips for " +
+                         std::to_string(z.labels.size()) + " faces");
+    }
 #ifndef MESHMOTION_HAVE_ZLIB
   if (options.compressed) throw InputError("write_polymesh: compressed files need zlib (meshmotion was built without it)");
 #endif
@@ -303,6 +319,34 @@ inline void write_polymesh(const std::filesystem::path& case_dir, const PolyMesh
                 ";\n    }\n";
   }
   detail::write_foam_file(dir / "boundary", boundary + ")\n" + end, options.compressed);
+  // Zones in ASCII whatever the lists' format: small beside the faces, and readable.
+  const auto zones = [&](const std::vector<PolyMesh::Zone>& list, const std::string& kind) {
+    if (list.empty()) return;
+    std::string text = header("regIOobject", (kind + "Zones").c_str(), false) + "\n" + std::to_string(list.size()) + "\n(\n";
+    const auto values = [&](const char* key, const char* type, const auto& v) {
+      text += std::string("    ") + key + " " + type + "\n";
+      detail::append_number(text, static_cast<Index>(v.size()));
+      text += "\n(\n";
+      for (const auto x : v) {
+        detail::append_number(text, static_cast<Index>(x));
+        text += '\n';
+      }
+      text += ")\n;\n";
+    };
+    for (const auto& z : list) {
+      text += z.name + "\n{\n    type " + kind + "Zone;\n";
+      values((kind + "Labels").c_str(), "List<label>", z.labels);
+      if (kind == "face") {
+        if (z.flip.empty()) values("flipMap", "List<bool>", std::vector<char>(z.labels.size(), 0));
+        else values("flipMap", "List<bool>", z.flip);
+      }
+      text += "}\n";
+    }
+    detail::write_foam_file(dir / (kind + "Zones"), text + ")\n" + end, options.compressed);
+  };
+  zones(mesh.cell_zones, "cell");
+  zones(mesh.face_zones, "face");
+  zones(mesh.point_zones, "point");
 }
 
 /// Writes a whole new case at `case_dir`, a path that does not exist or an empty folder, as

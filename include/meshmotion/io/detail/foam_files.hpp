@@ -292,22 +292,62 @@ inline void check_foam_class(FoamCursor& in, const FoamHeader& h, std::initializ
   return {};
 }
 
-/// A time folder of a case ("<case>/<number>", the case holding a constant/polyMesh): where a
-/// moved mesh's points go (<case>/<time>/polyMesh/points) and OpenFOAM's tools read them from.
+/// Whether a folder name is a time, as OpenFOAM names them ("0", "0.25", "1e-05").
+[[nodiscard]] inline bool is_foam_time_name(const std::string& name, double* value = nullptr) {
+  double t = 0;
+  const auto [end, ec] = std::from_chars(name.data(), name.data() + name.size(), t);
+  if (ec != std::errc() || end != name.data() + name.size() || name.empty()) return false;
+  if (value != nullptr) *value = t;
+  return true;
+}
+
+/// A time folder of a case ("<case>/<time>", the case holding a constant/polyMesh, or
+/// "<case>/<time>/<region>", the case holding a constant/<region>/polyMesh): where a moved
+/// mesh's points go (<case>/<time>[/<region>]/polyMesh/points) and OpenFOAM's tools read them
+/// from.
 struct FoamTimeFolder {
-  std::filesystem::path case_dir, constant;  ///< the case, and its polyMesh folder
+  std::filesystem::path case_dir, constant;  ///< the case, and its (region's) polyMesh folder
   std::string time;
-  [[nodiscard]] std::filesystem::path points() const { return case_dir / time / "polyMesh" / "points"; }
+  std::string region{};  ///< empty: the case's default region
+  [[nodiscard]] std::filesystem::path mesh_folder(const std::string& at) const {
+    return (region.empty() ? case_dir / at : case_dir / at / region) / "polyMesh";
+  }
+  [[nodiscard]] std::filesystem::path points() const { return mesh_folder(time) / "points"; }
+  /// The points OpenFOAM's tools read at this time: those of the latest time up to it that
+  /// holds them (the mesh moved then and not since), else the constant ones.
+  [[nodiscard]] std::filesystem::path current_points() const {
+    double now = 0, best = 0;
+    (void)is_foam_time_name(time, &now);
+    std::filesystem::path found = constant / "points";
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(case_dir, ec)) {
+      const std::string name = entry.path().filename().string();
+      double t = 0;
+      if (!is_foam_time_name(name, &t) || t > now || (found != constant / "points" && t <= best)) continue;
+      const std::filesystem::path file = mesh_folder(name) / "points";
+      if (std::filesystem::exists(file, ec) || std::filesystem::exists(file.string() + ".gz", ec)) {
+        found = file;
+        best = t;
+      }
+    }
+    return found;
+  }
 };
 [[nodiscard]] inline std::optional<FoamTimeFolder> foam_time_folder(const std::filesystem::path& path) {
-  const std::filesystem::path parent = path.has_filename() ? path.parent_path() : path.parent_path().parent_path();
-  const std::filesystem::path case_dir = parent.empty() ? std::filesystem::path(".") : parent;
-  std::string time = (path.has_filename() ? path : path.parent_path()).filename().string();
-  double t = 0;
-  const auto [end, ec] = std::from_chars(time.data(), time.data() + time.size(), t);
-  std::filesystem::path constant = polymesh_folder(case_dir);
-  if (ec != std::errc() || end != time.data() + time.size() || constant.empty()) return std::nullopt;
-  return FoamTimeFolder{case_dir, std::move(constant), std::move(time)};
+  const std::filesystem::path folder = path.has_filename() ? path : path.parent_path();
+  const auto case_of = [](const std::filesystem::path& p) { return p.empty() ? std::filesystem::path(".") : p; };
+  if (const std::string time = folder.filename().string(); is_foam_time_name(time)) {
+    const std::filesystem::path case_dir = case_of(folder.parent_path());
+    std::filesystem::path constant = polymesh_folder(case_dir);
+    if (constant.empty()) return std::nullopt;
+    return FoamTimeFolder{case_dir, std::move(constant), time};
+  }
+  const std::string time = folder.parent_path().filename().string(), region = folder.filename().string();
+  if (!is_foam_time_name(time) || region.empty()) return std::nullopt;
+  const std::filesystem::path case_dir = case_of(folder.parent_path().parent_path());
+  std::filesystem::path constant = polymesh_folder(case_dir / "constant" / region / "polyMesh");
+  if (constant.empty()) return std::nullopt;
+  return FoamTimeFolder{case_dir, std::move(constant), time, region};
 }
 
 }  // namespace meshmotion::detail
