@@ -96,6 +96,93 @@ void number_auxiliary_nodes(const PolyMesh& poly, Index nodes, const std::vector
     if (ids[i] < 0) ids[i] = own++;
 }
 
+// The whole case on rank 0, from every rank's processor mesh, for the methods that have no
+// distributed mover: points by global id, cells numbered rank after rank, each face between
+// two ranks once, as an internal face oriented out of the lower-numbered of its cells (as
+// OpenFOAM orients it), and a coupled face with no partner on another rank (a cyclic patch's)
+// as a boundary face the mover leaves interior (`coupled`). Collective; empty off rank 0.
+struct WholeCase {
+  PolyMesh poly;
+  std::vector<char> coupled;
+};
+WholeCase gather_case(const PolyMesh& poly, const std::vector<char>& coupled, const std::vector<std::int64_t>& ids,
+                      const std::vector<int>& owners) {
+  const MPI_Comm comm = MPI_COMM_WORLD;
+  std::int64_t num_points = 0;
+  for (const std::int64_t g : ids) num_points = std::max(num_points, g + 1);
+  MPI_Allreduce(MPI_IN_PLACE, &num_points, 1, MPI_INT64_T, MPI_MAX, comm);
+  const auto cells = static_cast<std::int64_t>(poly.num_cells);
+  std::int64_t first_cell = 0;
+  MPI_Exscan(&cells, &first_cell, 1, MPI_INT64_T, MPI_SUM, comm);
+  if (parallel::rank_of(comm) == 0) first_cell = 0;
+  // Per face: its point count, its points' global ids, its owner and neighbour cell (-1 on the
+  // boundary), whether it is coupled.
+  std::vector<std::int64_t> faces;
+  for (Index f = 0; f < poly.num_faces(); ++f) {
+    const auto v = poly.face(f);
+    faces.push_back(static_cast<std::int64_t>(v.size()));
+    for (const Index p : v) faces.push_back(ids[static_cast<std::size_t>(p)]);
+    faces.push_back(first_cell + poly.owner[static_cast<std::size_t>(f)]);
+    faces.push_back(f < poly.num_internal_faces() ? first_cell + poly.neighbour[static_cast<std::size_t>(f)] : -1);
+    faces.push_back(!coupled.empty() && coupled[static_cast<std::size_t>(f)] ? 1 : 0);
+  }
+  const Points<3> points = parallel::gather_owned(parallel::PartitionView<3>{comm, poly.points, ids, owners}, poly.points, num_points);
+  const std::vector<std::int64_t> every = parallel::gather_to(comm, 0, faces);
+  std::int64_t total_cells = first_cell + cells;
+  MPI_Bcast(&total_cells, 1, MPI_INT64_T, parallel::size_of(comm) - 1, comm);
+  WholeCase out;
+  if (parallel::rank_of(comm) != 0) return out;
+  struct Face {
+    std::vector<Index> points;
+    Index owner, neighbour;
+  };
+  std::vector<Face> internal, boundary;
+  std::vector<char> boundary_coupled;
+  std::map<std::vector<Index>, Face> waiting;  // coupled faces by their sorted points, until their partner comes
+  for (std::size_t at = 0; at < every.size();) {
+    const auto n = static_cast<std::size_t>(every[at]);
+    Face face{std::vector<Index>(every.begin() + static_cast<std::ptrdiff_t>(at + 1), every.begin() + static_cast<std::ptrdiff_t>(at + 1 + n)),
+              static_cast<Index>(every[at + 1 + n]), static_cast<Index>(every[at + 2 + n])};
+    const bool is_coupled = every[at + 3 + n] != 0;
+    at += n + 4;
+    if (face.neighbour >= 0) {
+      internal.push_back(std::move(face));
+    } else if (!is_coupled) {
+      boundary.push_back(std::move(face));
+      boundary_coupled.push_back(0);
+    } else {
+      std::vector<Index> key = face.points;
+      std::sort(key.begin(), key.end());
+      const auto partner = waiting.find(key);
+      if (partner == waiting.end()) {
+        waiting.emplace(std::move(key), std::move(face));
+        continue;
+      }
+      Face& first = partner->second;
+      Face& owner_side = first.owner < face.owner ? first : face;
+      internal.push_back({std::move(owner_side.points), std::min(first.owner, face.owner), std::max(first.owner, face.owner)});
+      waiting.erase(partner);
+    }
+  }
+  for (auto& [key, face] : waiting) {
+    boundary.push_back(std::move(face));
+    boundary_coupled.push_back(1);
+  }
+  out.poly.points = points;
+  out.poly.num_cells = static_cast<Index>(total_cells);
+  out.coupled.assign(internal.size(), 0);
+  out.coupled.insert(out.coupled.end(), boundary_coupled.begin(), boundary_coupled.end());
+  for (const auto* list : {&internal, &boundary})
+    for (const Face& face : *list) {
+      out.poly.face_nodes.insert(out.poly.face_nodes.end(), face.points.begin(), face.points.end());
+      out.poly.face_offsets.push_back(static_cast<Index>(out.poly.face_nodes.size()));
+      out.poly.owner.push_back(face.owner);
+      if (face.neighbour >= 0) out.poly.neighbour.push_back(face.neighbour);
+    }
+  out.poly.patches = {{"boundary", "patch", static_cast<Index>(internal.size()), static_cast<Index>(boundary.size())}};
+  return out;
+}
+
 }  // namespace
 #endif
 
@@ -172,6 +259,12 @@ struct Bridge::Impl {
   Points<3> points;  // the distributed RBF's view of them must outlive its setup
   std::vector<std::int64_t> global_ids;  // with the auxiliary nodes' where the cells are moved
   std::vector<int> owners;
+  // A method without a distributed mover: rank 0 moves the whole case (gather_case()) with the
+  // serial mover; per entry of its boundary, the gathered entry giving its displacement; per
+  // rank, its points' global ids, in its order, to send their displacements back.
+  bool gathered = false;
+  std::vector<std::size_t> picks;
+  std::vector<std::vector<std::int64_t>> rank_points;
 #endif
   Index points_count = 0, entries = 0;
   bool growing_radius = false;
@@ -183,7 +276,7 @@ struct Bridge::Impl {
   bool set_up(const Points<3>& d) {
     boundary.displacements.leftCols(d.cols()) = d;
 #ifdef MESHMOTION_FOAM_PARALLEL
-    if (!global_ids.empty() && needs_cells(config.method)) {
+    if (!global_ids.empty() && needs_cells(config.method) && !gathered) {
       parallel::DistributedElasticityOptions options = cells;
       options.elasticity = std::get<ElasticityOptions>(config.options);
       distributed_cells.emplace(options);
@@ -191,7 +284,7 @@ struct Bridge::Impl {
       ++setups;
       return true;
     }
-    if (!global_ids.empty()) {
+    if (!global_ids.empty() && !gathered) {
       const double before = radius;
       distributed.emplace(std::get<RbfOptions>(config.options), solve);
       distributed->setup(parallel::PartitionView<3>{MPI_COMM_WORLD, points, global_ids, owners}, boundary);
@@ -223,6 +316,83 @@ struct Bridge::Impl {
 #endif
     return out;
   }
+
+  // The given displacements: the boundary entries' `d`, then the face centres' entries.
+  void prescribe(const Eigen::Ref<const Points<3>>& d) {
+    given.leftCols(d.cols()) = d;
+    for (std::size_t k = 0; k < centre_entries.size(); ++k) {
+      const std::vector<Index>& face = centre_entries[k];
+      Vec<3> mean = Vec<3>::Zero();
+      for (const Index e : face) mean += d.col(e);
+      given.col(d.cols() + static_cast<Index>(k)) = face.empty() ? mean : Vec<3>(mean / static_cast<double>(face.size()));
+    }
+  }
+
+#ifdef MESHMOTION_FOAM_PARALLEL
+  // Sets the gathered case up (see `gathered`): rank 0 holds the whole case and its boundary,
+  // each point on several ranks' boundaries once, as the lowest rank gives it. Collective.
+  void gather(const PolyMesh& poly, const std::vector<char>& coupled, const BridgeInput& input) {
+    const MPI_Comm comm = MPI_COMM_WORLD;
+    const bool root = parallel::rank_of(comm) == 0;
+    const WholeCase whole = gather_case(poly, coupled, global_ids, owners);
+    std::vector<std::int64_t> entry_ids;
+    for (const Index v : boundary.nodes) entry_ids.push_back(global_ids[static_cast<std::size_t>(v)]);
+    const std::vector<std::int64_t> all_ids = parallel::gather_to(comm, 0, entry_ids);
+    const std::vector<int> all_roles = parallel::gather_to(comm, 0, input.roles);
+    const std::vector<double> all_directions = parallel::gather_to(comm, 0, input.directions);
+    const std::vector<std::int64_t> all_points = parallel::gather_to(comm, 0, global_ids);
+    const std::vector<std::int64_t> counts = parallel::gather_to(comm, 0, std::vector<std::int64_t>{points_count});
+    parallel::collective(comm, [&] {
+      if (!root) return;
+      std::map<std::int64_t, std::size_t> first;  // emplace keeps the lowest rank's
+      for (std::size_t f = 0; f < all_ids.size(); ++f) first.emplace(all_ids[f], f);
+      const auto nb = static_cast<Index>(first.size());
+      ResolvedBoundary<3>& b = boundary;
+      b = ResolvedBoundary<3>{};
+      b.displacements = b.normals = b.directions = Points<3>::Zero(3, nb);
+      for (const auto& [id, f] : first) {
+        const auto k = static_cast<Index>(b.nodes.size());
+        const auto role = static_cast<PointRole>(all_roles[f]);
+        const Vec<3> along(all_directions[3 * f], all_directions[3 * f + 1], all_directions[3 * f + 2]);
+        b.nodes.push_back(static_cast<Index>(id));
+        b.kinds.push_back(role == PointRole::prescribed ? BoundaryKind::prescribed : BoundaryKind::sliding);
+        if (role == PointRole::sliding_plane) b.normals.col(k) = along;
+        if (role == PointRole::sliding_line) b.directions.col(k) = along;
+        picks.push_back(f);
+      }
+      mesh = to_mesh(whole.poly);
+      centre_entries = add_face_centres(whole.poly, mesh, whole.coupled, b);
+      std::size_t at = 0;
+      for (const std::int64_t count : counts) {
+        rank_points.emplace_back(all_points.begin() + static_cast<std::ptrdiff_t>(at), all_points.begin() + static_cast<std::ptrdiff_t>(at + static_cast<std::size_t>(count)));
+        at += static_cast<std::size_t>(count);
+      }
+      set_up(Points<3>::Zero(3, nb));
+      given.setZero(3, b.size());
+      moved.resize(3, mesh.num_nodes());
+    });
+    setups = 1;
+  }
+
+  // A move of the gathered case: the entries' displacements to rank 0, the serial mover's
+  // displacements back to each rank's points. Collective.
+  void move_gathered(const std::vector<double>& boundary_displacements, std::vector<double>& out) {
+    const MPI_Comm comm = MPI_COMM_WORLD;
+    const std::vector<double> all = parallel::gather_to(comm, 0, boundary_displacements);
+    std::vector<std::vector<double>> send(static_cast<std::size_t>(parallel::size_of(comm)));
+    parallel::collective(comm, [&] {
+      if (parallel::rank_of(comm) != 0) return;
+      Points<3> d(3, static_cast<Index>(picks.size()));
+      for (std::size_t k = 0; k < picks.size(); ++k) d.col(static_cast<Index>(k)) = Eigen::Map<const Vec<3>>(all.data() + 3 * picks[k]);
+      prescribe(d);
+      move_cells();
+      for (std::size_t r = 0; r < rank_points.size(); ++r)
+        for (const std::int64_t g : rank_points[r])
+          send[r].insert(send[r].end(), moved.col(static_cast<Index>(g)).data(), moved.col(static_cast<Index>(g)).data() + 3);
+    });
+    out = std::move(parallel::exchange(comm, send)[0]);
+  }
+#endif
 
   // The cells' mover: the serial one, or on a decomposed case the distributed elasticity.
   void move_cells() {
@@ -266,9 +436,9 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
     const KeyValues& rest = given;
 #endif
     impl->config = mover_config<3>(input.method, rest);
-    if (!input.global_ids.empty() && needs_cells(input.method) && impl->config.method != "le" && impl->config.method != "sle")
-      throw InputError("method '" + input.method + "' has no mover for a decomposed case (expected rbf, le or sle; "
-                       "or run the case serially)");
+#ifdef MESHMOTION_FOAM_PARALLEL
+    impl->gathered = !input.global_ids.empty() && needs_cells(input.method) && impl->config.method != "le" && impl->config.method != "sle";
+#endif
     if (const auto* rbf = std::get_if<RbfOptions>(&impl->config.options))
       impl->growing_radius = rbf->support_radius == 0.0 && rbf->support_radii.empty();
 #ifdef MESHMOTION_FOAM_PARALLEL
@@ -297,6 +467,13 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
       poly.num_cells = input.cells;
       const Index internal = poly.num_internal_faces();
       poly.patches = {{"boundary", "patch", internal, poly.num_faces() - internal}};
+#ifdef MESHMOTION_FOAM_PARALLEL
+      if (impl->gathered) {
+        impl->gather(poly, coupled, input);
+        impl_ = impl.release();
+        return;
+      }
+#endif
       impl->mesh = to_mesh(poly);
 #ifdef MESHMOTION_FOAM_PARALLEL
       if (!input.global_ids.empty()) {
@@ -340,14 +517,9 @@ void Bridge::move(const std::vector<double>& boundary_displacements, std::vector
       out.assign(m.moved.data(), m.moved.data() + m.moved.size());
       return;
     }
+    if (m.gathered) return m.move_gathered(boundary_displacements, out);
 #endif
-    m.given.leftCols(m.entries) = d;
-    for (std::size_t k = 0; k < m.centre_entries.size(); ++k) {
-      const std::vector<Index>& face = m.centre_entries[k];
-      Vec<3> mean = Vec<3>::Zero();
-      for (const Index e : face) mean += d.col(e);
-      m.given.col(m.entries + static_cast<Index>(k)) = face.empty() ? mean : Vec<3>(mean / static_cast<double>(face.size()));
-    }
+    m.prescribe(d);
     m.move_cells();
     out.assign(m.moved.data(), m.moved.data() + 3 * m.points_count);
   } catch (const std::exception& e) {

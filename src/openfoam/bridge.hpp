@@ -35,7 +35,8 @@ struct BridgeInput {
 };
 
 /// Whether `method` moves the interior through the mesh's cells (every method but rbf). On a
-/// decomposed case le and sle do (PETSc's distributed elasticity), the others are refused.
+/// decomposed case le and sle do so through PETSc's distributed elasticity; the others gather
+/// the case on rank 0, which moves it with the serial mover and sends each rank its points.
 bool needs_cells(const std::string& method);
 
 class Bridge {
