@@ -308,7 +308,8 @@ class USMesh:
 
 def _surfaces(mesh, options):
     """(design groups, sliding groups) of the mesh for IDWarp's options."""
-    groups = list(mesh.groups)
+    # Surfaces are facet groups: an OpenFOAM case's zones are groups of nodes, not surfaces.
+    groups = [g for g, (dim, _) in mesh.group_tags.items() if dim == mesh.dim - 1]
     symmetry = list(options.get("symmetrySurfaces") or [])
     for point, normal in options.get("symmetryPlanes") or []:
         point, normal = _np.asarray(point, dtype=float), _np.asarray(normal, dtype=float)

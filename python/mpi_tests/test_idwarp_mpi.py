@@ -4,6 +4,7 @@ the serial Warp's grid, a gradient that central differences confirm, and IDWarp'
 
 import os
 import pathlib
+import shutil
 import warnings
 
 import numpy as np
@@ -180,3 +181,23 @@ def test_a_structured_multiblock_cgns_grid():
     if comm.rank == 0:
         assert cgns_zone_types(folder / "warped.cgns") == ["Structured", "Structured"]
         np.testing.assert_allclose(mm.read_mesh(str(folder / "warped.cgns")).points, expected, rtol=0, atol=1e-12)
+
+
+def test_an_openfoam_cases_zones_are_not_design_surfaces():
+    """Without specifiedSurfaces the design surfaces are the case's patches not named like a far
+    field: a cell zone, a group of nodes, is none of them."""
+    folder = pathlib.Path(os.environ.get("MESHMOTION_TEST_TMP_DIR", "/tmp")) / f"idwarp_foam_{comm.size}"
+    if comm.rank == 0:
+        shutil.rmtree(folder, ignore_errors=True)
+        mm.write_mesh(str(folder), box())  # a new OpenFOAM case
+        (folder / "constant" / "polyMesh" / "cellZones").write_text(
+            "FoamFile { version 2.0; format ascii; class regIOobject; object cellZones; }\n"
+            "1\n(core { type cellZone; cellLabels List<label> 3(0 1 2); })\n")
+    comm.Barrier()
+    assert mm.read_mesh(str(folder)).group_tags["core"][0] == 0
+    base = {"gridFile": str(folder), "fileType": "OpenFOAM", "symmetrySurfaces": ["symmetry"],
+            "meshmotion": {"support_radius": 0.7}}
+    by_default = USMesh(options=base, comm=comm).getSurfaceCoordinates()
+    named = USMesh(options=dict(base, specifiedSurfaces=["wall"]), comm=comm).getSurfaceCoordinates()
+    assert by_default.shape == named.shape
+    assert np.array_equal(by_default, named)
