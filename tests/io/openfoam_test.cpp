@@ -746,3 +746,61 @@ TEST_CASE("OpenFOAM: a region's mesh and a time's points are read and written as
   CHECK_FALSE(is_openfoam_target(dir / "0.5/polyMesh"));
   CHECK_FALSE(is_openfoam_target(dir / "0.5/liquid"));
 }
+
+TEST_CASE("OpenFOAM: a decomposed case's processor folders take the moved points through their addressing", "[io][openfoam]") {
+  const fs::path dir = test::scratch_path("foam_decomposed");
+  const PolyMesh c = hanging_node_case();
+  write_case(dir, c);
+  // Each processor's points and pointProcAddressing (what decomposePar writes; the rest of a
+  // processor's mesh is not read here): points 0 to 9, and 6 to 15 (6 to 9 on both).
+  const auto addressing_of = [](Index first, Index last) {
+    std::vector<Index> a;
+    for (Index i = first; i <= last; ++i) a.push_back(i);
+    return a;
+  };
+  const std::vector<std::vector<Index>> addressing{addressing_of(0, 9), addressing_of(6, 15)};
+  const auto processor_file = [&](int rank, const std::string& object, const std::string& cls, const std::string& body) {
+    const fs::path poly = dir / ("processor" + std::to_string(rank)) / "constant/polyMesh";
+    fs::create_directories(poly);
+    std::ofstream(poly / object) << "FoamFile { version 2.0; format ascii; class " << cls << "; location \"constant/polyMesh\"; object "
+                                 << object << "; }\n" << body;
+  };
+  for (int rank = 0; rank < 2; ++rank) {
+    std::ostringstream points, labels;
+    points << addressing[rank].size() << "\n(\n";
+    labels << addressing[rank].size() << "\n(\n";
+    for (const Index a : addressing[rank]) {
+      points << "(" << c.points(0, a) << " " << c.points(1, a) << " " << c.points(2, a) << ")\n";
+      labels << a << "\n";
+    }
+    processor_file(rank, "points", "vectorField", points.str() + ")\n");
+    processor_file(rank, "pointProcAddressing", "labelList", labels.str() + ")\n");
+  }
+  Mesh<3> moved = read_openfoam(dir);
+  moved.points.row(0).array() += 0.25;
+  const auto processors_follow = [&](const std::string& folder) {
+    for (int rank = 0; rank < 2; ++rank) {
+      const fs::path file = dir / ("processor" + std::to_string(rank)) / folder / "points";
+      const Points<3> local = detail::read_foam_points(file);
+      REQUIRE(local.cols() == static_cast<Index>(addressing[rank].size()));
+      for (std::size_t i = 0; i < addressing[rank].size(); ++i) CHECK(local.col(static_cast<Index>(i)) == moved.points.col(addressing[rank][i]));
+      CHECK(detail::read_foam_file(file).find("\"" + folder + "\"") != std::string::npos);
+    }
+  };
+  write_mesh(dir / "0.5", moved);
+  processors_follow("0.5/polyMesh");
+  write_mesh(dir, moved);
+  processors_follow("constant/polyMesh");
+  // An addressing that names a point the case lacks: refused, nothing written.
+  processor_file(1, "pointProcAddressing", "labelList", "1\n(99)\n");
+  CHECK_THAT(test::message_of<InputError>([&] { write_mesh(dir / "0.75", moved); }),
+             Catch::Contains("pointProcAddressing: entry 0 is point 99 (the case has 16)"));
+  CHECK_FALSE(fs::exists(dir / "0.75/polyMesh/points"));
+  // One processor folder on its own is no place for moved points; a decomposed case without
+  // its whole mesh is no input.
+  const fs::path alone = test::scratch_path("foam_decomposed_alone") / "processor3";
+  write_case(alone, c);
+  CHECK_THAT(test::message_of<InputError>([&] { write_mesh(alone / "0.5", moved); }), Catch::Contains("one processor folder"));
+  fs::remove_all(dir / "constant");
+  CHECK_THAT(test::message_of<IoError>([&] { (void)read_polymesh(dir); }), Catch::Contains("a decomposed case without its whole mesh"));
+}

@@ -280,6 +280,10 @@ void check_closed_cells(const PolyMesh& mesh, Fail&& fail) {
     dir = time->constant;
     points = time->current_points();
   }
+  if (dir.empty() && std::filesystem::is_directory(path / "processor0", ec))
+    throw IoError(path.string() + ": a decomposed case without its whole mesh in constant/polyMesh (reconstructParMesh "
+                                  "-constant makes it; or move the case inside OpenFOAM with the meshmotion plugin and -parallel): "
+                                  "one processor folder moved alone would leave its interface points apart from its neighbours'");
   if (dir.empty())
     throw IoError(path.string() + ": not an OpenFOAM case, polyMesh folder or time folder of a case (no constant/polyMesh/faces "
                                   "nor faces in it)");

@@ -15,6 +15,7 @@
 #include "meshmotion/io/detail/foam_files.hpp"
 #include "meshmotion/io/detail/number_format.hpp"
 #include "meshmotion/io/openfoam_polymesh.hpp"
+#include "meshmotion/io/openfoam_reader.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -23,6 +24,8 @@
 #include <string>
 #include <system_error>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 namespace meshmotion {
 namespace detail {
@@ -155,10 +158,68 @@ struct FoamPointsTarget {
   return std::filesystem::is_directory(path, ec) && std::filesystem::is_empty(path, ec);
 }
 
+namespace detail {
+
+/// A points file about to replace `file`: `reference`'s header (its format, its location set
+/// to `location` when `file` is elsewhere) and compression, with `points`. InputError (naming
+/// `target`) when the reference holds another number of points.
+struct PreparedPoints {
+  std::filesystem::path file;
+  std::string text;
+  bool compressed = false;
+};
+[[nodiscard]] inline PreparedPoints prepare_foam_points(const std::filesystem::path& file, const std::filesystem::path& reference,
+                                                        const std::string& location, const Eigen::Ref<const Points<3>>& points,
+                                                        int precision, const std::string& target) {
+  const std::string reference_text = read_foam_file(reference);
+  FoamCursor in(reference_text, reference);
+  const FoamHeader h = read_foam_header(in);
+  const auto expected = in.integer<Index>("point count", 0, Index{1} << 40);
+  if (points.cols() != expected)
+    throw InputError(target + ": the mesh has " + std::to_string(points.cols()) + " points, the case " + std::to_string(expected) +
+                     " (" + reference.string() + "): not this case's mesh");
+  std::string text(reference_text.substr(0, h.data_offset));
+  if (file != reference) {
+    const std::size_t at = text.find("location");
+    if (at != std::string::npos) text.replace(at, text.find(';', at) - at, "location    \"" + location + "\"");
+  }
+  append_foam_points(text, points, h, precision);
+  text += "\n\n// ************************************************************************* //\n";
+  return {file, std::move(text), foam_file_is_compressed(reference)};
+}
+
+/// The processor folders of a decomposed case (processor0, processor1, ...), in rank order;
+/// empty when it is not decomposed. InputError for a collated decomposition (processorsN).
+[[nodiscard]] inline std::vector<std::filesystem::path> foam_processor_folders(const std::filesystem::path& case_dir) {
+  std::vector<std::pair<long, std::filesystem::path>> found;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(case_dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("processors", 0) == 0 && entry.is_directory(ec))
+      throw InputError(entry.path().string() + ": a collated decomposition, which meshmotion does not write into "
+                       "(reconstructParMesh first, or decompose uncollated)");
+    if (name.rfind("processor", 0) != 0 || name.size() == 9 || !entry.is_directory(ec)) continue;
+    long rank = 0;
+    const auto [end, bad] = std::from_chars(name.data() + 9, name.data() + name.size(), rank);
+    if (bad == std::errc() && end == name.data() + name.size()) found.emplace_back(rank, entry.path());
+  }
+  std::sort(found.begin(), found.end());
+  std::vector<std::filesystem::path> out;
+  for (auto& [rank, path] : found) out.push_back(std::move(path));
+  return out;
+}
+
+}  // namespace detail
+
 /// Replaces the points of the OpenFOAM case at `target` by the mesh's nodes (those before the
-/// auxiliary ones), atomically, with the case's header, format and compression. Throws
-/// InputError when `target` is not an OpenFOAM folder, when the mesh has high-order elements or
-/// a node count other than the case's, IoError when writing fails.
+/// auxiliary ones), atomically, with the case's header, format and compression. In a
+/// decomposed case (processor0, processor1, ... beside the whole mesh), each processor's points
+/// are replaced in its own folder as well, through its `pointProcAddressing`, so that a
+/// `-parallel` run reads the moved mesh too; every file is checked before any is written.
+/// Throws InputError when `target` is not an OpenFOAM folder, when it is a processor folder
+/// (one rank's part moved alone would leave its interface points apart from its
+/// neighbours'), when the mesh has high-order elements or a node count other than the case's,
+/// or a processor's addressing does not fit; IoError when writing fails.
 inline void write_polymesh_points(const std::filesystem::path& target, const Mesh<3>& mesh) {
   validate(mesh);
   const detail::FoamPointsTarget where = detail::foam_points_target(target);
@@ -167,32 +228,44 @@ inline void write_polymesh_points(const std::filesystem::path& target, const Mes
   for (const auto* list : {&mesh.cells, &mesh.facets})
     for (const auto& b : *list)
       if (order(b.type) > 1) throw InputError(target.string() + ": OpenFOAM meshes are linear (the mesh has " + std::string(name(b.type)) + ")");
+  const std::string case_name = where.case_dir.filename().string();
+  if (case_name.rfind("processor", 0) == 0 && case_name.size() > 9)
+    throw InputError(target.string() + ": one processor folder of a decomposed case: moved alone, its interface points would "
+                     "leave its neighbours' (move the whole case: its processor folders follow)");
   const Index n = mesh.num_nodes() - mesh.num_auxiliary_nodes;
-  const bool compressed = detail::foam_file_is_compressed(where.reference);
-  const std::string reference_text = detail::read_foam_file(where.reference);
-  detail::FoamCursor in(reference_text, where.reference);
-  const detail::FoamHeader h = detail::read_foam_header(in);
-  const auto expected = in.integer<Index>("point count", 0, Index{1} << 40);
-  if (n != expected)
-    throw InputError(target.string() + ": the mesh has " + std::to_string(n) + " points, the case " + std::to_string(expected) +
-                     " (" + where.reference.string() + "): not this case's mesh");
-  std::string header(reference_text.substr(0, h.data_offset));
-  if (where.points != where.reference) {
-    // A time folder: the header's location names it.
-    const std::size_t at = header.find("location");
-    if (at != std::string::npos) {
-      const std::size_t end = header.find(';', at);
-      const std::string folder = where.points.parent_path().lexically_relative(where.case_dir).generic_string();
-      header.replace(at, end - at, "location    \"" + folder + "\"");
+  const int precision = detail::foam_write_precision(where.case_dir);
+  const auto folder_of = [](const std::filesystem::path& file, const std::filesystem::path& base) {
+    return file.parent_path().lexically_relative(base).generic_string();
+  };
+  std::vector<detail::PreparedPoints> files{detail::prepare_foam_points(
+      where.points, where.reference, folder_of(where.points, where.case_dir), mesh.points.leftCols(n), precision, target.string())};
+  if (!where.case_dir.empty()) {
+    const std::filesystem::path constant = where.reference.parent_path().lexically_relative(where.case_dir);
+    const std::filesystem::path moved = where.points.lexically_relative(where.case_dir);
+    for (const std::filesystem::path& processor : detail::foam_processor_folders(where.case_dir)) {
+      const std::filesystem::path addressing_file = processor / constant / "pointProcAddressing";
+      std::error_code ec;
+      if (!std::filesystem::exists(addressing_file, ec) && !std::filesystem::exists(addressing_file.string() + ".gz", ec))
+        throw InputError(processor.string() + ": a processor folder without " + (constant / "pointProcAddressing").string() +
+                         " (decomposePar writes it): its points cannot follow the case's");
+      const std::vector<Index> addressing = detail::read_foam_labels(addressing_file, "pointProcAddressing", 0);
+      Points<3> local(3, static_cast<Index>(addressing.size()));
+      for (std::size_t i = 0; i < addressing.size(); ++i) {
+        if (addressing[i] < 0 || addressing[i] >= n)
+          throw InputError(addressing_file.string() + ": entry " + std::to_string(i) + " is point " + std::to_string(addressing[i]) +
+                           " (the case has " + std::to_string(n) + ")");
+        local.col(static_cast<Index>(i)) = mesh.points.col(addressing[i]);
+      }
+      files.push_back(detail::prepare_foam_points(processor / moved, processor / constant / "points", folder_of(processor / moved, processor),
+                                                  local, precision, processor.string()));
     }
   }
-  std::string out = header;
-  detail::append_foam_points(out, mesh.points.leftCols(n), h, detail::foam_write_precision(where.case_dir));
-  out += "\n\n// ************************************************************************* //\n";
-  std::error_code ec;
-  std::filesystem::create_directories(where.points.parent_path(), ec);
-  if (ec) throw IoError(where.points.parent_path().string() + ": cannot create the folder (" + ec.message() + ")");
-  detail::write_foam_file(where.points, out, compressed);
+  for (const detail::PreparedPoints& f : files) {
+    std::error_code ec;
+    std::filesystem::create_directories(f.file.parent_path(), ec);
+    if (ec) throw IoError(f.file.parent_path().string() + ": cannot create the folder (" + ec.message() + ")");
+    detail::write_foam_file(f.file, f.text, f.compressed);
+  }
 }
 
 /// Options of write_polymesh().
