@@ -221,6 +221,13 @@ inline void check_output(const std::filesystem::path& input, const std::filesyst
   std::error_code ec;
   if (!overwrite && !input.empty() && std::filesystem::exists(output, ec) && std::filesystem::equivalent(input, output, ec))
     throw InputError("output " + output.string() + " is the input file (give --overwrite to replace it)");
+  // An OpenFOAM output named otherwise (the case's polyMesh folder for the case) that would
+  // replace the points the input was read from.
+  if (!overwrite && !input.empty() && std::filesystem::is_directory(input, ec) && is_openfoam_target(output)) {
+    const std::filesystem::path written = detail::foam_points_target(output).points, read = detail::foam_points_target(input).points;
+    if (!read.empty() && std::filesystem::weakly_canonical(written, ec) == std::filesystem::weakly_canonical(read, ec))
+      throw InputError("output " + output.string() + " replaces the input's points (" + read.string() + "; give --overwrite to replace them)");
+  }
 }
 
 /// A consistently reversed mesh (every cell negative: the file's convention) is mirrored and

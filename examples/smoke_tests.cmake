@@ -395,6 +395,8 @@ smoke_test(NAME move_mesh.openfoam_pattern_naming_nothing.json REQUIRES examples
            VALUES kind=input
            COMMAND move_mesh "${smoke_dir}/foam_case" -o "${smoke_dir}/foam_case/0.9" --group top --translate 0.05,0,0
                    --fixed "(inlet|outlet)" --json)
+smoke_test(NAME move_mesh.openfoam_polymesh_folder_of_input_needs_overwrite.json REQUIRES examples_foam_case EXPECT_RC 1 KEYS error
+           COMMAND move_mesh "${smoke_dir}/foam_case" -o "${smoke_dir}/foam_case/constant/polyMesh" --group top --translate 0.05,0,0 --json)
 smoke_test(NAME move_mesh.openfoam_in_place_needs_overwrite.json REQUIRES examples_foam_case EXPECT_RC 1 KEYS error
            COMMAND move_mesh "${smoke_dir}/foam_case" -o "${smoke_dir}/foam_case" --group top --translate 0.05,0,0
                    --fixed bottom --json)
@@ -422,6 +424,12 @@ smoke_test(NAME move_mesh.openfoam_polyhedra_judged_on_cells.json KEYS output,ch
 smoke_test(NAME mesh_info.openfoam_polyhedra.json KEYS openfoam/patches
            VALUES openfoam/cells=3,openfoam/cell_shapes/hexahedra=2,openfoam/cell_shapes/polyhedra=1,mesh/cells/tet4=78,openfoam/zones/0/name=hexes,openfoam/zones/0/kind=cellZone,openfoam/zones/0/size=2
            COMMAND mesh_info "${smoke_dir}/foam_poly" --json)
+# Displacements of a polyhedral case's wall by OpenFOAM's point labels: the centre of its face
+# (the library's node) follows.
+file(WRITE "${smoke_dir}/foam_poly_wall.txt" "0 0.01 0 0\n5 0.01 0 0\n8 0.01 0 0\n13 0.01 0 0\n")
+smoke_test(NAME move_mesh.openfoam_polyhedra_displacements_by_label.json KEYS output VALUES after/invalid=0
+           COMMAND move_mesh "${smoke_dir}/foam_poly" -o "${smoke_dir}/foam_poly/0.2" --group wall
+                   --displacements "${smoke_dir}/foam_poly_wall.txt" --fixed outlet --json)
 # A cell zone moved as a body, written as a new case: the case's own cells, patches and zone.
 file(REMOVE_RECURSE "${smoke_dir}/foam_poly_moved")
 smoke_test(NAME move_mesh.openfoam_zone_to_new_case.json SETUP examples_foam_poly_moved KEYS output

@@ -804,3 +804,31 @@ TEST_CASE("OpenFOAM: a decomposed case's processor folders take the moved points
   fs::remove_all(dir / "constant");
   CHECK_THAT(test::message_of<IoError>([&] { (void)read_polymesh(dir); }), Catch::Contains("a decomposed case without its whole mesh"));
 }
+
+TEST_CASE("OpenFOAM: a moved case goes into another case only where that case holds the same mesh", "[io][openfoam]") {
+  const fs::path source = test::scratch_path("foam_source"), other = test::scratch_path("foam_other");
+  const PolyMesh c = hanging_node_case();
+  write_case(source, c);
+  Mesh<3> moved = read_openfoam(source);
+  moved.points.row(0).array() += 0.125;
+  // As many points, another mesh: a face listed from another vertex, or a patch renamed.
+  PolyMesh rotated = c;
+  std::rotate(rotated.face_nodes.begin() + rotated.face_offsets[3], rotated.face_nodes.begin() + rotated.face_offsets[3] + 1,
+              rotated.face_nodes.begin() + rotated.face_offsets[4]);
+  PolyMesh renamed = c;
+  renamed.patches[1].name = "exit";
+  for (const auto& [mesh, says] : {std::pair{&rotated, "face 3 differs"}, std::pair{&renamed, "patch 1 is 'exit' there, 'outlet' here"}}) {
+    write_case(other, *mesh);
+    CHECK_THAT(test::message_of<InputError>([&] { write_moved_case(other, source, moved); }),
+               Catch::Contains("holds another mesh") && Catch::Contains(says));
+    CHECK_THAT(test::message_of<InputError>([&] { write_moved_case(other / "0.5", source, moved); }), Catch::Contains(says));
+    CHECK(read_polymesh(other).points == c.points);
+    CHECK_FALSE(fs::exists(other / "0.5/polyMesh/points"));
+  }
+  // The same mesh in another case, and the source's own time folder: written.
+  write_case(other, c);
+  write_moved_case(other / "0.5", source, moved);
+  CHECK(read_polymesh(other / "0.5").points == moved.points.leftCols(16));
+  write_moved_case(source / "0.5", source, moved);
+  CHECK(read_polymesh(source / "0.5").points == moved.points.leftCols(16));
+}

@@ -3,6 +3,7 @@
 
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/core/mesh_like.hpp"
+#include "meshmotion/io/openfoam_polymesh.hpp"
 #include "meshmotion/movers/mover_options.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/rbf.hpp"
@@ -236,3 +237,37 @@ TEST_CASE("a name of several groups, an OpenFOAM patch group or a pattern, gives
              Catch::Contains("group 'top' is given twice"));
 }
 
+
+TEST_CASE("displacements by node: a polyhedral mesh's auxiliary centres take their face's or cell's mean", "[movers][boundary]") {
+  // A box's cells cut into tetrahedra around the centres of their faces and cells, as a
+  // polyhedral OpenFOAM case is: the user gives the displacements of the box's own points.
+  const Mesh<3> mesh = to_mesh(to_polymesh(box_mesh({.nx = 3, .ny = 2, .nz = 2})), true);
+  REQUIRE(mesh.num_auxiliary_nodes > 0);
+  const Index first_auxiliary = mesh.num_nodes() - mesh.num_auxiliary_nodes;
+  const Rotation3D turn{Vec<3>(0.5, 0.5, 0.5), Vec<3>(0.3, -0.2, 1.0), 0.2};
+  const auto motion_at = [&](const Vec<3>& x) -> Vec<3> { return turn.position(x) - x; };
+  const auto given_for = [&](const std::vector<Index>& group) {
+    std::pair<std::vector<Index>, Points<3>> out;
+    for (const Index v : group)
+      if (v < first_auxiliary) out.first.push_back(v);
+    out.second.resize(3, static_cast<Index>(out.first.size()));
+    for (std::size_t k = 0; k < out.first.size(); ++k)
+      out.second.col(static_cast<Index>(k)) = motion_at(mesh.points.col(out.first[k]));
+    return out;
+  };
+  const std::vector<Index> bottom = mesh.group_nodes("bottom");
+  auto [nodes, d] = given_for(bottom);
+  REQUIRE(nodes.size() < bottom.size());  // the bottom's face centres are left out
+  BoundarySpec<3> spec;
+  spec.moving("bottom", nodes, d);
+  const ResolvedBoundary<3> r = spec.resolve(mesh);
+  // Affine: the centres' mean is the motion at the centre.
+  for (const Index v : bottom)
+    CHECK((r.displacements.col(r.column(v)) - motion_at(mesh.points.col(v))).norm() < 1e-14);
+  // A centre whose face has a point without a displacement stays missing.
+  nodes.erase(nodes.begin());
+  d = Points<3>(d.rightCols(d.cols() - 1));
+  BoundarySpec<3> short_one;
+  short_one.moving("bottom", nodes, d);
+  CHECK_THAT(input_error_of([&] { (void)short_one.resolve(mesh); }), Catch::Contains("has no displacement"));
+}

@@ -34,7 +34,9 @@
 #include "meshmotion/io/openfoam_reader.hpp"
 #include "meshmotion/io/openfoam_writer.hpp"
 
+#include <algorithm>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 namespace meshmotion {
@@ -44,10 +46,42 @@ namespace meshmotion {
 /// a new or empty folder, a whole case holding `source`'s own polyMesh (its cells, not the
 /// tetrahedra a polyhedral case is cut into; its patches with their types and groups; its
 /// zones) with the moved points. Throws as those functions do, and InputError when `moved` does
-/// not have `source`'s point count.
+/// not have `source`'s point count, or when `target` is another case whose faces, cells or
+/// patches are not `source`'s (nothing is written then).
 inline void write_moved_case(const std::filesystem::path& target, const std::filesystem::path& source, const Mesh<3>& moved) {
-  if (!is_new_openfoam_case(target)) return write_polymesh_points(target, moved);
   PolyMesh poly = read_polymesh(source);
+  if (!is_new_openfoam_case(target)) {
+    // Another case of as many points must hold this mesh: its points would make no sense
+    // on other faces (a moved mesh written over its neighbour's case).
+    const detail::FoamPointsTarget where = detail::foam_points_target(target);
+    std::error_code ec;
+    std::filesystem::path source_folder = detail::polymesh_folder(source);
+    if (const auto time = source_folder.empty() ? detail::foam_time_folder(source) : std::nullopt) source_folder = time->constant;
+    if (!where.reference.empty() && !std::filesystem::equivalent(where.reference.parent_path(), source_folder, ec)) {
+      const PolyMesh other = read_polymesh(where.reference.parent_path());
+      const auto differs = [&]() -> std::string {
+        if (other.num_faces() != poly.num_faces() || other.num_cells != poly.num_cells || other.points.cols() != poly.points.cols())
+          return std::to_string(other.points.cols()) + " points, " + std::to_string(other.num_faces()) + " faces and " +
+                 std::to_string(other.num_cells) + " cells against " + std::to_string(poly.points.cols()) + ", " +
+                 std::to_string(poly.num_faces()) + " and " + std::to_string(poly.num_cells);
+        for (Index f = 0; f < poly.num_faces(); ++f) {
+          const auto a = poly.face(f), b = other.face(f);
+          if (!std::equal(a.begin(), a.end(), b.begin(), b.end()) || other.owner[static_cast<std::size_t>(f)] != poly.owner[static_cast<std::size_t>(f)] ||
+              (f < poly.num_internal_faces() && (f >= other.num_internal_faces() || other.neighbour[static_cast<std::size_t>(f)] != poly.neighbour[static_cast<std::size_t>(f)])))
+            return "face " + std::to_string(f) + " differs";
+        }
+        if (other.patches.size() != poly.patches.size()) return std::to_string(other.patches.size()) + " patches against " + std::to_string(poly.patches.size());
+        for (std::size_t p = 0; p < poly.patches.size(); ++p)
+          if (other.patches[p].name != poly.patches[p].name || other.patches[p].start != poly.patches[p].start ||
+              other.patches[p].size != poly.patches[p].size)
+            return "patch " + std::to_string(p) + " is '" + other.patches[p].name + "' there, '" + poly.patches[p].name + "' here";
+        return {};
+      }();
+      if (!differs.empty())
+        throw InputError(target.string() + ": holds another mesh than " + source.string() + " (" + differs + "): its points were not replaced");
+    }
+    return write_polymesh_points(target, moved);
+  }
   const Index n = moved.num_nodes() - moved.num_auxiliary_nodes;
   if (n != poly.points.cols())
     throw InputError(target.string() + ": the mesh has " + std::to_string(n) + " points, the case it comes from (" + source.string() +

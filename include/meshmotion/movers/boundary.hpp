@@ -329,6 +329,8 @@ class BoundarySpec {
   /// sliding group its own plane). Throws InputError for an unknown group (listing the known
   /// ones), a malformed pattern, a displacement array given to a name of several groups, a
   /// wrong-sized or non-finite displacement array, or a non-planar sliding group.
+  /// Displacements given by node need not name a polyhedral mesh's auxiliary centres: each
+  /// left out takes the mean of its face's or cell's nodes (derive_auxiliary()).
   /// Messages name a node by its index and, where the file numbers it otherwise, its id there.
   [[nodiscard]] ResolvedBoundary<Dim> resolve(const Mesh<Dim>& mesh, double to = 1.0, double from = 0.0) const {
     const std::vector<Group> groups = expand(mesh);
@@ -463,6 +465,44 @@ class BoundarySpec {
     return fit.normal;
   }
 
+  // The auxiliary nodes of a polyhedral mesh (the centres to_mesh() cuts its cells around) are
+  // the library's, not the user's: one the displacements leave out takes the mean of the
+  // displacements of the nodes it is the centre of (those of its face, or of its cell: the
+  // other nodes of the elements around it), exact for a rigid or affine motion, as the centre
+  // is their mean. Left missing when one of those has no displacement either.
+  static void derive_auxiliary(const Mesh<Dim>& mesh, const std::vector<Index>& list, const std::vector<Index>& slot,
+                               std::vector<char>& given, Points<Dim>& out) {
+    const Index first_auxiliary = mesh.num_nodes() - mesh.num_auxiliary_nodes;
+    std::vector<std::vector<Index>> around(list.size());
+    bool any = false;
+    for (std::size_t s = 0; s < list.size(); ++s) any = any || (!given[s] && list[s] >= first_auxiliary);
+    if (!any) return;
+    for (const auto& b : mesh.cells)
+      for (Index e = 0; e < b.size(); ++e) {
+        const auto nodes = b.element(e);
+        for (const Index v : nodes) {
+          const Index s = v < first_auxiliary ? -1 : slot[static_cast<std::size_t>(v)];
+          if (s < 0 || given[static_cast<std::size_t>(s)]) continue;
+          for (const Index u : nodes)
+            if (u < first_auxiliary) around[static_cast<std::size_t>(s)].push_back(u);
+        }
+      }
+    for (std::size_t s = 0; s < list.size(); ++s) {
+      std::vector<Index>& centre_of = around[s];
+      std::sort(centre_of.begin(), centre_of.end());
+      centre_of.erase(std::unique(centre_of.begin(), centre_of.end()), centre_of.end());
+      const bool known = !centre_of.empty() && std::all_of(centre_of.begin(), centre_of.end(), [&](Index u) {
+        const Index t = slot[static_cast<std::size_t>(u)];
+        return t >= 0 && given[static_cast<std::size_t>(t)] != 0;
+      });
+      if (!known) continue;
+      Vec<Dim> mean = Vec<Dim>::Zero();
+      for (const Index u : centre_of) mean += out.col(slot[static_cast<std::size_t>(u)]);
+      out.col(static_cast<Index>(s)) = mean / static_cast<double>(centre_of.size());
+      given[s] = 2;
+    }
+  }
+
   // The displacements of a group given with their nodes, in the order of the sorted `list`.
   static Points<Dim> by_node(const Group& g, const std::vector<Index>& list, Index num_nodes, const NodeNames& node_name) {
     std::vector<Index> slot(static_cast<std::size_t>(num_nodes), -1);
@@ -483,6 +523,7 @@ class BoundarySpec {
       given[static_cast<std::size_t>(s)] = 1;
       out.col(s) = g.displacements.col(static_cast<Index>(k));
     }
+    if (node_name.mesh != nullptr) derive_auxiliary(*node_name.mesh, list, slot, given, out);
     const auto missing = std::find(given.begin(), given.end(), 0);
     if (missing != given.end())
       throw InputError(where + node_name(list[static_cast<std::size_t>(missing - given.begin())]) +
