@@ -397,6 +397,8 @@ smoke_test(NAME move_mesh.openfoam_pattern_naming_nothing.json REQUIRES examples
                    --fixed "(inlet|outlet)" --json)
 smoke_test(NAME move_mesh.openfoam_polymesh_folder_of_input_needs_overwrite.json REQUIRES examples_foam_case EXPECT_RC 1 KEYS error
            COMMAND move_mesh "${smoke_dir}/foam_case" -o "${smoke_dir}/foam_case/constant/polyMesh" --group top --translate 0.05,0,0 --json)
+smoke_test(NAME move_mesh.openfoam_no_case_inside_the_case.json REQUIRES examples_foam_case EXPECT_RC 1 KEYS error
+           COMMAND move_mesh "${smoke_dir}/foam_case" -o "${smoke_dir}/foam_case/latest" --group top --translate 0.05,0,0 --json)
 smoke_test(NAME move_mesh.openfoam_in_place_needs_overwrite.json REQUIRES examples_foam_case EXPECT_RC 1 KEYS error
            COMMAND move_mesh "${smoke_dir}/foam_case" -o "${smoke_dir}/foam_case" --group top --translate 0.05,0,0
                    --fixed bottom --json)

@@ -832,3 +832,20 @@ TEST_CASE("OpenFOAM: a moved case goes into another case only where that case ho
   write_moved_case(source / "0.5", source, moved);
   CHECK(read_polymesh(source / "0.5").points == moved.points.leftCols(16));
 }
+
+TEST_CASE("OpenFOAM: a new case is not written inside another case", "[io][openfoam]") {
+  const fs::path dir = test::scratch_path("foam_nested");
+  write_case(dir, hanging_node_case());
+  const Mesh<3> mesh = read_openfoam(dir);
+  for (const fs::path& inside : {dir / "0.3" / "polyMesh", dir / "latest", dir / "constant" / "polyMesh" / "copy"}) {
+    INFO(inside);
+    CHECK_THAT(test::message_of<InputError>([&] { check_mesh_output(inside); }), Catch::Contains("inside the OpenFOAM case"));
+    CHECK_THAT(test::message_of<InputError>([&] { write_mesh(inside, mesh); }), Catch::Contains("inside the OpenFOAM case"));
+    CHECK_FALSE(fs::exists(inside));
+  }
+  // Beside it, a new case is written.
+  const fs::path beside = test::scratch_path("foam_nested_beside");
+  fs::remove_all(beside);
+  write_mesh(beside, mesh);
+  CHECK(read_polymesh(beside).num_cells > 0);
+}

@@ -208,6 +208,7 @@ inline void check_mesh_output(const std::filesystem::path& file, int order = 1) 
     if (order > 1)
       throw InputError("output " + file.string() + ": an OpenFOAM case holds linear cells only (expected " +
                        detail::format_extensions(order) + " for order " + std::to_string(order) + ")");
+    if (!is_openfoam_target(file)) check_not_inside_case(file);
     return;
   }
   const MeshFormatEntry* format = mesh_format_of(file);

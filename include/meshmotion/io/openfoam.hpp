@@ -49,7 +49,6 @@ namespace meshmotion {
 /// not have `source`'s point count, or when `target` is another case whose faces, cells or
 /// patches are not `source`'s (nothing is written then).
 inline void write_moved_case(const std::filesystem::path& target, const std::filesystem::path& source, const Mesh<3>& moved) {
-  PolyMesh poly = read_polymesh(source);
   if (!is_new_openfoam_case(target)) {
     // Another case of as many points must hold this mesh: its points would make no sense
     // on other faces (a moved mesh written over its neighbour's case).
@@ -58,7 +57,8 @@ inline void write_moved_case(const std::filesystem::path& target, const std::fil
     std::filesystem::path source_folder = detail::polymesh_folder(source);
     if (const auto time = source_folder.empty() ? detail::foam_time_folder(source) : std::nullopt) source_folder = time->constant;
     if (!where.reference.empty() && !std::filesystem::equivalent(where.reference.parent_path(), source_folder, ec)) {
-      const PolyMesh other = read_polymesh(where.reference.parent_path());
+      // The source is read only here: its own case or time folder needs no comparison.
+      const PolyMesh poly = read_polymesh(source), other = read_polymesh(where.reference.parent_path());
       const auto differs = [&]() -> std::string {
         if (other.num_faces() != poly.num_faces() || other.num_cells != poly.num_cells || other.points.cols() != poly.points.cols())
           return std::to_string(other.points.cols()) + " points, " + std::to_string(other.num_faces()) + " faces and " +
@@ -82,6 +82,7 @@ inline void write_moved_case(const std::filesystem::path& target, const std::fil
     }
     return write_polymesh_points(target, moved);
   }
+  PolyMesh poly = read_polymesh(source);
   const Index n = moved.num_nodes() - moved.num_auxiliary_nodes;
   if (n != poly.points.cols())
     throw InputError(target.string() + ": the mesh has " + std::to_string(n) + " points, the case it comes from (" + source.string() +

@@ -422,10 +422,23 @@ inline void write_polymesh(const std::filesystem::path& case_dir, const PolyMesh
   zones(mesh.point_zones, "point");
 }
 
+/// Refuses a new case inside an existing one (`case/0.3/polyMesh`, `case/latest`): OpenFOAM
+/// reads nothing there, and a moved mesh meant for the case would be lost in it.
+inline void check_not_inside_case(const std::filesystem::path& target) {
+  std::error_code ec;
+  const std::filesystem::path full = std::filesystem::absolute(target, ec);
+  for (std::filesystem::path up = full.parent_path(); !up.empty() && up != up.root_path(); up = up.parent_path())
+    if (!detail::polymesh_folder(up).empty())
+      throw InputError(target.string() + ": inside the OpenFOAM case " + up.string() +
+                       " (a new case is not written into another: give a time folder of it, such as " + (up / "0.3").string() +
+                       ", or a folder outside it)");
+}
+
 /// Writes a whole new case at `case_dir`, a path that does not exist or an empty folder, as
 /// one step: write_polymesh() into a temporary folder beside it, renamed into place once
 /// complete, so a full disk or a killed run leaves no half case (points and faces without
-/// owner). InputError when `case_dir` holds something, IoError when writing fails.
+/// owner). InputError when `case_dir` holds something or lies inside another case
+/// (check_not_inside_case()), IoError when writing fails.
 inline void write_new_polymesh_case(const std::filesystem::path& case_dir, const PolyMesh& mesh,
                                     const PolyMeshWriteOptions& options = {}) {
   // "out/" names the folder "out": its temporary goes beside it, not into it.
@@ -433,6 +446,7 @@ inline void write_new_polymesh_case(const std::filesystem::path& case_dir, const
   std::error_code ec;
   if (std::filesystem::exists(target, ec) && !(std::filesystem::is_directory(target, ec) && std::filesystem::is_empty(target, ec)))
     throw InputError(target.string() + ": not empty (a new OpenFOAM case is written into a new or empty folder)");
+  check_not_inside_case(target);
   detail::remove_stale_temporaries(target);
   const std::filesystem::path tmp = detail::temporary_path_for(target);
   try {
