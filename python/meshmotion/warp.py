@@ -82,8 +82,85 @@ class Warp:
             boundary = self._partition(mesh, design, symmetry, fixed, orientation, cell_ranks)
             self._mover = (_core.DistributedMover2 if self._dim == 2 else _core.DistributedMover3)(method, **options)
             self._mover.setup(self._part, boundary)
+        self._owned = slice(0, self._num_owned)
+        self._finish(boundary, method, _np.array(self._mesh.points, copy=True))
+
+    @classmethod
+    def from_partition(cls, comm, points, global_ids, owner, groups, design, symmetry=(), fixed=(), method="rbf",
+                       **options):
+        """A Warp on a solver's own partition, where no rank holds the whole mesh (collective).
+
+        Each rank gives its local nodes in its own order: points (n_local, dim), their global
+        ids (n_local,), the rank owning each (n_local,; every global node owned by one rank,
+        a ghost listed on other ranks with the same id), and groups, a dict from group name to
+        the local indices of that group's nodes on this rank (a group may be absent or empty
+        on a rank). design, symmetry and fixed name groups as in Warp(); a symmetry group's
+        plane is fitted to its nodes on every rank together. Rows of warp() and of
+        warp_derivative's dI_dXv are the local nodes in the order given; a rank's design
+        surface is the design nodes it owns, by ascending global id. RBF only (elasticity
+        needs the cells: Warp(mesh, comm=...) partitions a mesh read on rank 0)."""
+        self = cls.__new__(cls)
+        self._comm = comm
+        _check_comm(comm)
+        self._part = self._whole = self._mesh = None
+        failure = None
+        try:
+            points = real_array(points, "Warp.from_partition: points")
+            if points.ndim != 2 or points.shape[1] not in (2, 3):
+                raise _core.InputError(f"Warp.from_partition: points must be (n_local, 2 or 3) (got {points.shape})")
+            ids = index_array(global_ids, "Warp.from_partition: global_ids").astype(_np.int64)
+            owner = index_array(owner, "Warp.from_partition: owner").astype(_np.int64)
+            if len(ids) != len(points) or len(owner) != len(points):
+                raise _core.InputError(f"Warp.from_partition: {len(points)} local nodes but {len(ids)} global ids and "
+                                       f"{len(owner)} owners (expected one each)")
+            local = {}
+            for name, nodes in dict(groups).items():
+                nodes = index_array(nodes, f"Warp.from_partition: group '{name}'")
+                if len(nodes) and (nodes.min() < 0 or nodes.max() >= len(points)):
+                    bad = int(nodes[(nodes < 0) | (nodes >= len(points))][0])
+                    raise _core.InputError(f"Warp.from_partition: group '{name}' refers to local node {bad} (expected "
+                                           f"0 to {len(points) - 1})")
+                local[str(name)] = nodes
+        except Exception as error:
+            failure = (type(error).__name__, str(error))
+        _raise_any(comm, failure)
+        self._dim = _agree(comm, points.shape[1], "the points' dimension")
+        if not design:
+            raise _core.InputError("Warp: give at least one design group")
+        known = set().union(*comm.allgather(sorted(local)))
+        for name in list(design) + list(symmetry) + list(fixed):
+            if name not in known:
+                raise _core.InputError(f"Warp.from_partition: no group named '{name}' on any rank (known: "
+                                       f"{', '.join(sorted(known)) or 'none'})")
+            local.setdefault(name, _np.zeros(0, dtype=_np.int64))
+        owned = owner == comm.Get_rank()
+        spec = _core.BoundarySpec2() if self._dim == 2 else _core.BoundarySpec3()
+        for group in design:
+            spec.prescribed(group)
+        for group in symmetry:
+            spec.sliding(group, normal=_fit_plane(comm, group, points[local[group][owned[local[group]]]]))
+        for group in fixed:
+            spec.fixed(group)
+        failure = None
+        try:
+            boundary = spec.resolve_nodes(points, {k: v.tolist() for k, v in local.items()})
+        except Exception as error:
+            failure = (type(error).__name__, str(error))
+        _raise_any(comm, failure)
+        self._mover = (_core.DistributedMover2 if self._dim == 2 else _core.DistributedMover3)(method, **options)
+        self._mover.setup_partition(comm, points, ids.tolist(), owner.astype(_np.int32).tolist(), boundary)
+        self._ids = ids.copy()
+        self._owned = owned
+        self._num_owned = int(owned.sum())
+        mine = _np.array([v for v in _design_nodes(boundary) if owned[v]], dtype=_np.int64)
+        self._design = mine[_np.argsort(ids[mine], kind="stable")]
+        self._finish(boundary, method, points.copy())
+        return self
+
+    def _finish(self, boundary, method, reference):
+        comm = self._comm
         self._boundary = boundary
-        self._reference = _np.array(self._mesh.points, copy=True)
+        self._reference = reference
         self._columns = _np.array([boundary.column(int(v)) for v in self._design], dtype=_np.int64)
         self._order = _np.arange(len(self._design))  # user position -> design position
         if not self._mover.has_derivatives:
@@ -100,16 +177,13 @@ class Warp:
             _warnings.warn(f"Warp: the RBF system's condition number is at least {self.condition:.1e}: warp_derivative "
                            f"may carry relative rounding errors up to {self.condition * 2.2e-16:.0e} (a smaller "
                            "support_radius, or centres less close together, conditions it better)",
-                           RuntimeWarning, stacklevel=2)
+                           RuntimeWarning, stacklevel=3)
 
     def _partition(self, mesh, design, symmetry, fixed, orientation, cell_ranks):
         """Rank 0 reads and resolves; every rank gets its part, its boundary entries and its
         owned design nodes. Returns this rank's boundary."""
         comm = self._comm
-        if not (hasattr(comm, "py2f") and hasattr(comm, "bcast")):
-            raise _core.InputError(f"Warp: comm must be an mpi4py communicator (got {type(comm).__name__})")
-        if not getattr(_core, "have_mpi", False):
-            raise _core.InputError("Warp: comm given but the module has no MPI: " + _core.mpi_missing)
+        _check_comm(comm)
         root = comm.Get_rank() == 0
         whole = whole_boundary = design_ids = None
         failure = None
@@ -167,12 +241,21 @@ class Warp:
     @property
     def num_owned(self):
         """Rows 0..num_owned-1 of volume_coordinates() are nodes this rank owns, the others ghosts
-        (all of them without MPI)."""
+        (all of them without MPI). From a solver's partition: how many rows this rank owns, in
+        the order it gave them (`owned` says which)."""
         return self._num_owned
 
     @property
+    def owned(self):
+        """Per row of volume_coordinates(): whether this rank owns the node (a copy)."""
+        mask = _np.zeros(len(self._ids), dtype=bool)
+        mask[self._owned] = True
+        return mask
+
+    @property
     def mesh(self):
-        """The mesh moved (over MPI: this rank's part), in its reference position."""
+        """The mesh moved (over MPI: this rank's part), in its reference position; None for a
+        solver's own partition (from_partition), which gives no cells."""
         return self._mesh
 
     def set_surface_order(self, nodes):
@@ -220,7 +303,9 @@ class Warp:
         rank 0 (None on the others; collective), else a copy."""
         if self._comm is None:
             return self._volume.copy()
-        return self._part.gather_owned(self._volume)
+        if self._part is not None:
+            return self._part.gather_owned(self._volume)
+        return _gather_owned(self._comm, self._ids[self._owned], self._volume[self._owned])
 
     def write_mesh(self, file, like=None):
         """Writes the mesh at the last warp() (format by extension). Over MPI, collective: rank 0
@@ -228,6 +313,10 @@ class Warp:
         the mesh was read from, written again with the new coordinates (its structured blocks,
         BCs and solutions kept)."""
         from . import write_mesh as _write_mesh
+
+        if self._comm is not None and self._part is None:
+            raise _core.InputError("write_mesh: a Warp on a solver's own partition holds no cells to write; "
+                                   "gather_volume_coordinates() gives the whole mesh's coordinates on rank 0")
 
         def _write(target, mesh):
             if like is None:
@@ -306,7 +395,7 @@ class Warp:
 
     def _sum(self, terms, owned_only=True):
         """Σ of terms over the nodes (rows) each rank owns, over every rank."""
-        local = float(_np.sum(terms[:self._num_owned] if owned_only else terms))
+        local = float(_np.sum(terms[self._owned] if owned_only else terms))
         return local if self._comm is None else self._comm.allreduce(local)
 
 
@@ -318,10 +407,77 @@ CONDITION_WARNING = 1e12
 def _raise_everywhere(comm, failure):
     """Raises on every rank the error rank 0 caught, (class name, message), so that no rank goes
     on to a collective call the others never reach."""
-    failure = comm.bcast(failure, root=0)
+    _raise_everywhere_from(comm.bcast(failure, root=0))
+
+
+def _raise_any(comm, failure):
+    """Raises on every rank the error of the first rank that caught one, (class name, message)."""
+    failures = [f for f in comm.allgather(failure) if f is not None]
+    _raise_everywhere_from(failures[0] if failures else None)
+
+
+def _raise_everywhere_from(failure):
     if failure is not None:
         kind = getattr(_core, failure[0], None)
         raise (kind if isinstance(kind, type) and issubclass(kind, Exception) else RuntimeError)(failure[1])
+
+
+def _check_comm(comm):
+    if not (hasattr(comm, "py2f") and hasattr(comm, "bcast")):
+        raise _core.InputError(f"Warp: comm must be an mpi4py communicator (got {type(comm).__name__})")
+    if not getattr(_core, "have_mpi", False):
+        raise _core.InputError("Warp: comm given but the module has no MPI: " + _core.mpi_missing)
+
+
+def _agree(comm, value, what):
+    """value, when every rank has the same; else InputError on every rank."""
+    values = comm.allgather(value)
+    if any(v != values[0] for v in values):
+        raise _core.InputError(f"Warp.from_partition: the ranks disagree on {what} ({values})")
+    return values[0]
+
+
+def _fit_plane(comm, group, points):
+    """The unit normal of the least-squares plane through the owned nodes `points` of a
+    symmetry group on every rank (collective), as BoundarySpec fits one on a whole mesh; raises
+    on every rank when they are too few or not planar (1e-8 of their extent)."""
+    dim = points.shape[1]
+    count = comm.allreduce(len(points))
+    if count < dim:
+        raise _core.InputError(f"BoundarySpec::resolve: sliding group '{group}' has {count} nodes, too few to fit a "
+                               "plane")
+    centroid = comm.allreduce(points.sum(axis=0)) / count
+    r = points - centroid
+    scatter = comm.allreduce(r.T @ r)
+    normal = _np.linalg.eigh(scatter)[1][:, 0]
+    extent = comm.allreduce(float(_np.linalg.norm(r, axis=1).max()) if len(r) else 0.0, op=_max())
+    off = comm.allreduce(float(_np.abs(r @ normal).max()) if len(r) else 0.0, op=_max())
+    if off > 1e-8 * max(extent, 1e-300):
+        raise _core.InputError(f"BoundarySpec::resolve: sliding group '{group}' is not planar (a node lies {off:g} off "
+                               "the fitted plane, expected 0)")
+    return normal.tolist()
+
+
+def _gather_owned(comm, ids, values):
+    """values (rows of the global nodes `ids` this rank owns) of every rank as one array in
+    global order on rank 0 (None elsewhere); raises on every rank for a global node no rank
+    owns or one owned twice."""
+    ids = comm.gather(ids, root=0)
+    values = comm.gather(values, root=0)
+    out, failure = None, None
+    if comm.Get_rank() == 0:
+        ids, values = _np.concatenate(ids), _np.concatenate(values)
+        count = int(ids.max()) + 1 if len(ids) else 0
+        seen = _np.bincount(ids, minlength=count) if len(ids) else _np.zeros(0, dtype=_np.int64)
+        if len(ids) and (ids.min() < 0 or (seen != 1).any()):
+            bad = int(ids.min()) if ids.min() < 0 else int(_np.flatnonzero(seen != 1)[0])
+            failure = ("InputError", f"gather_volume_coordinates: global node {bad} is owned by "
+                                     f"{int(seen[bad]) if bad >= 0 else 0} ranks (expected ids 0..n-1, each owned once)")
+        else:
+            out = _np.empty((count, values.shape[1]))
+            out[ids] = values
+    _raise_everywhere(comm, failure)
+    return out
 
 
 def _max():

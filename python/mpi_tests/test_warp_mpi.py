@@ -83,6 +83,70 @@ def test_a_solvers_own_partition_gives_the_same_mesh():
     np.testing.assert_allclose(part, whole[parallel.node_ids], rtol=0, atol=1e-12)
 
 
+def scattered_partition(mesh):
+    """This rank's share of `mesh` as a solver might hold it, without the library's partition:
+    node g owned by rank g % size, ghosts the nodes rank (g + 1) % size owns, all in a shuffled
+    order; groups as local indices."""
+    n = mesh.num_nodes
+    ids = np.flatnonzero((np.arange(n) % comm.size == comm.rank) | ((np.arange(n) + 1) % comm.size == comm.rank))
+    ids = np.random.default_rng(comm.rank).permutation(ids)
+    local = {int(g): k for k, g in enumerate(ids)}
+    groups = {name: [local[int(g)] for g in mesh.group_nodes(name) if int(g) in local]
+              for name in ("wall", "symmetry", "farfield")}
+    return np.asarray(mesh.points)[ids], ids, (ids % comm.size).astype(np.int32), groups
+
+
+def test_a_partition_no_rank_holds_whole_gives_the_serial_warp_and_gradient():
+    mesh = box()
+    serial = mm.Warp(mesh, design=["wall"], symmetry=["symmetry"], fixed=["farfield"], support_radius=0.7)
+    points, ids, owner, groups = scattered_partition(mesh)
+    parallel = mm.Warp.from_partition(comm, points, ids, owner, groups, design=["wall"], symmetry=["symmetry"],
+                                      fixed=["farfield"], support_radius=0.7)
+    assert parallel.mesh is None and parallel.num_owned == int((owner == comm.rank).sum())
+    np.testing.assert_array_equal(parallel.node_ids, ids)
+    np.testing.assert_array_equal(parallel.owned, owner == comm.rank)
+    mine = parallel.design_nodes
+    assert np.all(np.diff(mine) > 0) and np.all(mine % comm.size == comm.rank)
+    np.testing.assert_array_equal(np.sort(np.concatenate(comm.allgather(mine))), serial.design_nodes)
+    whole, part = warp_both(serial, parallel)
+    moved = np.abs(whole - serial.mesh.points).max()
+    assert moved > 0.01
+    # Rows in the order given, ghosts included; the symmetry plane fitted over every rank.
+    np.testing.assert_allclose(part, whole[ids], rtol=0, atol=1e-12 * moved)
+    gathered = parallel.gather_volume_coordinates()
+    if comm.rank == 0:
+        np.testing.assert_allclose(gathered, whole, rtol=0, atol=1e-12 * moved)
+    else:
+        assert gathered is None
+    g_serial = serial.warp_derivative(seed(serial.node_ids))
+    g_part = parallel.warp_derivative(seed(ids))
+    row = {int(v): k for k, v in enumerate(serial.design_nodes)}
+    expected = g_serial[[row[int(v)] for v in mine]] if len(mine) else np.zeros((0, 3))
+    np.testing.assert_allclose(g_part, expected, rtol=0, atol=1e-12 * np.abs(g_serial).max())
+    assert parallel.verify_derivative(verbose=False) < 1e-6
+    with pytest.raises(mm.InputError, match="holds no cells"):
+        parallel.write_mesh("unused.msh")
+
+
+def test_a_partition_no_rank_holds_whole_is_refused_clearly():
+    mesh = box(3, 3, 2)
+    points, ids, owner, groups = scattered_partition(mesh)
+    with pytest.raises(mm.InputError, match="no group named 'nowhere' on any rank"):
+        mm.Warp.from_partition(comm, points, ids, owner, groups, design=["nowhere"])
+    with pytest.raises(mm.InputError, match="rbf only"):
+        mm.Warp.from_partition(comm, points, ids, owner, groups, design=["wall"], fixed=["farfield"], method="sle")
+    # One rank's bad array raises on every rank, with that rank's message.
+    bad = groups if comm.rank != comm.size - 1 else dict(groups, wall=[len(ids)])
+    with pytest.raises(mm.InputError, match="group 'wall' refers to local node"):
+        mm.Warp.from_partition(comm, points, ids, owner, bad, design=["wall"])
+    with pytest.raises(mm.InputError, match="not planar"):
+        mm.Warp.from_partition(comm, points, ids, owner, groups, design=["wall"], symmetry=["farfield"])
+    if comm.size > 1:  # a node owned by two ranks
+        with pytest.raises(mm.InputError, match="owned boundary node on two ranks"):
+            mm.Warp.from_partition(comm, points, ids, np.full(len(ids), comm.rank, dtype=np.int32), groups,
+                                   design=["wall"], fixed=["farfield"])
+
+
 def test_elasticity_over_petsc_agrees_with_the_serial_solve_and_its_gradient():
     serial, parallel = pair(method="sle")
     whole, part = warp_both(serial, parallel)

@@ -6,6 +6,7 @@
 #include "meshmotion/movers/motion.hpp"
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -52,8 +53,17 @@ void bind_boundary(py::module_& m) {
              py::arg("group"), py::arg("translation"), py::return_value_policy::reference_internal)
         .def("prescribed", &S::prescribed, py::arg("group"), py::return_value_policy::reference_internal)
         .def("fixed", &S::fixed, py::arg("group"), py::return_value_policy::reference_internal)
-        .def("sliding", [](S& s, const std::string& g) -> S& { return s.sliding(g); }, py::arg("group"),
-             py::return_value_policy::reference_internal)
+        .def(
+            "sliding",
+            [](S& s, const std::string& g, std::optional<std::vector<double>> normal) -> S& {
+              if (!normal) return s.sliding(g);
+              if (static_cast<int>(normal->size()) != Dim)
+                throw InputError("sliding: the normal of '" + g + "' needs " + std::to_string(Dim) + " numbers (got " +
+                                 std::to_string(normal->size()) + ")");
+              return s.sliding(g, Vec<Dim>(Eigen::Map<const Vec<Dim>>(normal->data())));
+            },
+            py::arg("group"), py::arg("normal") = std::nullopt, py::return_value_policy::reference_internal,
+            "the group slides in its plane: the normal given, or fitted to the group's nodes")
         .def("resolve", [](const S& s, const M& mesh) { return s.resolve(mesh); }, py::arg("mesh"))
         .def("resolve_nodes",
              [](const S& s, const py::array& points, const std::map<std::string, std::vector<Index>>& groups) {

@@ -90,6 +90,18 @@ class DistributedMover {
       std::get<Elasticity>(mover_)->setup(mesh, boundary);
     }
   }
+  // A solver's own partition: no cells, so RBF only. The arrays are kept here, as the
+  // distributed RBF views them.
+  void setup(MPI_Comm comm, Points<Dim> points, std::vector<std::int64_t> global_ids, std::vector<int> owner,
+             const ResolvedBoundary<Dim>& boundary) {
+    if (!std::holds_alternative<Rbf>(mover_))
+      throw InputError("a solver's own partition (local nodes without cells) is moved by rbf only: elasticity needs the "
+                       "cells (partition a mesh read on rank 0 instead)");
+    points_ = std::move(points);
+    global_ids_ = std::move(global_ids);
+    owner_ = std::move(owner);
+    std::get<Rbf>(mover_)->setup(parallel::PartitionView<Dim>{comm, points_, global_ids_, owner_}, boundary);
+  }
   void move_into(PointsView<Dim> d, Points<Dim>& out) {
     std::visit([&](auto& m) { m->move_into(d, out); }, mover_);
   }
@@ -116,6 +128,9 @@ class DistributedMover {
   using Elasticity = std::unique_ptr<parallel::DistributedElasticityMover<Dim>>;
   std::variant<Rbf, Elasticity> mover_;
   Points<Dim> out_;  ///< move_into's result before it is copied to the caller's array
+  Points<Dim> points_;  ///< a solver's own partition (setup from arrays)
+  std::vector<std::int64_t> global_ids_;
+  std::vector<int> owner_;
 };
 
 }  // namespace
@@ -183,6 +198,19 @@ void bind_parallel(py::module_& m) {
               a.setup(mesh, boundary);
             },
             py::arg("mesh"), py::arg("boundary"), "collective: set up on each rank's part and its boundary entries")
+        .def(
+            "setup_partition",
+            [](A& a, const py::object& comm, const py::array& points, std::vector<std::int64_t> global_ids,
+               std::vector<int> owner, const B& boundary) {
+              const MPI_Comm communicator_of_ranks = communicator(comm);
+              Points<Dim> local(rows_of<Dim>(points, "setup_partition: points"));
+              ensure_petsc();
+              py::gil_scoped_release release;
+              a.setup(communicator_of_ranks, std::move(local), std::move(global_ids), std::move(owner), boundary);
+            },
+            py::arg("comm"), py::arg("points"), py::arg("global_ids"), py::arg("owner"), py::arg("boundary"),
+            "collective: set up on a solver's own partition, each rank's local nodes (n_local, dim) in its order with "
+            "their global ids and owner ranks, and the boundary entries of those nodes (rbf only)")
         .def_property_readonly("petsc_solve", &A::petsc_solve);
     bind_move_calls<Dim>(c);
   });
