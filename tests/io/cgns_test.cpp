@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -27,6 +28,8 @@ using namespace meshmotion;
 namespace fs = std::filesystem;
 
 #ifdef MESHMOTION_HAVE_CGNS
+
+#include <cgns_io.h>
 
 namespace {
 
@@ -111,6 +114,13 @@ class CgnsBuilder {
   /// A structured block of ni × nj [× nk] vertices (nk 0 in 2D) on a unit grid from x = x0,
   /// i fastest.
   int structured_zone(const char* name, int ni, int nj, int nk, double x0) {
+    return structured_zone(name, ni, nj, nk, [x0](int i, int j, int k) {
+      return std::array<double, 3>{x0 + i, static_cast<double>(j), static_cast<double>(k)};
+    });
+  }
+  /// A structured block whose vertex (i, j, k) (0-based) is at place(i, j, k).
+  template <class Place>
+  int structured_zone(const char* name, int ni, int nj, int nk, Place&& place) {
     const bool three = nk > 0;
     cgsize_t size[9] = {};
     const std::array<int, 3> n{ni, nj, three ? nk : 1};
@@ -126,7 +136,7 @@ class CgnsBuilder {
       std::vector<double> c;
       for (int k = 0; k < n[2]; ++k)
         for (int j = 0; j < nj; ++j)
-          for (int i = 0; i < ni; ++i) c.push_back(d == 0 ? x0 + i : d == 1 ? j : k);
+          for (int i = 0; i < ni; ++i) c.push_back(place(i, j, k)[static_cast<std::size_t>(d)]);
       int C = 0;
       REQUIRE(cg_coord_write(fn_, base_, z, CGNS_ENUMV(RealDouble), names[d], c.data(), &C) == CG_OK);
     }
@@ -150,6 +160,23 @@ class CgnsBuilder {
                           points.data(), &bc) == CG_OK);
     if (location != CGNS_ENUMV(Vertex)) REQUIRE(cg_boco_gridlocation_write(fn_, base_, z, bc, location) == CG_OK);
     return bc;
+  }
+  /// A 1-to-1 connection of zone z with zone `donor` (index ranges as CGNS stores them).
+  void one_to_one(int z, const char* name, const char* donor, const std::vector<cgsize_t>& range,
+                  const std::vector<cgsize_t>& donor_range, const std::vector<int>& transform) {
+    int I = 0;
+    REQUIRE(cg_1to1_write(fn_, base_, z, name, donor, range.data(), donor_range.data(), transform.data(), &I) == CG_OK);
+  }
+  /// Overwrites the data of the node at `path` (from the file's root) as a file written by
+  /// another tool could hold it, past the checks of the library's own writers.
+  template <class T>
+  void overwrite(const std::string& path, const std::vector<T>& data) {
+    int cgio = 0;
+    double root = 0.0, node = 0.0;
+    REQUIRE(cg_get_cgio(fn_, &cgio) == CG_OK);
+    REQUIRE(cg_root_id(fn_, &root) == CG_OK);
+    REQUIRE(cgio_get_node_id(cgio, root, path.c_str(), &node) == CG_OK);
+    REQUIRE(cgio_write_all_data(cgio, node, data.data()) == CG_OK);
   }
   void family(int z, int bc, const char* name) {
     int F = 0;
@@ -475,14 +502,134 @@ TEST_CASE("CGNS structured zones read as hexahedra and quadrilaterals, blocks jo
       }
       require_input_error([&] { (void)read_mesh(file); }, parts);
     };
-    refused("structured_face_bc", [](CgnsBuilder& f) {
+    refused("structured_cell_bc", [](CgnsBuilder& f) {
       const int z = f.structured_zone("blk", 3, 3, 3, 0.0);
-      f.boco(z, "wall", CGNS_ENUMV(PointRange), {1, 1, 1, 2, 2, 1}, CGNS_ENUMV(FaceCenter), 3);
-    }, {"/Base/blk/ZoneBC/wall", "structured zone's BC on faces"});
+      f.boco(z, "wall", CGNS_ENUMV(PointRange), {1, 1, 1, 2, 2, 1}, CGNS_ENUMV(CellCenter), 3);
+    }, {"/Base/blk/ZoneBC/wall", "located at cells or edges"});
     refused("structured_range", [](CgnsBuilder& f) {
       const int z = f.structured_zone("blk", 3, 3, 3, 0.0);
       f.boco(z, "wall", CGNS_ENUMV(PointRange), {1, 1, 1, 4, 3, 1}, CGNS_ENUMV(Vertex), 3);
     }, {"/Base/blk/ZoneBC/wall", "index 1 is 4", "3 vertices along it"});
+  }
+}
+
+TEST_CASE("CGNS structured: a C-grid's wake cut joined by its 1-to-1 record, BCs located at faces", "[io][cgns]") {
+  // z = ζ² maps the strip ζ = s + i t, s in [-4, 4], t in [0, 3] onto a C-grid around a slit
+  // of the x axis: vertices (s, 0) and (-s, 0) coincide. |s| ≥ 2 is the wake cut, declared
+  // 1-to-1 (i 1..3 with i 9..7, the trailing edge at x = 4 included); |s| < 2 is a plate of zero
+  // thickness whose two sides coincide too but are no connection: they stay apart.
+  const int ni = 9, nj = 4;
+  const auto cgrid = [](int i, int j, int) {
+    const double s = i - 4.0, t = j;
+    return std::array<double, 3>{s * s - t * t, 2.0 * s * t, 0.0};
+  };
+  const auto build = [&](const fs::path& file, auto&& extra) {
+    CgnsBuilder f(file);
+    const int z = f.structured_zone("cgrid", ni, nj, 0, cgrid);
+    extra(f, z);
+  };
+  const auto count_at = [](const Mesh<2>& mesh, double x, double y) {
+    Index n = 0;
+    for (Index v = 0; v < mesh.num_nodes(); ++v) n += mesh.points(0, v) == x && mesh.points(1, v) == y ? 1 : 0;
+    return n;
+  };
+  SECTION("the cut is one node per pair, its facets interior; face BCs by range; written back as the block") {
+    const fs::path file = test::scratch_path("cgrid.cgns");
+    build(file, [](CgnsBuilder& f, int z) {
+      f.one_to_one(z, "wake", "cgrid", {1, 1, 3, 1}, {9, 1, 7, 1}, {-1, -2});
+      // A 2D block's face BCs are at EdgeCenter (the library refuses FaceCenter there).
+      f.boco(z, "plate", CGNS_ENUMV(PointRange), {3, 1, 6, 1}, CGNS_ENUMV(EdgeCenter), 2);    // cells i 3..6 at j = 1
+      f.boco(z, "outflow", CGNS_ENUMV(PointRange), {1, 1, 1, 3}, CGNS_ENUMV(EdgeCenter), 2);  // i = 1, cells j 1..3
+      f.boco(z, "far", CGNS_ENUMV(PointRange), {1, 4, 9, 4}, CGNS_ENUMV(Vertex), 2);
+    });
+    const Mesh<2> mesh = read_mesh_as<2>(file);
+    CHECK(mesh.num_nodes() == ni * nj - 3);
+    CHECK(mesh.num_cells() == 24);
+    // Free edges: the plate's 4, the far field's 8 and the two outflows' 3 each; the wake's
+    // 2 + 2 edges are interior (a cut read apart would leave 22).
+    Index free = 0;
+    for (const auto& b : boundary_facets(mesh)) free += b.size();
+    CHECK(free == 18);
+    CHECK(count_at(mesh, 9.0, 0.0) == 1);   // wake (s = ±3)
+    CHECK(count_at(mesh, 4.0, 0.0) == 1);   // trailing edge (s = ±2)
+    CHECK(count_at(mesh, 1.0, 0.0) == 2);   // the plate's two sides (s = ±1)
+    CHECK(test::group_size(mesh, "plate") == 4);
+    CHECK(mesh.group_nodes("plate").size() == 4);
+    CHECK(test::group_size(mesh, "outflow") == 3);
+    for (const Index v : mesh.group_nodes("outflow")) CHECK(mesh.points(1, v) <= 0.0);  // s = -4: y = -8 t
+    CHECK(test::group_size(mesh, "far") == 8);
+
+    Mesh<2> moved = mesh;
+    for (Index v = 0; v < moved.num_nodes(); ++v) moved.points(1, v) += 0.01 * moved.points(0, v);
+    const fs::path out = test::scratch_path("cgrid_moved.cgns");
+    write_cgns_coordinates(file, out, moved);
+    const Mesh<2> back = read_mesh_as<2>(out);
+    CHECK(back.num_nodes() == mesh.num_nodes());  // both copies of each cut vertex written alike
+    CHECK(back.points == moved.points);
+  }
+  SECTION("a connection whose vertices are apart (periodic) joins nothing") {
+    const fs::path file = test::scratch_path("cgrid_periodic.cgns");
+    build(file, [](CgnsBuilder& f, int z) { f.one_to_one(z, "periodic", "cgrid", {1, 2, 1, 4}, {9, 2, 9, 4}, {1, 2}); });
+    CHECK(read_mesh_as<2>(file).num_nodes() == ni * nj);
+  }
+  SECTION("3D: face BCs by range (FaceCenter, on the block face it lies on) and by list (KFaceCenter)") {
+    const fs::path file = test::scratch_path("structured_face_bcs.cgns");
+    {
+      CgnsBuilder f(file, 3, 3);
+      const int z = f.structured_zone("blk", 3, 3, 3, 0.0);
+      f.boco(z, "top", CGNS_ENUMV(PointRange), {1, 1, 3, 2, 2, 3}, CGNS_ENUMV(FaceCenter), 3);      // k = 3, every cell
+      f.boco(z, "bottom", CGNS_ENUMV(PointList), {1, 1, 1, 2, 2, 1}, CGNS_ENUMV(KFaceCenter), 3);   // two of the four at k = 1
+      f.boco(z, "inlet", CGNS_ENUMV(PointRange), {1, 2, 1, 1, 2, 2}, CGNS_ENUMV(IFaceCenter), 3);   // i = 1, j cell 2, k cells 1..2
+    }
+    const Mesh<3> mesh = read_mesh_as<3>(file);
+    CHECK(test::group_size(mesh, "top") == 4);
+    for (const Index v : mesh.group_nodes("top")) CHECK(mesh.points(2, v) == 2.0);
+    CHECK(test::group_size(mesh, "bottom") == 2);
+    for (const Index v : mesh.group_nodes("bottom")) CHECK((mesh.points(2, v) == 0.0 && std::abs(mesh.points(0, v) - mesh.points(1, v)) <= 1.0));
+    CHECK(mesh.group_nodes("bottom").size() == 7);  // faces (1,1) and (2,2) share their corner (1,1)
+    CHECK(test::group_size(mesh, "inlet") == 2);
+    for (const Index v : mesh.group_nodes("inlet")) CHECK((mesh.points(0, v) == 0.0 && mesh.points(1, v) >= 1.0));
+  }
+  SECTION("refused, naming the record") {
+    const auto refused = [&](const std::string& stem, auto&& extra, const std::vector<std::string>& parts) {
+      const fs::path file = test::scratch_path(stem + ".cgns");
+      build(file, extra);
+      require_input_error([&] { (void)read_mesh(file); }, parts);
+    };
+    // The library's writer refuses these three; another tool's file may hold them.
+    const auto wake = [](std::vector<cgsize_t> range, std::vector<cgsize_t> donor, std::vector<int> transform) {
+      return [=](CgnsBuilder& f, int z) {
+        f.one_to_one(z, "wake", "cgrid", {1, 1, 3, 1}, {9, 1, 7, 1}, {-1, -2});
+        const std::string at = "/Base/cgrid/ZoneGridConnectivity/wake";
+        f.overwrite(at + "/PointRange", range);
+        f.overwrite(at + "/PointRangeDonor", donor);
+        f.overwrite(at + "/Transform", transform);
+      };
+    };
+    refused("cgrid_transform", wake({1, 1, 3, 1}, {9, 1, 7, 1}, {-1, -1}),
+            {"/Base/cgrid/ZoneGridConnectivity/wake", "transform (-1, -1)", "signed permutation"});
+    refused("cgrid_range", wake({1, 1, 10, 1}, {9, 1, 7, 1}, {-1, -2}),
+            {"/Base/cgrid/ZoneGridConnectivity/wake", "range index 1 is 10", "9 vertices"});
+    refused("cgrid_donor", wake({1, 1, 3, 1}, {9, 1, 8, 1}, {-1, -2}),
+            {"/Base/cgrid/ZoneGridConnectivity/wake", "vertex (3, 1)", "outside the donor range"});
+    refused("cgrid_face_list", [](CgnsBuilder& f, int z) { f.boco(z, "plate", CGNS_ENUMV(PointList), {3, 1}, CGNS_ENUMV(EdgeCenter), 2); },
+            {"/Base/cgrid/ZoneBC/plate", "EdgeCenter PointList", "IFaceCenter"});
+    refused("cgrid_face_inside", [](CgnsBuilder& f, int z) { f.boco(z, "cut", CGNS_ENUMV(PointRange), {3, 2, 6, 2}, CGNS_ENUMV(EdgeCenter), 2); },
+            {"/Base/cgrid/ZoneBC/cut", "lies on no block face"});
+    refused("cgrid_face_index", [](CgnsBuilder& f, int z) { f.boco(z, "outflow", CGNS_ENUMV(PointRange), {1, 1, 1, 4}, CGNS_ENUMV(EdgeCenter), 2); },
+            {"/Base/cgrid/ZoneBC/outflow", "face index 2 is 4", "expected 1 to 3 for cells"});
+    const auto refused_3d = [&](const std::string& stem, auto&& extra, const std::vector<std::string>& parts) {
+      const fs::path file = test::scratch_path(stem + ".cgns");
+      {
+        CgnsBuilder f(file, 3, 3);
+        extra(f, f.structured_zone("blk", 3, 3, 3, 0.0));
+      }
+      require_input_error([&] { (void)read_mesh(file); }, parts);
+    };
+    refused_3d("structured_face_interior", [](CgnsBuilder& f, int z) { f.boco(z, "cut", CGNS_ENUMV(PointRange), {2, 1, 1, 2, 2, 2}, CGNS_ENUMV(IFaceCenter), 3); },
+               {"/Base/blk/ZoneBC/cut", "not on the block's boundary"});
+    refused_3d("structured_edge_bc", [](CgnsBuilder& f, int z) { f.boco(z, "edge", CGNS_ENUMV(PointRange), {1, 1, 1, 2, 1, 1}, CGNS_ENUMV(EdgeCenter), 3); },
+               {"/Base/blk/ZoneBC/edge", "located at cells or edges"});
   }
 }
 

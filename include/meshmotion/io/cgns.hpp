@@ -19,10 +19,12 @@
 ///   node of an earlier zone is that node (conforming zone interfaces), and element numbers
 ///   continue from one zone to the next.
 /// - A structured zone (the multiblock grids of ADflow and IDWarp) reads as quadrilaterals or
-///   hexahedra, i fastest; its BCs (vertex PointRange or PointList of i, j[, k]) as the facet
-///   groups of the block faces they cover; block interfaces join by their coordinates, as the
-///   zones of an unstructured file do. Nodes repeated within one block (a C-grid's wake cut)
-///   stay apart.
+///   hexahedra, i fastest; its BCs (PointRange or PointList at vertices, or at faces:
+///   FaceCenter, IFaceCenter, JFaceCenter, KFaceCenter) as the facet groups of the block faces
+///   they cover; block interfaces join by their coordinates, as the zones of an unstructured
+///   file do. A block's 1-to-1 connection with itself (a C-grid's wake cut, an O-grid's seam)
+///   makes each pair of its vertices one node where they coincide; other nodes repeated within
+///   one block (a zero-thickness plate's two sides) stay apart.
 /// - Refused with the CGNS node path: several bases, no zone, polyhedral
 ///   (NGON_n/NFACE_n) or order ≥ 3 sections, a node or element number out of range, an element
 ///   in two BCs, coordinates other than CoordinateX/Y/Z.

@@ -13,11 +13,15 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstdlib>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <iterator>
+#include <limits>
 #include <map>
+#include <numeric>
 #include <string>
 #include <tuple>
 #include <unordered_map>
@@ -183,8 +187,10 @@ class CgnsReader {
   }
 
   /// A structured zone (ni × nj [× nk] vertices, i fastest): its cells as quadrilaterals or
-  /// hexahedra, its BCs (vertex ranges or lists of i, j, k) as facet groups on the block's faces;
-  /// block interfaces join as the nodes of several zones do, by their coordinates.
+  /// hexahedra, its BCs (vertex or face ranges or lists of i, j, k) as facet groups on the
+  /// block's faces; block interfaces join as the nodes of several zones do, by their
+  /// coordinates, and the block's 1-to-1 connections with itself (a C-grid's wake cut, an
+  /// O-grid's seam) by its connectivity records.
   void read_structured_zone(int z) {
     const int fn = cgns_.id();
     char name[33] = {};
@@ -199,7 +205,7 @@ class CgnsReader {
         cgns_.fail(zone_, "structured zone of " + std::to_string(n[static_cast<std::size_t>(d)]) + " vertices along index " +
                               std::to_string(d + 1) + " (expected at least 2)");
     }
-    const std::vector<Index>& node_of_vertex = zone_nodes_.emplace_back(read_coordinates(z, n));
+    const std::vector<Index>& node_of_vertex = zone_nodes_.emplace_back(read_coordinates(z, n, self_joins(z, n)));
     const std::int64_t ni = n[0], nj = n[1], nk = cell_dim_ == 3 ? n[2] : 2;
     const auto vertex = [&](std::int64_t i, std::int64_t j, std::int64_t k) { return i + ni * (j + nj * k); };
     const ElementType type = cell_dim_ == 3 ? ElementType::hex8 : ElementType::quad4;
@@ -226,9 +232,86 @@ class CgnsReader {
     finish_zone(number);
   }
 
+  /// A structured zone's 1-to-1 connection with itself: pairs of its vertices (0-based, i
+  /// fastest) that are one node when they coincide.
+  struct SelfJoin {
+    std::string path;
+    std::vector<std::pair<std::int64_t, std::int64_t>> pairs;
+  };
+
+  /// The 1-to-1 connections of structured zone z (vertices per index `n`) whose donor is the
+  /// zone itself, each vertex of the range paired with its donor vertex through the
+  /// connection's transform (SIDS: donor = T (index − range begin) + donor begin). Refuses a
+  /// range or transform that does not fit the zone.
+  [[nodiscard]] std::vector<SelfJoin> self_joins(int z, const std::vector<std::int64_t>& n) {
+    const int fn = cgns_.id();
+    int count = 0;
+    cgns_.check(cgns_api().cg_n1to1(fn, 1, z, &count), zone_ + "/ZoneGridConnectivity");
+    std::vector<SelfJoin> out;
+    const std::size_t dim = n.size();
+    for (int c = 1; c <= count; ++c) {
+      char name[33] = {}, donor[33] = {};
+      std::array<cgsize_t, 6> range{}, donor_range{};
+      std::array<int, 3> transform{};
+      cgns_.check(cgns_api().cg_1to1_read(fn, 1, z, c, name, donor, range.data(), donor_range.data(), transform.data()),
+                  zone_ + "/ZoneGridConnectivity");
+      if (std::string(donor) != zone_name_) continue;  // another zone: joined by coordinates
+      SelfJoin& join = out.emplace_back();
+      join.path = zone_ + "/ZoneGridConnectivity/" + name;
+      std::array<bool, 3> used{};
+      for (std::size_t a = 0; a < dim; ++a) {
+        const int t = transform[a];
+        const auto to = static_cast<std::size_t>(std::abs(t) - 1);
+        if (t == 0 || std::abs(t) > static_cast<int>(dim) || used[to])
+          cgns_.fail(join.path, "transform (" + std::to_string(transform[0]) + ", " + std::to_string(transform[1]) +
+                                    (dim == 3 ? ", " + std::to_string(transform[2]) : std::string()) +
+                                    ") is not a signed permutation of the indices");
+        used[to] = true;
+      }
+      const auto inside = [&](const std::array<cgsize_t, 6>& r, std::size_t d, std::int64_t v) {
+        return v >= std::min(r[d], r[dim + d]) && v <= std::max(r[d], r[dim + d]) && v >= 1 && v <= n[d];
+      };
+      for (std::size_t d = 0; d < dim; ++d)
+        for (const cgsize_t v : {range[d], range[dim + d]})
+          if (v < 1 || v > n[d])
+            cgns_.fail(join.path, "range index " + std::to_string(d + 1) + " is " + std::to_string(v) + " (the zone has " +
+                                      std::to_string(n[d]) + " vertices along it, numbered from 1)");
+      std::array<std::int64_t, 3> lo{1, 1, 1}, hi{1, 1, 1};
+      for (std::size_t d = 0; d < dim; ++d) {
+        lo[d] = std::min(range[d], range[dim + d]);
+        hi[d] = std::max(range[d], range[dim + d]);
+      }
+      const auto linear = [&](const std::array<std::int64_t, 3>& ijk) {
+        std::int64_t at = 0;
+        for (std::size_t d = dim; d-- > 0;) at = at * n[d] + ijk[d] - 1;
+        return at;
+      };
+      for (std::int64_t k = lo[2]; k <= hi[2]; ++k)
+        for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
+          for (std::int64_t i = lo[0]; i <= hi[0]; ++i) {
+            const std::array<std::int64_t, 3> p{i, j, k};
+            std::array<std::int64_t, 3> q{1, 1, 1};
+            for (std::size_t a = 0; a < dim; ++a) {
+              const auto to = static_cast<std::size_t>(std::abs(transform[a]) - 1);
+              q[to] = donor_range[to] + (transform[a] > 0 ? 1 : -1) * (p[a] - range[a]);
+            }
+            for (std::size_t d = 0; d < dim; ++d)
+              if (!inside(donor_range, d, q[d]))
+                cgns_.fail(join.path, "vertex (" + std::to_string(i) + ", " + std::to_string(j) +
+                                          (dim == 3 ? ", " + std::to_string(k) : std::string()) +
+                                          ") maps outside the donor range (its transform and ranges disagree)");
+            join.pairs.emplace_back(linear(p), linear(q));
+          }
+    }
+    return out;
+  }
+
   /// Reads the zone's coordinates (`size`: its vertices, or per index of a structured zone);
-  /// returns the mesh node of each CGNS vertex (0-based, i fastest).
-  [[nodiscard]] std::vector<Index> read_coordinates(int z, const std::vector<std::int64_t>& size) {
+  /// returns the mesh node of each CGNS vertex (0-based, i fastest). The vertices a self join
+  /// pairs are one node where every pair of that join coincides (to 1e-9 of the zone's size; a
+  /// periodic connection, whose vertices are apart, joins nothing).
+  [[nodiscard]] std::vector<Index> read_coordinates(int z, const std::vector<std::int64_t>& size,
+                                                    const std::vector<SelfJoin>& joins = {}) {
     std::int64_t num_vertices = 1;
     for (const std::int64_t extent : size) num_vertices *= extent;
     const int fn = cgns_.id();
@@ -261,26 +344,77 @@ class CgnsReader {
     }
     std::vector<Index> node(static_cast<std::size_t>(num_vertices));
     const Index first = raw_.num_nodes();
-    if (!multi_zone_) {
+    const std::vector<std::int64_t> same = joined_vertices(xyz, joins);
+    if (!multi_zone_ && same.empty()) {
       raw_.coords = std::move(xyz);
       for (std::int64_t i = 0; i < num_vertices; ++i) node[static_cast<std::size_t>(i)] = first + i;
       return node;
     }
     // Conforming zone interfaces: the same coordinates in an earlier zone are the same node
-    // (not within one zone: duplicated nodes there are the file's, kept apart).
+    // (not within one zone: duplicated nodes there are the file's, kept apart unless joined).
     std::vector<std::pair<Key, Index>> added;
     for (std::int64_t i = 0; i < num_vertices; ++i) {
-      const Key key = key_of(&xyz[static_cast<std::size_t>(3 * i)]);
-      if (const auto it = node_at_.find(key); it != node_at_.end()) {
-        node[static_cast<std::size_t>(i)] = it->second;
+      if (!same.empty() && same[static_cast<std::size_t>(i)] != i) {
+        node[static_cast<std::size_t>(i)] = node[static_cast<std::size_t>(same[static_cast<std::size_t>(i)])];
         continue;
+      }
+      if (multi_zone_) {
+        const Key key = key_of(&xyz[static_cast<std::size_t>(3 * i)]);
+        if (const auto it = node_at_.find(key); it != node_at_.end()) {
+          node[static_cast<std::size_t>(i)] = it->second;
+          continue;
+        }
+        added.emplace_back(key, raw_.num_nodes());
       }
       node[static_cast<std::size_t>(i)] = raw_.num_nodes();
       raw_.coords.insert(raw_.coords.end(), xyz.begin() + 3 * i, xyz.begin() + 3 * i + 3);
-      added.emplace_back(key, node[static_cast<std::size_t>(i)]);
     }
     for (const auto& [key, index] : added) node_at_.try_emplace(key, index);
     return node;
+  }
+
+  /// Per vertex of `xyz` (3 per vertex), the first vertex it is one node with through `joins`
+  /// (itself when none); empty when no join applies.
+  [[nodiscard]] static std::vector<std::int64_t> joined_vertices(const std::vector<double>& xyz, const std::vector<SelfJoin>& joins) {
+    if (joins.empty()) return {};
+    const auto count = static_cast<std::int64_t>(xyz.size() / 3);
+    std::array<double, 3> lo{}, hi{};
+    lo.fill(std::numeric_limits<double>::infinity());
+    hi.fill(-std::numeric_limits<double>::infinity());
+    for (std::int64_t v = 0; v < count; ++v)
+      for (std::size_t d = 0; d < 3; ++d) {
+        lo[d] = std::min(lo[d], xyz[static_cast<std::size_t>(3 * v) + d]);
+        hi[d] = std::max(hi[d], xyz[static_cast<std::size_t>(3 * v) + d]);
+      }
+    double diagonal = 0.0;
+    for (std::size_t d = 0; d < 3; ++d) diagonal += (hi[d] - lo[d]) * (hi[d] - lo[d]);
+    const double tolerance = 1e-9 * std::sqrt(diagonal);
+    const auto apart = [&](std::int64_t a, std::int64_t b) {
+      double d2 = 0.0;
+      for (std::size_t d = 0; d < 3; ++d) {
+        const double e = xyz[static_cast<std::size_t>(3 * a) + d] - xyz[static_cast<std::size_t>(3 * b) + d];
+        d2 += e * e;
+      }
+      return d2 > tolerance * tolerance;
+    };
+    std::vector<std::int64_t> root(static_cast<std::size_t>(count));
+    std::iota(root.begin(), root.end(), std::int64_t{0});
+    const auto find = [&](std::int64_t v) {
+      while (root[static_cast<std::size_t>(v)] != v) v = root[static_cast<std::size_t>(v)] = root[static_cast<std::size_t>(root[static_cast<std::size_t>(v)])];
+      return v;
+    };
+    bool any = false;
+    for (const SelfJoin& join : joins) {
+      if (std::any_of(join.pairs.begin(), join.pairs.end(), [&](const auto& p) { return apart(p.first, p.second); })) continue;
+      for (const auto& [a, b] : join.pairs) {
+        const std::int64_t ra = find(a), rb = find(b);
+        if (ra != rb) root[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+        any = any || ra != rb;
+      }
+    }
+    if (!any) return {};
+    for (std::int64_t v = 0; v < count; ++v) root[static_cast<std::size_t>(v)] = find(v);
+    return root;
   }
 
   /// Reads section s into the blocks; returns its last element number (zone numbering).
@@ -417,9 +551,12 @@ class CgnsReader {
       if (range && points.size() != 2 * index_dim)
         cgns_.fail(path, "a range needs " + std::to_string(2 * index_dim) + " numbers (got " + std::to_string(points.size()) + ")");
       if (!structured.empty()) {
-        if (location != CGNS_ENUMV(Vertex) || ptset == CGNS_ENUMV(ElementRange) || ptset == CGNS_ENUMV(ElementList))
-          cgns_.fail(path, "a structured zone's BC on faces or elements (meshmotion reads its BCs as vertex ranges or lists)");
-        tag_facets_on_vertices(structured_bc_vertices(points, range, structured, path), node_of_vertex, tag, path, false, sections);
+        if (ptset == CGNS_ENUMV(ElementRange) || ptset == CGNS_ENUMV(ElementList))
+          cgns_.fail(path, "a structured zone's BC by element numbers (expected a PointRange or PointList of indices)");
+        if (location == CGNS_ENUMV(Vertex))
+          tag_facets_on_vertices(structured_bc_vertices(points, range, structured, path), node_of_vertex, tag, path, false, sections);
+        else
+          tag_structured_faces(structured_bc_faces(points, range, structured, location, path), node_of_vertex, tag, path, sections);
         continue;
       }
       const bool elements = ptset == CGNS_ENUMV(ElementRange) || ptset == CGNS_ENUMV(ElementList) ||
@@ -487,6 +624,110 @@ class CgnsReader {
       for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
         for (std::int64_t i = lo[0]; i <= hi[0]; ++i) flag({i, j, k});
     return in_bc;
+  }
+
+  /// The faces of a structured BC located at faces, each as its vertices (0-based, i fastest;
+  /// 2 in 2D, 4 in 3D): a range or list of face indices, the index normal to the faces taking
+  /// vertex values (1..n) and the others cell values (1..n−1), as SIDS numbers them. The normal
+  /// index is the location's (IFaceCenter, JFaceCenter, KFaceCenter) or, for FaceCenter (and a
+  /// 2D block's EdgeCenter), the one a range holds at the block's first or last vertex plane.
+  std::vector<std::array<std::int64_t, 4>> structured_bc_faces(const std::vector<cgsize_t>& points, bool range,
+                                                                const std::vector<std::int64_t>& n,
+                                                                CGNS_ENUMT(GridLocation_t) location, const std::string& path) const {
+    const std::size_t dim = n.size();
+    int normal = -1;
+    // A 2D block's faces are its edges: CGNS writes their BCs at EdgeCenter.
+    const bool faces = location == CGNS_ENUMV(FaceCenter) || (dim == 2 && location == CGNS_ENUMV(EdgeCenter));
+    if (location == CGNS_ENUMV(IFaceCenter)) normal = 0;
+    else if (location == CGNS_ENUMV(JFaceCenter)) normal = 1;
+    else if (location == CGNS_ENUMV(KFaceCenter) && dim == 3) normal = 2;
+    else if (!faces)
+      cgns_.fail(path, "a structured zone's BC located at cells or edges (expected Vertex, FaceCenter, IFaceCenter, "
+                       "JFaceCenter, KFaceCenter, or EdgeCenter in 2D)");
+    if (normal < 0) {
+      if (!range) cgns_.fail(path, "a FaceCenter or EdgeCenter PointList does not say which index is normal to its faces "
+                                   "(give IFaceCenter, JFaceCenter or KFaceCenter, or a PointRange)");
+      for (std::size_t d = 0; d < dim; ++d)
+        if (points[d] == points[dim + d] && (points[d] == 1 || points[d] == n[d])) {
+          if (normal >= 0)
+            cgns_.fail(path, "the face range lies on two block faces (indices " + std::to_string(normal + 1) + " and " +
+                                 std::to_string(d + 1) + "): give IFaceCenter, JFaceCenter or KFaceCenter");
+          normal = static_cast<int>(d);
+        }
+      if (normal < 0) cgns_.fail(path, "the face range lies on no block face (expected one index fixed at 1 or at its last vertex)");
+    }
+    const auto check = [&](std::size_t d, std::int64_t v) {
+      const std::int64_t last = static_cast<int>(d) == normal ? n[d] : n[d] - 1;
+      if (v < 1 || v > last)
+        cgns_.fail(path, "face index " + std::to_string(d + 1) + " is " + std::to_string(v) + " (expected 1 to " +
+                             std::to_string(last) + " for " + (static_cast<int>(d) == normal ? "vertex planes" : "cells") +
+                             " along it)");
+    };
+    std::vector<std::array<std::int64_t, 4>> out;
+    const auto add = [&](const std::array<std::int64_t, 3>& f) {
+      std::array<std::int64_t, 4> face{-1, -1, -1, -1};
+      const std::size_t corners = std::size_t{1} << (dim - 1);
+      for (std::size_t c = 0; c < corners; ++c) {
+        std::array<std::int64_t, 3> v = f;
+        std::size_t bit = 0;
+        for (std::size_t d = 0; d < dim; ++d)
+          if (static_cast<int>(d) != normal) v[d] += static_cast<std::int64_t>((c >> bit++) & 1U);
+        std::int64_t at = 0;
+        for (std::size_t d = dim; d-- > 0;) at = at * n[d] + v[d] - 1;
+        face[c] = at;
+      }
+      out.push_back(face);
+    };
+    if (!range) {
+      for (std::size_t p = 0; p + dim <= points.size(); p += dim) {
+        std::array<std::int64_t, 3> f{1, 1, 1};
+        for (std::size_t d = 0; d < dim; ++d) check(d, f[d] = points[p + d]);
+        add(f);
+      }
+      return out;
+    }
+    std::array<std::int64_t, 3> lo{1, 1, 1}, hi{1, 1, 1};
+    for (std::size_t d = 0; d < dim; ++d) {
+      check(d, points[d]);
+      check(d, points[dim + d]);
+      lo[d] = std::min<std::int64_t>(points[d], points[dim + d]);
+      hi[d] = std::max<std::int64_t>(points[d], points[dim + d]);
+    }
+    for (std::int64_t k = lo[2]; k <= hi[2]; ++k)
+      for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
+        for (std::int64_t i = lo[0]; i <= hi[0]; ++i) add({i, j, k});
+    return out;
+  }
+
+  /// A face BC of a structured zone: each face (its vertices) is the boundary facet with those
+  /// nodes; a face inside the block is refused.
+  void tag_structured_faces(const std::vector<std::array<std::int64_t, 4>>& faces, const std::vector<Index>& node_of_vertex,
+                            int tag, const std::string& path, const CgnsSections& sections) {
+    if (boundary_.empty()) boundary_ = cell_dim_ == 3 ? zone_boundary<3>(sections) : zone_boundary<2>(sections);
+    const auto sorted = [](std::array<Index, 4> key) {
+      std::sort(key.begin(), key.end());
+      return key;
+    };
+    std::map<std::array<Index, 4>, std::pair<std::size_t, Index>> facet_at;
+    for (std::size_t k = 0; k < boundary_.size(); ++k)
+      for (Index e = 0; e < boundary_[k].size(); ++e) {
+        std::array<Index, 4> key{-1, -1, -1, -1};
+        const auto nodes = boundary_[k].element(e);
+        std::copy_n(nodes.begin(), std::min<std::size_t>(nodes.size(), 4), key.begin());
+        facet_at.emplace(sorted(key), std::pair{k, e});
+      }
+    for (const auto& face : faces) {
+      std::array<Index, 4> key{-1, -1, -1, -1};
+      for (std::size_t c = 0; c < 4 && face[c] >= 0; ++c) key[c] = node_of_vertex[static_cast<std::size_t>(face[c])];
+      const auto found = facet_at.find(sorted(key));
+      if (found == facet_at.end())
+        cgns_.fail(path, "a face of the BC (vertex " + std::to_string(face[0] + 1) + " of the zone, counted i fastest from 1) is "
+                         "not on the block's boundary");
+      int& t = boundary_[found->second.first].tags[static_cast<std::size_t>(found->second.second)];
+      if (t != 0 && t != tag) cgns_.fail(path, "a boundary facet lies in two BCs (the groups of tags " + std::to_string(t) +
+                                                   " and " + std::to_string(tag) + ")");
+      t = tag;
+    }
   }
 
   /// A vertex BC: the zone's facets whose vertices the BC all holds; its boundary facets when

@@ -27,7 +27,7 @@
   X(cg_coord_read) X(cg_coord_write) X(cg_nsections) X(cg_section_read) X(cg_elements_read)                  \
   X(cg_poly_elements_read) X(cg_section_write) X(cg_poly_section_write) X(cg_nbocos) X(cg_boco_info)         \
   X(cg_boco_read) X(cg_boco_write) X(cg_boco_gridlocation_read) X(cg_boco_gridlocation_write)                \
-  X(cg_famname_read) X(cg_dataclass_write) X(cg_exponents_write) X(cg_ElementDataSize) X(cg_ElementTypeName)
+  X(cg_famname_read) X(cg_n1to1) X(cg_1to1_read) X(cg_dataclass_write) X(cg_exponents_write) X(cg_ElementDataSize) X(cg_ElementTypeName)
 
 namespace meshmotion::detail {
 
