@@ -271,37 +271,25 @@ class CgnsReader {
       const auto inside = [&](const std::array<cgsize_t, 6>& r, std::size_t d, std::int64_t v) {
         return v >= std::min(r[d], r[dim + d]) && v <= std::max(r[d], r[dim + d]) && v >= 1 && v <= n[d];
       };
-      for (std::size_t d = 0; d < dim; ++d)
-        for (const cgsize_t v : {range[d], range[dim + d]})
-          if (v < 1 || v > n[d])
-            cgns_.fail(join.path, "range index " + std::to_string(d + 1) + " is " + std::to_string(v) + " (the zone has " +
-                                      std::to_string(n[d]) + " vertices along it, numbered from 1)");
-      std::array<std::int64_t, 3> lo{1, 1, 1}, hi{1, 1, 1};
-      for (std::size_t d = 0; d < dim; ++d) {
-        lo[d] = std::min(range[d], range[dim + d]);
-        hi[d] = std::max(range[d], range[dim + d]);
-      }
-      const auto linear = [&](const std::array<std::int64_t, 3>& ijk) {
-        std::int64_t at = 0;
-        for (std::size_t d = dim; d-- > 0;) at = at * n[d] + ijk[d] - 1;
-        return at;
+      const auto check = [&](std::size_t d, std::int64_t v) {
+        if (v < 1 || v > n[d])
+          cgns_.fail(join.path, "range index " + std::to_string(d + 1) + " is " + std::to_string(v) + " (the zone has " +
+                                    std::to_string(n[d]) + " vertices along it, numbered from 1)");
       };
-      for (std::int64_t k = lo[2]; k <= hi[2]; ++k)
-        for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
-          for (std::int64_t i = lo[0]; i <= hi[0]; ++i) {
-            const std::array<std::int64_t, 3> p{i, j, k};
-            std::array<std::int64_t, 3> q{1, 1, 1};
-            for (std::size_t a = 0; a < dim; ++a) {
-              const auto to = static_cast<std::size_t>(std::abs(transform[a]) - 1);
-              q[to] = donor_range[to] + (transform[a] > 0 ? 1 : -1) * (p[a] - range[a]);
-            }
-            for (std::size_t d = 0; d < dim; ++d)
-              if (!inside(donor_range, d, q[d]))
-                cgns_.fail(join.path, "vertex (" + std::to_string(i) + ", " + std::to_string(j) +
-                                          (dim == 3 ? ", " + std::to_string(k) : std::string()) +
-                                          ") maps outside the donor range (its transform and ranges disagree)");
-            join.pairs.emplace_back(linear(p), linear(q));
-          }
+      const std::vector<cgsize_t> corners(range.begin(), range.begin() + static_cast<std::ptrdiff_t>(2 * dim));
+      for_each_index(corners, true, dim, check, [&](const std::array<std::int64_t, 3>& p) {
+        std::array<std::int64_t, 3> q{1, 1, 1};
+        for (std::size_t a = 0; a < dim; ++a) {
+          const auto to = static_cast<std::size_t>(std::abs(transform[a]) - 1);
+          q[to] = donor_range[to] + (transform[a] > 0 ? 1 : -1) * (p[a] - range[a]);
+        }
+        for (std::size_t d = 0; d < dim; ++d)
+          if (!inside(donor_range, d, q[d]))
+            cgns_.fail(join.path, "vertex (" + std::to_string(p[0]) + ", " + std::to_string(p[1]) +
+                                      (dim == 3 ? ", " + std::to_string(p[2]) : std::string()) +
+                                      ") maps outside the donor range (its transform and ranges disagree)");
+        join.pairs.emplace_back(vertex_number(p, n), vertex_number(q, n));
+      });
     }
     return out;
   }
@@ -587,6 +575,38 @@ class CgnsReader {
     }
   }
 
+  /// Calls visit(ijk) for each index (i, j[, k]) of a point set of a `dim`-index zone: a list
+  /// (dim numbers per point) or the box between a range's two corners, in any order; check(d, v)
+  /// sees each number given first.
+  template <class Check, class Visit>
+  static void for_each_index(const std::vector<cgsize_t>& points, bool range, std::size_t dim, Check&& check, Visit&& visit) {
+    if (!range) {
+      for (std::size_t p = 0; p + dim <= points.size(); p += dim) {
+        std::array<std::int64_t, 3> ijk{1, 1, 1};
+        for (std::size_t d = 0; d < dim; ++d) check(d, ijk[d] = points[p + d]);
+        visit(ijk);
+      }
+      return;
+    }
+    std::array<std::int64_t, 3> lo{1, 1, 1}, hi{1, 1, 1};
+    for (std::size_t d = 0; d < dim; ++d) {
+      check(d, points[d]);
+      check(d, points[dim + d]);
+      lo[d] = std::min<std::int64_t>(points[d], points[dim + d]);
+      hi[d] = std::max<std::int64_t>(points[d], points[dim + d]);
+    }
+    for (std::int64_t k = lo[2]; k <= hi[2]; ++k)
+      for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
+        for (std::int64_t i = lo[0]; i <= hi[0]; ++i) visit(std::array<std::int64_t, 3>{i, j, k});
+  }
+
+  /// The 0-based number (i fastest) of vertex ijk (1-based) of a zone with n vertices per index.
+  [[nodiscard]] static std::int64_t vertex_number(const std::array<std::int64_t, 3>& ijk, const std::vector<std::int64_t>& n) {
+    std::int64_t at = 0;
+    for (std::size_t d = n.size(); d-- > 0;) at = at * n[d] + ijk[d] - 1;
+    return at;
+  }
+
   /// The vertices (flags, i fastest) of a structured BC: the box between a range's two
   /// corners, or the listed (i, j[, k]), each index within the zone.
   std::vector<char> structured_bc_vertices(const std::vector<cgsize_t>& points, bool range, const std::vector<std::int64_t>& n,
@@ -600,29 +620,8 @@ class CgnsReader {
         cgns_.fail(path, "index " + std::to_string(d + 1) + " is " + std::to_string(v) + " (the zone has " + std::to_string(n[d]) +
                              " vertices along it, numbered from 1)");
     };
-    const auto flag = [&](const std::array<std::int64_t, 3>& ijk) {
-      std::int64_t at = 0;
-      for (std::size_t d = dim; d-- > 0;) at = at * n[d] + ijk[d] - 1;
-      in_bc[static_cast<std::size_t>(at)] = 1;
-    };
-    if (!range) {
-      for (std::size_t p = 0; p + dim <= points.size(); p += dim) {
-        std::array<std::int64_t, 3> ijk{1, 1, 1};
-        for (std::size_t d = 0; d < dim; ++d) check(d, ijk[d] = points[p + d]);
-        flag(ijk);
-      }
-      return in_bc;
-    }
-    std::array<std::int64_t, 3> lo{1, 1, 1}, hi{1, 1, 1};
-    for (std::size_t d = 0; d < dim; ++d) {
-      check(d, points[d]);
-      check(d, points[dim + d]);
-      lo[d] = std::min<std::int64_t>(points[d], points[dim + d]);
-      hi[d] = std::max<std::int64_t>(points[d], points[dim + d]);
-    }
-    for (std::int64_t k = lo[2]; k <= hi[2]; ++k)
-      for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
-        for (std::int64_t i = lo[0]; i <= hi[0]; ++i) flag({i, j, k});
+    const auto flag = [&](const std::array<std::int64_t, 3>& ijk) { in_bc[static_cast<std::size_t>(vertex_number(ijk, n))] = 1; };
+    for_each_index(points, range, dim, check, flag);
     return in_bc;
   }
 
@@ -672,30 +671,11 @@ class CgnsReader {
         std::size_t bit = 0;
         for (std::size_t d = 0; d < dim; ++d)
           if (static_cast<int>(d) != normal) v[d] += static_cast<std::int64_t>((c >> bit++) & 1U);
-        std::int64_t at = 0;
-        for (std::size_t d = dim; d-- > 0;) at = at * n[d] + v[d] - 1;
-        face[c] = at;
+        face[c] = vertex_number(v, n);
       }
       out.push_back(face);
     };
-    if (!range) {
-      for (std::size_t p = 0; p + dim <= points.size(); p += dim) {
-        std::array<std::int64_t, 3> f{1, 1, 1};
-        for (std::size_t d = 0; d < dim; ++d) check(d, f[d] = points[p + d]);
-        add(f);
-      }
-      return out;
-    }
-    std::array<std::int64_t, 3> lo{1, 1, 1}, hi{1, 1, 1};
-    for (std::size_t d = 0; d < dim; ++d) {
-      check(d, points[d]);
-      check(d, points[dim + d]);
-      lo[d] = std::min<std::int64_t>(points[d], points[dim + d]);
-      hi[d] = std::max<std::int64_t>(points[d], points[dim + d]);
-    }
-    for (std::int64_t k = lo[2]; k <= hi[2]; ++k)
-      for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
-        for (std::int64_t i = lo[0]; i <= hi[0]; ++i) add({i, j, k});
+    for_each_index(points, range, dim, check, add);
     return out;
   }
 
