@@ -7,7 +7,9 @@
 The calls keep IDWarp's names, shapes and orderings: surface arrays are (N, 3), volume grids
 flat (3 N) as IDWarp returns them. Each rank holds a part of the mesh (Warp(comm=...)); the
 surface is the solver's (setSurfaceDefinition: points on any rank, repeated where the solver
-repeats them) or, by default, every node of the specified surfaces on rank 0. A surface node
+repeats them) or, by default, every node of the specified surfaces on rank 0. A decomposed
+OpenFOAM case is read as DAFoam runs it: each rank its own processor folder, none the whole
+mesh, the solver's nodes that folder's points. A surface node
 given several times takes the mean of its copies, so each copy's row of getdXs() is the
 gradient divided by the number of copies: the directional derivative along any change of the
 points is the sum of the rows' products, as finite differences give it.
@@ -29,7 +31,7 @@ import numpy as _np
 
 from . import _core
 from ._arrays import index_array, real_array
-from .warp import Warp
+from .warp import Warp, _raise_any, _raise_everywhere
 
 _FILE_TYPES = ("CGNS", "OpenFOAM", "SU2")
 _INVERSE_DISTANCE_OPTIONS = ("aExp", "bExp", "LdefFact", "alpha", "errTol", "evalMode", "symmTol", "useRotations",
@@ -37,6 +39,9 @@ _INVERSE_DISTANCE_OPTIONS = ("aExp", "bExp", "LdefFact", "alpha", "errTol", "eva
 _KNOWN = ("gridFile", "fileType", "specifiedSurfaces", "symmetrySurfaces", "symmetryPlanes", "restartFile",
           "meshmotion") + _INVERSE_DISTANCE_OPTIONS
 _NOT_WALLS = ("far", "inlet", "outlet", "inflow", "outflow", "freestream")
+# OpenFOAM patch types that are no surface of the mesh: interfaces between processors or periodic
+# halves, and the planes of a 2D case.
+_NOT_SURFACES = ("processor", "processorCyclic", "cyclic", "cyclicAMI", "empty", "wedge")
 
 
 class _Route:
@@ -122,34 +127,82 @@ class USMesh:
         if not self.gridFile:
             raise _core.InputError("USMesh: the option gridFile is required")
         self._options = dict(options)
+        self._solver = None
+        self._dXs = None
+        grid = str(self.gridFile)
+        self._decomposed = self.fileType == "OpenFOAM" and self.comm.size > 1 and os.path.isdir(os.path.join(grid, "processor0"))
+        if self._decomposed:
+            surface = self._read_processors(options)
+        else:
+            surface = self._read_on_rank_0(options)
+        if self._warp.dim != 3:
+            raise _core.InputError("USMesh: the mesh is 2D (IDWarp's arrays are 3D; use meshmotion.Warp)")
+        owned = _np.flatnonzero(self._warp.owned)
+        ids = self._warp.node_ids
+        self._owned_rows = owned[_np.argsort(ids[owned], kind="stable")]  # owned rows by ascending global id
+        self._owned = ids[self._owned_rows]
+        self._design = self._warp.design_nodes  # this rank's owned design nodes, ascending
+        self._reference = self._warp.surface_coordinates()
+        self._surface = None  # global id of each surface point of this rank
+        self._define(*surface())
+        if self._decomposed:  # the solver's nodes are this rank's processor points, in their order
+            self.setExternalMeshIndices(ids)
+
+    def _read_on_rank_0(self, options):
+        """Rank 0 reads the grid; the Warp partitions it. Returns the internal surface's maker:
+        every design node on rank 0, with the design facets."""
         whole, groups = None, None
         failure = None
         if self.comm.rank == 0:
             try:
                 whole = _core.read_mesh(str(self.gridFile), "fix_reversed")
-                groups = _surfaces(whole, options)
+                groups = _surfaces([g for g, (dim, _) in whole.group_tags.items() if dim == whole.dim - 1], options,
+                                   _lies_in_mesh(whole))
             except Exception as error:  # every rank raises what rank 0 found
                 failure = (type(error).__name__, str(error))
-        from .warp import _raise_everywhere
         _raise_everywhere(self.comm, failure)
         design, symmetry = self.comm.bcast(groups, root=0)
         self._warp = Warp(whole, design=design, symmetry=symmetry, comm=self.comm, **dict(options.get("meshmotion", {})))
-        if self._warp.dim != 3:
-            raise _core.InputError("USMesh: the mesh is 2D (IDWarp's arrays are 3D; use meshmotion.Warp)")
-        self._owned = self._warp.node_ids[:self._warp.num_owned]
-        self._design = self._warp.design_nodes  # this rank's owned design nodes, ascending
-        self._reference = self._warp.surface_coordinates()
-        self._surface = None  # global id of each surface point of this rank
-        self._solver = None
-        self._dXs = None
-        # The internal surface: every design node on rank 0, with the design facets.
-        everyone = self.comm.gather(self._design, root=0)
-        if self.comm.rank == 0:
-            ids = _np.sort(_np.concatenate(everyone))
-            conn, sizes = _facets_of(whole, design, ids)
-        else:
-            ids, conn, sizes = _np.zeros(0, dtype=_np.int64), _np.zeros(0, dtype=_np.intc), _np.zeros(0, dtype=_np.intc)
-        self._define(ids, conn, sizes)
+
+        def surface():
+            everyone = self.comm.gather(self._design, root=0)
+            if self.comm.rank == 0:
+                ids = _np.sort(_np.concatenate(everyone))
+                return (ids,) + _facets_of(whole, design, ids)
+            return _np.zeros(0, dtype=_np.int64), _np.zeros(0, dtype=_np.intc), _np.zeros(0, dtype=_np.intc)
+        return surface
+
+    def _read_processors(self, options):
+        """A decomposed OpenFOAM case, as IDWarp and DAFoam read it: each rank its own processor
+        folder (points in OpenFOAM's order, global ids from pointProcAddressing); no rank holds
+        the whole mesh. Returns the internal surface's maker: each rank's faces of the design
+        patches."""
+        comm, grid = self.comm, str(self.gridFile)
+        local, failure = None, None
+        try:
+            count = sum(1 for d in os.listdir(grid) if d.startswith("processor") and d[9:].isdigit())
+            if count != comm.size:
+                raise _core.InputError(f"USMesh: {grid} is decomposed into {count} processor folders for {comm.size} ranks "
+                                       "(run as many ranks as folders)")
+            local = _core.read_foam_processor(os.path.join(grid, f"processor{comm.rank}"))
+        except Exception as error:
+            failure = (type(error).__name__, str(error))
+        _raise_any(comm, failure)
+        points, ids = local["points"], local["global_ids"]
+        patches = [p for p in local["patches"] if p["type"] not in _NOT_SURFACES]
+        groups = {p["name"]: _np.unique(p["conn"]) for p in patches}
+        names = list(dict.fromkeys(name for names in comm.allgather([p["name"] for p in patches]) for name in names))
+        design, symmetry = _surfaces(names, options, _lies_in_partition(comm, points, groups))
+        self._warp = Warp.from_partition(comm, points, ids, _lowest_holders(comm, ids), groups, design=design,
+                                         symmetry=symmetry, **dict(options.get("meshmotion", {})))
+
+        def surface():
+            chosen = [p for p in patches if p["name"] in design]
+            conn = _np.concatenate([p["conn"] for p in chosen]) if chosen else _np.zeros(0, dtype=_np.int64)
+            sizes = _np.concatenate([p["sizes"] for p in chosen]) if chosen else _np.zeros(0, dtype=_np.int64)
+            surface_ids = _np.unique(ids[conn])
+            return surface_ids, _np.searchsorted(surface_ids, ids[conn]).astype(_np.intc), sizes.astype(_np.intc)
+        return surface
 
     # The surface -----------------------------------------------------------------------------
     def _define(self, ids, conn, sizes):
@@ -211,7 +264,7 @@ class USMesh:
 
     def getSolverGrid(self):
         """The solver's nodes (setExternalMeshIndices), flat (3 n), after the last warpMesh."""
-        owned = self._warp.volume_coordinates()[:self._warp.num_owned]
+        owned = self._warp.volume_coordinates()[self._owned_rows]
         return self._solver_route("getSolverGrid").fetch(owned).ravel()
 
     def getCommonGrid(self):
@@ -225,6 +278,9 @@ class USMesh:
         grid file itself is not overwritten."""
         if fileName is None:
             raise _core.InputError("writeGrid: give a file name (the grid file itself is not overwritten)")
+        if self._decomposed:
+            raise _core.InputError("writeGrid: a decomposed OpenFOAM case is written by its solver (getSolverGrid gives "
+                                   "this rank's points in its processor folder's order)")
         if os.path.abspath(str(fileName)) == os.path.abspath(str(self.gridFile)):
             raise _core.InputError(f"writeGrid: {fileName} is the grid file (write the warped grid elsewhere)")
         same_format = str(self.gridFile).endswith(".cgns") and str(fileName).endswith(".cgns")
@@ -235,10 +291,9 @@ class USMesh:
         """dI/dXs for dI/dXv (the solver's nodes when solverVec, else the warp grid's), kept for
         getdXs(). Collective."""
         seed = real_array(dXv, "warpDeriv").reshape(-1, 3)
-        n_owned = self._warp.num_owned
         local = _np.zeros((len(self._warp.node_ids), 3))
         if solverVec:
-            local[:n_owned] = self._solver_route("warpDeriv").add_to_owners(seed, n_owned)
+            local[self._owned_rows] = self._solver_route("warpDeriv").add_to_owners(seed, len(self._owned_rows))
         else:
             if seed.shape != local.shape:
                 raise _core.InputError(f"warpDeriv: expected {local.size} values on rank {self.comm.rank} (got {seed.size})")
@@ -263,7 +318,7 @@ class USMesh:
         mean = _np.divide(total, self._copies, out=_np.zeros_like(total), where=self._copies > 0)
         dXv = self._warp.warp_derivative_forward(mean)
         if solverVec:
-            return self._solver_route("warpDerivFwd").fetch(dXv[:self._warp.num_owned]).ravel()
+            return self._solver_route("warpDerivFwd").fetch(dXv[self._owned_rows]).ravel()
         return dXv.ravel()
 
     def verifyWarpDeriv(self, dXv=None, solverVec=True, dofStart=0, dofEnd=10, h=1e-6, randomSeed=314):
@@ -277,7 +332,7 @@ class USMesh:
         dXv = real_array(dXv, "verifyWarpDeriv").ravel()
         if not solver:
             dXv = dXv.reshape(-1, 3).copy()
-            dXv[self._warp.num_owned:] = 0.0  # a ghost's row belongs to its owner
+            dXv[~self._warp.owned] = 0.0  # a ghost's row belongs to its owner
             dXv = dXv.ravel()
         direction = rng.standard_normal(self._points.shape)
         base = self._points.copy()
@@ -306,17 +361,15 @@ class USMesh:
         return self._solver
 
 
-def _surfaces(mesh, options):
-    """(design groups, sliding groups) of the mesh for IDWarp's options."""
-    # Surfaces are facet groups: an OpenFOAM case's zones are groups of nodes, not surfaces.
-    groups = [g for g, (dim, _) in mesh.group_tags.items() if dim == mesh.dim - 1]
+def _surfaces(groups, options, lies_in):
+    """(design groups, sliding groups) among the surface groups `groups` for IDWarp's options;
+    lies_in(group, point, unit normal) says whether a group lies in a plane (collective where
+    the mesh is)."""
     symmetry = list(options.get("symmetrySurfaces") or [])
     for point, normal in options.get("symmetryPlanes") or []:
         point, normal = _np.asarray(point, dtype=float), _np.asarray(normal, dtype=float)
         normal = normal / _np.linalg.norm(normal)
-        size = float(_np.ptp(mesh.points, axis=0).max())
-        lying = [g for g in groups if g not in symmetry and len(mesh.groups[g])
-                 and _np.abs((mesh.points[mesh.groups[g]] - point) @ normal).max() <= 1e-6 * size]
+        lying = [g for g in groups if g not in symmetry and lies_in(g, point, normal)]
         if not lying:
             raise _core.InputError(f"USMesh: no group lies in the symmetry plane through {point.tolist()} with normal "
                                    f"{normal.tolist()} (groups: {', '.join(groups)})")
@@ -328,6 +381,50 @@ def _surfaces(mesh, options):
     if design is None:
         design = [g for g in groups if g not in symmetry and not any(word in g.lower() for word in _NOT_WALLS)]
     return list(design), symmetry
+
+
+def _lies_in_mesh(mesh):
+    """_surfaces' plane test on a whole mesh: every node of the group within 1e-6 of its size."""
+    size = float(_np.ptp(mesh.points, axis=0).max())
+
+    def lies_in(group, point, normal):
+        nodes = mesh.groups[group]
+        return bool(len(nodes)) and _np.abs((mesh.points[nodes] - point) @ normal).max() <= 1e-6 * size
+    return lies_in
+
+
+def _lies_in_partition(comm, points, groups):
+    """_surfaces' plane test on each rank's nodes of a group (collective), as _lies_in_mesh."""
+    from mpi4py import MPI
+    corners = _np.array(comm.allgather(_np.vstack([points.min(axis=0), points.max(axis=0)]) if len(points)
+                                       else _np.full((2, 3), _np.nan)))
+    size = float((_np.nanmax(corners[:, 1], axis=0) - _np.nanmin(corners[:, 0], axis=0)).max())
+
+    def lies_in(group, point, normal):
+        nodes = groups.get(group, ())
+        off = float(_np.abs((points[nodes] - point) @ normal).max()) if len(nodes) else 0.0
+        return comm.allreduce(len(nodes)) > 0 and comm.allreduce(off, op=MPI.MAX) <= 1e-6 * size
+    return lies_in
+
+
+def _lowest_holders(comm, ids):
+    """The owner of each of this rank's global `ids`: the lowest rank holding it, found through a
+    directory spread over the ranks by id range (collective)."""
+    from mpi4py import MPI
+    p = comm.size
+    num_global = comm.allreduce(int(ids.max()) + 1 if len(ids) else 0, op=MPI.MAX)
+    directory = _np.minimum(ids * p // max(num_global, 1), p - 1)
+    sent = comm.alltoall([ids[directory == r] for r in range(p)])
+    every = _np.concatenate(sent)
+    senders = _np.concatenate([_np.full(len(a), r, dtype=_np.int32) for r, a in enumerate(sent)])
+    order = _np.lexsort((senders, every))
+    known, first = _np.unique(every[order], return_index=True)
+    lowest = senders[order][first]
+    replies = comm.alltoall([lowest[_np.searchsorted(known, a)] for a in sent])
+    owner = _np.empty(len(ids), dtype=_np.int32)
+    for r in range(p):
+        owner[directory == r] = replies[r]
+    return owner
 
 
 def _facets_of(mesh, design, ids):

@@ -201,3 +201,78 @@ def test_an_openfoam_cases_zones_are_not_design_surfaces():
     named = USMesh(options=dict(base, specifiedSurfaces=["wall"]), comm=comm).getSurfaceCoordinates()
     assert by_default.shape == named.shape
     assert np.array_equal(by_default, named)
+
+
+def decomposed_case(name, parts):
+    """The box as an OpenFOAM case decomposed by decomposePar into `parts` processor folders (on
+    rank 0; None everywhere without OpenFOAM's tools)."""
+    folder = pathlib.Path(os.environ.get("MESHMOTION_TEST_TMP_DIR", "/tmp")) / f"{name}_{comm.size}"
+    tool = shutil.which("decomposePar")
+    if comm.rank == 0 and tool is not None:
+        import subprocess
+        shutil.rmtree(folder, ignore_errors=True)
+        mm.write_mesh(str(folder), box())
+        header = "FoamFile { version 2.0; format ascii; class dictionary; object %s; }\n"
+        (folder / "system").mkdir(exist_ok=True)
+        (folder / "system" / "controlDict").write_text(header % "controlDict" + "application none; startFrom startTime; "
+                                                       "startTime 0; stopAt endTime; endTime 1; deltaT 1; "
+                                                       "writeControl timeStep; writeInterval 1;\n")
+        (folder / "system" / "decomposeParDict").write_text(header % "decomposeParDict" +
+                                                            f"numberOfSubdomains {parts};\nmethod simple;\n"
+                                                            f"simpleCoeffs {{ n ({parts} 1 1); delta 0.001; }}\n")
+        script = "decomposePar -force"
+        bashrc = "/usr/share/openfoam/etc/bashrc"  # Debian's OpenFOAM finds its etc files through it
+        if os.path.isfile(bashrc):
+            script = f"source {bashrc} >/dev/null 2>&1; {script}"
+        subprocess.run(["bash", "-c", script], cwd=folder, check=True, capture_output=True)
+    comm.Barrier()
+    return folder if tool is not None else None
+
+
+def test_a_decomposed_openfoam_case_is_read_by_each_rank_as_dafoam_runs_it():
+    folder = decomposed_case("idwarp_decomposed", comm.size)
+    if folder is None:
+        pytest.skip("OpenFOAM's decomposePar is not installed (apt-get install openfoam)")
+    base = {"gridFile": str(folder), "fileType": "OpenFOAM", "specifiedSurfaces": ["wall"],
+            "symmetrySurfaces": ["symmetry"], "meshmotion": {"support_radius": 0.7}}
+    mesh = USMesh(options=base, comm=comm)
+    serial, expected = serial_warp(folder)
+    if comm.size > 1:  # each rank holds its processor folder's points, in their order
+        mine = mm._core.read_foam_processor(str(folder / f"processor{comm.rank}"))
+        address = mine["global_ids"]
+        np.testing.assert_array_equal(mesh.getSolverGrid().reshape(-1, 3), mine["points"])
+        with pytest.raises(mm.InputError, match="written by its solver"):
+            mesh.writeGrid(str(folder / "moved.msh"))
+    else:  # one rank reads the whole case; the solver's nodes are given as for any grid
+        address = np.arange(serial.mesh.num_nodes)
+        mesh.setExternalMeshIndices(address)
+    xs = mesh.getSurfaceCoordinates()
+    # Every rank's surface is its faces of the wall: together, each wall node at least once.
+    distinct = np.unique(np.round(np.concatenate(comm.allgather(xs)), 12), axis=0)
+    assert len(distinct) == len(serial.design_nodes)
+    mesh.setSurfaceCoordinates(bump(xs))
+    mesh.warpMesh()
+    np.testing.assert_allclose(mesh.getSolverGrid().reshape(-1, 3), expected[address], rtol=0, atol=1e-12)
+    # The gradient: a surface point on several ranks gets its share on each, so a change given by
+    # position sees the serial gradient.
+    dXv = np.sin(np.arange(3 * len(address)) + 0.1 * comm.rank)
+    mesh.warpDeriv(dXv)
+    whole = np.zeros((serial.mesh.num_nodes, 3))
+    for index, values in comm.allgather((address, dXv.reshape(-1, 3))):
+        np.add.at(whole, index, values)
+    g = serial.warp_derivative(whole)
+    along = lambda x: np.column_stack([np.cos(x[:, 0]), np.sin(x[:, 1]), x[:, 2]])  # noqa: E731
+    directional = comm.allreduce(float(np.sum(mesh.getdXs() * along(xs))))
+    serial_directional = float(np.sum(g * along(serial.mesh.points[serial.design_nodes])))
+    assert abs(directional - serial_directional) <= 1e-12 * np.abs(g).sum()
+    assert mesh.verifyWarpDeriv(h=1e-6) < 1e-6
+
+
+def test_a_case_decomposed_for_another_rank_count_is_refused():
+    if comm.size == 1:
+        pytest.skip("one rank reads the whole case")
+    folder = decomposed_case("idwarp_decomposed_other", comm.size + 1)
+    if folder is None:
+        pytest.skip("OpenFOAM's decomposePar is not installed (apt-get install openfoam)")
+    with pytest.raises(mm.InputError, match=f"{comm.size + 1} processor folders for {comm.size} ranks"):
+        USMesh(options={"gridFile": str(folder), "fileType": "OpenFOAM", "specifiedSurfaces": ["wall"]}, comm=comm)
