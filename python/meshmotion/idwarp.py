@@ -44,6 +44,15 @@ _NOT_WALLS = ("far", "inlet", "outlet", "inflow", "outflow", "freestream")
 _NOT_SURFACES = ("processor", "processorCyclic", "cyclic", "cyclicAMI", "empty", "wedge")
 
 
+def _to_directory(comm, ids, num_global):
+    """Sends each of `ids` (global ids 0..num_global-1) to the rank keeping its range of a
+    directory spread over the ranks by id range (collective). Returns each id's directory rank
+    and, per rank, the ids it sent here."""
+    p = comm.size
+    where = _np.minimum(ids * p // max(num_global, 1), p - 1)
+    return where, comm.alltoall([ids[where == r] for r in range(p)])
+
+
 class _Route:
     """Rows of node fields between the ranks that ask for global nodes (`wanted`, any order,
     repeats allowed) and the ranks that own them (`owned`, sorted global ids of this rank).
@@ -57,16 +66,12 @@ class _Route:
         if len(bad):
             raise _core.InputError(f"{what}: node index {int(bad[0])} on rank {comm.rank} is outside 0..{num_global - 1}")
 
-        def directory(ids):
-            return _np.minimum(ids * p // max(num_global, 1), p - 1)
-
-        registered = comm.alltoall([owned[directory(owned) == r] for r in range(p)])
+        _, registered = _to_directory(comm, owned, num_global)
         ids = _np.concatenate(registered)
         ranks = _np.concatenate([_np.full(len(a), r, dtype=_np.int64) for r, a in enumerate(registered)])
         order = _np.argsort(ids)
         ids, ranks = ids[order], ranks[order]
-        asked = directory(wanted)
-        queries = comm.alltoall([wanted[asked == r] for r in range(p)])
+        asked, queries = _to_directory(comm, wanted, num_global)
         answers = []
         for q in queries:
             at = _np.minimum(_np.searchsorted(ids, q), max(len(ids) - 1, 0))
@@ -411,10 +416,8 @@ def _lowest_holders(comm, ids):
     """The owner of each of this rank's global `ids`: the lowest rank holding it, found through a
     directory spread over the ranks by id range (collective)."""
     from mpi4py import MPI
-    p = comm.size
     num_global = comm.allreduce(int(ids.max()) + 1 if len(ids) else 0, op=MPI.MAX)
-    directory = _np.minimum(ids * p // max(num_global, 1), p - 1)
-    sent = comm.alltoall([ids[directory == r] for r in range(p)])
+    directory, sent = _to_directory(comm, ids, num_global)
     every = _np.concatenate(sent)
     senders = _np.concatenate([_np.full(len(a), r, dtype=_np.int32) for r, a in enumerate(sent)])
     order = _np.lexsort((senders, every))
@@ -422,7 +425,7 @@ def _lowest_holders(comm, ids):
     lowest = senders[order][first]
     replies = comm.alltoall([lowest[_np.searchsorted(known, a)] for a in sent])
     owner = _np.empty(len(ids), dtype=_np.int32)
-    for r in range(p):
+    for r in range(comm.size):
         owner[directory == r] = replies[r]
     return owner
 
