@@ -477,7 +477,8 @@ smoke_test(NAME move_mesh.section_2d_motion_along_axis.json KEYS output VALUES a
                    --translate 0.05,0,0.01 --fixed bottom --json)
 
 # move_mesh_mpi: the same mesh as move_mesh's, byte for byte, from 3 ranks with the boundary
-# system replicated (the serial mover's factorization); through PETSc on request; elasticity
+# system replicated (the serial mover's factorization); through PETSc on request; the
+# partition of unity with its patches on the ranks (automatic's choice for it); elasticity
 # through PETSc; an unknown group or boundary solve refused by every rank with rank 0's message.
 if(TARGET move_mesh_mpi)
   smoke_test(NAME move_mesh_mpi.help KEYS "" EXPECT_RC 0 RANKS 1 COMMAND move_mesh_mpi --version)
@@ -494,6 +495,10 @@ if(TARGET move_mesh_mpi)
              KEYS after/min VALUES boundary_solve=petsc,threads_per_rank=2,after/invalid=0
              COMMAND move_mesh_mpi "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_mpi_petsc.vtu" --group wall --rotate 5
                      --fixed farfield --boundary-solve petsc --threads 2 --json)
+  smoke_test(NAME move_mesh_mpi.rbf_patches.json REQUIRES examples_demo_mesh RANKS 2
+             KEYS after/min VALUES boundary_solve=patches,after/invalid=0
+             COMMAND move_mesh_mpi "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_mpi_patches.vtu" --group wall --rotate 5
+                     --fixed farfield --partition-of-unity --patch-centres 8 --json)
   smoke_test(NAME move_mesh_mpi.bad_boundary_solve.json REQUIRES examples_demo_mesh RANKS 2 EXPECT_RC 1 KEYS error
              VALUES kind=input
              COMMAND move_mesh_mpi "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_mpi_bad_solve.msh" --group wall --rotate 5

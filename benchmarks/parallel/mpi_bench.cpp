@@ -1,11 +1,13 @@
 // mpi_bench: the distributed movers against the serial ones in the same run.
 //
-//   mpiexec -n R mpi_bench [box_cells_per_axis=126] [automatic|replicated|petsc] [path/to/su2_30p30n_rans_L1_coarse.su2]
+//   mpiexec -n R mpi_bench [box_cells_per_axis=126] [automatic|replicated|petsc|patches] [path/to/su2_30p30n_rans_L1_coarse.su2]
 //
 // The second argument is where the distributed RBF solves its boundary system (BoundarySolve;
 // automatic: PETSc from 50000 centres on).
 // Cases: the 3D hex box of rbf_bench (bottom face moving as a bump, support radius 6 grid
-// spacings; 126 cells per axis = 2.05M nodes) with the RBF mover, and the 30P30N RANS mesh
+// spacings; 126 cells per axis = 2.05M nodes) with the RBF mover, the same box with the
+// partition-of-unity RBF (patches of at most 1000 centres, so that the quick box's 4225 make
+// several; distributed: BoundarySolve::patches under automatic, each patch on one rank), and the 30P30N RANS mesh
 // (../shared/data, skipped when absent) with the RBF mover (wall rotated 2°) and the
 // stiffened elasticity mover (χ = 2.75; serial: direct Cholesky, distributed: CG + GAMG).
 // The serial mover runs first on rank 0 with every core's threads while the other ranks
@@ -74,7 +76,7 @@ Figures measure(Mover& mover, Setup&& setup, const Points<Mover::dim>& d, int mo
   return f;
 }
 
-enum class Method { rbf, sle };
+enum class Method { rbf, pu, sle };
 
 BoundarySolveOptions boundary_solve;
 
@@ -87,6 +89,8 @@ void run_case(const std::string& name, const Mesh<Dim>& whole, const ResolvedBou
   const int moves = 3;
   RbfOptions rbf;
   rbf.support_radius = radius;
+  rbf.partition_of_unity = method == Method::pu;
+  rbf.patch_centres = 1000;
   ElasticityOptions elasticity;
   elasticity.stiffening_exponent = 2.75;
 
@@ -94,7 +98,7 @@ void run_case(const std::string& name, const Mesh<Dim>& whole, const ResolvedBou
   Figures serial;
   if (rank == 0) {
     set_num_threads(cores);
-    if (method == Method::rbf) {
+    if (method != Method::sle) {
       RbfMover<Dim> mover(rbf);
       serial = measure(mover, [&] { mover.setup(whole, boundary); }, boundary.displacements, moves);
     } else {
@@ -108,11 +112,11 @@ void run_case(const std::string& name, const Mesh<Dim>& whole, const ResolvedBou
   const DistributedMesh<Dim> part = partition_mesh(comm, whole);
   const ResolvedBoundary<Dim> local = distribute_boundary(part, boundary);
   Figures mine;
-  bool petsc = method == Method::sle;
-  if (method == Method::rbf) {
+  BoundarySolve solved = BoundarySolve::petsc;
+  if (method != Method::sle) {
     DistributedRbfMover<Dim> mover(rbf, boundary_solve);
     mine = measure(mover, [&] { mover.setup(part.view(), local); }, local.displacements, moves);
-    petsc = mover.petsc_solve();
+    solved = mover.solved_by();
   } else {
     DistributedElasticityOptions options;
     options.elasticity = elasticity;
@@ -125,7 +129,10 @@ void run_case(const std::string& name, const Mesh<Dim>& whole, const ResolvedBou
   if (rank != 0) return;
   const bool oversubscribed = ranks > cores;
   const double setup_ratio = worst[0] / serial.setup, move_ratio = worst[1] / serial.move;
-  const char* label = method == Method::sle ? "sle" : petsc ? "rbf/petsc" : "rbf/repl";
+  const char* label = method == Method::sle                 ? "sle"
+                      : solved == BoundarySolve::petsc      ? "rbf/petsc"
+                      : solved == BoundarySolve::patches    ? "rbf/patches"
+                                                            : "rbf/repl";
   std::printf("%-16s %10s %5d %10ld %10.3f %10.3f %10.4f %10.4f %8.2f %8.2f %10.0f %10.0f %s\n", name.c_str(),
               label, ranks, static_cast<long>(whole.num_nodes()), serial.setup, worst[0],
               serial.move, worst[1], setup_ratio, move_ratio, serial.memory, worst[2], oversubscribed ? "oversubscribed" : "");
@@ -133,7 +140,7 @@ void run_case(const std::string& name, const Mesh<Dim>& whole, const ResolvedBou
               "\"boundary_nodes\":%ld,\"serial_setup_seconds\":%.6f,\"setup_seconds\":%.6f,\"serial_move_seconds\":%.6f,"
               "\"move_seconds\":%.6f,\"setup_ratio\":%.3f,\"move_ratio\":%.3f,\"serial_setup_memory_mb\":%.1f,"
               "\"setup_memory_mb_per_rank_max\":%.1f,\"rank0_setup_memory_mb\":%.1f,\"threads_per_rank\":%d}\n",
-              name.c_str(), method == Method::rbf ? "rbf" : "sle", petsc ? "petsc" : "replicated", ranks, cores, oversubscribed ? "true" : "false",
+              name.c_str(), method == Method::sle ? "sle" : "rbf", meshmotion::parallel::name(solved), ranks, cores, oversubscribed ? "true" : "false",
               static_cast<long>(whole.num_nodes()), static_cast<long>(boundary.size()), serial.setup, worst[0], serial.move,
               worst[1], setup_ratio, move_ratio, serial.memory, worst[2], mine.memory, num_threads());
   std::fflush(stdout);
@@ -150,6 +157,7 @@ void box(int n) {
     boundary = bench::bottom_bump(mesh);
   }
   run_case("box" + std::to_string(n), mesh, boundary, Method::rbf, 6.0 / n);
+  run_case("pu-box" + std::to_string(n), mesh, boundary, Method::pu, 6.0 / n);
 }
 
 void airfoil(const std::filesystem::path& file) {
@@ -184,12 +192,13 @@ int main(int argc, char** argv) {
   if (PetscInitialize(&petsc_argc, &argv, nullptr, nullptr) != 0) return 1;
   const int n = argc > 1 ? std::atoi(argv[1]) : 126;
   const std::string solve = argc > 2 ? argv[2] : "automatic";
-  if (solve != "automatic" && solve != "replicated" && solve != "petsc") {
-    std::fprintf(stderr, "mpi_bench: the boundary solve '%s' is not one of automatic, replicated, petsc\n", solve.c_str());
+  try {
+    (void)set_option(boundary_solve, "boundary_solve", solve);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mpi_bench: %s\n", e.what());
     PetscFinalize();
     return 2;
   }
-  boundary_solve.kind = solve == "petsc" ? BoundarySolve::petsc : solve == "replicated" ? BoundarySolve::replicated : BoundarySolve::automatic;
   const std::filesystem::path airfoil_file =
       argc > 3 ? std::filesystem::path(argv[3]) : std::filesystem::path(MESHMOTION_SHARED_DATA_DIR) / "su2_30p30n_rans_L1_coarse.su2";
   if (rank_of(MPI_COMM_WORLD) == 0)

@@ -120,7 +120,7 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
     mover.setup(part.view(), local);
     displacement = mover.move(local.displacements);
     stats = mover.stats();
-    if (mover.petsc_solve()) boundary_solve = BoundarySolve::petsc;
+    boundary_solve = mover.solved_by();
   } else {
     DistributedElasticityOptions options = parallel.elasticity;
     options.elasticity = std::get<ElasticityOptions>(config.options);

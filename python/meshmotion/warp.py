@@ -220,6 +220,13 @@ class Warp:
         return float(self._mover.stats["condition"])
 
     @property
+    def boundary_solve(self):
+        """Over MPI, where the RBF boundary system is solved: "replicated" (every rank),
+        "petsc" (MUMPS across the ranks) or "patches" (partition_of_unity=True: each patch on one
+        rank, nothing replicated); "none" for elasticity; None without MPI."""
+        return self._mover.boundary_solve if self._comm is not None else None
+
+    @property
     def dim(self):
         return self._dim
 

@@ -128,6 +128,33 @@ def test_a_partition_no_rank_holds_whole_gives_the_serial_warp_and_gradient():
         parallel.write_mesh("unused.msh")
 
 
+def test_partition_of_unity_keeps_each_patch_on_one_rank_with_the_serial_result():
+    # No sliding group (a symmetry plane makes two systems per patch: replicated instead).
+    mesh = box()
+    options = dict(design=["wall"], fixed=["farfield", "symmetry"], support_radius=0.5, partition_of_unity=True,
+                   patch_centres=12)
+    serial = mm.Warp(mesh, **options)
+    points, ids, owner, groups = scattered_partition(mesh)
+    parallel = mm.Warp.from_partition(comm, points, ids, owner, groups, boundary_solve="patches", **options)
+    assert parallel.boundary_solve == "patches"
+    whole, part = warp_both(serial, parallel)
+    moved = np.abs(whole - serial.mesh.points).max()
+    assert moved > 0.01
+    np.testing.assert_allclose(part, whole[ids], rtol=0, atol=1e-12 * moved)
+    g_serial = serial.warp_derivative(seed(serial.node_ids))
+    g_part = parallel.warp_derivative(seed(ids))
+    row = {int(v): k for k, v in enumerate(serial.design_nodes)}
+    mine = parallel.design_nodes
+    expected = g_serial[[row[int(v)] for v in mine]] if len(mine) else np.zeros((0, 3))
+    np.testing.assert_allclose(g_part, expected, rtol=0, atol=1e-12 * np.abs(g_serial).max())
+    assert parallel.verify_derivative(verbose=False) < 1e-6
+    # With a symmetry plane, the default (automatic) replicates and still equals the serial Warp.
+    serial, parallel = pair(support_radius=0.5, partition_of_unity=True, patch_centres=12)
+    assert parallel.boundary_solve == "replicated"
+    whole, part = warp_both(serial, parallel)
+    np.testing.assert_allclose(part, whole[parallel.node_ids], rtol=0, atol=1e-12 * np.abs(whole).max())
+
+
 def test_a_partition_no_rank_holds_whole_is_refused_clearly():
     mesh = box(3, 3, 2)
     points, ids, owner, groups = scattered_partition(mesh)

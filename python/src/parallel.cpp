@@ -122,6 +122,10 @@ class DistributedMover {
   }
   /// The RBF boundary system is solved through PETSc (false for elasticity, which always is).
   [[nodiscard]] bool petsc_solve() const { return std::holds_alternative<Rbf>(mover_) && std::get<Rbf>(mover_)->petsc_solve(); }
+  /// Where the RBF boundary system is solved (BoundarySolve's name; elasticity: none).
+  [[nodiscard]] std::string boundary_solve() const {
+    return std::holds_alternative<Rbf>(mover_) ? parallel::name(std::get<Rbf>(mover_)->solved_by()) : "none";
+  }
 
  private:
   using Rbf = std::unique_ptr<parallel::DistributedRbfMover<Dim>>;
@@ -211,7 +215,10 @@ void bind_parallel(py::module_& m) {
             py::arg("comm"), py::arg("points"), py::arg("global_ids"), py::arg("owner"), py::arg("boundary"),
             "collective: set up on a solver's own partition, each rank's local nodes (n_local, dim) in its order with "
             "their global ids and owner ranks, and the boundary entries of those nodes (rbf only)")
-        .def_property_readonly("petsc_solve", &A::petsc_solve);
+        .def_property_readonly("petsc_solve", &A::petsc_solve)
+        .def_property_readonly("boundary_solve", &A::boundary_solve,
+                               "where the last setup solves the RBF boundary system: replicated, petsc or patches "
+                               "(the partition of unity, each patch on one rank); none for elasticity");
     bind_move_calls<Dim>(c);
   });
 }

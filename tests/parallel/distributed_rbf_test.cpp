@@ -31,6 +31,9 @@ struct Outcome {
   // wall) amplifies that rounding alike. The distributed gradient must agree within it.
   double gradient_rounding = 0.0;
   Index global_entries = 0;
+  BoundarySolve solved_by = BoundarySolve::automatic;
+  Index patches = 0;
+  double radius = 0.0;  // the distributed mover's support radius
 };
 
 // Moves `whole` with `spec` serially and distributed (partitioned by `cell_ranks`, or METIS),
@@ -66,6 +69,10 @@ Outcome compare_with_serial(const Mesh<Dim>& whole, const ResolvedBoundary<Dim>&
   const Points<Dim> got = mover.move(local_b.displacements);
 
   Outcome out;
+  out.solved_by = mover.solved_by();
+  out.patches = mover.num_patches();
+  out.radius = mover.support_radius();
+  if (!radius_per_entry) CHECK(out.radius == serial.support_radius());
   out.gradient_rounding = (serial.derivative_reverse(v_rounded) - expected_gradient).colwise().norm().maxCoeff() / gradient_scale;
   out.global_entries = mover.global_boundary_size();
   double worst = 0.0;
@@ -170,6 +177,68 @@ TEST_CASE("distributed RBF with the boundary system factorized across the ranks 
   DistributedRbfMover<2> automatic({.support_radius = 0.5}, {BoundarySolve::automatic, 1});
   automatic.setup(part.view(), b);
   CHECK_FALSE(automatic.petsc_solve());
+}
+
+TEST_CASE("distributed partition of unity: patches on their ranks, the serial PU-RBF's result", "[parallel][rbf][patches]") {
+  const BoundarySolveOptions patches{BoundarySolve::patches};
+  RbfOptions options;
+  options.partition_of_unity = true;
+  options.patch_centres = 7;  // many patches, a run of them on each rank
+  SECTION("2D, given and default radius") {
+    const Mesh<2> mesh = rectangle_mesh({.nx = 24, .ny = 18, .cells = RectangleCells::tri_quad});
+    BoundarySpec<2> spec;
+    spec.moving("bottom", Rotation2D{{0.5, 0.0}, radians(8.0)}).fixed("top").fixed("left");
+    for (const double radius : {0.3, 0.0}) {
+      options.support_radius = radius;
+      const Outcome r = compare_with_serial(mesh, spec.resolve(mesh), options, {}, false, patches);
+      INFO("radius " << radius << ": move " << r.error << ", gradient " << r.gradient << ", rounding " << r.gradient_rounding);
+      CHECK(r.solved_by == BoundarySolve::patches);
+      CHECK(r.patches >= 8);
+      CHECK(r.error <= 1e-12);
+      CHECK(r.gradient <= std::max(1e-12, 100.0 * r.gradient_rounding));
+      CHECK(r.global_entries == static_cast<Index>(spec.resolve(mesh).size()));
+    }
+  }
+  SECTION("3D, and ranks without moving nodes, without group nodes, or empty") {
+    const Mesh<3> mesh = box_mesh({.nx = 8, .ny = 6, .nz = 6, .cells = BoxCells::tet4});
+    BoundarySpec<3> spec;
+    spec.moving("bottom", Rotation3D{{0.5, 0.5, 0.0}, {1.0, 0.0, 0.0}, radians(5.0)}).fixed("top").fixed("front");
+    options.support_radius = 0.4;
+    options.patch_centres = 20;
+    const Outcome r = compare_with_serial(mesh, spec.resolve(mesh), options, {}, false, patches);
+    INFO("move " << r.error << ", gradient " << r.gradient << ", rounding " << r.gradient_rounding);
+    CHECK(r.solved_by == BoundarySolve::patches);
+    CHECK(r.error <= 1e-12);
+    CHECK(r.gradient <= std::max(1e-12, 100.0 * r.gradient_rounding));
+    const Mesh<2> square = rectangle_mesh({.nx = 10, .ny = 10});
+    BoundarySpec<2> bands;
+    bands.moving("bottom", Translation<2>{{0.0, 0.08}}).fixed("top");
+    options.support_radius = 0.5;
+    options.patch_centres = 4;
+    const Outcome b = compare_with_serial(square, bands.resolve(square), options, test::row_bands(10, 10), false, patches);
+    CHECK(b.error <= 1e-12);
+    CHECK(b.gradient <= std::max(1e-12, 100.0 * b.gradient_rounding));
+  }
+  SECTION("what patches cannot take: replicated by automatic, refused when asked for") {
+    const Mesh<2> mesh = rectangle_mesh({.nx = 12, .ny = 10});
+    BoundarySpec<2> spec;
+    spec.moving("bottom", Translation<2>{{0.0, 0.05}}).fixed("top").sliding("left");
+    options.support_radius = 0.4;
+    const Outcome r = compare_with_serial(mesh, spec.resolve(mesh), options);
+    CHECK(r.solved_by == BoundarySolve::replicated);
+    CHECK(r.error <= 1e-12);
+    const DistributedMesh<2> part = partition_mesh(world(), mesh);
+    const ResolvedBoundary<2> b = distribute_boundary(part, spec.resolve(mesh));
+    DistributedRbfMover<2> sliding(options, patches);
+    CHECK_THROWS_WITH(sliding.setup(part.view(), b), Catch::Contains("sliding nodes") && Catch::Contains("replicated"));
+    DistributedRbfMover<2> no_patches({.support_radius = 0.4}, patches);
+    CHECK_THROWS_WITH(no_patches.setup(part.view(), b), Catch::Contains("partition_of_unity"));
+    // The serial refusal of a global kernel comes through the replicated path, on every rank.
+    RbfOptions global = options;
+    global.kernel = RbfKernel::gaussian;
+    DistributedRbfMover<2> automatic(global);
+    CHECK_THROWS_WITH(automatic.setup(part.view(), b), Catch::Contains("compact kernel"));
+  }
 }
 
 TEST_CASE("parallel options: described once, set from text, bad values refused naming the key", "[parallel][options]") {

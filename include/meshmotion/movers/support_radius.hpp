@@ -22,6 +22,17 @@ struct SupportRadiusOptions {
   double spacing_factor = 10.0;      ///< radius ≥ this × the median boundary node spacing
 };
 
+/// max(displacement_factor × `largest` displacement, spacing_factor × `median` spacing): the
+/// last step of suggest_support_radius(), for callers that find the two figures themselves (a
+/// distributed boundary). Throws InputError when no positive radius follows.
+[[nodiscard]] inline double support_radius_from(double largest, double median, const SupportRadiusOptions& options = {}) {
+  const double radius = std::max(options.displacement_factor * largest, options.spacing_factor * median);
+  if (!(radius > 0.0) || !std::isfinite(radius))
+    throw InputError("suggest_support_radius: cannot propose a radius (got " + std::to_string(radius) +
+                     "; all boundary nodes coincide and do not move?)");
+  return radius;
+}
+
 /// suggest_support_radius() given the largest boundary displacement instead of every one (a
 /// distributed boundary reduces it over the ranks). Throws InputError when m < 2 or no
 /// positive radius follows.
@@ -43,11 +54,7 @@ template <int Dim>
     std::nth_element(spacing.begin(), mid, spacing.end());
     median = *mid;
   }
-  const double radius = std::max(options.displacement_factor * largest, options.spacing_factor * median);
-  if (!(radius > 0.0) || !std::isfinite(radius))
-    throw InputError("suggest_support_radius: cannot propose a radius (got " + std::to_string(radius) +
-                     "; all boundary nodes coincide and do not move?)");
-  return radius;
+  return support_radius_from(largest, median, options);
 }
 
 /// A support radius proposed from the boundary: max(displacement_factor × largest

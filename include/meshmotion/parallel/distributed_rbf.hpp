@@ -15,6 +15,9 @@
 ///   petsc_min_node_centres.
 ///   Each rank then builds the evaluation operator of its own local nodes (owned and ghost)
 ///   with its own k-d tree over the centres.
+/// - With RbfOptions::partition_of_unity (BoundarySolve::patches, automatic's choice for it),
+///   nothing above is gathered: each patch lives on one rank
+///   (detail::DistributedPartitionOfUnity, distributed_partition_of_unity.hpp).
 /// - move: one allgatherv of the owned entries' displacements (Dim doubles per boundary node),
 ///   then one solve and the local evaluation. Ghost nodes get the values their owners compute.
 /// - derivative_reverse: the transposed evaluation on each rank's owned nodes, summed over the
@@ -35,6 +38,7 @@
 #include "meshmotion/movers/rbf.hpp"
 #include "meshmotion/parallel/communicator.hpp"
 #include "meshmotion/parallel/distributed_mesh.hpp"
+#include "meshmotion/parallel/distributed_partition_of_unity.hpp"
 #include "meshmotion/parallel/petsc_rbf_system.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 
@@ -50,9 +54,10 @@ namespace meshmotion::parallel {
 
 /// Where the distributed RBF mover solves its boundary system.
 enum class BoundarySolve {
-  automatic,   ///< PETSc when the options allow it and the system is big enough (BoundarySolveOptions), else replicated
+  automatic,   ///< patches for a partition of unity; PETSc when the options allow it and the system is big enough (BoundarySolveOptions); else replicated
   replicated,  ///< factorized on every rank (any option: sliding, radius per node, global kernels)
   petsc,       ///< factorized once across the ranks by MUMPS (compact kernel, one radius, no sliding, distinct centres)
+  patches,     ///< RbfOptions::partition_of_unity with each patch on one rank (no sliding, distinct centres)
 };
 
 [[nodiscard]] constexpr const char* name(BoundarySolve k) {
@@ -60,11 +65,12 @@ enum class BoundarySolve {
     case BoundarySolve::automatic: return "automatic";
     case BoundarySolve::replicated: return "replicated";
     case BoundarySolve::petsc: return "petsc";
+    case BoundarySolve::patches: return "patches";
   }
   return "?";
 }
-[[nodiscard]] constexpr std::array<BoundarySolve, 3> option_choices(BoundarySolve) {
-  return {BoundarySolve::automatic, BoundarySolve::replicated, BoundarySolve::petsc};
+[[nodiscard]] constexpr std::array<BoundarySolve, 4> option_choices(BoundarySolve) {
+  return {BoundarySolve::automatic, BoundarySolve::replicated, BoundarySolve::petsc, BoundarySolve::patches};
 }
 
 /// How automatic chooses, from the figures of docs/parallel.md: replicated, every rank on a node
@@ -100,6 +106,12 @@ class DistributedRbfMover {
 
   /// True when the last setup solves the boundary system through PETSc.
   [[nodiscard]] bool petsc_solve() const noexcept { return petsc_; }
+  /// Where the last setup solves the boundary system (never automatic).
+  [[nodiscard]] BoundarySolve solved_by() const noexcept {
+    return patches_ ? BoundarySolve::patches : petsc_ ? BoundarySolve::petsc : BoundarySolve::replicated;
+  }
+  /// The distributed partition of unity's patches, all ranks together (0 on other paths).
+  [[nodiscard]] Index num_patches() const noexcept { return patches_ ? patches_->num_patches() : 0; }
 
   [[nodiscard]] const RbfOptions& options() const noexcept { return options_; }
   /// The support radius of the last setup (RbfMover::support_radius(): the default one is
@@ -108,7 +120,7 @@ class DistributedRbfMover {
   /// This rank's figures; boundary_nodes counts the whole boundary's centres.
   [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
   /// Entries of the whole boundary (before merging coincident nodes).
-  [[nodiscard]] Index global_boundary_size() const noexcept { return static_cast<Index>(sorted_ids_.size()); }
+  [[nodiscard]] Index global_boundary_size() const noexcept { return global_entries_; }
 
   /// Collective. `part`: this rank's nodes; `boundary`: entries of local nodes (owned and
   /// ghost; may be empty on a rank). RbfOptions::support_radii, when given, has one radius per
@@ -161,6 +173,8 @@ class DistributedRbfMover {
   [[nodiscard]] bool choose_petsc(const GatheredBoundary& gathered, const Points<Dim>& centres) const;
   /// Why PETSc cannot solve this boundary system (empty: it can).
   [[nodiscard]] std::string petsc_obstacle(const std::vector<int>& kinds, bool radius_per_entry, const Points<Dim>& centres) const;
+  /// move_into() once the boundary was gathered (replicated or PETSc).
+  void move_gathered(PointsView<Dim> d, Points<Dim>& out);
   void setup_petsc(const PartitionView<Dim>& part, Points<Dim> centres);
   void move_petsc(Points<Dim>& out);
   [[nodiscard]] Points<Dim> reverse_petsc(const PointsView<Dim>& v);
@@ -172,6 +186,9 @@ class DistributedRbfMover {
   BoundarySolveOptions solve_;
   bool petsc_ = false;
   std::unique_ptr<detail::PetscRbfSystem<Dim>> system_;  ///< PETSc: the boundary system
+  std::unique_ptr<detail::DistributedPartitionOfUnity<Dim>> patches_;  ///< patches: the whole mover
+  Index global_entries_ = 0;
+  Index n_entries_ = 0;  ///< this rank's boundary entries
   Points<Dim> local_points_;                 ///< PETSc: this rank's nodes
   std::vector<Index> interior_;              ///< PETSc: local nodes that are not centres
   std::vector<Index> evaluated_;             ///< PETSc: those with kernel weights (operator rows)
@@ -205,11 +222,37 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
     if (!radii.empty() && static_cast<Index>(radii.size()) != boundary.size())
       throw InputError("DistributedRbfMover::setup: " + std::to_string(radii.size()) + " support radii for " +
                        std::to_string(boundary.size()) + " local boundary entries (expected one per entry, or none)");
+    if (solve_.kind == BoundarySolve::patches && !options_.partition_of_unity)
+      throw InputError("DistributedRbfMover::setup: BoundarySolve::patches needs RbfOptions::partition_of_unity");
   });
   n_local_ = n;
+  n_entries_ = boundary.size();
   owned_.resize(static_cast<std::size_t>(n));
   for (Index i = 0; i < n; ++i) owned_[static_cast<std::size_t>(i)] = part.owns(i) ? 1 : 0;
+  patches_.reset();
+  if (options_.partition_of_unity && (solve_.kind == BoundarySolve::automatic || solve_.kind == BoundarySolve::patches)) {
+    // No rank gathers the boundary: patches own it.
+    auto patches = std::make_unique<detail::DistributedPartitionOfUnity<Dim>>();
+    const std::string obstacle = patches->setup(part, boundary, options_);
+    if (obstacle.empty()) {
+      petsc_ = false;
+      system_.reset();
+      radius_ = patches->support_radius();
+      global_entries_ = patches->global_centres();
+      owned_entries_ = patches->entries();
+      stats_ = patches->stats();
+      stats_.evaluated_nodes = std::min(stats_.evaluated_nodes, n);
+      patches_ = std::move(patches);
+      ready_ = true;
+      stats_.setup_seconds = watch.seconds();
+      return;
+    }
+    if (solve_.kind == BoundarySolve::patches)
+      throw InputError("DistributedRbfMover::setup: the partition of unity cannot be spread over the ranks: " + obstacle +
+                       " (use BoundarySolve::replicated)");
+  }
   const GatheredBoundary gathered = gather_boundary(part, boundary);
+  global_entries_ = static_cast<Index>(sorted_ids_.size());
   const auto m = static_cast<Index>(sorted_ids_.size());
   number_columns(part, boundary);
   Points<Dim> points;
@@ -359,7 +402,7 @@ void DistributedRbfMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& out) {
   const meshmotion::detail::Stopwatch watch;
   collective(comm_, [&] {
     require_ready("move");
-    const auto expected = static_cast<Index>(entry_slot_.size());
+    const Index expected = n_entries_;
     if (d.cols() != expected)
       throw InputError("DistributedRbfMover::move: got " + std::to_string(d.cols()) + " displacements (expected " +
                        std::to_string(expected) + ", one per local boundary entry)");
@@ -367,6 +410,17 @@ void DistributedRbfMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& out) {
       if (!d.col(k).allFinite())
         throw InputError("DistributedRbfMover::move: boundary entry " + std::to_string(k) + " has a non-finite displacement");
   });
+  if (patches_) {
+    patches_->move_into(d, out);
+  } else {
+    move_gathered(d, out);
+  }
+  ++stats_.moves;
+  stats_.move_seconds = watch.seconds();
+}
+
+template <int Dim>
+void DistributedRbfMover<Dim>::move_gathered(PointsView<Dim> d, Points<Dim>& out) {
   std::vector<double> mine;
   mine.reserve(owned_entries_.size() * Dim);
   for (const Index k : owned_entries_)
@@ -385,8 +439,6 @@ void DistributedRbfMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& out) {
     stats_.residual = s.residual;
     stats_.fell_back = s.fell_back;
   }
-  ++stats_.moves;
-  stats_.move_seconds = watch.seconds();
 }
 
 template <int Dim>
@@ -395,6 +447,7 @@ Points<Dim> DistributedRbfMover<Dim>::derivative_reverse(PointsView<Dim> v) {
     require_ready("derivative_reverse");
     meshmotion::detail::check_node_field<Dim>("DistributedRbfMover::derivative_reverse", v, n_local_);
   });
+  if (patches_) return patches_->derivative_reverse(v, owned_, n_entries_);
   if (petsc_) return reverse_petsc(v);
   const Index m = global_boundary_size();
   Points<Dim> seed = Points<Dim>::Zero(Dim, inner_columns_);
@@ -415,7 +468,7 @@ template <int Dim>
 std::string DistributedRbfMover<Dim>::petsc_obstacle(const std::vector<int>& kinds, bool radius_per_entry,
                                                      const Points<Dim>& centres) const {
   if (!is_compact(options_.kernel)) return "the kernel is global (dense system)";
-  if (options_.partition_of_unity) return "the options ask for a partition of unity (local systems, replicated)";
+  if (options_.partition_of_unity) return "the options ask for a partition of unity (local systems: BoundarySolve::patches)";
   if (radius_per_entry) return "the support radius differs between nodes (nonsymmetric system)";
   if (std::find(kinds.begin(), kinds.end(), static_cast<int>(BoundaryKind::sliding)) != kinds.end())
     return "the boundary has sliding nodes";

@@ -2,9 +2,11 @@
 /// \file
 /// Partition-of-unity RBF interpolation: for boundaries too large for one factorization.
 ///
-/// The centres are split by recursive bisection (median along the longest side) into clusters
-/// of at most `patch_centres`. Cluster j, with bounding-box centre p_j and radius ρ_j (its
-/// farthest centre), becomes the patch of radius R_j = ρ_j + max(overlap ρ_j, r) (r: the
+/// The centres are split by recursive bisection (the middle of the longest side of a cluster's
+/// bounding box) into clusters of at most `patch_centres` (patch_layout(): the middle, not the
+/// median, so that ranks holding parts of the centres find the same clusters from a few
+/// reductions, parallel/distributed_partition_of_unity.hpp). Cluster j, with bounding-box
+/// centre p_j and radius ρ_j (its farthest centre), becomes the patch of radius R_j = ρ_j + max(overlap ρ_j, r) (r: the
 /// kernel's support radius); the patch's local system is the compact RBF system of every
 /// centre within R_j of p_j (RbfSystem), factorized on its own. The interpolant blends the
 /// local ones with Shepard weights of Wendland C2 bumps:
@@ -35,11 +37,128 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
-#include <numeric>
+#include <limits>
 #include <string>
 #include <vector>
 
 namespace meshmotion::detail {
+
+/// The clusters of a partition of unity: patch_of[c] is centre c's cluster, numbered depth
+/// first (left before right); middle[j] the centre of cluster j's bounding box, reach[j] its
+/// farthest centre's distance from there (ρ_j), count[j] its centres.
+template <int Dim>
+struct PatchLayout {
+  Points<Dim> middle;
+  std::vector<double> reach;
+  std::vector<double> count;
+  std::vector<Index> patch_of;
+  Vec<Dim> lower, upper;  ///< the bounding box of every centre
+};
+
+/// Splits clusters at the middle of their bounding box's longest side until each holds at most
+/// `most` centres (a cluster whose box is too thin to split stays whole). `reduce(low, high,
+/// count)` combines, elementwise, the per-cluster figures of every holder of centres: the
+/// minimum of `low`, the maximum of `high`, the sum of `count` (any may be empty). Serially it
+/// does nothing; ranks each holding some centres pass MPI reductions and get the layout of all
+/// the centres, each rank's patch_of for its own.
+template <int Dim, class Reduce>
+[[nodiscard]] PatchLayout<Dim> patch_layout(const Points<Dim>& centres, Index most, Reduce&& reduce) {
+  struct Cluster {
+    Vec<Dim> lo, hi;
+    double count = 0.0;
+    Index left = -1, right = -1;
+    int axis = 0;
+    double middle = 0.0;
+  };
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  const Index k = centres.cols();
+  std::vector<Cluster> clusters(1);
+  std::vector<Index> label(static_cast<std::size_t>(k), 0), active{0};
+  while (!active.empty()) {
+    const auto a = active.size();
+    std::vector<double> low(Dim * a, inf), high(Dim * a, -inf), count(a, 0.0);
+    std::vector<Index> slot(clusters.size(), -1);
+    for (std::size_t s = 0; s < a; ++s) slot[static_cast<std::size_t>(active[s])] = static_cast<Index>(s);
+    for (Index c = 0; c < k; ++c) {
+      const Index s = slot[static_cast<std::size_t>(label[static_cast<std::size_t>(c)])];
+      if (s < 0) continue;
+      for (int d = 0; d < Dim; ++d) {
+        low[static_cast<std::size_t>(Dim * s + d)] = std::min(low[static_cast<std::size_t>(Dim * s + d)], centres(d, c));
+        high[static_cast<std::size_t>(Dim * s + d)] = std::max(high[static_cast<std::size_t>(Dim * s + d)], centres(d, c));
+      }
+      count[static_cast<std::size_t>(s)] += 1.0;
+    }
+    reduce(low, high, count);
+    std::vector<Index> next;
+    for (std::size_t s = 0; s < a; ++s) {
+      const auto id = static_cast<std::size_t>(active[s]);
+      for (int d = 0; d < Dim; ++d) {
+        clusters[id].lo[d] = low[Dim * s + static_cast<std::size_t>(d)];
+        clusters[id].hi[d] = high[Dim * s + static_cast<std::size_t>(d)];
+      }
+      clusters[id].count = count[s];
+      if (count[s] <= static_cast<double>(most)) continue;
+      int axis = 0;
+      (clusters[id].hi - clusters[id].lo).maxCoeff(&axis);
+      const double middle = 0.5 * (clusters[id].lo[axis] + clusters[id].hi[axis]);
+      if (!(clusters[id].lo[axis] < middle && middle < clusters[id].hi[axis])) continue;
+      clusters[id].axis = axis;
+      clusters[id].middle = middle;
+      clusters[id].left = static_cast<Index>(clusters.size());
+      clusters[id].right = clusters[id].left + 1;
+      next.push_back(clusters[id].left);
+      next.push_back(clusters[id].right);
+      clusters.resize(clusters.size() + 2);
+    }
+    for (Index c = 0; c < k; ++c) {
+      const Cluster& at = clusters[static_cast<std::size_t>(label[static_cast<std::size_t>(c)])];
+      if (at.left >= 0) label[static_cast<std::size_t>(c)] = centres(at.axis, c) < at.middle ? at.left : at.right;
+    }
+    active = std::move(next);
+  }
+
+  PatchLayout<Dim> out;
+  out.lower = clusters[0].lo;
+  out.upper = clusters[0].hi;
+  std::vector<Index> patch(clusters.size(), -1), stack{0}, leaves;
+  while (!stack.empty()) {
+    const Index id = stack.back();
+    stack.pop_back();
+    const Cluster& at = clusters[static_cast<std::size_t>(id)];
+    if (at.left < 0) {
+      if (at.count > 0.0) {
+        patch[static_cast<std::size_t>(id)] = static_cast<Index>(leaves.size());
+        leaves.push_back(id);
+      }
+      continue;
+    }
+    stack.push_back(at.right);
+    stack.push_back(at.left);
+  }
+  const auto n = static_cast<Index>(leaves.size());
+  out.middle.resize(Dim, n);
+  out.count.resize(static_cast<std::size_t>(n));
+  for (Index j = 0; j < n; ++j) {
+    const Cluster& at = clusters[static_cast<std::size_t>(leaves[static_cast<std::size_t>(j)])];
+    out.middle.col(j) = 0.5 * (at.lo + at.hi);
+    out.count[static_cast<std::size_t>(j)] = at.count;
+  }
+  out.patch_of.resize(static_cast<std::size_t>(k));
+  out.reach.assign(static_cast<std::size_t>(n), 0.0);
+  for (Index c = 0; c < k; ++c) {
+    const Index j = patch[static_cast<std::size_t>(label[static_cast<std::size_t>(c)])];
+    out.patch_of[static_cast<std::size_t>(c)] = j;
+    out.reach[static_cast<std::size_t>(j)] = std::max(out.reach[static_cast<std::size_t>(j)], (centres.col(c) - out.middle.col(j)).norm());
+  }
+  std::vector<double> none;
+  reduce(none, out.reach, none);
+  return out;
+}
+
+/// Patch j's radius R_j = ρ_j + max(overlap ρ_j, r).
+[[nodiscard]] inline double patch_radius(double reach, double overlap, double support_radius) {
+  return reach + std::max(overlap * reach, support_radius);
+}
 
 template <int Dim>
 class PartitionOfUnityRbf {
@@ -53,35 +172,18 @@ class PartitionOfUnityRbf {
     kernel_ = kernel;
     k_ = centres.cols();
     const double r = kernel.radius;
-    std::vector<Index> order(static_cast<std::size_t>(k_));
-    std::iota(order.begin(), order.end(), Index{0});
-    std::vector<std::pair<Index, Index>> clusters;  // ranges of `order`
-    split(centres, order, 0, k_, std::max<Index>(patch_centres, 1), clusters);
-
-    const auto n_patches = static_cast<Index>(clusters.size());
-    patch_centre_.resize(Dim, n_patches);
-    patch_radius_.assign(static_cast<std::size_t>(n_patches), 0.0);
-    for (Index j = 0; j < n_patches; ++j) {
-      const auto [begin, end] = clusters[static_cast<std::size_t>(j)];
-      Vec<Dim> lo = centres.col(order[static_cast<std::size_t>(begin)]), hi = lo;
-      for (Index i = begin; i < end; ++i) {
-        lo = lo.cwiseMin(centres.col(order[static_cast<std::size_t>(i)]));
-        hi = hi.cwiseMax(centres.col(order[static_cast<std::size_t>(i)]));
-      }
-      const Vec<Dim> mid = 0.5 * (lo + hi);
-      double rho = 0.0;
-      for (Index i = begin; i < end; ++i) rho = std::max(rho, (centres.col(order[static_cast<std::size_t>(i)]) - mid).norm());
-      patch_centre_.col(j) = mid;
-      patch_radius_[static_cast<std::size_t>(j)] = rho + std::max(overlap * rho, r);
-    }
-    largest_radius_ = patch_radius_.empty() ? 0.0 : *std::max_element(patch_radius_.begin(), patch_radius_.end());
+    const PatchLayout<Dim> layout = patch_layout(centres, std::max<Index>(patch_centres, 1), [](auto&&...) {});
+    const auto n_patches = static_cast<Index>(layout.reach.size());
+    patch_centre_ = layout.middle;
+    patch_radius_.resize(static_cast<std::size_t>(n_patches));
+    for (Index j = 0; j < n_patches; ++j)
+      patch_radius_[static_cast<std::size_t>(j)] = patch_radius(layout.reach[static_cast<std::size_t>(j)], overlap, r);
 
     // Local sets, sorted so that a patch's system does not depend on the tree's order.
     centres_ = centres;
     tree_ = KdTree<Dim>{};
     tree_.build(centres_);
     local_.assign(static_cast<std::size_t>(n_patches), {});
-    offsets_.assign(static_cast<std::size_t>(n_patches) + 1, 0);
     std::vector<Neighbor> found;
     for (Index j = 0; j < n_patches; ++j) {
       tree_.radius_search(Vec<Dim>(patch_centre_.col(j)), patch_radius_[static_cast<std::size_t>(j)], found);
@@ -89,17 +191,8 @@ class PartitionOfUnityRbf {
       ids.reserve(found.size());
       for (const auto& hit : found) ids.push_back(static_cast<Index>(hit.first));
       std::sort(ids.begin(), ids.end());
-      offsets_[static_cast<std::size_t>(j) + 1] = offsets_[static_cast<std::size_t>(j)] + static_cast<Index>(ids.size());
     }
-    // Centre → the coefficients it has (one per patch holding it): an evaluation then asks the
-    // tree once per point, not once per patch covering it.
-    // Each entry packs the patch (high 32 bits) and the centre's place in it (low 32 bits).
-    membership_ = csr_from_pairs(k_, [&](auto&& f) {
-      for (Index j = 0; j < n_patches; ++j) {
-        const auto& ids = local_[static_cast<std::size_t>(j)];
-        for (std::size_t i = 0; i < ids.size(); ++i) f(ids[i], (j << 32) | static_cast<Index>(i));
-      }
-    });
+    index_patches();
 
     // Patches are factorized side by side; each factorization runs on one thread.
     systems_.clear();
@@ -111,8 +204,6 @@ class PartitionOfUnityRbf {
       for (std::size_t i = 0; i < ids.size(); ++i) at.col(static_cast<Index>(i)) = centres.col(ids[i]);
       systems_[static_cast<std::size_t>(j)].setup(at, local_kernel, solver, DenseSolverKind::partial_piv_lu, 0);
     });
-    patch_tree_ = KdTree<Dim>{};
-    patch_tree_.build(patch_centre_);
     report_ = SolverReport{};
     nonzeros_ = 0;
     condition_ = 1.0;
@@ -126,8 +217,32 @@ class PartitionOfUnityRbf {
     }
   }
 
+  /// For evaluation only (no systems): the patches of centres `middle`, radii `radius`, local
+  /// sets `at` (the stacked coefficients follow them in this order), of a partition of unity
+  /// whose other patches do not reach the points to be evaluated: a rank's view of a
+  /// distributed one.
+  void cover(Points<Dim> middle, std::vector<double> radius, const std::vector<Points<Dim>>& at, const RbfKernelSettings& kernel) {
+    kernel_ = kernel;
+    patch_centre_ = std::move(middle);
+    patch_radius_ = std::move(radius);
+    Index total = 0;
+    for (const auto& p : at) total += p.cols();
+    centres_.resize(Dim, total);
+    local_.assign(at.size(), {});
+    k_ = 0;
+    for (std::size_t j = 0; j < at.size(); ++j)
+      for (Index i = 0; i < at[j].cols(); ++i) {
+        centres_.col(k_) = at[j].col(i);
+        local_[j].push_back(k_++);
+      }
+    tree_ = KdTree<Dim>{};
+    tree_.build(centres_);
+    systems_.clear();
+    index_patches();
+  }
+
   [[nodiscard]] Index size() const noexcept { return k_; }
-  [[nodiscard]] Index num_patches() const noexcept { return static_cast<Index>(systems_.size()); }
+  [[nodiscard]] Index num_patches() const noexcept { return static_cast<Index>(local_.size()); }
   /// Rows of the stacked coefficients (the local sets' sizes summed).
   [[nodiscard]] Index num_coefficients() const noexcept { return offsets_.empty() ? 0 : offsets_.back(); }
   [[nodiscard]] Index largest_patch() const {
@@ -197,7 +312,7 @@ class PartitionOfUnityRbf {
     {
       std::vector<Neighbor> patches, hits;
       std::vector<double> share;  // per patch, its weight at x (0: not covering)
-      errors.run([&] { share.assign(systems_.size(), 0.0); });
+      errors.run([&] { share.assign(local_.size(), 0.0); });
 #pragma omp for schedule(dynamic, 1)
       for (Index c = 0; c < chunks; ++c)
         errors.run([&] {
@@ -243,27 +358,24 @@ class PartitionOfUnityRbf {
   }
 
  private:
-  /// Splits order[begin, end) at the median of the longest side until ranges hold at most `most`.
-  static void split(const Points<Dim>& centres, std::vector<Index>& order, Index begin, Index end, Index most,
-                    std::vector<std::pair<Index, Index>>& out) {
-    if (end - begin <= most) {
-      if (end > begin) out.emplace_back(begin, end);
-      return;
-    }
-    Vec<Dim> lo = centres.col(order[static_cast<std::size_t>(begin)]), hi = lo;
-    for (Index i = begin; i < end; ++i) {
-      lo = lo.cwiseMin(centres.col(order[static_cast<std::size_t>(i)]));
-      hi = hi.cwiseMax(centres.col(order[static_cast<std::size_t>(i)]));
-    }
-    int axis = 0;
-    (hi - lo).maxCoeff(&axis);
-    const Index mid = begin + (end - begin) / 2;
-    std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end, [&](Index a, Index b) {
-      const double ca = centres(axis, a), cb = centres(axis, b);
-      return ca < cb || (ca == cb && a < b);
+  /// offsets_, membership_ and the patch tree, from the local sets.
+  void index_patches() {
+    const auto n_patches = static_cast<Index>(local_.size());
+    offsets_.assign(static_cast<std::size_t>(n_patches) + 1, 0);
+    for (Index j = 0; j < n_patches; ++j)
+      offsets_[static_cast<std::size_t>(j) + 1] = offsets_[static_cast<std::size_t>(j)] + static_cast<Index>(local_[static_cast<std::size_t>(j)].size());
+    // Centre → the coefficients it has (one per patch holding it): an evaluation then asks the
+    // tree once per point, not once per patch covering it.
+    // Each entry packs the patch (high 32 bits) and the centre's place in it (low 32 bits).
+    membership_ = csr_from_pairs(k_, [&](auto&& f) {
+      for (Index j = 0; j < n_patches; ++j) {
+        const auto& ids = local_[static_cast<std::size_t>(j)];
+        for (std::size_t i = 0; i < ids.size(); ++i) f(ids[i], (j << 32) | static_cast<Index>(i));
+      }
     });
-    split(centres, order, begin, mid, most, out);
-    split(centres, order, mid, end, most, out);
+    largest_radius_ = patch_radius_.empty() ? 0.0 : *std::max_element(patch_radius_.begin(), patch_radius_.end());
+    patch_tree_ = KdTree<Dim>{};
+    patch_tree_.build(patch_centre_);
   }
 
   /// f(j) for every patch, in parallel; the first error (by patch) is rethrown after all ran.
