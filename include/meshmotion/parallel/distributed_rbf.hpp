@@ -241,7 +241,6 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
       global_entries_ = patches->global_centres();
       owned_entries_ = patches->entries();
       stats_ = patches->stats();
-      stats_.evaluated_nodes = std::min(stats_.evaluated_nodes, n);
       patches_ = std::move(patches);
       ready_ = true;
       stats_.setup_seconds = watch.seconds();
