@@ -26,7 +26,6 @@
 /// merges) are not taken: setup() says why, the same on every rank.
 
 #include "meshmotion/core/error.hpp"
-#include "meshmotion/core/threads.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/detail/coincident_nodes.hpp"
@@ -42,7 +41,6 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <exception>
 #include <limits>
 #include <string>
 #include <vector>
@@ -354,17 +352,10 @@ std::string DistributedPartitionOfUnity<Dim>::setup(const PartitionView<Dim>& pa
   // Patches are factorized side by side; each factorization runs on one thread.
   kernel_ = {options.kernel, radius_, false};
   collective(comm_, [&] {
-    std::vector<std::string> errors(systems_.size());
-#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(dynamic, 1)
-    for (std::size_t p = 0; p < systems_.size(); ++p) {
-      try {
-        systems_[p].setup(at[p], kernel_, options.solver, DenseSolverKind::partial_piv_lu, 0);
-      } catch (const std::exception& e) {
-        errors[p] = std::string("patch ") + std::to_string(first_ + static_cast<Index>(p)) + ": " + e.what();
-      }
-    }
-    for (const auto& e : errors)
-      if (!e.empty()) throw SolverError("DistributedRbfMover::setup: " + e);
+    meshmotion::detail::for_each_in_parallel(owned_patches(), [&](Index p) {
+      systems_[static_cast<std::size_t>(p)].setup(at[static_cast<std::size_t>(p)], kernel_, options.solver,
+                                                  DenseSolverKind::partial_piv_lu, 0);
+    });
   });
   alpha_.assign(systems_.size(), {});
   build_evaluation(part, at);
@@ -455,7 +446,8 @@ void DistributedPartitionOfUnity<Dim>::move_into(PointsView<Dim> d, Points<Dim>&
       for (int a = 0; a < Dim; ++a) send[static_cast<std::size_t>(r)].push_back(d(a, entries_[static_cast<std::size_t>(c)]));
   const auto values = parallel::exchange(comm_, send);
   collective(comm_, [&] {
-    for (std::size_t p = 0; p < systems_.size(); ++p) {
+    meshmotion::detail::for_each_in_parallel(owned_patches(), [&](Index j) {
+      const auto p = static_cast<std::size_t>(j);
       Eigen::MatrixXd local(static_cast<Index>(sources_[p].size()), Dim);
       for (std::size_t c = 0; c < sources_[p].size(); ++c) {
         const auto [r, slot] = sources_[p][c];
@@ -463,7 +455,7 @@ void DistributedPartitionOfUnity<Dim>::move_into(PointsView<Dim> d, Points<Dim>&
       }
       typename meshmotion::detail::RbfSystem<Dim>::PolyCoefficients beta;
       systems_[p].solve(local, alpha_[p], beta);
-    }
+    });
   });
   // Each patch's coefficients to the ranks whose nodes it covers.
   std::vector<std::vector<double>> coefficients(static_cast<std::size_t>(ranks_));
@@ -515,15 +507,17 @@ Points<Dim> DistributedPartitionOfUnity<Dim>::derivative_reverse(PointsView<Dim>
   // The transposed solves, and each centre's share back to the rank that owns it.
   std::vector<std::vector<double>> shares(static_cast<std::size_t>(ranks_));
   for (int r = 0; r < ranks_; ++r) shares[static_cast<std::size_t>(r)].assign(static_cast<std::size_t>(Dim * wanted_count_[static_cast<std::size_t>(r)]), 0.0);
+  // Each centre of a patch has its own slot, so the patches write apart.
   collective(comm_, [&] {
-    for (std::size_t p = 0; p < systems_.size(); ++p) {
+    meshmotion::detail::for_each_in_parallel(owned_patches(), [&](Index j) {
+      const auto p = static_cast<std::size_t>(j);
       Eigen::MatrixXd values_bar;
       systems_[p].solve_transpose(alpha_bar[p], meshmotion::detail::RbfSystem<Dim>::PolyCoefficients::Zero(), values_bar);
       for (std::size_t c = 0; c < sources_[p].size(); ++c) {
         const auto [r, slot] = sources_[p][c];
         for (int k = 0; k < Dim; ++k) shares[static_cast<std::size_t>(r)][static_cast<std::size_t>(Dim * slot + k)] += values_bar(static_cast<Index>(c), k);
       }
-    }
+    });
   });
   const auto mine = parallel::exchange(comm_, shares);
   for (int r = 0; r < ranks_; ++r) {

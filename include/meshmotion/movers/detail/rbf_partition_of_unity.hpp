@@ -155,6 +155,23 @@ template <int Dim, class Reduce>
   return out;
 }
 
+/// f(j) for j in [0, n), side by side on the library's threads (patches: each on one thread);
+/// the first error (by j) is rethrown after all ran.
+template <class F>
+void for_each_in_parallel(Index n, F&& f) {
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(n));
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(dynamic, 1)
+  for (Index j = 0; j < n; ++j) {
+    try {
+      f(j);
+    } catch (...) {
+      errors[static_cast<std::size_t>(j)] = std::current_exception();
+    }
+  }
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
 /// Patch j's radius R_j = ρ_j + max(overlap ρ_j, r).
 [[nodiscard]] inline double patch_radius(double reach, double overlap, double support_radius) {
   return reach + std::max(overlap * reach, support_radius);
@@ -378,21 +395,9 @@ class PartitionOfUnityRbf {
     patch_tree_.build(patch_centre_);
   }
 
-  /// f(j) for every patch, in parallel; the first error (by patch) is rethrown after all ran.
   template <class F>
   void for_each_patch(F&& f) {
-    const auto n = static_cast<Index>(systems_.size());
-    std::vector<std::exception_ptr> errors(static_cast<std::size_t>(n));
-#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(dynamic, 1)
-    for (Index j = 0; j < n; ++j) {
-      try {
-        f(j);
-      } catch (...) {
-        errors[static_cast<std::size_t>(j)] = std::current_exception();
-      }
-    }
-    for (const auto& e : errors)
-      if (e) std::rethrow_exception(e);
+    for_each_in_parallel(static_cast<Index>(systems_.size()), f);
   }
 
   RbfKernelSettings kernel_;
