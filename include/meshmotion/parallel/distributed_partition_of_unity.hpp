@@ -76,6 +76,16 @@ class DistributedPartitionOfUnity {
     std::vector<std::vector<double>> positions;
     static constexpr int tag_size = 4;
   };
+  /// A centre received for an owned patch.
+  struct Candidate {
+    std::int64_t id;
+    int rank;            ///< its owner
+    std::int64_t index;  ///< in its owner's entries_
+    bool member;         ///< of the patch's cluster
+    Vec<Dim> x;
+  };
+  /// What this rank received, by owned patch, in the order received.
+  [[nodiscard]] std::vector<std::vector<Candidate>> by_patch(const Received& got) const;
   [[nodiscard]] int owner(Index patch) const {
     return static_cast<int>(patch * static_cast<Index>(ranks_) / static_cast<Index>(radius_of_.size()));
   }
@@ -165,25 +175,15 @@ double DistributedPartitionOfUnity<Dim>::default_radius(const meshmotion::detail
     }
     reach[uj] = layout.reach[uj] + bound;
   }
-  const Received got = send_to_patches(reach, layout.patch_of);
   // Per owned patch, the nearest other centre of each member, among the centres sent for it.
   std::vector<double> spacing;
-  for (Index j = first_; j < first_ + static_cast<Index>(systems_.size()); ++j) {
-    std::vector<double> xs;
-    std::vector<char> member;
-    for (int r = 0; r < ranks_; ++r) {
-      const auto& tags = got.tags[static_cast<std::size_t>(r)];
-      for (std::size_t t = 0; t < tags.size() / Received::tag_size; ++t) {
-        if (tags[Received::tag_size * t] != j) continue;
-        member.push_back(tags[Received::tag_size * t + 3] != 0 ? 1 : 0);
-        for (int d = 0; d < Dim; ++d) xs.push_back(got.positions[static_cast<std::size_t>(r)][Dim * t + static_cast<std::size_t>(d)]);
-      }
-    }
-    const Points<Dim> candidates = Eigen::Map<const Points<Dim>>(xs.data(), Dim, static_cast<Index>(member.size()));
-    const KdTree<Dim> tree(candidates);
-    for (std::size_t c = 0; c < member.size(); ++c) {
-      if (member[c] == 0) continue;
-      const auto nn = tree.nearest(Vec<Dim>(candidates.col(static_cast<Index>(c))), 2);
+  for (const auto& all : by_patch(send_to_patches(reach, layout.patch_of))) {
+    Points<Dim> xs(Dim, static_cast<Index>(all.size()));
+    for (std::size_t c = 0; c < all.size(); ++c) xs.col(static_cast<Index>(c)) = all[c].x;
+    const KdTree<Dim> tree(xs);
+    for (const Candidate& c : all) {
+      if (!c.member) continue;
+      const auto nn = tree.nearest(c.x, 2);
       if (nn.size() == 2 && nn[1].second > 0.0) spacing.push_back(std::sqrt(nn[1].second));
     }
   }
@@ -211,24 +211,26 @@ double DistributedPartitionOfUnity<Dim>::default_radius(const meshmotion::detail
 }
 
 template <int Dim>
-std::string DistributedPartitionOfUnity<Dim>::gather_patches(const Received& got, double tolerance, std::vector<Points<Dim>>& at,
-                                                             std::vector<std::vector<std::int64_t>>& requests) {
-  const auto owned = systems_.size();
-  struct Candidate {
-    std::int64_t id;
-    int rank;
-    std::int64_t index;  ///< in the sender's entries_
-    Vec<Dim> x;
-  };
-  std::vector<std::vector<Candidate>> candidates(owned);
+std::vector<std::vector<typename DistributedPartitionOfUnity<Dim>::Candidate>> DistributedPartitionOfUnity<Dim>::by_patch(
+    const Received& got) const {
+  std::vector<std::vector<Candidate>> out(systems_.size());
   for (int r = 0; r < ranks_; ++r) {
     const auto& tags = got.tags[static_cast<std::size_t>(r)];
     for (std::size_t t = 0; t < tags.size() / Received::tag_size; ++t) {
-      Candidate c{tags[Received::tag_size * t + 1], r, tags[Received::tag_size * t + 2], Vec<Dim>::Zero()};
+      const std::int64_t* tag = tags.data() + Received::tag_size * t;
+      Candidate c{tag[1], r, tag[2], tag[3] != 0, Vec<Dim>::Zero()};
       for (int d = 0; d < Dim; ++d) c.x[d] = got.positions[static_cast<std::size_t>(r)][Dim * t + static_cast<std::size_t>(d)];
-      candidates[static_cast<std::size_t>(tags[Received::tag_size * t] - first_)].push_back(c);
+      out[static_cast<std::size_t>(tag[0] - first_)].push_back(c);
     }
   }
+  return out;
+}
+
+template <int Dim>
+std::string DistributedPartitionOfUnity<Dim>::gather_patches(const Received& got, double tolerance, std::vector<Points<Dim>>& at,
+                                                             std::vector<std::vector<std::int64_t>>& requests) {
+  const auto owned = systems_.size();
+  const std::vector<std::vector<Candidate>> candidates = by_patch(got);
   // The serial radius query over the candidates keeps what it keeps over every centre; the
   // members are then sorted by global id, as the serial patch sorts its centres by index.
   at.assign(owned, {});
