@@ -218,7 +218,10 @@ std::optional<double> set_support_radius(MoverConfig<Dim>& config, const MotionA
               // The mover's own default, within its memory budget (RbfOptions::max_memory_bytes).
               const DefaultSupportRadius fitted = default_support_radius(points, b, o);
               o.support_radius = fitted.radius;
-              if (fitted.reduced)
+              if (fitted.rigid_part)
+                std::cerr << "note: the moving group's rigid motion is blended into the volume and the RBF carries "
+                             "the rest (rigid_part=automatic; rigid_part=none interpolates it all; docs/interpolation.md)\n";
+              else if (fitted.reduced)
                 std::cerr << "note: support radius reduced to " << format_option_value(fitted.radius)
                           << " to keep the system and the evaluation operator within the memory budget "
                              "(RbfOptions::max_memory_bytes; docs/interpolation.md)\n";

@@ -439,8 +439,15 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
 #ifdef MESHMOTION_FOAM_PARALLEL
     impl->gathered = !input.global_ids.empty() && needs_cells(input.method) && impl->config.method != "le" && impl->config.method != "sle";
 #endif
-    if (const auto* rbf = std::get_if<RbfOptions>(&impl->config.options))
+    if (auto* rbf = std::get_if<RbfOptions>(&impl->config.options)) {
       impl->growing_radius = rbf->support_radius == 0.0 && rbf->support_radii.empty();
+      // One setup serves many time steps: a rigid part blended from one step's motion would
+      // be wrong for the next, so the whole motion is interpolated.
+      if (rbf->rigid_part == RigidPart::blend)
+        throw InputError("rigid_part=blend: the plugin sets its mover up once for many time steps and interpolates "
+                         "the whole motion (rigid_part=none)");
+      rbf->rigid_part = RigidPart::none;
+    }
 #ifdef MESHMOTION_FOAM_PARALLEL
     if (!input.global_ids.empty()) {
       // OpenFOAM has MPI running; PETSc, which the boundary system may take, is started once.

@@ -750,17 +750,19 @@ TEST_CASE("global kernels: the cached evaluation matrix gives the uncached resul
 
 TEST_CASE("rbf: the memory is estimated before assembly, a default radius shrinks to the budget and a given one is refused",
           "[movers]") {
-  // A quarter turn of the whole boundary: the default radius (5 × the largest displacement)
-  // reaches every centre from every node, a dense system and operator (about 14 MB estimated here).
+  // A quarter turn of the whole boundary, interpolated (rigid_part=none; automatic would move
+  // every node rigidly): the default radius (5 × the largest displacement) reaches every centre
+  // from every node, a dense system and operator (about 14 MB estimated here).
   const Grid<3> g = grid<3>(10);
   BoundarySpec<3> spec;
   spec.moving("outer", Rotation3D{Vec<3>(0.5, 0.5, 0.5), Vec<3>(0.0, 0.0, 1.0), 1.5707963267948966});
   const auto boundary = spec.resolve(g.mesh.points, with_outer<3>(g.groups));
-  RbfMover<3> unlimited;
+  RbfOptions options;
+  options.rigid_part = RigidPart::none;
+  RbfMover<3> unlimited(options);
   unlimited.setup(g.mesh, boundary);
   CHECK_FALSE(unlimited.support_radius_reduced());  // within max(1 KiB a node, 256 MiB)
 
-  RbfOptions options;
   options.max_memory_bytes = 1e6;
   RbfMover<3> limited(options);
   limited.setup(g.mesh, boundary);
@@ -826,4 +828,126 @@ TEST_CASE("a mesh whose whole boundary turns 56 degrees, stretches and swirls st
     CHECK(q.num_invalid == 0);
     CHECK(q.min > 0.8);  // 0.959 and 0.970 measured
   }
+}
+
+namespace {
+
+/// The boundary of a body (group `body`) turned by `motion` inside held walls (`fixed`), and
+/// `sliding` groups (plane normals from the mesh).
+template <int Dim, class M>
+ResolvedBoundary<Dim> turned_body(const Mesh<Dim>& mesh, const M& motion, std::vector<std::string> fixed,
+                                  std::vector<std::string> sliding = {}) {
+  BoundarySpec<Dim> spec;
+  spec.moving("inner", motion);
+  for (auto& g : fixed) spec.fixed(std::move(g));
+  for (auto& g : sliding) spec.sliding(std::move(g));
+  return spec.resolve(mesh);
+}
+
+}  // namespace
+
+TEST_CASE("a body turned 90 degrees inside held walls: its rigid motion is blended in, valid, nothing factorized",
+          "[movers]") {
+  // The ring's inner circle turns a quarter turn, its outer circle is held. Interpolated
+  // displacements (rigid_part=none) pull the cells halfway between towards the centre and
+  // fold them; the blended rotation shears them instead.
+  const Mesh<2> ring = annulus_mesh({.n_around = 96});
+  const auto boundary = turned_body<2>(ring, Rotation2D{Vec<2>::Zero(), std::numbers::pi / 2}, {"outer"});
+  RbfMover<2> mover;
+  mover.setup(ring, boundary);
+  REQUIRE(mover.rigid_part_taken_out());
+  CHECK(mover.stats().rigid_part);
+  Mesh<2> moved = ring;
+  moved.points += mover.move(boundary.displacements);
+  CHECK(mover.stats().nonzeros == 0);  // the rigid motion left nothing to interpolate
+  const QualityReport blended = quality_report(moved, Metric::scaled_jacobian);
+  CHECK(blended.num_invalid == 0);
+  for (Index v = 0; v < ring.num_nodes(); ++v) {
+    const Vec<2> x = ring.points.col(v), y = moved.points.col(v);
+    CAPTURE(v, x.norm());
+    CHECK(std::abs(y.norm() - x.norm()) < 1e-12);  // turned, never pulled towards the centre
+    if (x.norm() < 0.5 + 1e-9) CHECK((y - Vec<2>(-x.y(), x.x())).norm() < 1e-12);  // the body, exactly
+    if (x.norm() > 1.5 - 1e-9) CHECK(y == x);                                        // the held wall, untouched
+  }
+  RbfOptions plain;
+  plain.rigid_part = RigidPart::none;
+  RbfMover<2> interpolated(plain);
+  interpolated.setup(ring, boundary);
+  CHECK_FALSE(interpolated.rigid_part_taken_out());
+  Mesh<2> folded = ring;
+  folded.points += interpolated.move(boundary.displacements);
+  const QualityReport q = quality_report(folded, Metric::scaled_jacobian);
+  CAPTURE(blended.min, q.min, q.num_invalid);
+  CHECK(blended.min > q.min + 0.1);
+}
+
+TEST_CASE("rigid part: sliding planes the rotation keeps move with the blend, others hold it; small motions stay "
+          "interpolated", "[movers]") {
+  // The ring extruded: its ends slide in their planes, normal to the axis of the turn.
+  const Mesh<3> ring = extrude_mesh(annulus_mesh({.n_around = 48, .core_spacing = 0.08}), {.layers = 2, .height = 0.3});
+  const auto about_z = turned_body<3>(ring, Rotation3D{Vec<3>::Zero(), Vec<3>::UnitZ(), std::numbers::pi / 2}, {"outer"},
+                                      {"z_min", "z_max"});
+  RbfMover<3> mover;
+  mover.setup(ring, about_z);
+  REQUIRE(mover.rigid_part_taken_out());
+  Mesh<3> moved = ring;
+  moved.points += mover.move(about_z.displacements);
+  CHECK(quality_report(moved, Metric::scaled_jacobian).num_invalid == 0);
+  CHECK((moved.points.row(2) - ring.points.row(2)).cwiseAbs().maxCoeff() < 1e-12);  // the ends stay in their planes
+  // Turned about x instead, the ends' planes would be left: they hold the blend, 1e-4 from the
+  // body (its first cells) leaves no room for one, and automatic interpolates the whole motion
+  // (the nodes' determinants alone read 1 there: no node lies within the gap).
+  const auto about_x = turned_body<3>(ring, Rotation3D{Vec<3>::Zero(), Vec<3>::UnitX(), 0.05}, {"outer"}, {"z_min", "z_max"});
+  RbfMover<3> tilted;
+  tilted.setup(ring, about_x);
+  CHECK_FALSE(tilted.rigid_part_taken_out());
+  RbfOptions forced;
+  forced.rigid_part = RigidPart::blend;
+  RbfMover<3> blended(forced);
+  blended.setup(ring, about_x);
+  CHECK(blended.rigid_part_taken_out());
+  // A small turn against the gap (5 × the largest displacement within it) is interpolated.
+  const Mesh<2> flat = annulus_mesh({.n_around = 48, .core_spacing = 0.08});
+  RbfMover<2> small;
+  small.setup(flat, turned_body<2>(flat, Rotation2D{Vec<2>::Zero(), 0.1}, {"outer"}));
+  CHECK_FALSE(small.rigid_part_taken_out());
+}
+
+TEST_CASE("rigid part: moves are affine, derivatives are the interpolation's, a non-rigid motion is refused by blend",
+          "[movers]") {
+  const Mesh<2> ring = annulus_mesh({.n_around = 48, .core_spacing = 0.08});
+  const auto boundary = turned_body<2>(ring, Rotation2D{Vec<2>(0.01, -0.02), 1.2}, {"outer"});
+  RbfMover<2> mover;
+  mover.setup(ring, boundary);
+  REQUIRE(mover.rigid_part_taken_out());
+  const Points<2> d = boundary.displacements;
+  Points<2> w = random_displacements<2>(boundary.size(), 5, 1e-2);
+  for (Index b = 0; b < boundary.size(); ++b)
+    if (boundary.kinds[static_cast<std::size_t>(b)] != BoundaryKind::prescribed) w.col(b).setZero();
+  const Points<2> at_d = mover.move(d);
+  const Points<2> at_dw = mover.move(d + w);  // not the setup's rigid motion: interpolated
+  CHECK(mover.stats().nonzeros > 0);
+  const Points<2> jw = mover.derivative_forward(w);
+  CHECK((at_dw - at_d - jw).norm() < 1e-12 * jw.norm());
+  for (Index b = 0; b < boundary.size(); ++b)
+    CHECK((at_dw.col(boundary.nodes[static_cast<std::size_t>(b)]) - (d + w).col(b)).norm() < 1e-15);
+  const Points<2> v = random_displacements<2>(ring.num_nodes(), 6, 1.0);
+  CHECK((v.array() * jw.array()).sum() == Approx((mover.derivative_reverse(v).array() * w.array()).sum()).epsilon(1e-10));
+  // A fresh setup is as lazy: its first derivative builds the interpolation.
+  RbfMover<2> fresh;
+  fresh.setup(ring, boundary);
+  CHECK((fresh.derivative_forward(w) - jw).norm() < 1e-12 * jw.norm());
+
+  Points<2> grow = Points<2>::Zero(2, boundary.size());
+  for (Index b = 0; b < boundary.size(); ++b)
+    if (boundary.kinds[static_cast<std::size_t>(b)] == BoundaryKind::prescribed)
+      grow.col(b) = 0.3 * ring.points.col(boundary.nodes[static_cast<std::size_t>(b)]);
+  ResolvedBoundary<2> growing = boundary;
+  growing.displacements = grow;
+  RbfOptions forced;
+  forced.rigid_part = RigidPart::blend;
+  CHECK_THROWS_WITH(RbfMover<2>(forced).setup(ring, growing), Catch::Contains("do not move as one rigid body"));
+  RbfMover<2> automatic;
+  automatic.setup(ring, growing);
+  CHECK_FALSE(automatic.rigid_part_taken_out());
 }

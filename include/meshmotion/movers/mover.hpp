@@ -27,6 +27,9 @@ struct MoverStats {
   /// A lower bound of the interpolation system's 2-norm condition number (RBF: the largest
   /// over its systems or patches); 0 where the mover has none or does not estimate it.
   double condition = 0.0;
+  /// RBF: the rigid part of the boundary's motion was blended into the volume and the
+  /// interpolation carried the rest (RbfOptions::rigid_part).
+  bool rigid_part = false;
 };
 
 template <class F>
@@ -42,6 +45,7 @@ void visit_fields(const MoverStats& s, F&& f) {
   f("evaluated_nodes", s.evaluated_nodes, "nodes whose displacement the mover computes");
   f("nonzeros", s.nonzeros, "stored nonzeros of the system and evaluation operators");
   f("condition", s.condition, "lower bound of the RBF system's condition number (0: not estimated)");
+  f("rigid_part", s.rigid_part, "RBF: the rigid part of the boundary's motion was blended in first");
 }
 
 /// A mesh mover in Dim = M::dim dimensions.

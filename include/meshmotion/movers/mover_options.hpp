@@ -78,6 +78,7 @@ void visit_options(RbfOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "patch_overlap", o.patch_overlap, "partition of unity: overlap, x each patch's radius (at least the support radius)");
   f(prefix + "max_memory_bytes", o.max_memory_bytes,
     "compact kernels: estimated memory allowed, bytes (0: half the machine's); a default radius is reduced to fit");
+  f(prefix + "rigid_part", o.rigid_part, "blend a large rigid motion into the volume before interpolating the rest");
 }
 
 template <class F>

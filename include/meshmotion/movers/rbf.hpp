@@ -3,7 +3,10 @@
 /// RbfMover: radial basis function interpolation of boundary displacements into the volume
 /// (thesis section 2.2.2, eqs. 2.10–2.14; de Boer, van der Schoot & Bijl 2007).
 ///
-/// - Linear in the displacements: move(a d1 + b d2) = a move(d1) + b move(d2).
+/// - Linear in the displacements: move(a d1 + b d2) = a move(d1) + b move(d2); affine when
+///   setup took the rigid part of a large rigid motion out (RbfOptions::rigid_part,
+///   rigid_part.hpp): move(d) = B + J(d − B_b), B that motion blended over the volume, J the
+///   interpolation, which the derivatives give.
 /// - Setup caches: merged boundary centres and their k-d tree, the factorized interpolation
 ///   matrix (sparse SimplicialLDLT for the compact Wendland kernels, dense LU for global
 ///   kernels), and for compact kernels the evaluation operator E (a sparse matrix of kernel
@@ -44,6 +47,7 @@
 #include "meshmotion/movers/detail/rbf_system.hpp"
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
+#include "meshmotion/movers/rigid_part.hpp"
 #include "meshmotion/movers/support_radius.hpp"
 #include "meshmotion/spatial/kd_tree.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
@@ -114,6 +118,12 @@ struct RbfOptions {
   /// which made the system and the operator dense (22 GB on a 28k-node case).
   /// support_radius_reduced() says when it was.
   double max_memory_bytes = 0.0;
+  /// Take the rigid part of the setup boundary's motion out before interpolating
+  /// (rigid_part.hpp): every node follows the prescribed nodes' rigid motion, its angle and
+  /// translation blended to nothing at the nearest held node, and the interpolation carries
+  /// the rest. The default (automatic) does it for a large rigid motion, the one a compact
+  /// support cannot spread without reaching across the domain (a body turned 90° in a box).
+  RigidPart rigid_part = RigidPart::automatic;
 };
 
 /// The options an RBF mover runs with: `options` with the polynomial on where the kernel needs
@@ -196,17 +206,15 @@ template <int Dim>
 struct DefaultSupportRadius {
   double radius = 0.0;
   bool reduced = false;  ///< reduced from suggest_support_radius() to fit the memory budget
+  bool rigid_part = false;  ///< taken from what remains once the rigid part is out (RbfOptions::rigid_part)
 };
 
-/// The support radius an RbfMover given none takes, for the mesh's nodes `points` (Dim ×
-/// n_nodes) and `boundary` (its nodes and displacements): suggest_support_radius(), reduced
-/// until the memory estimate of RbfOptions::max_memory_bytes fits max(1 KiB per node, an
-/// eighth of the machine's memory) and that limit (compact kernels, one system). The programs and Python take it
-/// from here too. Throws InputError as suggest_support_radius() does, or for a boundary node
-/// outside `points`.
+namespace detail {
+
+/// default_support_radius() for a boundary whose rigid part is already out (or stays in).
 template <int Dim>
-[[nodiscard]] DefaultSupportRadius default_support_radius(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary,
-                                                          const RbfOptions& options) {
+[[nodiscard]] DefaultSupportRadius budgeted_support_radius(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary,
+                                                           const RbfOptions& options) {
   const Points<Dim> centres = detail::boundary_positions(points, boundary, "RbfMover::setup");
   DefaultSupportRadius out{suggest_support_radius(centres, boundary.displacements), false};
   if (!detail::memory_checked(options)) return out;
@@ -223,6 +231,25 @@ template <int Dim>
     out.reduced = true;
     bytes = detail::compact_rbf_bytes(points, centres, tree, sliding, out.radius, options);
   }
+  return out;
+}
+
+}  // namespace detail
+
+/// The support radius an RbfMover given none takes, for the mesh's nodes `points` (Dim ×
+/// n_nodes) and `boundary` (its nodes and displacements): suggest_support_radius() of what the
+/// interpolation carries (the displacements less their rigid part where RbfOptions::rigid_part
+/// takes it out), reduced until the memory estimate of RbfOptions::max_memory_bytes fits
+/// max(1 KiB per node, an eighth of the machine's memory) and that limit (compact kernels, one
+/// system). The programs and Python take it from here too. Throws InputError as
+/// suggest_support_radius() and rigid_blend() do, or for a boundary node outside `points`.
+template <int Dim>
+[[nodiscard]] DefaultSupportRadius default_support_radius(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary,
+                                                          const RbfOptions& options) {
+  const auto blend = rigid_blend(points, boundary, options.rigid_part, SupportRadiusOptions{}.displacement_factor);
+  DefaultSupportRadius out =
+      detail::budgeted_support_radius(points, blend ? without_rigid_part(boundary, *blend) : boundary, options);
+  out.rigid_part = blend.has_value();
   return out;
 }
 
@@ -263,6 +290,11 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   /// True when the last setup reduced the default support radius to fit its memory budget
   /// (RbfOptions::max_memory_bytes).
   [[nodiscard]] bool support_radius_reduced() const noexcept { return radius_reduced_; }
+  /// True when the last setup took the rigid part of the boundary's motion out
+  /// (RbfOptions::rigid_part); moves then add its blend, rigid_part_displacement().
+  [[nodiscard]] bool rigid_part_taken_out() const noexcept { return rigid_.size() > 0; }
+  /// The rigid part's displacement of every node (Dim × n_nodes; empty when none was taken out).
+  [[nodiscard]] const Points<Dim>& rigid_part_displacement() const noexcept { return rigid_; }
   /// Patches of the partition of unity after setup (0: one global system).
   [[nodiscard]] Index patches() const noexcept { return patched_all_ ? patched_all_->num_patches() : 0; }
 
@@ -319,6 +351,8 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   void factorize(const Points<Dim>& centres, const detail::RbfKernelSettings& kernel);
   /// The operator evaluating the interpolant at the non-boundary nodes.
   void build_evaluation(const detail::RbfKernelSettings& kernel);
+  /// factorize() and build_evaluation() of the pending centres, once after each setup.
+  void build_interpolation();
 
   /// f(the system over every centre), global or patched; likewise over the constrained ones.
   template <class F>
@@ -384,11 +418,32 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
     return samples == 0 ? 0.0 : covered / (static_cast<double>(samples) * static_cast<double>(all_.size()));
   }
 
-  /// A move: apply() checked, timed and counted, with the solver's report in stats_.
+  /// A move: apply() checked, timed and counted, with the solver's report in stats_; the
+  /// rigid part, when setup took it out, interpolated no more and added whole.
   template <class Out>
   void timed_apply(PointsView<Dim> d, Out& out) {
     detail::timed_move<Dim>("RbfMover::move", ready_, d, boundary_nodes_, stats_, [&] {
-      apply(d, out);
+      if (rigid_.size() == 0) {
+        apply(d, out);
+      } else {
+        Points<Dim> rest = d;
+        double off = 0.0;
+        for (std::size_t b = 0; b < boundary_nodes_.size(); ++b) {
+          rest.col(static_cast<Index>(b)) -= rigid_.col(boundary_nodes_[b]);
+          if (kinds_[b] != BoundaryKind::sliding) off = std::max(off, rest.col(static_cast<Index>(b)).norm());
+        }
+        // What the rigid fit leaves of its own motion is round-off: nothing to interpolate.
+        if (off > 1e-10 * rigid_scale_) {
+          build_interpolation();
+          apply(rest, out);
+          out += rigid_;
+        } else {
+          shape_output(out);
+          out = rigid_;
+        }
+        for (std::size_t b = 0; b < boundary_nodes_.size(); ++b)
+          if (kinds_[b] != BoundaryKind::sliding) out.col(boundary_nodes_[b]) = d.col(static_cast<Index>(b));
+      }
       const SolverReport& r = with_all([](auto& system) -> const SolverReport& { return system.report(); });
       stats_.iterations = r.iterations;
       stats_.residual = r.residual;
@@ -424,14 +479,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
       values_.bottomRows(k - n_constrained_) = s;
     }
     with_all([&](auto& system) { system.solve(values_, alpha_, beta_); });
-
-    const Index n = points_.cols();
-    if constexpr (std::same_as<Out, Points<Dim>>) {
-      if (out.cols() != n) out.resize(Dim, n);
-    } else if (out.cols() != n) {
-      throw InputError("RbfMover::move_into: the output has " + std::to_string(out.cols()) + " columns (expected " +
-                       std::to_string(n) + ", one per node)");
-    }
+    shape_output(out);
     out.setZero();
     evaluate_interior(out);
     for (Index b = 0; b < m; ++b) {
@@ -439,6 +487,18 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
       out.col(node) = kinds_[static_cast<std::size_t>(b)] == BoundaryKind::sliding
                           ? Vec<Dim>(values_.row(centre_of_[static_cast<std::size_t>(b)]).transpose())
                           : Vec<Dim>(d.col(b));
+    }
+  }
+
+  /// Resizes a Points<Dim> `out` to Dim × n_nodes; refuses any other output of another shape.
+  template <class Out>
+  void shape_output(Out& out) const {
+    const Index n = points_.cols();
+    if constexpr (std::same_as<Out, Points<Dim>>) {
+      if (out.cols() != n) out.resize(Dim, n);
+    } else if (out.cols() != n) {
+      throw InputError("RbfMover::move_into: the output has " + std::to_string(out.cols()) + " columns (expected " +
+                       std::to_string(n) + ", one per node)");
     }
   }
 
@@ -523,6 +583,13 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   Poly beta_ = Poly::Zero();
   double radius_ = 0.0;  ///< the last setup's support radius
   bool radius_reduced_ = false;  ///< the default radius_ was reduced to fit the memory budget
+  Points<Dim> rigid_;            ///< the rigid part's blend (Dim × n), empty when not taken out
+  double rigid_scale_ = 0.0;     ///< the largest displacement of the motion it was fitted to
+  /// With the rigid part out, the interpolation is factorized at the first move or derivative
+  /// that needs it (a move by the setup's own rigid motion does not): its centres and kernel.
+  Points<Dim> pending_centres_;
+  detail::RbfKernelSettings pending_kernel_;
+  bool pending_ = false;
 };
 
 template <int Dim>
@@ -530,16 +597,19 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   const detail::Stopwatch watch;
   check_options(boundary);
   radius_reduced_ = false;
+  rigid_.resize(Dim, 0);
+  if (!points.allFinite()) throw InputError("RbfMover::setup: mesh has a non-finite coordinate");
+  detail::check_boundary<Dim>("RbfMover::setup", boundary, points.cols(), false);
+  auto blend = rigid_blend(points, boundary, options_.rigid_part, SupportRadiusOptions{}.displacement_factor);
   if (options_.support_radii.empty() && radius_ == 0.0) {
-    const DefaultSupportRadius fitted = default_support_radius(points, boundary, options_);
+    const DefaultSupportRadius fitted =
+        detail::budgeted_support_radius(points, blend ? without_rigid_part(boundary, *blend) : boundary, options_);
     radius_ = fitted.radius;
     radius_reduced_ = fitted.reduced;
   } else if (options_.support_radii.empty()) {
     check_support_radius_memory(points, boundary, radius_, options_);
   }
   points_ = std::move(points);
-  if (!points_.allFinite()) throw InputError("RbfMover::setup: mesh has a non-finite coordinate");
-  detail::check_boundary<Dim>("RbfMover::setup", boundary, points_.cols(), false);
   boundary_nodes_ = boundary.nodes;
   kinds_ = boundary.kinds;
   const Points<Dim> centres = merge_centres(boundary);
@@ -553,14 +623,32 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   }
   stats_ = MoverStats{};
   stats_.boundary_nodes = n_centres_;
-  factorize(centres, kernel);
-  build_evaluation(kernel);
+  pending_centres_ = centres;
+  pending_kernel_ = kernel;
+  pending_ = true;
+  if (blend) {
+    rigid_ = std::move(blend->displacement);
+    rigid_scale_ = boundary.displacements.colwise().norm().maxCoeff();
+    stats_.rigid_part = true;
+    stats_.evaluated_nodes = points_.cols() - static_cast<Index>(boundary_nodes_.size());
+  } else {
+    build_interpolation();
+  }
+  ready_ = true;
+  stats_.setup_seconds = watch.seconds();
+}
+
+template <int Dim>
+void RbfMover<Dim>::build_interpolation() {
+  if (!pending_) return;
+  pending_ = false;
+  factorize(pending_centres_, pending_kernel_);
+  build_evaluation(pending_kernel_);
+  pending_centres_.resize(Dim, 0);
   stats_.factorizations = with_all([](auto& system) { return system.report().factorizations; }) +
                           (n_centres_ > n_constrained_ ? with_constrained([](auto& system) { return system.report().factorizations; }) : 0);
   stats_.condition = std::max(with_all([](auto& system) { return system.condition(); }),
                               n_centres_ > n_constrained_ ? with_constrained([](auto& system) { return system.condition(); }) : 0.0);
-  ready_ = true;
-  stats_.setup_seconds = watch.seconds();
 }
 
 template <int Dim>
@@ -731,6 +819,7 @@ template <int Dim>
 Points<Dim> RbfMover<Dim>::derivative_forward(PointsView<Dim> w) {
   require_ready("derivative_forward");
   detail::check_displacements<Dim>("RbfMover::derivative_forward", w, boundary_nodes_);
+  build_interpolation();
   Points<Dim> out;
   apply(w, out);
   return out;
@@ -740,6 +829,7 @@ template <int Dim>
 Points<Dim> RbfMover<Dim>::derivative_reverse(PointsView<Dim> v) {
   require_ready("derivative_reverse");
   detail::check_node_field<Dim>("RbfMover::derivative_reverse", v, points_.cols());
+  build_interpolation();
   const Index m = static_cast<Index>(boundary_nodes_.size());
   const Index k = n_centres_;
   Points<Dim> grad = Points<Dim>::Zero(Dim, m);

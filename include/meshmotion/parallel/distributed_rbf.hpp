@@ -27,6 +27,9 @@
 /// operator of its local nodes. What grows with the boundary is replicated; what grows with
 /// the volume is split (docs/parallel.md measures both).
 ///
+/// The whole motion is interpolated (RbfOptions::rigid_part as none; blend is refused): a large
+/// rigid motion, which the serial mover blends into the volume first, is not (yet) distributed.
+///
 /// The owner's entry decides: a ghost's boundary entry on another rank is ignored (its kind,
 /// plane and displacement come from its owner), so parts need not agree on ghosts.
 
@@ -224,6 +227,9 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
                        std::to_string(boundary.size()) + " local boundary entries (expected one per entry, or none)");
     if (solve_.kind == BoundarySolve::patches && !options_.partition_of_unity)
       throw InputError("DistributedRbfMover::setup: BoundarySolve::patches needs RbfOptions::partition_of_unity");
+    if (options_.rigid_part == RigidPart::blend)
+      throw InputError("DistributedRbfMover::setup: rigid_part=blend is not distributed (the ranks interpolate the whole "
+                       "motion; give rigid_part=automatic or none)");
   });
   n_local_ = n;
   n_entries_ = boundary.size();
@@ -276,6 +282,7 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
     RbfOptions options = options_;
     options.support_radius = radius_;
     options.support_radii = std::move(radii);
+    options.rigid_part = RigidPart::none;  // as the PETSc and patches solves: the whole motion interpolated
     inner_ = RbfMover<Dim>(std::move(options));
     collective(comm_, [&] { inner_.setup_reference(std::move(points), centres); });
     stats_ = inner_.stats();
