@@ -5,9 +5,12 @@ the certified minimum and the median wall time of each (whole program, outputs w
 run in turn, and time_ratio is the median of the paired ratios). A
 case whose files are absent from ../shared/data, or that needs the CAD component this build
 lacks, is skipped with a message; the 3D bump's mesh is made by bump3d_mesh.py with Gmsh's
-Python module (skipped without it).
+Python module (skipped without it). With --move-mesh, move_mesh likewise on a snappyHexMesh
+case (snappy_sphere_case.sh; skipped without Debian's openfoam): a sphere turned 90 degrees in
+a fixed box, the minimum skewness quality of the moved cells against the thesis's mover for
+a rigid body (DGRBF2, in 2 steps).
 
-  defaults_bench.py CURVE_MESH [--runs N] [--data DIR]
+  defaults_bench.py CURVE_MESH [--move-mesh MOVE_MESH] [--runs N] [--data DIR]
 
 One table, and one JSON line per case: {"bench": "defaults", "case", "defaults_min",
 "tuned_min", "defaults_s", "tuned_s", "quality_ratio", "time_ratio"}; targets.py holds the
@@ -26,6 +29,12 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 # The input of a case made by bump3d_mesh.py instead of read from the data folder.
 GENERATED_BUMP = "generated: bump3d_mesh.py"
+
+# move_mesh's cases, made by snappy_sphere_case.sh: (case, defaults' flags, hand-set flags).
+TURN = ["--group", "sphere", "--fixed", "box", "--rotate", "90", "--center", "0,0,0"]
+MOVE_CASES = [
+    ("snappy_sphere_90", TURN, TURN + ["--method", "dgrbf2", "--steps", "2"]),
+]
 
 # (case, input file, CAD file or None, defaults' flags, hand-set flags: what the benchmarks set)
 CASES = [
@@ -56,32 +65,62 @@ def generate_bump(work):
 
 
 def timed(program, arguments, output):
-    """The certified minimum, the invalid count and the wall time of one run."""
+    """The minimum quality (curve_mesh: certified scaled Jacobian; move_mesh: skewness quality
+    of the moved cells), the invalid count and the wall time of one run."""
     start = time.perf_counter()
     done = subprocess.run([program, *arguments, "-o", output, "--json"], capture_output=True, text=True)
     seconds = time.perf_counter() - start
     if done.returncode not in (0, 2):
         raise RuntimeError(f"{' '.join(arguments)}: exit {done.returncode}: {done.stdout}{done.stderr}")
     report = json.loads(done.stdout)
+    if "after" in report:
+        return report["after"]["min"], report["after"]["invalid"], seconds
     return report["min_scaled_jacobian"], report["invalid"], seconds
 
 
-def compare(program, defaults, tuned, runs):
+def compare(program, defaults, tuned, runs, output_name="curved.msh"):
     """Both flag sets run in turn `runs` times, so that a burst of load on a shared machine falls
     on both alike (run one after the other, a 0.4 s case read 1.7x slower by defaults that took
-    1.05x by hand). Returns each one's certified minimum, invalid count and median time, and the
-    median of the paired time ratios."""
+    1.05x by hand). Returns each one's minimum, invalid count and median time, and the median of
+    the paired time ratios. Each run writes a new output (an OpenFOAM case folder is not
+    written over)."""
     with tempfile.TemporaryDirectory() as work:
-        output = os.path.join(work, "curved.msh")
-        pairs = [(timed(program, defaults, output), timed(program, tuned, output)) for _ in range(runs)]
+        outputs = (os.path.join(work, f"{i}{output_name}") for i in range(2 * runs))
+        pairs = [(timed(program, defaults, next(outputs)), timed(program, tuned, next(outputs))) for _ in range(runs)]
     d, t = pairs[-1]
     return (d[0], d[1], statistics.median(p[0][2] for p in pairs), t[0], t[1], statistics.median(p[1][2] for p in pairs),
             statistics.median(p[0][2] / p[1][2] for p in pairs))
 
 
+def report(name, compared, tuned_flags, lines):
+    """Prints the table row of `compared` (compare()'s answer) and keeps its JSON line."""
+    d_min, d_invalid, d_s, t_min, t_invalid, t_s, ratio = compared
+    line = {"bench": "defaults", "case": name, "defaults_min": d_min, "tuned_min": t_min,
+            "defaults_invalid": d_invalid, "tuned_invalid": t_invalid, "defaults_s": d_s, "tuned_s": t_s,
+            "quality_ratio": d_min / t_min if t_min > 0 else None, "time_ratio": ratio}
+    quality = f"{d_min / t_min:6.3f}" if t_min > 0 else f"{'n/a':>6}"
+    print(f"{name:18} {d_min:12.4f} {t_min:10.4f} {quality} {d_s:10.3f} {t_s:8.3f} {ratio:6.2f}"
+          f"  {' '.join(tuned_flags)}" + (f" ({t_invalid} cells invalid by hand)" if t_invalid else ""))
+    lines.append(line)
+
+
+def move_cases(program, runs, lines):
+    """MOVE_CASES on the case snappy_sphere_case.sh makes, or a message when it cannot."""
+    with tempfile.TemporaryDirectory() as work:
+        case = os.path.join(work, "sphere")
+        made = subprocess.run(["bash", os.path.join(HERE, "snappy_sphere_case.sh"), case], capture_output=True, text=True)
+        if made.returncode != 0:
+            for name, _, _ in MOVE_CASES:
+                print(f"{name:18} skipped: {made.stderr.strip().splitlines()[-1] if made.stderr.strip() else 'no case'}")
+            return
+        for name, defaults, tuned in MOVE_CASES:
+            report(name, compare(program, [case] + defaults, [case] + tuned, runs, "moved"), tuned, lines)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("program")
+    parser.add_argument("--move-mesh", help="move_mesh program: also its cases (MOVE_CASES)")
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--data", default=os.environ.get("MESHMOTION_SHARED_DATA_DIR",
                                                          os.path.join(HERE, "..", "..", "shared", "data")))
@@ -102,20 +141,16 @@ def main():
             continue
         base = [files[0]] + (["--geometry", files[1]] if cad else [])
         try:
-            d_min, d_invalid, d_s, t_min, t_invalid, t_s, ratio = compare(args.program, base + defaults, base + tuned,
-                                                                         args.runs)
+            compared = compare(args.program, base + defaults, base + tuned, args.runs)
         except RuntimeError as e:
             if cad and "CAD component" in str(e):
                 print(f"{name:18} skipped: this build has no CAD component")
                 continue
             raise
-        line = {"bench": "defaults", "case": name, "defaults_min": d_min, "tuned_min": t_min,
-                "defaults_invalid": d_invalid, "tuned_invalid": t_invalid, "defaults_s": d_s, "tuned_s": t_s,
-                "quality_ratio": d_min / t_min if t_min > 0 else None, "time_ratio": ratio}
-        print(f"{name:18} {d_min:12.4f} {t_min:10.4f} {d_min / t_min:6.3f} {d_s:10.3f} {t_s:8.3f} {ratio:6.2f}"
-              f"  {' '.join(tuned)}")
-        lines.append(line)
+        report(name, compared, tuned, lines)
     generated.cleanup()
+    if args.move_mesh:
+        move_cases(args.move_mesh, args.runs, lines)
     for line in lines:
         print(json.dumps(line))
     return 0

@@ -232,7 +232,10 @@ fi
 # The programs' defaults beside the options the benchmarks set by hand, on the same cases
 # (this build only: the comparison is within it).
 if [[ -x "$build_dir/examples/curve_mesh" && ( -z "$only" || "$only" == *",defaults_bench,"* ) ]]; then
-  run defaults_bench python3 "$here/defaults_bench.py" "$build_dir/examples/curve_mesh" --data "$source_dir/../shared/data"
+  move_mesh=()
+  [[ -x "$build_dir/examples/move_mesh" ]] && move_mesh=(--move-mesh "$build_dir/examples/move_mesh")
+  run defaults_bench python3 "$here/defaults_bench.py" "$build_dir/examples/curve_mesh" "${move_mesh[@]}" \
+    --data "$source_dir/../shared/data"
 fi
 # The OpenFOAM plugin in OpenFOAM's time loop against displacementLaplacian (it says why when
 # the plugin or OpenFOAM is missing).
