@@ -218,6 +218,9 @@ std::optional<double> set_support_radius(MoverConfig<Dim>& config, const MotionA
               // The mover's own default, within its memory budget (RbfOptions::max_memory_bytes).
               const DefaultSupportRadius fitted = default_support_radius(points, b, o);
               o.support_radius = fitted.radius;
+              // The radius is the one for what the interpolation will carry: the mover, given it,
+              // must take the rigid part out (or not) as decided here.
+              if (o.rigid_part == RigidPart::automatic) o.rigid_part = fitted.rigid_part ? RigidPart::blend : RigidPart::none;
               if (fitted.rigid_part)
                 std::cerr << "note: the moving group's rigid motion is blended into the volume and the RBF carries "
                              "the rest (rigid_part=automatic; rigid_part=none interpolates it all; docs/interpolation.md)\n";

@@ -93,6 +93,10 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
     config = mover_config<Dim>(a.mover.method, given);
     if (config.method != "rbf" && config.method != "le" && config.method != "sle")
       throw InputError("move_mesh_mpi: --method '" + config.method + "' has no distributed mover (expected rbf, le or sle)");
+    // The distributed RBF interpolates the whole motion, so its default radius is the one for
+    // the whole motion, not for what remains once a rigid part is out (blend: the mover refuses).
+    if (auto* rbf = std::get_if<RbfOptions>(&config.options); rbf && rbf->rigid_part == RigidPart::automatic)
+      rbf->rigid_part = RigidPart::none;
     if (!root) return;
     // As move_mesh: an output that cannot hold the mesh's order is refused before any work.
     int order = 1;

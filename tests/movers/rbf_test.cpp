@@ -848,12 +848,15 @@ ResolvedBoundary<Dim> turned_body(const Mesh<Dim>& mesh, const M& motion, std::v
 
 TEST_CASE("a body turned 90 degrees inside held walls: its rigid motion is blended in, valid, nothing factorized",
           "[movers]") {
-  // The ring's inner circle turns a quarter turn, its outer circle is held. Interpolated
-  // displacements (rigid_part=none) pull the cells halfway between towards the centre and
-  // fold them; the blended rotation shears them instead.
+  // The ring's inner circle turns a quarter turn, its outer circle is held, and the memory
+  // budget (1 MB here) cuts the default radius, as 3 GB cut it on a 28.8k-point case.
+  // Interpolated displacements (rigid_part=none) pull the cells halfway between towards the
+  // centre and fold them; the blended rotation shears them instead.
   const Mesh<2> ring = annulus_mesh({.n_around = 96});
   const auto boundary = turned_body<2>(ring, Rotation2D{Vec<2>::Zero(), std::numbers::pi / 2}, {"outer"});
-  RbfMover<2> mover;
+  RbfOptions budget;
+  budget.max_memory_bytes = 1e6;
+  RbfMover<2> mover(budget);
   mover.setup(ring, boundary);
   REQUIRE(mover.rigid_part_taken_out());
   CHECK(mover.stats().rigid_part);
@@ -869,11 +872,16 @@ TEST_CASE("a body turned 90 degrees inside held walls: its rigid motion is blend
     if (x.norm() < 0.5 + 1e-9) CHECK((y - Vec<2>(-x.y(), x.x())).norm() < 1e-12);  // the body, exactly
     if (x.norm() > 1.5 - 1e-9) CHECK(y == x);                                        // the held wall, untouched
   }
-  RbfOptions plain;
+  RbfOptions plain = budget;
   plain.rigid_part = RigidPart::none;
   RbfMover<2> interpolated(plain);
   interpolated.setup(ring, boundary);
   CHECK_FALSE(interpolated.rigid_part_taken_out());
+  CHECK(interpolated.support_radius_reduced());
+  // Without the budget's cut the interpolation spreads the turn as it wants: automatic keeps it.
+  RbfMover<2> unbounded;
+  unbounded.setup(ring, boundary);
+  CHECK_FALSE(unbounded.rigid_part_taken_out());
   Mesh<2> folded = ring;
   folded.points += interpolated.move(boundary.displacements);
   const QualityReport q = quality_report(folded, Metric::scaled_jacobian);
@@ -881,13 +889,16 @@ TEST_CASE("a body turned 90 degrees inside held walls: its rigid motion is blend
   CHECK(blended.min > q.min + 0.1);
 }
 
-TEST_CASE("rigid part: sliding planes the rotation keeps move with the blend, others hold it; small motions stay "
-          "interpolated", "[movers]") {
-  // The ring extruded: its ends slide in their planes, normal to the axis of the turn.
+TEST_CASE("rigid part: sliding planes the rotation keeps move with the blend, others hold it; a narrow gap and a "
+          "radius within the budget stay interpolated", "[movers]") {
+  // The ring extruded: its ends slide in their planes, normal to the axis of the turn. A
+  // budget of 1 MB cuts the default radii.
   const Mesh<3> ring = extrude_mesh(annulus_mesh({.n_around = 48, .core_spacing = 0.08}), {.layers = 2, .height = 0.3});
   const auto about_z = turned_body<3>(ring, Rotation3D{Vec<3>::Zero(), Vec<3>::UnitZ(), std::numbers::pi / 2}, {"outer"},
                                       {"z_min", "z_max"});
-  RbfMover<3> mover;
+  RbfOptions budget;
+  budget.max_memory_bytes = 1e6;
+  RbfMover<3> mover(budget);
   mover.setup(ring, about_z);
   REQUIRE(mover.rigid_part_taken_out());
   Mesh<3> moved = ring;
@@ -898,18 +909,20 @@ TEST_CASE("rigid part: sliding planes the rotation keeps move with the blend, ot
   // body (its first cells) leaves no room for one, and automatic interpolates the whole motion
   // (the nodes' determinants alone read 1 there: no node lies within the gap).
   const auto about_x = turned_body<3>(ring, Rotation3D{Vec<3>::Zero(), Vec<3>::UnitX(), 0.05}, {"outer"}, {"z_min", "z_max"});
-  RbfMover<3> tilted;
+  RbfMover<3> tilted(budget);
   tilted.setup(ring, about_x);
+  CHECK(tilted.support_radius_reduced());
   CHECK_FALSE(tilted.rigid_part_taken_out());
   RbfOptions forced;
   forced.rigid_part = RigidPart::blend;
   RbfMover<3> blended(forced);
   blended.setup(ring, about_x);
   CHECK(blended.rigid_part_taken_out());
-  // A small turn against the gap (5 × the largest displacement within it) is interpolated.
+  // A small turn, whose radius fits the default budget, is interpolated.
   const Mesh<2> flat = annulus_mesh({.n_around = 48, .core_spacing = 0.08});
   RbfMover<2> small;
-  small.setup(flat, turned_body<2>(flat, Rotation2D{Vec<2>::Zero(), 0.1}, {"outer"}));
+  small.setup(flat, turned_body<2>(flat, Rotation2D{Vec<2>::Zero(), 0.02}, {"outer"}));
+  CHECK_FALSE(small.support_radius_reduced());
   CHECK_FALSE(small.rigid_part_taken_out());
 }
 
@@ -917,7 +930,9 @@ TEST_CASE("rigid part: moves are affine, derivatives are the interpolation's, a 
           "[movers]") {
   const Mesh<2> ring = annulus_mesh({.n_around = 48, .core_spacing = 0.08});
   const auto boundary = turned_body<2>(ring, Rotation2D{Vec<2>(0.01, -0.02), 1.2}, {"outer"});
-  RbfMover<2> mover;
+  RbfOptions budget;
+  budget.max_memory_bytes = 2e5;
+  RbfMover<2> mover(budget);
   mover.setup(ring, boundary);
   REQUIRE(mover.rigid_part_taken_out());
   const Points<2> d = boundary.displacements;
@@ -934,7 +949,7 @@ TEST_CASE("rigid part: moves are affine, derivatives are the interpolation's, a 
   const Points<2> v = random_displacements<2>(ring.num_nodes(), 6, 1.0);
   CHECK((v.array() * jw.array()).sum() == Approx((mover.derivative_reverse(v).array() * w.array()).sum()).epsilon(1e-10));
   // A fresh setup is as lazy: its first derivative builds the interpolation.
-  RbfMover<2> fresh;
+  RbfMover<2> fresh(budget);
   fresh.setup(ring, boundary);
   CHECK((fresh.derivative_forward(w) - jw).norm() < 1e-12 * jw.norm());
 
@@ -947,7 +962,7 @@ TEST_CASE("rigid part: moves are affine, derivatives are the interpolation's, a 
   RbfOptions forced;
   forced.rigid_part = RigidPart::blend;
   CHECK_THROWS_WITH(RbfMover<2>(forced).setup(ring, growing), Catch::Contains("do not move as one rigid body"));
-  RbfMover<2> automatic;
+  RbfMover<2> automatic(budget);
   automatic.setup(ring, growing);
   CHECK_FALSE(automatic.rigid_part_taken_out());
 }

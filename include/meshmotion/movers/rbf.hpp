@@ -59,6 +59,7 @@
 #include <cstddef>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -121,8 +122,8 @@ struct RbfOptions {
   /// Take the rigid part of the setup boundary's motion out before interpolating
   /// (rigid_part.hpp): every node follows the prescribed nodes' rigid motion, its angle and
   /// translation blended to nothing at the nearest held node, and the interpolation carries
-  /// the rest. The default (automatic) does it for a large rigid motion, the one a compact
-  /// support cannot spread without reaching across the domain (a body turned 90° in a box).
+  /// the rest. The default (automatic) does it for a rigid motion the default radius cannot
+  /// spread within the memory budget (a body turned 90° in a box), or when nothing is held.
   RigidPart rigid_part = RigidPart::automatic;
 };
 
@@ -246,10 +247,11 @@ template <int Dim>
 template <int Dim>
 [[nodiscard]] DefaultSupportRadius default_support_radius(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary,
                                                           const RbfOptions& options) {
-  const auto blend = rigid_blend(points, boundary, options.rigid_part, SupportRadiusOptions{}.displacement_factor);
-  DefaultSupportRadius out =
-      detail::budgeted_support_radius(points, blend ? without_rigid_part(boundary, *blend) : boundary, options);
-  out.rigid_part = blend.has_value();
+  const DefaultSupportRadius whole = detail::budgeted_support_radius(points, boundary, options);
+  const auto blend = rigid_blend(points, boundary, options.rigid_part, whole.reduced);
+  if (!blend) return whole;
+  DefaultSupportRadius out = detail::budgeted_support_radius(points, without_rigid_part(boundary, *blend), options);
+  out.rigid_part = true;
   return out;
 }
 
@@ -600,10 +602,14 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   rigid_.resize(Dim, 0);
   if (!points.allFinite()) throw InputError("RbfMover::setup: mesh has a non-finite coordinate");
   detail::check_boundary<Dim>("RbfMover::setup", boundary, points.cols(), false);
-  auto blend = rigid_blend(points, boundary, options_.rigid_part, SupportRadiusOptions{}.displacement_factor);
-  if (options_.support_radii.empty() && radius_ == 0.0) {
+  const bool default_radius = options_.support_radii.empty() && radius_ == 0.0;
+  std::optional<DefaultSupportRadius> whole;
+  if (default_radius && options_.rigid_part != RigidPart::none) whole = detail::budgeted_support_radius(points, boundary, options_);
+  auto blend = rigid_blend(points, boundary, options_.rigid_part, whole && whole->reduced);
+  if (default_radius) {
     const DefaultSupportRadius fitted =
-        detail::budgeted_support_radius(points, blend ? without_rigid_part(boundary, *blend) : boundary, options_);
+        blend ? detail::budgeted_support_radius(points, without_rigid_part(boundary, *blend), options_)
+              : (whole ? *whole : detail::budgeted_support_radius(points, boundary, options_));
     radius_ = fitted.radius;
     radius_reduced_ = fitted.reduced;
   } else if (options_.support_radii.empty()) {
