@@ -889,7 +889,7 @@ TEST_CASE("a body turned 90 degrees inside held walls: its rigid motion is blend
   CHECK(blended.min > q.min + 0.1);
 }
 
-TEST_CASE("rigid part: sliding planes the rotation keeps move with the blend, others hold it; a narrow gap and a "
+TEST_CASE("rigid part: sliding planes the rotation keeps move with the blend, others hold it, a narrow gap and a "
           "radius within the budget stay interpolated", "[movers]") {
   // The ring extruded: its ends slide in their planes, normal to the axis of the turn. A
   // budget of 1 MB cuts the default radii.
