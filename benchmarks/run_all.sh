@@ -18,7 +18,7 @@
 # table shows its figures and the ratios. A benchmark that does not compile against the older
 # library is reported and skipped.
 #
-# --only runs the named benchmarks alone (e.g. --only conversion_bench,io_bench,curve_mesh_program,move_mesh_section,defaults_bench,openfoam_plugin).
+# --only runs the named benchmarks alone (e.g. --only conversion_bench,io_bench,curve_mesh_program,move_mesh_section,defaults_bench,conditioning_bench,openfoam_plugin).
 #
 # Programs and benchmarks run with glibc's huge-page heap (GLIBC_TUNABLES, see
 # include/meshmotion/core/process_memory.hpp) for both builds; MESHMOTION_HUGE_PAGES=0 runs
@@ -235,6 +235,12 @@ if [[ -x "$build_dir/examples/curve_mesh" && ( -z "$only" || "$only" == *",defau
   move_mesh=()
   [[ -x "$build_dir/examples/move_mesh" ]] && move_mesh=(--move-mesh "$build_dir/examples/move_mesh")
   run defaults_bench python3 "$here/defaults_bench.py" "$build_dir/examples/curve_mesh" "${move_mesh[@]}" \
+    --data "$source_dir/../shared/data"
+fi
+# The RBF's conditioning on a RANS grid: thinned by default, beside the system as it is
+# (needs the Python module, which --no-peers does not build: a build that has it runs it).
+if [[ -f "$build_dir/python/meshmotion/__init__.py" && ( -z "$only" || "$only" == *",conditioning_bench,"* ) ]]; then
+  run conditioning_bench env PYTHONPATH="$build_dir/python" /usr/bin/python3 "$here/conditioning_bench.py" \
     --data "$source_dir/../shared/data"
 fi
 # The OpenFOAM plugin in OpenFOAM's time loop against displacementLaplacian (it says why when

@@ -77,6 +77,19 @@ def python_mpi_overhead(rows, build):
     return max(ratios) if ratios else None
 
 
+def rbf_gradient_error(rows, build):
+    """The worst relative error of the RBF gradient against finite differences over
+    conditioning_bench.py's rows with the default condition_limit (every radius); infinite when
+    one of them failed to set up, warp or differentiate."""
+    errors = [row.get("derivative_error") if row.get("setup") != "error" and row.get("warp") == "ok" else None
+              for row in rows
+              if row.get("build", "current") == build and row.get("bench") == "conditioning"
+              and row.get("condition_limit") == "default"]
+    if not errors:
+        return None
+    return max(float("inf") if e is None else e for e in errors)
+
+
 # (name, rows' fields to match or a function of (rows, build), field, "<=" or ">=", limit, unit)
 TARGETS = [
     ("P1->P2 30P30N quads (median)", {"bench": "conversion", "case": "30p30n-quads"}, "median_s", "<=", 0.015, "s"),
@@ -105,6 +118,7 @@ TARGETS = [
      None, ">=", 1.0, "x"),
     ("Python over MPI / the C++ distributed mover, per call, worst rank count", python_mpi_overhead, None, "<=", 1.05,
      "x"),
+    ("RBF gradient on a RANS grid, default limit, worst radius: error", rbf_gradient_error, None, "<=", 1e-6, ""),
     ("PU RBF, 1M centres and 10M nodes: peak", {"bench": "pu_rbf", "mesh": "flat-707", "method": "pu"}, "peak_mb",
      "<=", 24576, "MB"),
 ]

@@ -176,7 +176,8 @@ class Warp:
         if self.condition > CONDITION_WARNING and (comm is None or comm.Get_rank() == 0):
             _warnings.warn(f"Warp: the RBF system's condition number is at least {self.condition:.1e}: warp_derivative "
                            f"may carry relative rounding errors up to {self.condition * 2.2e-16:.0e} (a smaller "
-                           "support_radius, or centres less close together, conditions it better)",
+                           "support_radius conditions it better; condition_limit thins compact kernels' systems "
+                           "without partition_of_unity)",
                            RuntimeWarning, stacklevel=3)
 
     def _partition(self, mesh, design, symmetry, fixed, orientation, cell_ranks):

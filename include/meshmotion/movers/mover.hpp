@@ -30,6 +30,8 @@ struct MoverStats {
   /// RBF: the rigid part of the boundary's motion was blended into the volume and the
   /// interpolation carried the rest (RbfOptions::rigid_part).
   bool rigid_part = false;
+  /// RBF: centres thinned because the system's condition exceeded RbfOptions::condition_limit.
+  Index thinned_centres = 0;
 };
 
 template <class F>
@@ -46,6 +48,7 @@ void visit_fields(const MoverStats& s, F&& f) {
   f("nonzeros", s.nonzeros, "stored nonzeros of the system and evaluation operators");
   f("condition", s.condition, "lower bound of the RBF system's condition number (0: not estimated)");
   f("rigid_part", s.rigid_part, "RBF: the rigid part of the boundary's motion was blended in first");
+  f("thinned_centres", s.thinned_centres, "RBF: centres thinned because the system's condition exceeded condition_limit");
 }
 
 /// A mesh mover in Dim = M::dim dimensions.

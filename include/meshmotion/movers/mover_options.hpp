@@ -79,6 +79,8 @@ void visit_options(RbfOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "max_memory_bytes", o.max_memory_bytes,
     "compact kernels: estimated memory allowed, bytes (0: half the machine's); a default radius is reduced to fit");
   f(prefix + "rigid_part", o.rigid_part, "blend a large rigid motion into the volume before interpolating the rest");
+  f(prefix + "condition_limit", o.condition_limit,
+    "compact kernels: thin centres closer than the radius resolves when the condition exceeds this (0: never)");
 }
 
 template <class F>

@@ -125,6 +125,14 @@ struct RbfOptions {
   /// the rest. The default (automatic) does it for a rigid motion the default radius cannot
   /// spread within the memory budget (a body turned 90° in a box), or when nothing is held.
   RigidPart rigid_part = RigidPart::automatic;
+  /// Compact kernels without partition of unity: a system whose estimated condition number
+  /// (MoverStats::condition) exceeds this is thinned: centres closer together than its radius
+  /// can resolve (a blunt trailing edge's two sides 1e-6 apart under a radius of 2) keep their
+  /// value through a bump no wider than the gap to their neighbour, and the system is that of
+  /// the centres kept (detail::RbfSystem::setup). Rounding in a move or a derivative grows by
+  /// up to the condition: 1e10 keeps derivatives to about 1e-6 relative. 0 never thins.
+  /// MoverStats::thinned_centres says how many were.
+  double condition_limit = 1e10;
 };
 
 /// The options an RBF mover runs with: `options` with the polynomial on where the kernel needs
@@ -352,7 +360,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   /// Factorizes the systems over every centre and over the constrained ones.
   void factorize(const Points<Dim>& centres, const detail::RbfKernelSettings& kernel);
   /// The operator evaluating the interpolant at the non-boundary nodes.
-  void build_evaluation(const detail::RbfKernelSettings& kernel);
+  void build_evaluation();
   /// factorize() and build_evaluation() of the pending centres, once after each setup.
   void build_interpolation();
 
@@ -649,12 +657,13 @@ void RbfMover<Dim>::build_interpolation() {
   if (!pending_) return;
   pending_ = false;
   factorize(pending_centres_, pending_kernel_);
-  build_evaluation(pending_kernel_);
+  build_evaluation();
   pending_centres_.resize(Dim, 0);
   stats_.factorizations = with_all([](auto& system) { return system.report().factorizations; }) +
                           (n_centres_ > n_constrained_ ? with_constrained([](auto& system) { return system.report().factorizations; }) : 0);
   stats_.condition = std::max(with_all([](auto& system) { return system.condition(); }),
                               n_centres_ > n_constrained_ ? with_constrained([](auto& system) { return system.condition(); }) : 0.0);
+  if (!patched_all_) stats_.thinned_centres = all_.thinned() + (n_centres_ > n_constrained_ ? constrained_.thinned() : 0);
 }
 
 template <int Dim>
@@ -746,7 +755,7 @@ void RbfMover<Dim>::factorize(const Points<Dim>& centres, const detail::RbfKerne
     all_ = detail::RbfSystem<Dim>{};
     patched_all_ = patched(centres, kernel);
   } else {
-    all_.setup(centres, kernel, options_.solver, options_.dense_solver, options_.max_dense_centres);
+    all_.setup(centres, kernel, options_.solver, options_.dense_solver, options_.max_dense_centres, options_.condition_limit);
   }
   stats_.nonzeros = with_all([](auto& system) { return system.nonzeros(); });
   if (k == n_constrained_) return;
@@ -758,14 +767,14 @@ void RbfMover<Dim>::factorize(const Points<Dim>& centres, const detail::RbfKerne
     sliding_operator_ = patched_constrained_->evaluation_rows(centres, sliding_rows_);
   } else {
     constrained_.setup(constrained_centres, kernel.leading(n_constrained_), options_.solver, options_.dense_solver,
-                       options_.max_dense_centres);
+                       options_.max_dense_centres, options_.condition_limit);
     sliding_operator_ = build_operator(centres, sliding_rows_, constrained_);
   }
   stats_.nonzeros += with_constrained([](auto& system) { return system.nonzeros(); }) + sliding_operator_.nonZeros();
 }
 
 template <int Dim>
-void RbfMover<Dim>::build_evaluation(const detail::RbfKernelSettings& kernel) {
+void RbfMover<Dim>::build_evaluation() {
   // Nodes evaluated: every non-boundary node inside some support (all of them for global
   // kernels); the polynomial part reaches every non-boundary node.
   const Index n = points_.cols(), k = n_centres_;
@@ -793,7 +802,8 @@ void RbfMover<Dim>::build_evaluation(const detail::RbfKernelSettings& kernel) {
     keep_rows(patched_all_->evaluation_rows(points_, interior_, &kept), kept);
   } else if (is_compact(options_.kernel) && !dense) {
     // Only rows with weights are kept, so skipped nodes cost nothing per move.
-    keep_rows(detail::compact_kernel_rows(points_, interior_, all_.within(), k, kernel, &kept), kept);
+    // The system's radii, which thinning may have changed from the ones asked for.
+    keep_rows(detail::compact_kernel_rows(points_, interior_, all_.within(), k, all_.kernel(), &kept), kept);
   } else {
     evaluated_ = interior_;
     operator_.resize(0, 0);

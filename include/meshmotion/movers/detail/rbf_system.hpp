@@ -208,8 +208,63 @@ class RbfSystem {
   /// Assembles and factorizes the system over `centres` (Dim × k, distinct points; with
   /// kernel.radii, one radius each). Throws InputError when a global kernel has more than
   /// `max_dense` centres, SolverError when the factorization fails.
+  ///
+  /// A compact system whose estimated condition exceeds `condition_limit` (> 0) is thinned:
+  /// centres within a spacing h of an earlier kept one keep their value but take as radius
+  /// their distance to the nearest other centre, so no other centre sees them and A becomes
+  ///   [A_kk 0; A_tk I]
+  /// (k kept, t thinned): its condition is that of the kept centres' system, which h bounds.
+  /// The interpolant still meets every centre's value: the kept centres carry the motion at
+  /// their radius, each thinned one adds a bump that closes what is left at it, no wider than
+  /// the gap to its neighbour. h starts from the closest pair, scaled by the cube root of the
+  /// excess (the condition grows about as (radius / closest pair)³), and grows until the
+  /// estimate is within the limit or a few rounds are spent (thinned() says how many centres).
   void setup(const Points<Dim>& centres, const RbfKernelSettings& kernel, SolverOptions sparse_options,
-             DenseSolverKind dense_kind, Index max_dense) {
+             DenseSolverKind dense_kind, Index max_dense, double condition_limit = 0.0) {
+    thinned_ = 0;
+    const bool cure = is_compact(kernel.kernel) && condition_limit > 0.0 && centres.cols() > 1;
+    try {
+      assemble(centres, kernel, sparse_options, dense_kind, max_dense);
+    } catch (const SolverError&) {
+      // A system too ill-conditioned to factorize or to pass the residual check is what
+      // thinning cures.
+      if (!cure) throw;
+      condition_ = std::numeric_limits<double>::infinity();
+    }
+    if (!cure || condition_ <= condition_limit) return;
+    KdTree<Dim> tree;
+    tree.build(centres);  // indexes `centres` in place: it outlives the tree
+    std::vector<double> gap(static_cast<std::size_t>(centres.cols()));
+    double spacing = std::numeric_limits<double>::infinity();
+    for (Index i = 0; i < centres.cols(); ++i) {
+      const auto found = tree.nearest(Vec<Dim>(centres.col(i)), 2);
+      gap[static_cast<std::size_t>(i)] = std::sqrt(found.back().second);
+      spacing = std::min(spacing, gap[static_cast<std::size_t>(i)]);
+    }
+    const double diameter = (centres.rowwise().maxCoeff() - centres.rowwise().minCoeff()).norm();
+    for (int round = 0; round < thinning_rounds && condition_ > condition_limit && spacing < diameter; ++round) {
+      spacing *= std::clamp(1.5 * std::cbrt(condition_ / condition_limit), 2.0, 1e3);
+      RbfKernelSettings thinned = kernel;
+      thinned.radii.resize(static_cast<std::size_t>(centres.cols()));
+      for (Index i = 0; i < centres.cols(); ++i) thinned.radii[static_cast<std::size_t>(i)] = kernel.radius_of(i);
+      const Index count = thin(tree, centres, spacing, gap, thinned.radii);
+      const bool last = round + 1 == thinning_rounds;
+      try {
+        assemble(centres, thinned, sparse_options, dense_kind, max_dense);
+      } catch (const SolverError&) {
+        if (last) throw;
+        condition_ = std::numeric_limits<double>::infinity();
+      }
+      thinned_ = count;
+    }
+  }
+
+  /// Centres thinned by setup's condition_limit (0: none).
+  [[nodiscard]] Index thinned() const noexcept { return thinned_; }
+
+ private:
+  void assemble(const Points<Dim>& centres, const RbfKernelSettings& kernel, SolverOptions sparse_options,
+                DenseSolverKind dense_kind, Index max_dense) {
     centres_ = centres;
     kernel_ = kernel;
     const Index k = centres_.cols();
@@ -259,6 +314,28 @@ class RbfSystem {
     }
   }
 
+  /// Keeps centres in index order unless an earlier kept one lies within `spacing`; a thinned
+  /// centre's radius becomes min(its radius, gap to its nearest centre). Returns the number
+  /// thinned.
+  static Index thin(const KdTree<Dim>& tree, const Points<Dim>& centres, double spacing, const std::vector<double>& gap,
+                    std::vector<double>& radii) {
+    std::vector<char> thinned(radii.size(), 0);
+    std::vector<Neighbor> near;
+    Index count = 0;
+    for (Index i = 0; i < centres.cols(); ++i) {
+      if (thinned[static_cast<std::size_t>(i)] != 0) continue;
+      tree.radius_search(Vec<Dim>(centres.col(i)), spacing, near);
+      for (const auto& [j, d2] : near) {
+        if (static_cast<Index>(j) <= i || thinned[j] != 0) continue;
+        thinned[j] = 1;
+        radii[j] = std::min(radii[j], gap[j]);
+        ++count;
+      }
+    }
+    return count;
+  }
+
+ public:
   [[nodiscard]] Index size() const noexcept { return centres_.cols(); }
   [[nodiscard]] const Points<Dim>& centres() const noexcept { return centres_; }
   /// The centres whose support holds x, as (centre, squared distance) pairs in `out`. With
@@ -429,6 +506,7 @@ class RbfSystem {
   };
   static constexpr std::size_t max_exact_classes = 16;
   static constexpr int condition_steps = 8;
+  static constexpr int thinning_rounds = 4;
 
   Points<Dim> centres_;
   RbfKernelSettings kernel_;
@@ -446,6 +524,7 @@ class RbfSystem {
   DenseSolver dense_;
   Index nonzeros_ = 0;
   double condition_ = 1.0;
+  Index thinned_ = 0;
   RbfPolynomial<Dim> polynomial_;
 };
 
