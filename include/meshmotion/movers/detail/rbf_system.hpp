@@ -29,6 +29,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -223,12 +224,14 @@ class RbfSystem {
              DenseSolverKind dense_kind, Index max_dense, double condition_limit = 0.0) {
     thinned_ = 0;
     const bool cure = is_compact(kernel.kernel) && condition_limit > 0.0 && centres.cols() > 1;
+    std::exception_ptr failure;
     try {
       assemble(centres, kernel, sparse_options, dense_kind, max_dense);
     } catch (const SolverError&) {
       // A system too ill-conditioned to factorize or to pass the residual check is what
       // thinning cures.
       if (!cure) throw;
+      failure = std::current_exception();
       condition_ = std::numeric_limits<double>::infinity();
     }
     if (!cure || condition_ <= condition_limit) return;
@@ -248,15 +251,18 @@ class RbfSystem {
       thinned.radii.resize(static_cast<std::size_t>(centres.cols()));
       for (Index i = 0; i < centres.cols(); ++i) thinned.radii[static_cast<std::size_t>(i)] = kernel.radius_of(i);
       const Index count = thin(tree, centres, spacing, gap, thinned.radii);
-      const bool last = round + 1 == thinning_rounds;
+      failure = nullptr;
       try {
         assemble(centres, thinned, sparse_options, dense_kind, max_dense);
       } catch (const SolverError&) {
-        if (last) throw;
+        failure = std::current_exception();
         condition_ = std::numeric_limits<double>::infinity();
       }
       thinned_ = count;
     }
+    // The rounds may end (out of rounds, or the spacing past the centres' extent) on a failed
+    // assembly: its half-built system must not be used.
+    if (failure) std::rethrow_exception(failure);
   }
 
   /// Centres thinned by setup's condition_limit (0: none).
