@@ -10,7 +10,10 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <random>
+#include <set>
 #include <vector>
 
 using namespace meshmotion;
@@ -127,6 +130,13 @@ TEST_CASE("the pipeline untangles after the regularization and reports it", "[cu
   CHECK(untangled.invalid() <= plain.invalid());
   CHECK(untangled.quality.min == untangled.untangle.min_after);
   CHECK(untangled.quality.min >= plain.quality.min);
+  // The wall's nodes slid on their circle, none off it; switched off, they stay.
+  CHECK(untangled.untangle.slid_nodes > 0);
+  for (const Index v : untangled.curved.group_nodes("wall")) CHECK(untangled.curved.points.col(v).norm() == Approx(0.5).margin(1e-12));
+  options.untangle.slide = false;
+  const CurveResult<2> held = curve_mesh(linear, options);
+  CHECK(held.untangle.slid_nodes == 0);
+  for (const Index v : held.curved.group_nodes("wall")) CHECK(held.curved.points.col(v) == plain.curved.points.col(v));
 }
 
 TEST_CASE("raising the worst cells lifts the certified minimum of a valid mesh, boundary kept", "[curving]") {
@@ -151,4 +161,120 @@ TEST_CASE("raising the worst cells lifts the certified minimum of a valid mesh, 
     for (Index v = 0; v < m.num_nodes(); ++v)
       if (fixed[static_cast<std::size_t>(v)]) CHECK(m.points.col(v) == before.points.col(v));
   }
+}
+
+TEST_CASE("a wall node slides along its geometry to untangle a cell the nodes inside cannot", "[curving]") {
+  // The O-mesh's wall curved on its circle at P2, then one wall edge's node turned along the
+  // circle to a tenth of the edge from one end: past the quarter, the edge folds at that end.
+  CurveOptions<2> options;
+  options.order = 2;
+  const BoundaryGeometry<2> circle = BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 0.5));
+  options.geometry.emplace("wall", circle);
+  options.untangle.enabled = false;
+  const CurveResult<2> curved = curve_mesh(o_mesh({.n_around = 24, .n_radial = 6, .first_height = 0.05, .farfield_radius = 4.0}), options);
+  REQUIRE(curved.invalid() == 0);
+  Mesh<2> m = curved.curved;
+  const int wall = m.find_group("wall")->tag;
+  const auto& block = m.facets.front();
+  Index facet = 0;
+  while (block.tags[static_cast<std::size_t>(facet)] != wall) ++facet;
+  const auto el = block.element(facet);
+  const Vec<2> a = m.points.col(el[0]), b = m.points.col(el[1]);
+  const Vec<2> middle = m.points.col(el[2]);
+  const double towards_a = middle.x() * a.y() - middle.y() * a.x() > 0.0 ? 1.0 : -1.0;  // counter-clockwise when a is
+  m.points.col(el[2]) = Eigen::Rotation2Dd(0.4 * towards_a * std::acos(a.dot(b) / a.squaredNorm())) * middle;
+  REQUIRE((Vec<2>(m.points.col(el[2])) - a).norm() < 0.2 * (b - a).norm());
+
+  std::vector<char> fixed(static_cast<std::size_t>(m.num_nodes()), 0);
+  for (const auto& f : m.facets)
+    for (const Index v : f.connectivity) fixed[static_cast<std::size_t>(v)] = 1;
+  const std::vector<double> tangled = cell_quality(m, Metric::scaled_jacobian);
+  REQUIRE(std::count_if(tangled.begin(), tangled.end(), [](double q) { return q <= 0.0; }) >= 1);
+
+  // Every node off the walls free: the fold stays.
+  Mesh<2> held = m;
+  std::vector<double> quality = tangled;
+  CHECK(untangle(held, fixed, quality, {}).invalid_after >= 1);
+
+  // The wall's nodes inside their facets slide on the circle: the fold opens, nothing leaves the circle.
+  const std::map<int, BoundaryGeometry<2>> geometry{{wall, circle}};
+  const SlidingNodes<2> sliding = detail::wall_sliding_nodes(m, geometry, 30.0);
+  CHECK(sliding.count(el[2]) == 1);
+  const Mesh<2> before = m;
+  quality = tangled;
+  const UntangleReport report = untangle(m, fixed, quality, {}, sliding);
+  INFO("invalid " << report.invalid_before << " -> " << report.invalid_after << ", min " << report.min_after);
+  CHECK(report.invalid_after == 0);
+  CHECK(report.slid_nodes >= 1);
+  const auto certified = cell_quality(m, Metric::scaled_jacobian);
+  CHECK(*std::min_element(certified.begin(), certified.end()) == Approx(report.min_after).margin(1e-12));
+  for (Index v = 0; v < m.num_nodes(); ++v) {
+    if (!fixed[static_cast<std::size_t>(v)]) continue;
+    if (sliding.count(v) == 0) CHECK(m.points.col(v) == before.points.col(v));
+    else CHECK(m.points.col(v).norm() == Approx(0.5).margin(1e-12));
+  }
+}
+
+TEST_CASE("wall nodes on a sharp edge of their group do not slide, whatever the facets' orientation", "[curving]") {
+  // A box's six faces as one group: its edges and corners are sharp (90 degrees), the diagonals
+  // of its faces flat. Half the facets turned over: the edge test does not depend on it.
+  Mesh<3> m = to_order(box_mesh({.nx = 2, .ny = 2, .nz = 2, .cells = BoxCells::tet4}), 2);
+  for (auto& block : m.facets) {
+    REQUIRE(block.type == ElementType::tri6);
+    for (Index e = 0; e < block.size(); ++e) {
+      block.tags[static_cast<std::size_t>(e)] = 1;
+      if (e % 2 == 0) {
+        auto el = block.element(e);
+        const std::array<Index, 6> turned{el[0], el[2], el[1], el[5], el[4], el[3]};
+        std::copy(turned.begin(), turned.end(), el.begin());
+      }
+    }
+  }
+  const std::map<int, BoundaryGeometry<3>> geometry{{1, BoundaryGeometry<3>::project([](const Vec<3>& x) { return x; })}};
+  const SlidingNodes<3> sliding = detail::wall_sliding_nodes(m, geometry, 30.0);
+  const auto on_box_edge = [&](Index v) {
+    int sides = 0;
+    for (int d = 0; d < 3; ++d) sides += std::abs(m.points(d, v)) < 1e-12 || std::abs(m.points(d, v) - 1.0) < 1e-12;
+    return sides >= 2;
+  };
+  std::set<Index> facet_nodes;
+  for (const auto& block : m.facets)
+    for (Index e = 0; e < block.size(); ++e)
+      for (std::size_t k = 3; k < 6; ++k) facet_nodes.insert(block.element(e)[k]);
+  Index flat = 0;
+  for (const Index v : facet_nodes) {
+    INFO("node " << v << " at " << m.points.col(v).transpose());
+    CHECK(sliding.count(v) == (on_box_edge(v) ? 0u : 1u));
+    flat += sliding.count(v) == 1;
+  }
+  CHECK(flat > 0);
+  // A sliding node searches its face's plane and stays on its geometry.
+  for (const auto& [v, node] : sliding) {
+    REQUIRE(node.directions.size() == 4);
+    Vec<3> normal = Vec<3>::Zero();
+    for (int d = 0; d < 3; ++d)
+      if (std::abs(m.points(d, v)) < 1e-12 || std::abs(m.points(d, v) - 1.0) < 1e-12) normal(d) = 1.0;
+    for (const Vec<3>& t : node.directions) CHECK(std::abs(t.dot(normal)) < 1e-12);
+    CHECK((node.project(m.points.col(v)) - m.points.col(v)).norm() < 1e-15);
+  }
+  // A group's border stays even where it is flat: the bottom's half x < 0.5 made another group.
+  for (auto& block : m.facets)
+    for (Index e = 0; e < block.size(); ++e) {
+      const auto el = block.element(e);
+      if (m.points(2, el[0]) + m.points(2, el[1]) + m.points(2, el[2]) < 1e-12 &&
+          m.points(0, el[0]) + m.points(0, el[1]) + m.points(0, el[2]) < 1.5)
+        block.tags[static_cast<std::size_t>(e)] = 2;
+    }
+  std::map<int, BoundaryGeometry<3>> two = geometry;
+  two.emplace(2, geometry.at(1));
+  const SlidingNodes<3> split = detail::wall_sliding_nodes(m, two, 30.0);
+  Index border = 0;
+  for (const Index v : facet_nodes) {
+    const bool on_border = std::abs(m.points(2, v)) < 1e-12 && std::abs(m.points(0, v) - 0.5) < 1e-12;
+    border += on_border;
+    CHECK(split.count(v) == (on_box_edge(v) || on_border ? 0u : 1u));
+  }
+  CHECK(border > 0);
+  // Without a projection for the group nothing slides.
+  CHECK(detail::wall_sliding_nodes(m, std::map<int, BoundaryGeometry<3>>{}, 30.0).empty());
 }

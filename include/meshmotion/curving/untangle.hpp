@@ -16,7 +16,13 @@
 /// axes and the diagonals, on which every cell's Bézier coefficients are polynomials of the
 /// step (two to four evaluations of a cell give its whole line); sweeps repeat while the
 /// patch's total shortfall falls. The nodes the caller
-/// marks fixed (the boundary) stay. Every cell the sweeps touched is then certified again
+/// marks fixed (the boundary) stay, except those it lets slide (SlidingNodes: a wall node
+/// inside a face of its geometry, or on an edge between two facets that meet smoothly): during
+/// the untangling (not the raising rounds below) each of them moves along its geometry, every
+/// trial place projected back onto it, in the tangent directions it is given; det J is no
+/// longer a polynomial of the step there, so each trial evaluates the cells around it. A cell
+/// whose nodes are all on the walls (across a sharp trailing edge, at a wing's tip) has no
+/// other node to move. Every cell the sweeps touched is then certified again
 /// (Bézier bounds) and the caller's per-cell values replaced; a result with more invalid cells
 /// or a lower certified minimum than the input is undone (UntangleReport::reverted).
 ///
@@ -35,12 +41,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <span>
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -52,6 +60,9 @@ struct UntangleOptions {
   double threshold = 0.1;   ///< cells whose certified scaled Jacobian is below this are optimized
   int layers = 3;           ///< rings of neighbouring cells that move with them
   int max_sweeps = 20;      ///< node sweeps at most per pass
+  /// Boundary nodes the caller lets slide (untangle()'s `sliding`; in the curving pipeline the
+  /// wall nodes off sharp edges and the symmetry planes' nodes) move along their geometry.
+  bool slide = true;
   /// After the cells below the threshold, rounds that raise the certified minimum: each
   /// optimizes the `raise_cells` worst cells (those within `raise_margin` of the minimum) and
   /// `raise_layers` rings around them towards the minimum plus the margin; the rounds stop when
@@ -65,6 +76,19 @@ struct UntangleOptions {
   double raise_budget = 4.0;
 };
 
+/// A boundary node that untangle() may move along its geometry: the unit directions of its
+/// tangent line or plane that it searches, and the projection of a nearby point onto the
+/// geometry it lies on.
+template <int Dim>
+struct SlidingNode {
+  std::vector<Vec<Dim>> directions;
+  std::function<Vec<Dim>(const Vec<Dim>&)> project;
+};
+
+/// Sliding nodes by node index.
+template <int Dim>
+using SlidingNodes = std::unordered_map<Index, SlidingNode<Dim>>;
+
 /// What untangle() did.
 struct UntangleReport {
   Index cells_below = 0;     ///< cells under the threshold before
@@ -74,6 +98,7 @@ struct UntangleReport {
   double min_after = 0.0;
   Index patch_cells = 0;     ///< cells in the optimized patches (summed over the passes)
   Index free_nodes = 0;      ///< nodes that were allowed to move (summed over the passes)
+  Index slid_nodes = 0;      ///< boundary nodes that moved along their geometry
   int sweeps = 0;            ///< node sweeps of every pass
   int raise_rounds = 0;      ///< rounds that raised the minimum
   long long evaluations = 0; ///< cell evaluations of the optimization (each a Bézier bound of det J)
@@ -88,6 +113,7 @@ void visit_options(UntangleOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "untangle_threshold", o.threshold, "optimize the high-order nodes around cells whose certified scaled Jacobian is below this");
   f(prefix + "untangle_layers", o.layers, "rings of neighbouring cells that move with a cell below the threshold");
   f(prefix + "untangle_sweeps", o.max_sweeps, "node sweeps at most per pass");
+  f(prefix + "untangle_slide", o.slide, "wall nodes off sharp edges, and sliding planes' nodes, move along their geometry while untangling");
   f(prefix + "raise_rounds", o.raise_rounds, "then rounds raising the worst cells while the minimum rises (0: none)");
   f(prefix + "raise_cells", o.raise_cells, "worst cells optimized per round");
   f(prefix + "raise_layers", o.raise_layers, "rings of cells around them that move too");
@@ -104,6 +130,7 @@ void visit_fields(const UntangleReport& r, F&& f) {
   f("min_after", r.min_after, "certified minimum over all cells after");
   f("patch_cells", r.patch_cells, "cells in the optimized patches (summed over the passes)");
   f("free_nodes", r.free_nodes, "nodes allowed to move (summed over the passes)");
+  f("slid_nodes", r.slid_nodes, "boundary nodes that moved along their geometry");
   f("sweeps", r.sweeps, "node sweeps of every pass");
   f("raise_rounds", r.raise_rounds, "rounds that raised the minimum");
   f("evaluations", r.evaluations, "cell evaluations of the optimization (each a Bezier bound of det J)");
@@ -143,11 +170,13 @@ class PatchOptimizer {
   struct Pass {
     Index patch_cells = 0;
     Index free_nodes = 0;
+    Index slid_nodes = 0;
     int sweeps = 0;
     bool reverted = false;
   };
 
-  PatchOptimizer(Mesh<Dim>& mesh, std::span<const char> fixed) : mesh_(mesh), fixed_(fixed) {
+  PatchOptimizer(Mesh<Dim>& mesh, std::span<const char> fixed, const SlidingNodes<Dim>& sliding)
+      : mesh_(mesh), fixed_(fixed), sliding_(sliding) {
     node_cells(mesh, offsets_, cells_, where_);
   }
 
@@ -155,9 +184,9 @@ class PatchOptimizer {
   // cell at or above `target`, stopping once evaluations() reaches `max_evaluations` (and,
   // with `raise`, after a sweep that did not lift the seeds' lowest value), then certifies the
   // touched cells again into `quality`; a result with more invalid cells or a lower certified
-  // minimum is undone.
+  // minimum is undone. With `slide`, the sliding nodes of the patch move too.
   Pass run(const std::vector<Index>& seeds, double target, int layers, int max_sweeps, long long max_evaluations,
-           bool raise, std::vector<double>& quality) {
+           bool raise, bool slide, std::vector<double>& quality) {
     Pass pass;
     std::vector<char> in_patch(where_.size(), 0);
     std::vector<Index> frontier = seeds, patch = seeds;
@@ -173,10 +202,21 @@ class PatchOptimizer {
     }
     pass.patch_cells = static_cast<Index>(patch.size());
     std::vector<Index> free_nodes;
+    std::vector<const SlidingNode<Dim>*> slides;  // per free node: how it slides, or null
     std::vector<char> is_free(static_cast<std::size_t>(mesh_.num_nodes()), 0);
     for (const Index c : patch)
-      for (const Index v : nodes_of(c))
-        if (!fixed_[static_cast<std::size_t>(v)] && !is_free[static_cast<std::size_t>(v)]) is_free[static_cast<std::size_t>(v)] = 1, free_nodes.push_back(v);
+      for (const Index v : nodes_of(c)) {
+        if (is_free[static_cast<std::size_t>(v)]) continue;
+        const SlidingNode<Dim>* on = nullptr;
+        if (fixed_[static_cast<std::size_t>(v)]) {
+          const auto it = slide ? sliding_.find(v) : sliding_.end();
+          if (it == sliding_.end()) continue;
+          on = &it->second;
+        }
+        is_free[static_cast<std::size_t>(v)] = 1;
+        free_nodes.push_back(v);
+        slides.push_back(on);
+      }
     pass.free_nodes = static_cast<Index>(free_nodes.size());
 
     const auto patch_deficit = [&] {
@@ -195,9 +235,9 @@ class PatchOptimizer {
     double lowest = raise ? lowest_seed() : 0.0;
     for (int sweep = 0; sweep < max_sweeps && evaluations_ < max_evaluations; ++sweep) {
       ++pass.sweeps;
-      for (const Index v : free_nodes) {
-        if (evaluations_ >= max_evaluations) break;
-        optimize_node(v, target);
+      for (std::size_t k = 0; k < free_nodes.size() && evaluations_ < max_evaluations; ++k) {
+        if (slides[k] != nullptr) slide_node(free_nodes[k], *slides[k], target);
+        else optimize_node(free_nodes[k], target);
       }
       const double now = patch_deficit();
       bool progress = now < total * (1.0 - 1e-3);
@@ -228,6 +268,8 @@ class PatchOptimizer {
       quality = input_quality;
       pass.reverted = true;
     }
+    for (std::size_t k = 0; k < free_nodes.size(); ++k)
+      if (slides[k] != nullptr && mesh_.points.col(free_nodes[k]) != original[k]) ++pass.slid_nodes;
     return pass;
   }
 
@@ -383,6 +425,74 @@ class PatchOptimizer {
     }
   }
 
+  // A cell's value with its nodes at `x` (CellLine::value at a point).
+  double value(ElementType type, const ElementCoords<Dim>& x, double degenerate_below) {
+    double linear = 0.0;
+    coefficients(type, x, samples_[0], linear);
+    const double measure = std::abs(linear);
+    return measure > degenerate_below ? samples_[0].minCoeff() / measure : -std::numeric_limits<double>::infinity();
+  }
+
+  // Moves sliding node v along its geometry: optimize_node's search and acceptance, each trial
+  // place the projection of the node's place plus the step (the step's direction in its tangent
+  // plane), the cells evaluated there (a projected line is no polynomial). The steps halve from
+  // 0.4 of its neighbourhood to 1/64 of that: each costs a projection (a local search on a CAD
+  // face) besides the cells.
+  void slide_node(Index v, const SlidingNode<Dim>& slide, double target) {
+    const auto around = cells_of(v);
+    const double span = 0.4 * reach(v);
+    if (!(span > 0.0) || slide.directions.empty()) return;
+    struct Around {
+      ElementCoords<Dim> x;
+      Index local = 0;
+      double degenerate_below = 0.0, at_zero = 0.0;
+    };
+    std::vector<Around> cells(around.size());
+    for (std::size_t i = 0; i < around.size(); ++i) {
+      const Index c = around[i];
+      const auto nodes = nodes_of(c);
+      Around& a = cells[i];
+      a.x = coords(c);
+      a.local = static_cast<Index>(std::find(nodes.begin(), nodes.end(), v) - nodes.begin());
+      const auto vertices = a.x.leftCols(num_vertices(type_of(c)));
+      a.degenerate_below = 1e-12 * std::pow((vertices.rowwise().maxCoeff() - vertices.rowwise().minCoeff()).maxCoeff(), Dim);
+    }
+    const auto score = [&](const Vec<Dim>& p, bool first) {
+      double sum = 0.0;
+      for (std::size_t i = 0; i < cells.size(); ++i) {
+        Around& a = cells[i];
+        a.x.col(a.local) = p;
+        const double j = value(type_of(around[i]), a.x, a.degenerate_below);
+        if (first) a.at_zero = j;
+        if (j < std::min(a.at_zero, target)) return -std::numeric_limits<double>::infinity();
+        sum += deficit(j, target);
+      }
+      return -sum;
+    };
+    double best = score(mesh_.points.col(v), true);
+    const auto count = static_cast<int>(slide.directions.size());
+    int still = 0;
+    for (int k = 0, lines = 0; still < count && lines < 4 * count && best != 0.0; k = (k + 1) % count, ++lines) {
+      const Vec<Dim> at = mesh_.points.col(v);
+      const Vec<Dim>& d = slide.directions[static_cast<std::size_t>(k)];
+      const auto gains = [&](double trial) { return std::isinf(best) ? trial > best : trial > best + 1e-12 * std::abs(best); };
+      Vec<Dim> place = at;
+      double step = 0.0;
+      const auto trial = [&](double t) {
+        const Vec<Dim> p = slide.project(at + t * d);
+        if (const double s = score(p, false); gains(s)) best = s, step = t, place = p;
+      };
+      for (double h = span; h > span / 64; h *= 0.5) trial(h), trial(-h);
+      for (double h = 0.25 * std::abs(step); step != 0.0 && h > span / 1024; h *= 0.5) trial(step + h), trial(step - h);
+      if (step == 0.0) {
+        ++still;
+        continue;
+      }
+      mesh_.points.col(v) = place;
+      still = 0;
+    }
+  }
+
   std::span<const Index> cells_of(Index v) const {
     return {cells_.data() + offsets_[static_cast<std::size_t>(v)],
             static_cast<std::size_t>(offsets_[static_cast<std::size_t>(v) + 1] - offsets_[static_cast<std::size_t>(v)])};
@@ -420,6 +530,7 @@ class PatchOptimizer {
 
   Mesh<Dim>& mesh_;
   std::span<const char> fixed_;
+  const SlidingNodes<Dim>& sliding_;
   std::vector<Index> offsets_, cells_;
   std::vector<std::pair<std::size_t, Index>> where_;
   std::vector<CellLine> lines_;
@@ -441,11 +552,13 @@ inline void check_untangle_options(const UntangleOptions& options) {
 
 /// Optimizes the nodes around the cells of `mesh` whose value in `quality` (the certified
 /// scaled Jacobian of each cell, in cell order) is below options.threshold, then raises the
-/// worst cells (options.raise_rounds); nodes with fixed[node] set do not move. `quality` is
-/// updated for every cell that was certified again. Throws InputError when the sizes do not
-/// match the mesh.
+/// worst cells (options.raise_rounds); nodes with fixed[node] set do not move, except the
+/// `sliding` ones, which move along their geometry while the cells below the threshold are
+/// optimized. `quality` is updated for every cell that was certified again. Throws InputError
+/// when the sizes do not match the mesh.
 template <int Dim>
-UntangleReport untangle(Mesh<Dim>& mesh, std::span<const char> fixed, std::vector<double>& quality, const UntangleOptions& options = {}) {
+UntangleReport untangle(Mesh<Dim>& mesh, std::span<const char> fixed, std::vector<double>& quality, const UntangleOptions& options = {},
+                        const SlidingNodes<Dim>& sliding = {}) {
   if (quality.size() != static_cast<std::size_t>(mesh.num_cells()) || fixed.size() != static_cast<std::size_t>(mesh.num_nodes()))
     throw InputError("untangle: " + std::to_string(quality.size()) + " cell values and " + std::to_string(fixed.size()) +
                      " node flags for a mesh of " + std::to_string(mesh.num_cells()) + " cells and " +
@@ -466,15 +579,16 @@ UntangleReport untangle(Mesh<Dim>& mesh, std::span<const char> fixed, std::vecto
   const bool raise = options.raise_rounds > 0 && options.raise_cells > 0;
   if (!options.enabled || (below.empty() && !raise)) return report;
 
-  detail::PatchOptimizer<Dim> optimizer(mesh, fixed);
+  detail::PatchOptimizer<Dim> optimizer(mesh, fixed, sliding);
   const auto add = [&](const typename detail::PatchOptimizer<Dim>::Pass& pass) {
     report.patch_cells += pass.patch_cells;
     report.free_nodes += pass.free_nodes;
+    report.slid_nodes += pass.slid_nodes;
     report.sweeps += pass.sweeps;
   };
   if (!below.empty()) {
     const auto pass = optimizer.run(below, options.threshold, options.layers, options.max_sweeps,
-                                    std::numeric_limits<long long>::max(), false, quality);
+                                    std::numeric_limits<long long>::max(), false, options.slide, quality);
     add(pass);
     report.reverted = pass.reverted;
   }
@@ -502,7 +616,7 @@ UntangleReport untangle(Mesh<Dim>& mesh, std::span<const char> fixed, std::vecto
     for (Index c = 0; c < static_cast<Index>(quality.size()); ++c)
       if (level(c) <= last && quality[static_cast<std::size_t>(c)] < target) seeds.push_back(c);
     std::stable_sort(seeds.begin(), seeds.end(), [&](Index a, Index b) { return level(a) < level(b); });
-    add(optimizer.run(seeds, target, options.raise_layers, options.max_sweeps, budget, true, quality));
+    add(optimizer.run(seeds, target, options.raise_layers, options.max_sweeps, budget, true, false, quality));
     if (!(minimum() > low + 1e-4)) break;
     ++report.raise_rounds;
   }
