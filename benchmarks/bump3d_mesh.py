@@ -11,6 +11,8 @@ import argparse
 import math
 import sys
 
+from gmsh_sizing import mesh_near_walls
+
 LENGTH, WIDTH, HEIGHT = 1.5, 0.5, 0.8
 
 
@@ -57,20 +59,7 @@ def write_bump(out, size=0.06, amplitude=0.1, samples=30):
             gmsh.model.setPhysicalName(2, tag, name)
         gmsh.model.addPhysicalGroup(3, [volume], 10)
         gmsh.model.setPhysicalName(3, 10, "fluid")
-        field = gmsh.model.mesh.field
-        field.add("Distance", 1)
-        field.setNumbers(1, "SurfacesList", [wall])
-        field.add("Threshold", 2)
-        field.setNumber(2, "InField", 1)
-        field.setNumber(2, "SizeMin", size / 3)
-        field.setNumber(2, "SizeMax", size)
-        field.setNumber(2, "DistMin", 0.02)
-        field.setNumber(2, "DistMax", 0.3)
-        field.setAsBackgroundMesh(2)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-        gmsh.model.mesh.generate(3)
-        gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
-        gmsh.write(out)
+        mesh_near_walls(gmsh, out, [wall], size / 3, size, 0.02, 0.3)
     finally:
         gmsh.finalize()
 

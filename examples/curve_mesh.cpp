@@ -130,11 +130,21 @@ int run(Mesh<Dim> linear, const Arguments& args) {
     // slide where it meets a curved group (a symmetry plane): snapping onto a plane moves nothing.
     const std::set<int> planar =
         args.groups.empty() && options.slide_planar_groups ? planar_group_tags(linear) : std::set<int>{};
-    for (const CadGroupMatch& m : matches)
-      if (m.matched() && !planar.count(linear.group(m.group).tag)) {
-        options.geometry.insert_or_assign(m.group, cad_boundary<Dim>(*model, m, args.cad_tolerance));
-        on_model.push_back(m.group);
+    // Unless named, a group on the model's planes alone (lines in 2D: a box's far field) has
+    // nothing to curve either and stays straight: projecting its nodes and measuring its facets
+    // took a third of the wing's run (benchmarks/wing_mesh.py) for no change.
+    const auto flat = [&](const CadGroupMatch& m) {
+      return std::all_of(m.entities.begin(), m.entities.end(), [&](int e) { return model->flat(m.dim, e); });
+    };
+    for (const CadGroupMatch& m : matches) {
+      if (!m.matched() || planar.count(linear.group(m.group).tag)) continue;
+      if (args.groups.empty() && flat(m)) {
+        options.geometry.insert_or_assign(m.group, BoundaryGeometry<Dim>::straight());
+        continue;
       }
+      options.geometry.insert_or_assign(m.group, cad_boundary<Dim>(*model, m, args.cad_tolerance));
+      on_model.push_back(m.group);
+    }
     cad_report = describe_cad_matches(matches);
     cad_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!args.json) std::fprintf(stderr, "CAD model %s:\n%s", args.geometry.front().c_str(), cad_report.c_str());

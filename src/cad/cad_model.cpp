@@ -127,6 +127,11 @@ std::array<double, 2> CadModel::periods(int dim, int index) const {
   return impl_->shape->periods(dim, index);
 }
 
+bool CadModel::flat(int dim, int index) const {
+  check_entity(*this, dim, index);
+  return impl_->shape->flat(dim, index);
+}
+
 double CadModel::arc_length_parameter(int index, double a, double b, double fraction) const {
   check_entity(*this, 1, index);
   return impl_->shape->arc_length_parameter(index, a, b, fraction);

@@ -37,6 +37,8 @@ class CadShape {
   [[nodiscard]] virtual std::optional<CadPoint> closest_point_near(int face, const Vec<3>& x, double u0, double v0) const = 0;
   [[nodiscard]] virtual Vec<3> point_at(int dim, int index, double u, double v) const = 0;
   [[nodiscard]] virtual std::array<double, 2> periods(int dim, int index) const = 0;
+  /// Whether the entity's geometry is a plane (face) or a line (edge).
+  [[nodiscard]] virtual bool flat(int dim, int index) const = 0;
   /// The parameter of edge `edge` between a and b (unwrapped: b may lie past the seam of a
   /// closed edge) where the arc length from a reaches `fraction` of the length from a to b.
   [[nodiscard]] virtual double arc_length_parameter(int edge, double a, double b, double fraction) const = 0;
@@ -46,7 +48,7 @@ class CadShape {
 };
 
 /// Raised whenever CadShape changes: a module built from other sources is refused.
-inline constexpr int cad_module_version = 3;
+inline constexpr int cad_module_version = 4;
 
 }  // namespace meshmotion::detail
 

@@ -109,6 +109,10 @@ class OcctShape final : public CadShape {
   std::optional<CadPoint> closest_point_near(int face, const Vec<3>& x, double u0, double v0) const override;
   Vec<3> point_at(int dim, int index, double u, double v) const override;
   std::array<double, 2> periods(int dim, int index) const override;
+  bool flat(int dim, int index) const override {
+    if (dim == 1) return BRepAdaptor_Curve(TopoDS::Edge(edges_(index))).GetType() == GeomAbs_Line;
+    return queries(index).surface.GetType() == GeomAbs_Plane;
+  }
   double arc_length_parameter(int edge, double a, double b, double fraction) const override;
   double isoline_arc_length_parameter(int face, int fixed, double at, double a, double b, double fraction) const override;
 

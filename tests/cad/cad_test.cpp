@@ -17,6 +17,8 @@
 #include <GeomConvert.hxx>
 #include <Geom_BSplineCurve.hxx>
 #include <Geom_Circle.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
@@ -202,6 +204,7 @@ TEST_CASE("CAD: a sphere from OpenCASCADE reads back as STEP and BREP, its close
     CHECK(model.num_faces() == 1);
     CHECK(model.diagonal() == Approx(std::sqrt(3.0)).epsilon(0.05));
     CHECK(model.periods(2, 1)[0] == Approx(2 * std::numbers::pi));
+    CHECK(!model.flat(2, 1));
     for (int k = 0; k < 20; ++k) {
       const Vec<3> x(coordinate(rng), coordinate(rng), coordinate(rng));
       const CadPoint c = model.nearest(2, {}, x);
@@ -210,6 +213,26 @@ TEST_CASE("CAD: a sphere from OpenCASCADE reads back as STEP and BREP, its close
       CHECK((model.point_at(2, 1, c.u, c.v) - c.point).norm() < 1e-9);
     }
   }
+}
+
+TEST_CASE("CAD: a box's faces are planes and its edges lines, a cylinder's side and rims neither", "[cad]") {
+  const auto box = test::scratch_path("box.brep");
+  const auto cylinder = test::scratch_path("cylinder.brep");
+  REQUIRE(BRepTools::Write(BRepPrimAPI_MakeBox(1.0, 2.0, 3.0).Shape(), box.c_str()));
+  REQUIRE(BRepTools::Write(BRepPrimAPI_MakeCylinder(0.5, 1.0).Shape(), cylinder.c_str()));
+  const CadModel b = CadModel::read(box);
+  REQUIRE(b.num_faces() == 6);
+  for (int f = 1; f <= 6; ++f) CHECK(b.flat(2, f));
+  for (int e = 1; e <= b.num_edges(); ++e) CHECK(b.flat(1, e));
+  CHECK_THROWS_WITH(b.flat(2, 7), Catch::Contains("no face 7"));
+  // The side, a cylinder: curved; its two caps planes; its rims circles, its seam a line.
+  const CadModel c = CadModel::read(cylinder);
+  int flat_faces = 0, flat_edges = 0;
+  for (int f = 1; f <= c.num_faces(); ++f) flat_faces += c.flat(2, f);
+  for (int e = 1; e <= c.num_edges(); ++e) flat_edges += c.flat(1, e);
+  CHECK(c.num_faces() == 3);
+  CHECK(flat_faces == 2);
+  CHECK(flat_edges == 1);
 }
 
 TEST_CASE("CAD: groups match the model's edges, and a model that does not fit is named", "[cad]") {

@@ -71,6 +71,9 @@ class CadModel {
   /// The period of each parameter of entity (dim, index): a periodic one's, the parameter range
   /// of one that closes without being periodic (IGES's closed B-splines), 0 elsewhere.
   [[nodiscard]] std::array<double, 2> periods(int dim, int index) const;
+  /// Whether entity (dim, index) is a plane (a face) or a straight line (an edge): nothing on it
+  /// needs curving.
+  [[nodiscard]] bool flat(int dim, int index) const;
   /// The parameter of edge `index` between parameters a and b where the arc length from a
   /// reaches `fraction` of the length from a to b, to round-off. On a closed edge b may lie
   /// past the seam (a parameter unwrapped by whole periods): the way goes across it.
