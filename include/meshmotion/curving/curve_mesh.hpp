@@ -685,6 +685,20 @@ template <int Dim>
   return radii;
 }
 
+/// The directions a sliding node searches: the columns of `basis` (an orthonormal basis of its
+/// tangent line or plane) and, in a plane, their two diagonals (as the inside nodes search the
+/// axes and diagonals).
+template <int Dim, class Basis>
+[[nodiscard]] std::vector<Vec<Dim>> tangent_directions(const Basis& basis) {
+  std::vector<Vec<Dim>> out;
+  for (Index c = 0; c < basis.cols(); ++c) out.emplace_back(basis.col(c));
+  if (basis.cols() == 2) {
+    out.emplace_back((basis.col(0) + basis.col(1)).normalized());
+    out.emplace_back((basis.col(0) - basis.col(1)).normalized());
+  }
+  return out;
+}
+
 /// The wall nodes the untangling may slide along their geometry (untangle.hpp): every
 /// high-order node of a facet of a group curved by projection (an analytic shape, a CAD model)
 /// that lies inside its facet, or on an edge between two facets of that group whose straight
@@ -762,12 +776,8 @@ template <int Dim>
     for (int k = 0; k < nv; ++k) vertices[static_cast<std::size_t>(k)] = mesh.points.col(el[static_cast<std::size_t>(k)]);
     const std::vector<double> weights = detail::facet_node_weights(block.type).weights[static_cast<std::size_t>(h.local)];
     SlidingNode<Dim> node;
-    if constexpr (Dim == 2) {
-      node.directions = {n};
-    } else {
-      const Eigen::Matrix<double, 3, 2> t = plane_basis<3>(n);
-      node.directions = {t.col(0), t.col(1), (t.col(0) + t.col(1)).normalized(), (t.col(0) - t.col(1)).normalized()};
-    }
+    if constexpr (Dim == 2) node.directions = {n};
+    else node.directions = tangent_directions<3>(plane_basis<3>(n));
     node.project = [g = &geo->second, vertices, nv, weights](const Vec<Dim>& x) {
       return g->project_in_facet(std::span<const Vec<Dim>>(vertices.data(), static_cast<std::size_t>(nv)), weights, x);
     };
@@ -784,11 +794,7 @@ void add_sliding_entries(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& bou
     if (boundary.kinds[static_cast<std::size_t>(k)] != BoundaryKind::sliding) continue;
     const typename ResolvedBoundary<Dim>::Basis basis = boundary.sliding_basis(k);
     SlidingNode<Dim> node;
-    for (Index c = 0; c < basis.cols(); ++c) node.directions.emplace_back(basis.col(c));
-    if (basis.cols() == 2) {
-      node.directions.emplace_back((basis.col(0) + basis.col(1)).normalized());
-      node.directions.emplace_back((basis.col(0) - basis.col(1)).normalized());
-    }
+    node.directions = tangent_directions<Dim>(basis);
     const Index v = boundary.nodes[static_cast<std::size_t>(k)];
     node.project = [basis, origin = Vec<Dim>(mesh.points.col(v))](const Vec<Dim>& x) {
       return Vec<Dim>(origin + basis * (basis.transpose() * (x - origin)));

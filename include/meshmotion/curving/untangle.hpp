@@ -314,15 +314,20 @@ class PatchOptimizer {
     linear = detail::linear_det<Dim>(s, x);
   }
 
+  // The straight measure below which a cell at `x` counts as degenerate: 1e-12 of its vertices'
+  // extent to the power Dim.
+  static double degenerate_below(ElementType type, const ElementCoords<Dim>& x) {
+    const auto vertices = x.leftCols(num_vertices(type));
+    return 1e-12 * std::pow((vertices.rowwise().maxCoeff() - vertices.rowwise().minCoeff()).maxCoeff(), Dim);
+  }
+
   // `line` for cell c along `direction` from node v's place: the polynomials from their values
   // at t = 0, s, -s, 2s (as many as the degree needs), s = `span`.
   void make_line(Index c, Index v, const Vec<Dim>& direction, bool axis, double span, CellLine& line) {
     const auto nodes = nodes_of(c);
     const auto local = static_cast<Index>(std::find(nodes.begin(), nodes.end(), v) - nodes.begin());
     ElementCoords<Dim> x = coords(c);
-    const auto vertices = x.leftCols(num_vertices(type_of(c)));
-    const double extent = (vertices.rowwise().maxCoeff() - vertices.rowwise().minCoeff()).maxCoeff();
-    line.degenerate_below = 1e-12 * std::pow(extent, Dim);
+    line.degenerate_below = degenerate_below(type_of(c), x);
     line.degree = axis ? 1 : Dim;
     const Vec<Dim> at = x.col(local);
     std::array<LatticeVector, 4>& f = samples_;
@@ -454,8 +459,7 @@ class PatchOptimizer {
       Around& a = cells[i];
       a.x = coords(c);
       a.local = static_cast<Index>(std::find(nodes.begin(), nodes.end(), v) - nodes.begin());
-      const auto vertices = a.x.leftCols(num_vertices(type_of(c)));
-      a.degenerate_below = 1e-12 * std::pow((vertices.rowwise().maxCoeff() - vertices.rowwise().minCoeff()).maxCoeff(), Dim);
+      a.degenerate_below = degenerate_below(type_of(c), a.x);
     }
     const auto score = [&](const Vec<Dim>& p, bool first) {
       double sum = 0.0;
