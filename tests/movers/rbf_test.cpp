@@ -147,6 +147,48 @@ TEST_CASE("Wendland C2 matrices are symmetric positive definite in 2D and 3D", "
   check(std::integral_constant<int, 3>{});
 }
 
+// The one-pass products of kernel rows a move and a reverse derivative use: Eigen's products'
+// sums in Eigen's order, so bit for bit, whatever the threads.
+TEST_CASE("kernel rows times centre values, and transposed, are Eigen's products exactly", "[movers]") {
+  const auto check = [](auto dim_tag) {
+    constexpr int Dim = decltype(dim_tag)::value;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    const Index k = 300, n = 3000;
+    Points<Dim> centres(Dim, k), at(Dim, n);
+    for (Index i = 0; i < k; ++i)
+      for (int d = 0; d < Dim; ++d) centres(d, i) = u(rng);
+    for (Index i = 0; i < n; ++i)
+      for (int d = 0; d < Dim; ++d) at(d, i) = u(rng);
+    std::vector<Index> rows(static_cast<std::size_t>(n));
+    for (Index i = 0; i < n; ++i) rows[std::size_t(i)] = i;
+    const KdTree<Dim> tree(centres);
+    const auto within = [&](const Vec<Dim>& x, std::vector<Neighbor>& out) { tree.radius_search(x, 0.5, out); };
+    const detail::KernelRows e = detail::compact_kernel_rows<Dim>(at, rows, within, k, {RbfKernel::wendland2, 0.5, false});
+    REQUIRE(e.nonZeros() > 20000);  // the threaded path
+    Eigen::MatrixXd x(k, Dim), v(n, Dim);
+    for (Index i = 0; i < x.size(); ++i) x.data()[i] = u(rng);
+    for (Index i = 0; i < v.size(); ++i) v.data()[i] = u(rng);
+    const Eigen::MatrixXd forward = e * x;
+    const Eigen::MatrixXd backward = e.transpose() * v;
+    for (const int threads : {1, 2}) {
+      CAPTURE(Dim, threads);
+      set_num_threads(threads);
+      Points<Dim> buffer;
+      Eigen::MatrixXd got(n, Dim);
+      detail::kernel_rows_times<Dim>(e, x, buffer, [&](Index r, const Vec<Dim>& value) { got.row(r) = value.transpose(); });
+      CHECK((got - forward).cwiseAbs().maxCoeff() == 0.0);
+      Eigen::MatrixXd got_back;
+      detail::kernel_rows_transpose_times<Dim>(e, [&](Index r) -> Vec<Dim> { return v.row(r).transpose(); }, buffer, got_back);
+      REQUIRE(got_back.rows() == k);
+      CHECK((got_back - backward).cwiseAbs().maxCoeff() == 0.0);
+    }
+    set_num_threads(0);
+  };
+  check(std::integral_constant<int, 2>{});
+  check(std::integral_constant<int, 3>{});
+}
+
 TEST_CASE("kernels: Wendland values and support", "[movers]") {
   CHECK(rbf_value(RbfKernel::wendland2, 0.5, 1.0) == Approx(0.0625 * 3.0));  // (1-ξ)^4 (4ξ+1), eq. 2.14
   for (const RbfKernel k : {RbfKernel::wendland0, RbfKernel::wendland2, RbfKernel::wendland4, RbfKernel::wendland6}) {

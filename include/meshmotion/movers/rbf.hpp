@@ -346,7 +346,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v);
 
  private:
-  using Operator = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
+  using Operator = detail::KernelRows;
   using Poly = typename detail::RbfSystem<Dim>::PolyCoefficients;
 
   [[nodiscard]] const Points<Dim>& all_centres() const { return all_.centres(); }
@@ -515,13 +515,13 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   template <class Out>
   void evaluate_interior(Out& out) {
     const auto n_eval = static_cast<Index>(evaluated_.size());
-    if (is_compact(options_.kernel) || evaluation_cached()) {
-      if (evaluation_cached())
-        evaluated_values_.noalias() = dense_operator_ * alpha_;
-      else
-        evaluated_values_.noalias() = operator_ * alpha_;
+    if (evaluation_cached()) {
+      evaluated_values_.noalias() = dense_operator_ * alpha_;
 #pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
       for (Index r = 0; r < n_eval; ++r) out.col(evaluated_[static_cast<std::size_t>(r)]) = evaluated_values_.row(r).transpose();
+    } else if (is_compact(options_.kernel)) {
+      detail::kernel_rows_times<Dim>(operator_, alpha_, centre_buffer_,
+                                     [&](Index r, const Vec<Dim>& value) { out.col(evaluated_[static_cast<std::size_t>(r)]) = value; });
     } else {
       detail::RegionErrors errors;
 #pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
@@ -542,20 +542,22 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   }
 
   /// Transpose of evaluate_interior: ᾱ = Eᵀ v_eval, β̄ = Σ q(x_i) v_iᵀ over interior nodes.
-  /// The seed's rows are gathered into a buffer kept across calls (a reverse product per
-  /// optimization iteration should not pay fresh pages for a volume-sized array).
+  /// Where the seed's rows are gathered, it is into a buffer kept across calls (a reverse
+  /// product per optimization iteration should not pay fresh pages for a volume-sized array).
   void interior_transpose(const PointsView<Dim>& v, Eigen::MatrixXd& alpha_bar, Poly& beta_bar) {
     const Index k = n_centres_;
     const auto gather = [&](const std::vector<Index>& nodes) {
       seed_rows_.resize(static_cast<Index>(nodes.size()), Dim);
       for (std::size_t r = 0; r < nodes.size(); ++r) seed_rows_.row(static_cast<Index>(r)) = v.col(nodes[r]).transpose();
     };
-    gather(evaluated_);
     if (evaluation_cached()) {
+      gather(evaluated_);
       alpha_bar.noalias() = dense_operator_.transpose() * seed_rows_;
     } else if (is_compact(options_.kernel)) {
-      alpha_bar.noalias() = operator_.transpose() * seed_rows_;
+      detail::kernel_rows_transpose_times<Dim>(
+          operator_, [&](Index r) -> Vec<Dim> { return v.col(evaluated_[static_cast<std::size_t>(r)]); }, centre_buffer_, alpha_bar);
     } else {
+      gather(evaluated_);
       alpha_bar.setZero(k, Dim);
       for (std::size_t r = 0; r < evaluated_.size(); ++r)
         alpha_bar += kernel_row(points_.col(evaluated_[r])).transpose() * seed_rows_.row(static_cast<Index>(r));
@@ -590,6 +592,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   Eigen::MatrixXd dense_operator_;          ///< evaluated_ × centres, when cached
   Eigen::MatrixXd values_, alpha_, evaluated_values_;
   Eigen::MatrixXd seed_rows_;               ///< a reverse product's seed, gathered by rows
+  Points<Dim> centre_buffer_;               ///< Dim × centres: the coefficients of a move, the sums of a reverse product
   Poly beta_ = Poly::Zero();
   double radius_ = 0.0;  ///< the last setup's support radius
   bool radius_reduced_ = false;  ///< the default radius_ was reduced to fit the memory budget

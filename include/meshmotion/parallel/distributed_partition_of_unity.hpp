@@ -132,7 +132,7 @@ class DistributedPartitionOfUnity {
   meshmotion::detail::PartitionOfUnityRbf<Dim> cover_;
   std::vector<int> coefficient_counts_;  ///< per owner rank: doubles of coefficients received
   std::vector<Index> evaluated_;
-  Eigen::SparseMatrix<double, Eigen::RowMajor, int> operator_;
+  meshmotion::detail::KernelRows operator_;
 };
 
 template <int Dim>
@@ -475,8 +475,10 @@ void DistributedPartitionOfUnity<Dim>::move_into(PointsView<Dim> d, Points<Dim>&
       for (int k = 0; k < Dim; ++k) stacked(row, k) = block[i + static_cast<std::size_t>(k)];
   if (out.cols() != n_local_) out.resize(Dim, n_local_);
   out.setZero();
-  const Eigen::MatrixXd moved = operator_ * stacked;
-  for (std::size_t r = 0; r < evaluated_.size(); ++r) out.col(evaluated_[r]) = moved.row(static_cast<Index>(r)).transpose();
+  Points<Dim> columns;
+  meshmotion::detail::kernel_rows_times<Dim>(operator_, stacked, columns, [&](Index r, const Vec<Dim>& value) {
+    out.col(evaluated_[static_cast<std::size_t>(r)]) = value;
+  });
   for (std::size_t c = 0; c < nodes_.size(); ++c) out.col(nodes_[c]) = d.col(entries_[c]);
 }
 
@@ -485,10 +487,15 @@ Points<Dim> DistributedPartitionOfUnity<Dim>::derivative_reverse(PointsView<Dim>
   Points<Dim> grad = Points<Dim>::Zero(Dim, n_entries);
   for (std::size_t c = 0; c < nodes_.size(); ++c) grad.col(entries_[c]) += v.col(nodes_[c]);
   // Owned nodes only: a ghost's term belongs to its owner.
-  Eigen::MatrixXd seed = Eigen::MatrixXd::Zero(static_cast<Index>(evaluated_.size()), Dim);
-  for (std::size_t r = 0; r < evaluated_.size(); ++r)
-    if (owned[static_cast<std::size_t>(evaluated_[r])] != 0) seed.row(static_cast<Index>(r)) = v.col(evaluated_[r]).transpose();
-  const Eigen::MatrixXd stacked_bar = operator_.transpose() * seed;
+  Points<Dim> sums_of_coefficients;
+  Eigen::MatrixXd stacked_bar;
+  meshmotion::detail::kernel_rows_transpose_times<Dim>(
+      operator_,
+      [&](Index r) -> Vec<Dim> {
+        const Index node = evaluated_[static_cast<std::size_t>(r)];
+        return owned[static_cast<std::size_t>(node)] != 0 ? Vec<Dim>(v.col(node)) : Vec<Dim>::Zero();
+      },
+      sums_of_coefficients, stacked_bar);
   // Back to the patches' owners, in the layout the coefficients came in.
   std::vector<std::vector<double>> back(static_cast<std::size_t>(ranks_));
   Index row = 0;

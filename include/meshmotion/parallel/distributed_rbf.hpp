@@ -195,7 +195,7 @@ class DistributedRbfMover {
   Points<Dim> local_points_;                 ///< PETSc: this rank's nodes
   std::vector<Index> interior_;              ///< PETSc: local nodes that are not centres
   std::vector<Index> evaluated_;             ///< PETSc: those with kernel weights (operator rows)
-  Eigen::SparseMatrix<double, Eigen::RowMajor, int> operator_;  ///< PETSc: evaluated_ × centres
+  meshmotion::detail::KernelRows operator_;  ///< PETSc: evaluated_ × centres
   Eigen::MatrixXd alpha_;
   typename detail::PetscRbfSystem<Dim>::PolyCoefficients beta_;
   MoverStats stats_;
@@ -514,8 +514,10 @@ void DistributedRbfMover<Dim>::move_petsc(Points<Dim>& out) {
   collective(comm_, [&] { system_->solve(gathered_.transpose(), alpha_, beta_); });
   if (out.cols() != n_local_) out.resize(Dim, n_local_);
   out.setZero();
-  const Eigen::MatrixXd values = operator_ * alpha_;
-  for (std::size_t r = 0; r < evaluated_.size(); ++r) out.col(evaluated_[r]) = values.row(static_cast<Index>(r)).transpose();
+  Points<Dim> columns;
+  meshmotion::detail::kernel_rows_times<Dim>(operator_, alpha_, columns, [&](Index r, const Vec<Dim>& value) {
+    out.col(evaluated_[static_cast<std::size_t>(r)]) = value;
+  });
   if (options_.polynomial)
     for (const Index i : interior_) out.col(i) += beta_.transpose() * system_->polynomial(local_points_.col(i));
   const Index m = global_boundary_size();
@@ -533,11 +535,14 @@ Points<Dim> DistributedRbfMover<Dim>::reverse_petsc(const PointsView<Dim>& v) {
   Eigen::Map<Points<Dim>> direct(sums.data() + m * Dim, Dim, m);
   Eigen::Map<typename detail::PetscRbfSystem<Dim>::PolyCoefficients> beta_bar(sums.data() + 2 * m * Dim);
   // Owned nodes only: a ghost's term belongs to its owner.
-  Eigen::MatrixXd seed(static_cast<Index>(evaluated_.size()), Dim);
-  for (std::size_t r = 0; r < evaluated_.size(); ++r)
-    seed.row(static_cast<Index>(r)) = owned_[static_cast<std::size_t>(evaluated_[r])] != 0 ? Eigen::RowVectorXd(v.col(evaluated_[r]).transpose())
-                                                                                      : Eigen::RowVectorXd::Zero(Dim);
-  alpha_bar = operator_.transpose() * seed;
+  Points<Dim> sums_of_centres;
+  meshmotion::detail::kernel_rows_transpose_times<Dim>(
+      operator_,
+      [&](Index r) -> Vec<Dim> {
+        const Index node = evaluated_[static_cast<std::size_t>(r)];
+        return owned_[static_cast<std::size_t>(node)] != 0 ? Vec<Dim>(v.col(node)) : Vec<Dim>::Zero();
+      },
+      sums_of_centres, alpha_bar);
   if (options_.polynomial)
     for (const Index i : interior_)
       if (owned_[static_cast<std::size_t>(i)] != 0) beta_bar += system_->polynomial(local_points_.col(i)) * v.col(i).transpose();

@@ -136,6 +136,45 @@ template <int Dim, class Within>
   return m;
 }
 
+/// Kernel rows (compact_kernel_rows(), evaluation_rows()): a row-major sparse matrix E whose
+/// columns are centres.
+using KernelRows = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
+
+/// Row r of E X for each row r, handed to `put(r, value)` (Vec<Dim>) on the library's threads:
+/// X has a row per column of E (a centre's or a patch coefficient's values), copied transposed
+/// into `columns` (a caller's buffer) so that one pass over E gives every component from
+/// contiguous values. Eigen's product makes a pass over E per component, each through a column
+/// of X: on a volume-sized E, Dim times the memory traffic. Each component is Eigen's sum, in
+/// the same order.
+template <int Dim, class Put>
+void kernel_rows_times(const KernelRows& e, const Eigen::MatrixXd& x, Points<Dim>& columns, Put&& put) {
+  columns = x.transpose();
+  const Index n = e.outerSize();
+  // Eigen's own threshold for a threaded sparse product: below it the threads cost more.
+  const bool threaded = e.nonZeros() > 20000;
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static) if (threaded)
+  for (Index r = 0; r < n; ++r) {
+    Vec<Dim> sum = Vec<Dim>::Zero();
+    for (KernelRows::InnerIterator it(e, r); it; ++it) sum += it.value() * columns.col(it.index());
+    put(r, sum);
+  }
+}
+
+/// Eᵀ V (E's columns × Dim, into `out`: a matrix, or a map of that shape) for the seed V whose
+/// row r is `seed(r)` (Vec<Dim>): one pass over E, each nonzero adding its row's seed to its
+/// column's Dim contiguous sums (`sums`, a caller's buffer). Serial: every sum runs over the
+/// rows in order whatever the threads, as in Eigen's transposed product, which scatters each
+/// nonzero into Dim columns a column's length apart.
+template <int Dim, class Seed, class Out>
+void kernel_rows_transpose_times(const KernelRows& e, Seed&& seed, Points<Dim>& sums, Out&& out) {
+  sums.setZero(Dim, e.cols());
+  for (Index r = 0; r < e.outerSize(); ++r) {
+    const Vec<Dim> s = seed(r);
+    for (KernelRows::InnerIterator it(e, r); it; ++it) sums.col(it.index()) += it.value() * s;
+  }
+  out = sums.transpose();
+}
+
 /// The linear polynomial part of an augmented system over its centres, eliminated through the
 /// Schur complement S = Pᵀ A⁻¹ P: with α₀ = A⁻¹ d, β = S⁻¹ Pᵀ α₀ and α = α₀ - G β (G = A⁻¹ P).
 /// The basis [1, (x - shift)/scale] is scaled to the centres for conditioning. Shared by the
