@@ -11,11 +11,11 @@ per operation, and the ratio Python / C++. One JSON line per case.
 
 The MPI rows do the same job over MPI at each rank count of --mpi-ranks (Python: the
 distributed mover Warp(comm=...) uses, through mpi4py; C++: python_mpi_overhead_peer), on a
-box of --mpi-cells³ cells, each rank on its share of the cores; the times are the slowest
-rank's. They are skipped, saying why, without the module's MPI or the peer.
+box of --mpi-cells³ cells, each rank unbound with its share of the cores; the times are the
+slowest rank's. They are skipped, saying why, without the module's MPI or the peer.
 
     PYTHONPATH=build/python /usr/bin/python3 benchmarks/python_overhead.py \
-        [--peer build-bench/benchmarks/python_overhead_peer] [--cells 80] [--moves 100] [--rounds 3] \
+        [--peer build-bench/benchmarks/python_overhead_peer] [--cells 80] [--moves 100] [--rounds 5] \
         [--mpi-ranks 1,2,4] [--mpi-cells 40]
 """
 
@@ -121,7 +121,10 @@ def mpi_rows(args, here, folder):
     subprocess.run([args.peer, "write", str(args.mpi_cells), file], check=True)
     radius = 6.0 / args.mpi_cells
     version = subprocess.run([mpiexec, "--version"], capture_output=True, text=True).stdout
-    flags = ["--oversubscribe", "--allow-run-as-root"] if "Open MPI" in version or "OpenRTE" in version else []
+    # Open MPI binds each rank to one core up to two ranks: the one rank's OMP_NUM_THREADS threads
+    # would take turns on one core while the other idles, timing the scheduler more than the call.
+    open_mpi = "Open MPI" in version or "OpenRTE" in version
+    flags = ["--oversubscribe", "--allow-run-as-root", "--bind-to", "none"] if open_mpi else []
     print(f"\nOver MPI: hex box of {args.mpi_cells}^3 cells, radius {radius:.4g}, {args.moves} operations x "
           f"{args.rounds} rounds, the slowest rank's times")
     print(f"{'ranks':>5}  {'operation':<22}{'C++ (ms)':>12}{'Python (ms)':>14}{'Python/C++':>12}")
@@ -159,7 +162,7 @@ def main():
     parser.add_argument("--peer", default=str(here.parent / "build-bench" / "benchmarks" / "python_overhead_peer"))
     parser.add_argument("--cells", type=int, default=80)
     parser.add_argument("--moves", type=int, default=100)
-    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--mpi-ranks", default="1,2,4")
     parser.add_argument("--mpi-cells", type=int, default=40)
     parser.add_argument("--mpi-peer", default=None, help="default: python_mpi_overhead_peer beside --peer")
