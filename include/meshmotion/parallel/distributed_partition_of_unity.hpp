@@ -47,6 +47,21 @@
 
 namespace meshmotion::parallel::detail {
 
+/// Eᵀ V for kernel rows E of the local nodes `rows` and a seed V of every local node, the
+/// nodes this rank does not own left out (a ghost's term belongs to its owner), into `out`.
+template <int Dim, class Out>
+void owned_transpose_times(const meshmotion::detail::KernelRows& e, const std::vector<Index>& rows,
+                           const std::vector<char>& owned, const PointsView<Dim>& v, Out&& out) {
+  Points<Dim> sums;
+  meshmotion::detail::kernel_rows_transpose_times<Dim>(
+      e,
+      [&](Index r) -> Vec<Dim> {
+        const Index node = rows[static_cast<std::size_t>(r)];
+        return owned[static_cast<std::size_t>(node)] != 0 ? Vec<Dim>(v.col(node)) : Vec<Dim>::Zero();
+      },
+      sums, out);
+}
+
 template <int Dim>
 class DistributedPartitionOfUnity {
  public:
@@ -486,16 +501,8 @@ template <int Dim>
 Points<Dim> DistributedPartitionOfUnity<Dim>::derivative_reverse(PointsView<Dim> v, const std::vector<char>& owned, Index n_entries) {
   Points<Dim> grad = Points<Dim>::Zero(Dim, n_entries);
   for (std::size_t c = 0; c < nodes_.size(); ++c) grad.col(entries_[c]) += v.col(nodes_[c]);
-  // Owned nodes only: a ghost's term belongs to its owner.
-  Points<Dim> sums_of_coefficients;
   Eigen::MatrixXd stacked_bar;
-  meshmotion::detail::kernel_rows_transpose_times<Dim>(
-      operator_,
-      [&](Index r) -> Vec<Dim> {
-        const Index node = evaluated_[static_cast<std::size_t>(r)];
-        return owned[static_cast<std::size_t>(node)] != 0 ? Vec<Dim>(v.col(node)) : Vec<Dim>::Zero();
-      },
-      sums_of_coefficients, stacked_bar);
+  owned_transpose_times<Dim>(operator_, evaluated_, owned, v, stacked_bar);
   // Back to the patches' owners, in the layout the coefficients came in.
   std::vector<std::vector<double>> back(static_cast<std::size_t>(ranks_));
   Index row = 0;

@@ -534,15 +534,7 @@ Points<Dim> DistributedRbfMover<Dim>::reverse_petsc(const PointsView<Dim>& v) {
   Eigen::Map<Eigen::MatrixXd> alpha_bar(sums.data(), m, Dim);
   Eigen::Map<Points<Dim>> direct(sums.data() + m * Dim, Dim, m);
   Eigen::Map<typename detail::PetscRbfSystem<Dim>::PolyCoefficients> beta_bar(sums.data() + 2 * m * Dim);
-  // Owned nodes only: a ghost's term belongs to its owner.
-  Points<Dim> sums_of_centres;
-  meshmotion::detail::kernel_rows_transpose_times<Dim>(
-      operator_,
-      [&](Index r) -> Vec<Dim> {
-        const Index node = evaluated_[static_cast<std::size_t>(r)];
-        return owned_[static_cast<std::size_t>(node)] != 0 ? Vec<Dim>(v.col(node)) : Vec<Dim>::Zero();
-      },
-      sums_of_centres, alpha_bar);
+  detail::owned_transpose_times<Dim>(operator_, evaluated_, owned_, v, alpha_bar);
   if (options_.polynomial)
     for (const Index i : interior_)
       if (owned_[static_cast<std::size_t>(i)] != 0) beta_bar += system_->polynomial(local_points_.col(i)) * v.col(i).transpose();
