@@ -28,7 +28,7 @@
 #include "meshmotion/core/topology.hpp"
 #include "meshmotion/curving/curve_mesh.hpp"
 #include "meshmotion/io/mesh_io.hpp"
-#include "meshmotion/movers/mover_options.hpp"
+#include "meshmotion/movers.hpp"
 #include "meshmotion/movers/step_driver.hpp"
 
 #include <algorithm>

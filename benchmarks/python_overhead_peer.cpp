@@ -12,7 +12,7 @@
 #include "bench_memory.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/io/mesh_io.hpp"
-#include "meshmotion/movers/mover_options.hpp"
+#include "meshmotion/movers.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 

@@ -6,7 +6,11 @@
 #include "meshmotion/core/extrusion.hpp"
 #include "meshmotion/core/option_text.hpp"
 #include "meshmotion/io/detail/read_file.hpp"
-#include "meshmotion/movers.hpp"
+#include "meshmotion/movers/boundary.hpp"
+#include "meshmotion/movers/motion.hpp"
+#include "meshmotion/movers/rbf.hpp"
+#include "meshmotion/movers/registry.hpp"
+#include "meshmotion/movers/support_radius.hpp"
 
 #include <CLI/CLI.hpp>
 

@@ -11,7 +11,8 @@
 #include "meshmotion/core/extrusion.hpp"
 #include "meshmotion/core/fields.hpp"
 #include "meshmotion/io.hpp"
-#include "meshmotion/movers.hpp"
+#include "meshmotion/movers/registry.hpp"
+#include "meshmotion/movers/step_driver.hpp"
 #include "meshmotion/movers/section_mover.hpp"
 #include "meshmotion/quality.hpp"
 
@@ -21,6 +22,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -42,12 +44,14 @@ struct Arguments {
   examples::FoamSelection foam;
 };
 
-// DGRBF2 rotates about the centre (and axis) of the rigid motion given here: in the section's
-// coordinates when a 2D case stored in 3D moves as its section.
+// A method whose options take a rotation's centre (and axis), as DGRBF2's do, rotates about
+// those of the rigid motion given here: in the section's coordinates when a 2D case stored in
+// 3D moves as its section.
 template <int MoverDim>
 KeyValues mover_options(const Arguments& a, const examples::MotionArguments& motion, const Extrusion* section) {
   KeyValues given = examples::given_options(a.mover);
-  if (a.mover.method != "dgrbf2") return given;
+  const std::vector<std::string> keys = mover_config<MoverDim>(a.mover.method).keys();
+  if (std::find(keys.begin(), keys.end(), "center") == keys.end()) return given;
   std::vector<double> center = motion.center;
   if (section != nullptr && center.size() == 3) {
     const Vec<2> uv = section->project(Vec<3>(center[0], center[1], center[2]));

@@ -7,7 +7,7 @@
 
 #include "meshmotion/core/option_text.hpp"
 #include "meshmotion/io/detail/read_file.hpp"
-#include "meshmotion/movers/mover_options.hpp"
+#include "meshmotion/movers/registry.hpp"
 
 #include <CLI/CLI.hpp>
 

@@ -6,7 +6,7 @@
 
 #include "bindings.hpp"
 
-#include "meshmotion/movers/mover_options.hpp"
+#include "meshmotion/movers/registry.hpp"
 
 #include <functional>
 #include <string>

@@ -3,7 +3,7 @@
 #include "bridge.hpp"
 
 #include "meshmotion/io/openfoam_polymesh.hpp"
-#include "meshmotion/movers/mover_options.hpp"
+#include "meshmotion/movers/registry.hpp"
 #include "meshmotion/movers/rbf.hpp"
 #include "meshmotion/movers/support_radius.hpp"
 #ifdef MESHMOTION_FOAM_PARALLEL

@@ -4,7 +4,7 @@
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/io/openfoam_polymesh.hpp"
-#include "meshmotion/movers/mover_options.hpp"
+#include "meshmotion/movers.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/rbf.hpp"
 #include "meshmotion/movers/step_driver.hpp"

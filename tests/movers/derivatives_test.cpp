@@ -4,7 +4,7 @@
 // prescribed, fixed and sliding groups in 2D and 3D, through the run-time registry.
 
 #include "meshmotion/core/generators.hpp"
-#include "meshmotion/movers/mover_options.hpp"
+#include "meshmotion/movers.hpp"
 #include "meshmotion/movers/boundary.hpp"
 
 #include "random_field.hpp"

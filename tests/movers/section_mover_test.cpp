@@ -4,7 +4,7 @@
 
 #include "meshmotion/core/extrusion.hpp"
 #include "meshmotion/core/generators.hpp"
-#include "meshmotion/movers/mover_options.hpp"
+#include "meshmotion/movers.hpp"
 #include "meshmotion/movers/section_mover.hpp"
 #include "meshmotion/movers/step_driver.hpp"
 

@@ -4,7 +4,7 @@
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/io/mesh_io.hpp"
-#include "meshmotion/movers/mover_options.hpp"
+#include "meshmotion/movers.hpp"
 #include "meshmotion/movers/step_driver.hpp"
 #include "meshmotion/quality/quality_report.hpp"
 

@@ -5,7 +5,7 @@
 #include "meshmotion/core/option_text.hpp"
 #include "meshmotion/curving/curve_mesh.hpp"
 #include "meshmotion/movers/any_mover.hpp"
-#include "meshmotion/movers/mover_options.hpp"
+#include "meshmotion/movers.hpp"
 
 #include "messages.hpp"
 

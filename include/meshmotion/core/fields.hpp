@@ -5,7 +5,7 @@
 /// Every options struct and every report of the library describes its fields once, next to
 /// the struct:
 /// - options: `visit_options(o, f)` calls `f(key, field, doc)` for each field text may set
-///   (movers/mover_options.hpp, curving/curve_mesh.hpp);
+///   (movers/registry.hpp, curving/curve_mesh.hpp);
 /// - results: `visit_fields(r, f)` calls `f(key, value, doc)` for each field of a report
 ///   (MoverStats, QualityReport, UntangleReport, CurveResult, ...).
 /// The key is the field's name in every outlet: the command-line flag (`--key-with-dashes`),

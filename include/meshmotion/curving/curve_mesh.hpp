@@ -43,8 +43,7 @@
 #include "meshmotion/movers/boundary_layer.hpp"
 #include "meshmotion/movers/detail/wall_distance.hpp"
 #include "meshmotion/movers/mover.hpp"
-#include "meshmotion/movers/mover_options.hpp"
-#include "meshmotion/movers/rbf.hpp"
+#include "meshmotion/movers/registry.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
 #include "meshmotion/movers/support_radius.hpp"
 #include "meshmotion/quality/cell_quality.hpp"
@@ -82,7 +81,7 @@ struct CurveOptions {
   /// Order of the curved mesh: 2 (default), 3 or 4 (hexahedra, prisms and pyramids stop at 3;
   /// element_type()).
   int order = 2;
-  /// Interior regularization: any registered method (mover_methods(), movers/mover_options.hpp).
+  /// Interior regularization: any registered method (mover_methods(), movers/registry.hpp).
   /// "blend" (wall-distance blending) is the default: it reached the best minimum on every
   /// case of curving_bench; "none" snaps the boundary alone, to show why the pipeline exists.
   std::string method = "blend";

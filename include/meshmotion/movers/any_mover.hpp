@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// AnyMover<Dim>: any MeshMover behind one type, for movers chosen at run time (make_mover()
-/// in movers/mover_options.hpp builds the registered ones by method name).
+/// in movers/registry.hpp builds the registered ones by method name).
 
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh_like.hpp"

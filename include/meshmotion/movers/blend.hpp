@@ -22,6 +22,7 @@
 /// wall and a closest-facet query per node within reach, O(n log m), over the threads
 /// (core/threads.hpp); move: O(nonzeros).
 
+#include "meshmotion/movers/blend_options.hpp"
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
@@ -53,31 +54,6 @@
 #include <vector>
 
 namespace meshmotion {
-
-/// Options of BlendMover (their keys: visit_options in movers/mover_options.hpp).
-struct BlendOptions {
-  /// Blending length for every wall; 0 (default): `blending_factor` × each wall's boundary-layer
-  /// thickness (estimate_boundary_layer), or, on a wall without an anisotropic layer,
-  /// `fallback_spacings` × the size of the facet closest to each node.
-  double blending_length = 0.0;
-  BoundaryLayerOptions layer{};
-  /// A wall without a layer has only its own spacing to size its motion by, and the spacing
-  /// varies along it (on the RAE2822 the leading-edge facets are 8 times shorter than the
-  /// largest): each node blends over a few of its own facets (docs/curving.md, "Walls without
-  /// a layer").
-  double fallback_spacings = 2.0;
-  /// The default length in layer thicknesses. φ is steepest at a quarter of the length, so at
-  /// 1 the steepest gradient lies inside the layer's thin cells; at k it lies k/4 layers out,
-  /// in cells that tolerate it, and the gradient within the layer falls roughly as 1/k. The
-  /// registered method "blend" starts at 6 (docs/curving.md, "Blending length").
-  double blending_factor = 1.0;
-  /// An estimate_boundary_layer() made on the mesh setup() is given, for any grouping of the
-  /// same wall vertices (the curving pipeline's, by group): setup takes the walls' default
-  /// lengths from it instead of estimating again (a tenth of the 30P30N's curving time), when
-  /// its wall vertices are exactly those of the walls. Not a keyed option: whoever sets it
-  /// vouches that the mesh is the one estimated.
-  std::shared_ptr<const BoundaryLayerEstimate> layer_estimate{};
-};
 
 /// Wall-distance blending mover (models MeshMover).
 template <int Dim>
@@ -398,3 +374,11 @@ class BlendMover {
 static_assert(MeshMover<BlendMover<2>> && MeshMover<BlendMover<3>>);
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template class BlendMover<2>;
+extern template class BlendMover<3>;
+}  // namespace meshmotion
+#endif

@@ -19,6 +19,7 @@
 /// edge, which is anisotropic too).
 /// Cost: linear in the cells of the layer, plus a k-d tree query per vertex reached.
 
+#include "meshmotion/movers/boundary_layer_options.hpp"
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
@@ -36,13 +37,6 @@
 #include <vector>
 
 namespace meshmotion {
-
-/// Options of estimate_boundary_layer().
-struct BoundaryLayerOptions {
-  /// Cells with longest/shortest vertex edge at least this belong to the layer; 2–4 separates
-  /// the stretched layer from the isotropic core of usual meshes.
-  double aspect_ratio_threshold = 3.0;
-};
 
 /// The estimated layer of one wall group.
 struct WallLayer {

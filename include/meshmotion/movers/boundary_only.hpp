@@ -6,6 +6,7 @@
 ///
 /// Linear in the displacements; setup keeps the boundary (O(boundary)), move scatters it.
 
+#include "meshmotion/movers/boundary_only_options.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary.hpp"
@@ -16,13 +17,6 @@
 #include <Eigen/Core>
 
 namespace meshmotion {
-
-/// Options of BoundaryOnlyMover: none.
-struct BoundaryOnlyOptions {
-  /// The mover leaves the interior where it is: a caller that repairs interior cells (the
-  /// curving pipeline's untangling) does not act on its result.
-  static constexpr bool moves_interior = false;
-};
 
 /// Moves the prescribed boundary nodes by their displacements and nothing else (models
 /// MeshMover).
@@ -81,3 +75,11 @@ class BoundaryOnlyMover : public detail::MoveFromMoveInto<BoundaryOnlyMover<Dim>
 };
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template class BoundaryOnlyMover<2>;
+extern template class BoundaryOnlyMover<3>;
+}  // namespace meshmotion
+#endif

@@ -7,6 +7,7 @@
 #include "meshmotion/movers/rbf_kernels.hpp"
 
 #include <array>
+#include <string>
 #include <string_view>
 
 namespace meshmotion {
@@ -47,5 +48,14 @@ struct SimplexRbfOptions {
   /// which plain RBF with Dim+1 centres does not. false gives the thesis's eq. 2.15 as is.
   bool normalize = true;
 };
+
+// visit_options(o, f) calls f(key, field, help) for every field of `o` that text may set.
+template <class F>
+void visit_options(SimplexRbfOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "kernel", o.kernel, "radial function of the per-simplex interpolation");
+  f(prefix + "simplex_support_radius", o.support_radius, "absolute per-simplex support radius (0: relative)");
+  f(prefix + "simplex_support", o.relative_support, "per-simplex support, × the simplex's longest edge");
+  f(prefix + "normalize", o.normalize, "divide the cardinal weights by their sum");
+}
 
 }  // namespace meshmotion

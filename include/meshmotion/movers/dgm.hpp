@@ -16,6 +16,7 @@
 ///   O((m + n) log m) in practice; move = (Dim+1) × Dim multiply-adds per node plus the
 ///   inversion test over the graph's O(m) simplices; no linear system.
 
+#include "meshmotion/movers/dgm_options.hpp"
 #include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary.hpp"
@@ -27,13 +28,6 @@
 #include <optional>
 
 namespace meshmotion {
-
-/// Options of DgmMover.
-struct DgmOptions {
-  OutsideGraph outside = OutsideGraph::clamp;
-  /// Refuse (InvalidMeshError) when the moved graph inverts; false maps anyway.
-  bool check_inversion = true;
-};
 
 /// The DGM mover in Dim dimensions; models MeshMover.
 template <int Dim>
@@ -79,3 +73,11 @@ class DgmMover : public detail::MoveFromMoveInto<DgmMover<Dim>, Dim> {
 };
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template class DgmMover<2>;
+extern template class DgmMover<3>;
+}  // namespace meshmotion
+#endif

@@ -14,6 +14,7 @@
 ///   evaluation per node; move = (Dim+1) × Dim multiply-adds per node.
 /// - Nodes outside the hull and sliding nodes as in DgmMover.
 
+#include "meshmotion/movers/dgrbf_options.hpp"
 #include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary.hpp"
@@ -23,12 +24,6 @@
 #include "meshmotion/movers/mover.hpp"
 
 namespace meshmotion {
-
-/// Options of DgrbfMover.
-struct DgrbfOptions {
-  SimplexRbfOptions rbf = {};
-  OutsideGraph outside = OutsideGraph::clamp;
-};
 
 /// The DGRBF mover in Dim dimensions; models MeshMover.
 template <int Dim>
@@ -73,3 +68,11 @@ class DgrbfMover : public detail::MoveFromMoveInto<DgrbfMover<Dim>, Dim> {
 };
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template class DgrbfMover<2>;
+extern template class DgrbfMover<3>;
+}  // namespace meshmotion
+#endif

@@ -20,6 +20,7 @@
 /// - Setup caches as DgrbfMover (graph, per-simplex systems, per-node weights); move adds
 ///   an O(m) fit and one rotation per node.
 
+#include "meshmotion/movers/dgrbf2_options.hpp"
 #include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/boundary.hpp"
@@ -37,18 +38,6 @@
 #include <utility>
 
 namespace meshmotion {
-
-/// Options of Dgrbf2Mover.
-template <int Dim>
-struct Dgrbf2Options {
-  SimplexRbfOptions rbf = {};
-  OutsideGraph outside = OutsideGraph::clamp;
-  /// Centre of rotation (the centre of the rigid Rotation2D/Rotation3D given to the moving
-  /// group; for a Composition, the rotation's centre). Empty: the centroid of the moving nodes.
-  std::optional<Vec<Dim>> center;
-  /// Rotation axis in 3D (any non-zero length; ignored in 2D).
-  Vec<3> axis = Vec<3>::UnitZ();
-};
 
 /// Options taking the centre (and axis) of a rigid rotation.
 [[nodiscard]] inline Dgrbf2Options<2> dgrbf2_options(const Rotation2D& rotation) {
@@ -219,3 +208,11 @@ class Dgrbf2Mover : public detail::MoveFromMoveInto<Dgrbf2Mover<Dim>, Dim> {
 };
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template class Dgrbf2Mover<2>;
+extern template class Dgrbf2Mover<3>;
+}  // namespace meshmotion
+#endif

@@ -23,6 +23,7 @@
 /// - Solvers: direct Cholesky (default, simplicial_ldlt), CG with Jacobi (as in the thesis,
 ///   table 4.2) or incomplete Cholesky; iterations and residual land in stats().
 
+#include "meshmotion/movers/elasticity_options.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/core/types.hpp"
@@ -40,28 +41,6 @@
 #include <vector>
 
 namespace meshmotion {
-
-/// Options of ElasticityMover.
-struct ElasticityOptions {
-  double youngs_modulus = 1.0;  ///< E > 0 (scales K only; the thesis uses 1e6)
-  double poisson_ratio = 0.3;   ///< ν in (−1, 0.5) (the thesis uses 0.4)
-  /// χ of eq. 2.8 (thesis table 4.2: 2.75 and 2.9); 0 disables Jacobian stiffening.
-  double stiffening_exponent = 0.0;
-  /// J0 of eq. 2.8 in mesh units of area/volume; ≤ 0 means the mean cell measure.
-  double reference_jacobian = 0.0;
-  /// ψ of the wall-distance stiffening (d̄/d_κ)^ψ; 0 disables it.
-  double distance_exponent = 0.0;
-  /// Solver of the SPD system. ElasticityMover always solves the diagonally scaled system
-  /// (solver.diagonal_scaling is switched on): stiffening spreads the rows of K over many
-  /// orders of magnitude, and an iterative solver's relative residual only means something
-  /// on the balanced system.
-  SolverOptions solver = {};
-  /// Solve only near the moving walls: nodes farther than this from every prescribed
-  /// boundary node keep zero displacement (a homogeneous Dirichlet condition there, like the
-  /// compact support of an RBF); cells without a free node are not assembled, and sliding
-  /// nodes beyond the radius are held fixed. ≤ 0 (default): the whole mesh.
-  double active_radius = 0.0;
-};
 
 /// The (stiffened) linear elasticity mover in Dim dimensions; models MeshMover.
 template <int Dim>

@@ -20,6 +20,7 @@
 ///   Cost: setup = RbfMover setup on m + L points + DGM setup; move = one RBF solve +
 ///   L evaluations + DGM's mapping. Graph inversion is refused as in DgmMover.
 
+#include "meshmotion/movers/improved_dgm_options.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/mesh_like.hpp"
@@ -40,24 +41,6 @@
 #include <vector>
 
 namespace meshmotion {
-
-/// Options of ImprovedDgmMover.
-struct ImprovedDgmOptions {
-  DgmOptions dgm = {};
-  /// Distance of the layer from the prescribed boundary nodes, in median spacings of those
-  /// nodes (> 0): about 1 makes the graph triangles between wall and layer well shaped.
-  double layer_offset = 1.0;
-  /// Thinning of the layer, in median prescribed-node spacings (0 keeps every layer node).
-  double layer_spacing = 1.0;
-  /// RBF moving the layer. Its support_radius is used when auto_support_radius is false.
-  RbfOptions rbf = {};
-  /// Support radius = relative_support_radius × the larger of the largest distance from a
-  /// layer node to the nearest prescribed node and the bounding-box diagonal of the
-  /// prescribed nodes, so every layer node moves nearly rigidly with its body (a radius of the
-  /// order of the layer offset lets the layer lag and fold the thin wall–layer triangles).
-  bool auto_support_radius = true;
-  double relative_support_radius = 1.0;
-};
 
 /// The improved DGM mover in Dim dimensions; models MeshMover.
 template <int Dim>
@@ -267,3 +250,11 @@ class ImprovedDgmMover : public detail::MoveFromMoveInto<ImprovedDgmMover<Dim>, 
 };
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template class ImprovedDgmMover<2>;
+extern template class ImprovedDgmMover<3>;
+}  // namespace meshmotion
+#endif

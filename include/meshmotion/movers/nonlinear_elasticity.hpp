@@ -23,6 +23,7 @@
 /// - stats().iterations counts Newton iterations of the last move, factorizations the
 ///   tangent factorizations since setup.
 
+#include "meshmotion/movers/nonlinear_elasticity_options.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/core/types.hpp"
@@ -41,20 +42,6 @@
 #include <vector>
 
 namespace meshmotion {
-
-/// Options of NonlinearElasticityMover.
-struct NonlinearElasticityOptions {
-  double youngs_modulus = 1.0;      ///< E > 0 (scales the energy only)
-  double poisson_ratio = 0.3;       ///< ν in (−1, 0.5)
-  int load_steps = 1;               ///< equal boundary increments, ≥ 1
-  int max_newton_iterations = 60;   ///< per load step, ≥ 1
-  /// Newton stops when the largest nodal update is ≤ tolerance × the mesh's bounding-box diagonal.
-  double tolerance = 1e-10;
-  /// Smallest line-search step before giving up.
-  double min_step = 1e-8;
-  /// Solver of the symmetric tangent (direct by default; it may be indefinite far from u = 0).
-  SolverOptions solver = {};
-};
 
 /// The neo-Hookean mover in Dim dimensions; models MeshMover.
 template <int Dim>
@@ -273,3 +260,11 @@ class NonlinearElasticityMover : public detail::MoveFromMoveInto<NonlinearElasti
 };
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template class NonlinearElasticityMover<2>;
+extern template class NonlinearElasticityMover<3>;
+}  // namespace meshmotion
+#endif

@@ -31,6 +31,7 @@
 #include "meshmotion/core/option_text.hpp"
 #include "meshmotion/core/threads.hpp"
 #include "meshmotion/core/types.hpp"
+#include "meshmotion/movers/rbf_options.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/spatial/kd_tree.hpp"
 
@@ -47,31 +48,6 @@
 #include <vector>
 
 namespace meshmotion {
-
-/// Whether an RBF mover takes the rigid part of the boundary's motion out first (see the file
-/// comment).
-enum class RigidPart {
-  /// When the prescribed nodes move as one rigid body (within 1e-3 of the largest
-  /// displacement) and either nothing is held, or the memory budget cut the interpolation's
-  /// default radius (RbfOptions::max_memory_bytes: it cannot spread the motion) while the gap
-  /// to the held nodes is at least 4 of the body's node spacings and the blend keeps every
-  /// node's Jacobian determinant ≥ min_blend_determinant.
-  automatic,
-  blend,  ///< always; InputError when the prescribed nodes do not move as one rigid body
-  none,   ///< never: the interpolation carries the whole motion
-};
-
-[[nodiscard]] constexpr std::string_view name(RigidPart r) {
-  switch (r) {
-    case RigidPart::automatic: return "automatic";
-    case RigidPart::blend: return "blend";
-    case RigidPart::none: return "none";
-  }
-  return "unknown";
-}
-[[nodiscard]] constexpr std::array<RigidPart, 3> option_choices(RigidPart) {
-  return {RigidPart::automatic, RigidPart::blend, RigidPart::none};
-}
 
 /// RigidPart::automatic's floor on the blend's smallest Jacobian determinant at the nodes.
 inline constexpr double min_blend_determinant = 0.3;

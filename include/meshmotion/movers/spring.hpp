@@ -16,6 +16,7 @@
 ///   factorization, move = one solve (forward/back substitution, or CG from the last solution).
 /// - Known weakness (thesis): inverts cells for moderate rotations; use it for small motions.
 
+#include "meshmotion/movers/spring_options.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh_like.hpp"
 #include "meshmotion/core/types.hpp"
@@ -30,14 +31,6 @@
 #include <vector>
 
 namespace meshmotion {
-
-/// Options of SpringMover.
-struct SpringOptions {
-  /// p in k_ij = ‖r_i − r_j‖^−p; Batina's choice (eq. 2.2) is 1. Must be finite.
-  double length_exponent = 1.0;
-  /// Solver of the (SPD) spring system.
-  SolverOptions solver = {};
-};
 
 /// Batina's lineal spring mover in Dim dimensions; models MeshMover.
 template <int Dim>
@@ -72,3 +65,11 @@ class SpringMover : public detail::LinearMechanicsMover<Dim> {
 };
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template class SpringMover<2>;
+extern template class SpringMover<3>;
+}  // namespace meshmotion
+#endif

@@ -27,6 +27,7 @@
 /// - Robust for moderate motions; for very large ones (thesis fig. 4.2, 60° flap rotation) it
 ///   still inverts cells.
 
+#include "meshmotion/movers/torsion_spring_options.hpp"
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh_like.hpp"
@@ -47,18 +48,6 @@
 #include <vector>
 
 namespace meshmotion {
-
-/// Options of TorsionSpringMover.
-struct TorsionSpringOptions {
-  /// Multiplies every torsional stiffness (0 gives plain coupled lineal springs); ≥ 0.
-  double torsion_weight = 1.0;
-  /// Lineal springs in Farhat et al.'s coupled truss form (true) or Batina's uncoupled form.
-  bool coupled_lineal = true;
-  /// 3D: add Degand & Farhat's vertex–facet (dihedral-angle) springs to the face-corner ones.
-  bool vertex_facet_springs = true;
-  /// Solver of the (SPD) coupled system.
-  SolverOptions solver = {};
-};
 
 namespace detail {
 
@@ -200,3 +189,11 @@ class TorsionSpringMover : public detail::LinearMechanicsMover<Dim> {
 };
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template class TorsionSpringMover<2>;
+extern template class TorsionSpringMover<3>;
+}  // namespace meshmotion
+#endif

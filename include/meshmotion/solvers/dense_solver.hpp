@@ -18,27 +18,6 @@
 
 namespace meshmotion {
 
-/// Dense factorizations.
-enum class DenseSolverKind {
-  llt,              ///< Cholesky: symmetric positive definite
-  ldlt,             ///< robust Cholesky with pivoting: symmetric semi-definite or indefinite
-  partial_piv_lu,   ///< LU with partial pivoting: any invertible matrix
-};
-
-[[nodiscard]] constexpr std::string_view name(DenseSolverKind kind) {
-  switch (kind) {
-    case DenseSolverKind::llt: return "dense_llt";
-    case DenseSolverKind::ldlt: return "dense_ldlt";
-    case DenseSolverKind::partial_piv_lu: return "dense_partial_piv_lu";
-  }
-  return "unknown";
-}
-
-/// Every dense factorization, for the option parser (core/option_text.hpp).
-[[nodiscard]] constexpr std::array<DenseSolverKind, 3> option_choices(DenseSolverKind) {
-  return {DenseSolverKind::llt, DenseSolverKind::ldlt, DenseSolverKind::partial_piv_lu};
-}
-
 /// A dense linear solver over one square matrix A (n × n), factorized once. A template
 /// (DenseSolver is BasicDenseSolver<>), so that its factorizations are compiled only where a
 /// solve is (docs/compiled.md).

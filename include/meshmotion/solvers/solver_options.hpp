@@ -6,6 +6,7 @@
 #include "meshmotion/core/types.hpp"
 
 #include <array>
+#include <string>
 #include <string_view>
 
 namespace meshmotion {
@@ -101,5 +102,36 @@ struct SolverReport {
   bool fell_back = false;    ///< an iterative solve failed and the direct fallback answered
   bool supernodal = false;   ///< the last factorization was CHOLMOD's supernodal one
 };
+
+/// Dense factorizations.
+enum class DenseSolverKind {
+  llt,              ///< Cholesky: symmetric positive definite
+  ldlt,             ///< robust Cholesky with pivoting: symmetric semi-definite or indefinite
+  partial_piv_lu,   ///< LU with partial pivoting: any invertible matrix
+};
+
+[[nodiscard]] constexpr std::string_view name(DenseSolverKind kind) {
+  switch (kind) {
+    case DenseSolverKind::llt: return "dense_llt";
+    case DenseSolverKind::ldlt: return "dense_ldlt";
+    case DenseSolverKind::partial_piv_lu: return "dense_partial_piv_lu";
+  }
+  return "unknown";
+}
+
+/// Every dense factorization, for the option parser (core/option_text.hpp).
+[[nodiscard]] constexpr std::array<DenseSolverKind, 3> option_choices(DenseSolverKind) {
+  return {DenseSolverKind::llt, DenseSolverKind::ldlt, DenseSolverKind::partial_piv_lu};
+}
+
+// visit_options(o, f) calls f(key, field, help) for every field of `o` that text may set.
+template <class F>
+void visit_options(SolverOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "solver", o.kind, "sparse solver of the system");
+  f(prefix + "tolerance", o.tolerance, "relative residual an iterative solver must reach");
+  f(prefix + "max_iterations", o.max_iterations, "iteration cap of an iterative solver (0: twice the size)");
+  f(prefix + "fallback_to_direct", o.fallback_to_direct, "solve with sparse LU when an iterative solver fails");
+  f(prefix + "diagonal_scaling", o.diagonal_scaling, "solve the diagonally scaled system");
+}
 
 }  // namespace meshmotion

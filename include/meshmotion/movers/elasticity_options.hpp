@@ -1,0 +1,46 @@
+#pragma once
+/// \file
+/// ElasticityOptions: the options of ElasticityMover (movers/elasticity.hpp).
+/// Light: the options and their one description (visit_options: key, field, doc), no mover.
+
+#include "meshmotion/solvers/solver_options.hpp"
+
+#include <string>
+
+namespace meshmotion {
+
+/// Options of ElasticityMover.
+struct ElasticityOptions {
+  double youngs_modulus = 1.0;  ///< E > 0 (scales K only; the thesis uses 1e6)
+  double poisson_ratio = 0.3;   ///< ν in (−1, 0.5) (the thesis uses 0.4)
+  /// χ of eq. 2.8 (thesis table 4.2: 2.75 and 2.9); 0 disables Jacobian stiffening.
+  double stiffening_exponent = 0.0;
+  /// J0 of eq. 2.8 in mesh units of area/volume; ≤ 0 means the mean cell measure.
+  double reference_jacobian = 0.0;
+  /// ψ of the wall-distance stiffening (d̄/d_κ)^ψ; 0 disables it.
+  double distance_exponent = 0.0;
+  /// Solver of the SPD system. ElasticityMover always solves the diagonally scaled system
+  /// (solver.diagonal_scaling is switched on): stiffening spreads the rows of K over many
+  /// orders of magnitude, and an iterative solver's relative residual only means something
+  /// on the balanced system.
+  SolverOptions solver = {};
+  /// Solve only near the moving walls: nodes farther than this from every prescribed
+  /// boundary node keep zero displacement (a homogeneous Dirichlet condition there, like the
+  /// compact support of an RBF); cells without a free node are not assembled, and sliding
+  /// nodes beyond the radius are held fixed. ≤ 0 (default): the whole mesh.
+  double active_radius = 0.0;
+};
+
+// visit_options(o, f) calls f(key, field, help) for every field of `o` that text may set.
+template <class F>
+void visit_options(ElasticityOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "youngs_modulus", o.youngs_modulus, "Young's modulus E > 0 (scales K only)");
+  f(prefix + "poisson_ratio", o.poisson_ratio, "Poisson ratio in (-1, 0.5)");
+  f(prefix + "stiffening_exponent", o.stiffening_exponent, "chi of the Jacobian stiffening (J0/J)^chi");
+  f(prefix + "reference_jacobian", o.reference_jacobian, "J0 (<= 0: the mean cell measure)");
+  f(prefix + "distance_exponent", o.distance_exponent, "psi of the wall-distance stiffening");
+  visit_options(o.solver, f, prefix);
+  f(prefix + "active_radius", o.active_radius, "solve only within this distance of the moving walls (0: whole mesh)");
+}
+
+}  // namespace meshmotion

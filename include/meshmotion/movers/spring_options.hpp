@@ -1,0 +1,27 @@
+#pragma once
+/// \file
+/// SpringOptions: the options of SpringMover (movers/spring.hpp).
+/// Light: the options and their one description (visit_options: key, field, doc), no mover.
+
+#include "meshmotion/solvers/solver_options.hpp"
+
+#include <string>
+
+namespace meshmotion {
+
+/// Options of SpringMover.
+struct SpringOptions {
+  /// p in k_ij = ‖r_i − r_j‖^−p; Batina's choice (eq. 2.2) is 1. Must be finite.
+  double length_exponent = 1.0;
+  /// Solver of the (SPD) spring system.
+  SolverOptions solver = {};
+};
+
+// visit_options(o, f) calls f(key, field, help) for every field of `o` that text may set.
+template <class F>
+void visit_options(SpringOptions& o, F&& f, const std::string& prefix = {}) {
+  f(prefix + "length_exponent", o.length_exponent, "p in k = length^-p");
+  visit_options(o.solver, f, prefix);
+}
+
+}  // namespace meshmotion
