@@ -30,6 +30,7 @@ add_test(NAME "cmake: every public header compiles alone"
 
 set(_consumer_args
   "-DSOURCE_DIR=${PROJECT_SOURCE_DIR}"
+  "-DBUILD_DIR=${PROJECT_BINARY_DIR}"
   "-DWORK_DIR=${CMAKE_CURRENT_BINARY_DIR}/consumer_tests"
   "-DGENERATOR=${CMAKE_GENERATOR}"
   "-DCXX_COMPILER=${CMAKE_CXX_COMPILER}")
