@@ -14,8 +14,12 @@ namespace meshmotion {
 constexpr int D = MESHMOTION_INSTANTIATE_DIM;
 
 template class DgmMover<D>;
+template void DgmMover<D>::setup<Mesh<D>>(const Mesh<D>&, const ResolvedBoundary<D>&);
 template class ImprovedDgmMover<D>;
+template void ImprovedDgmMover<D>::setup<Mesh<D>>(const Mesh<D>&, const ResolvedBoundary<D>&);
 template class DgrbfMover<D>;
+template void DgrbfMover<D>::setup<Mesh<D>>(const Mesh<D>&, const ResolvedBoundary<D>&);
 template class Dgrbf2Mover<D>;
+template void Dgrbf2Mover<D>::setup<Mesh<D>>(const Mesh<D>&, const ResolvedBoundary<D>&);
 
 }  // namespace meshmotion

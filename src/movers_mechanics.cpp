@@ -15,8 +15,12 @@ constexpr int D = MESHMOTION_INSTANTIATE_DIM;
 
 template class detail::LinearMechanicsMover<D>;
 template class SpringMover<D>;
+template void SpringMover<D>::setup<Mesh<D>>(const Mesh<D>&, const ResolvedBoundary<D>&);
 template class TorsionSpringMover<D>;
+template void TorsionSpringMover<D>::setup<Mesh<D>>(const Mesh<D>&, const ResolvedBoundary<D>&);
 template class ElasticityMover<D>;
+template void ElasticityMover<D>::setup<Mesh<D>>(const Mesh<D>&, const ResolvedBoundary<D>&);
 template class NonlinearElasticityMover<D>;
+template void NonlinearElasticityMover<D>::setup<Mesh<D>>(const Mesh<D>&, const ResolvedBoundary<D>&);
 
 }  // namespace meshmotion

@@ -66,3 +66,13 @@ add_test(NAME "cmake: the same header compiles without -ffast-math"
   COMMAND ${CMAKE_CXX_COMPILER} -std=c++20 -fsyntax-only ${_fast_math_includes}
           "${CMAKE_CURRENT_SOURCE_DIR}/consumer/fast_math.cpp")
 set_tests_properties("cmake: the same header compiles without -ffast-math" PROPERTIES LABELS cmake)
+
+# Each mover compiled once outside the tests (the registries are compiled; front ends include
+# options and registries only).
+if(MESHMOTION_BUILD_COMPILED AND CMAKE_NM)
+  add_test(NAME "cmake: each mover is compiled in one object"
+           COMMAND ${CMAKE_COMMAND} "-DBUILD_DIR=${PROJECT_BINARY_DIR}" "-DNM=${CMAKE_NM}"
+                   -P "${CMAKE_CURRENT_SOURCE_DIR}/check_instantiations.cmake")
+  set_tests_properties("cmake: each mover is compiled in one object" PROPERTIES LABELS cmake
+                       PASS_REGULAR_EXPRESSION "each mover's setup defined in one at most")
+endif()

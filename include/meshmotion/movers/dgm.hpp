@@ -79,5 +79,8 @@ class DgmMover : public detail::MoveFromMoveInto<DgmMover<Dim>, Dim> {
 namespace meshmotion {
 extern template class DgmMover<2>;
 extern template class DgmMover<3>;
+// setup is a template over the mesh type: its Mesh<Dim> form, the one make_mover() uses, too.
+extern template void DgmMover<2>::setup<Mesh<2>>(const Mesh<2>&, const ResolvedBoundary<2>&);
+extern template void DgmMover<3>::setup<Mesh<3>>(const Mesh<3>&, const ResolvedBoundary<3>&);
 }  // namespace meshmotion
 #endif

@@ -74,5 +74,8 @@ class DgrbfMover : public detail::MoveFromMoveInto<DgrbfMover<Dim>, Dim> {
 namespace meshmotion {
 extern template class DgrbfMover<2>;
 extern template class DgrbfMover<3>;
+// setup is a template over the mesh type: its Mesh<Dim> form, the one make_mover() uses, too.
+extern template void DgrbfMover<2>::setup<Mesh<2>>(const Mesh<2>&, const ResolvedBoundary<2>&);
+extern template void DgrbfMover<3>::setup<Mesh<3>>(const Mesh<3>&, const ResolvedBoundary<3>&);
 }  // namespace meshmotion
 #endif

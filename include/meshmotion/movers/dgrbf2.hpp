@@ -214,5 +214,8 @@ class Dgrbf2Mover : public detail::MoveFromMoveInto<Dgrbf2Mover<Dim>, Dim> {
 namespace meshmotion {
 extern template class Dgrbf2Mover<2>;
 extern template class Dgrbf2Mover<3>;
+// setup is a template over the mesh type: its Mesh<Dim> form, the one make_mover() uses, too.
+extern template void Dgrbf2Mover<2>::setup<Mesh<2>>(const Mesh<2>&, const ResolvedBoundary<2>&);
+extern template void Dgrbf2Mover<3>::setup<Mesh<3>>(const Mesh<3>&, const ResolvedBoundary<3>&);
 }  // namespace meshmotion
 #endif

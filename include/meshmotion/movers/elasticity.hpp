@@ -257,5 +257,8 @@ void ElasticityMover<Dim>::setup_mesh(const Mesh<Dim>& mesh, const ResolvedBound
 namespace meshmotion {
 extern template class ElasticityMover<2>;
 extern template class ElasticityMover<3>;
+// setup is a template over the mesh type: its Mesh<Dim> form, the one make_mover() uses, too.
+extern template void ElasticityMover<2>::setup<Mesh<2>>(const Mesh<2>&, const ResolvedBoundary<2>&);
+extern template void ElasticityMover<3>::setup<Mesh<3>>(const Mesh<3>&, const ResolvedBoundary<3>&);
 }  // namespace meshmotion
 #endif

@@ -256,5 +256,8 @@ class ImprovedDgmMover : public detail::MoveFromMoveInto<ImprovedDgmMover<Dim>, 
 namespace meshmotion {
 extern template class ImprovedDgmMover<2>;
 extern template class ImprovedDgmMover<3>;
+// setup is a template over the mesh type: its Mesh<Dim> form, the one make_mover() uses, too.
+extern template void ImprovedDgmMover<2>::setup<Mesh<2>>(const Mesh<2>&, const ResolvedBoundary<2>&);
+extern template void ImprovedDgmMover<3>::setup<Mesh<3>>(const Mesh<3>&, const ResolvedBoundary<3>&);
 }  // namespace meshmotion
 #endif

@@ -266,5 +266,8 @@ class NonlinearElasticityMover : public detail::MoveFromMoveInto<NonlinearElasti
 namespace meshmotion {
 extern template class NonlinearElasticityMover<2>;
 extern template class NonlinearElasticityMover<3>;
+// setup is a template over the mesh type: its Mesh<Dim> form, the one make_mover() uses, too.
+extern template void NonlinearElasticityMover<2>::setup<Mesh<2>>(const Mesh<2>&, const ResolvedBoundary<2>&);
+extern template void NonlinearElasticityMover<3>::setup<Mesh<3>>(const Mesh<3>&, const ResolvedBoundary<3>&);
 }  // namespace meshmotion
 #endif

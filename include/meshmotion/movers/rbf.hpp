@@ -819,6 +819,9 @@ Points<Dim> RbfMover<Dim>::derivative_reverse(PointsView<Dim> v) {
 namespace meshmotion {
 extern template class RbfMover<2>;
 extern template class RbfMover<3>;
+// setup is a template over the mesh type: its Mesh<Dim> form, the one make_mover() uses, too.
+extern template void RbfMover<2>::setup<Mesh<2>>(const Mesh<2>&, const ResolvedBoundary<2>&);
+extern template void RbfMover<3>::setup<Mesh<3>>(const Mesh<3>&, const ResolvedBoundary<3>&);
 extern template DefaultSupportRadius default_support_radius<2>(const Points<2>&, const ResolvedBoundary<2>&, const RbfOptions&);
 extern template DefaultSupportRadius default_support_radius<3>(const Points<3>&, const ResolvedBoundary<3>&, const RbfOptions&);
 }  // namespace meshmotion

@@ -71,5 +71,8 @@ class SpringMover : public detail::LinearMechanicsMover<Dim> {
 namespace meshmotion {
 extern template class SpringMover<2>;
 extern template class SpringMover<3>;
+// setup is a template over the mesh type: its Mesh<Dim> form, the one make_mover() uses, too.
+extern template void SpringMover<2>::setup<Mesh<2>>(const Mesh<2>&, const ResolvedBoundary<2>&);
+extern template void SpringMover<3>::setup<Mesh<3>>(const Mesh<3>&, const ResolvedBoundary<3>&);
 }  // namespace meshmotion
 #endif
