@@ -17,8 +17,10 @@
 
 #include "meshmotion/core/json.hpp"
 #include "meshmotion/io.hpp"
-#include "meshmotion/movers.hpp"
-#include "meshmotion/parallel.hpp"
+#include "meshmotion/movers/registry.hpp"
+#include "meshmotion/movers/step_driver.hpp"
+#include "meshmotion/parallel/partition.hpp"
+#include "meshmotion/parallel/registry.hpp"
 #include "meshmotion/quality.hpp"
 
 #include "../motion_arguments.hpp"
@@ -42,25 +44,11 @@ namespace {
 struct Arguments {
   std::string input, output;
   examples::MotionArguments motion;
-  KeyValues parallel;  ///< the flags of BoundarySolveOptions and DistributedElasticityOptions given
+  KeyValues parallel;  ///< the flags of ParallelOptions given
   int threads = 0;
   bool json = false, strict = false, overwrite = false, keep_orientation = false, rank_files = false;
   examples::MoverArguments mover;
 };
-
-// The distributed solves' options: the descriptions' defaults with the flags given set over them.
-struct ParallelOptions {
-  BoundarySolveOptions boundary;
-  DistributedElasticityOptions elasticity;
-};
-
-ParallelOptions parallel_options(const KeyValues& given) {
-  ParallelOptions o;
-  for (const auto& [key, text] : given)
-    if (!set_option(o.boundary, key, text) && !set_option(o.elasticity, key, text))
-      throw InputError("move_mesh_mpi: unknown parallel option '" + key + "'");
-  return o;
-}
 
 // Threads per rank: --threads, else OMP_NUM_THREADS, else the node's cores shared among its ranks.
 int threads_per_rank(MPI_Comm comm, int asked) {
@@ -88,15 +76,15 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
   ParallelOptions parallel;
   double radius = 0.0;
   collective(comm, [&] {
-    parallel = parallel_options(a.parallel);
-    KeyValues given = examples::given_options(a.mover);
-    config = mover_config<Dim>(a.mover.method, given);
-    if (config.method != "rbf" && config.method != "le" && config.method != "sle")
-      throw InputError("move_mesh_mpi: --method '" + config.method + "' has no distributed mover (expected rbf, le or sle)");
-    // The distributed RBF interpolates the whole motion, so its default radius is the one for
-    // the whole motion, not for what remains once a rigid part is out (blend: the mover refuses).
-    if (auto* rbf = std::get_if<RbfOptions>(&config.options); rbf && rbf->rigid_part == RigidPart::automatic)
-      rbf->rigid_part = RigidPart::none;
+    KeyValues given = a.parallel;
+    for (auto& kv : examples::given_options(a.mover)) given.push_back(std::move(kv));
+    config = mover_config<Dim>(a.mover.method, take_parallel_options(given, parallel));
+    // A method without a distributed mover is refused on every rank, before any work.
+    const DistributedMethod<Dim>* method = find_distributed_method<Dim>(config.method);
+    if (method == nullptr)
+      throw InputError("move_mesh_mpi: --method '" + config.method + "' has no distributed mover (expected " +
+                       known_distributed_methods<Dim>() + ")");
+    method->prepare(config.options);
     if (!root) return;
     // As move_mesh: an output that cannot hold the mesh's order is refused before any work.
     int order = 1;
@@ -105,34 +93,22 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
     examples::handle_orientation(*whole, a.input, a.keep_orientation);
     name_unnamed_facet_groups(*whole);
     const BoundarySpec<Dim> spec = examples::boundary_spec<Dim>(a.motion, *whole);
+    // move_mesh's default radius, found on the whole mesh (with its memory budget, which the
+    // distributed mover does not apply yet), so both programs move a mesh alike.
     if (const auto r = examples::set_support_radius(config, a.motion, given, whole->points, [&] { return spec.resolve(*whole); })) radius = *r;
     boundary = spec.resolve(*whole);
     examples::note_unlisted_groups(*whole, boundary);
     before = quality_report(*whole, Metric::skew);
   });
-  MPI_Bcast(&radius, 1, MPI_DOUBLE, 0, comm);
-  if (auto* rbf = std::get_if<RbfOptions>(&config.options)) rbf->support_radius = radius;
-
   const Mesh<Dim> empty;
   const DistributedMesh<Dim> part = partition_mesh(comm, root ? *whole : empty);
   const ResolvedBoundary<Dim> local = distribute_boundary(part, boundary);
-  Points<Dim> displacement;
-  MoverStats stats;
-  BoundarySolve boundary_solve = BoundarySolve::replicated;  ///< the one the RBF mover took
-  if (auto* rbf = std::get_if<RbfOptions>(&config.options)) {
-    DistributedRbfMover<Dim> mover(*rbf, parallel.boundary);
-    mover.setup(part.view(), local);
-    displacement = mover.move(local.displacements);
-    stats = mover.stats();
-    boundary_solve = mover.solved_by();
-  } else {
-    DistributedElasticityOptions options = parallel.elasticity;
-    options.elasticity = std::get<ElasticityOptions>(config.options);
-    DistributedElasticityMover<Dim> mover(options);
-    mover.setup(part, local);
-    displacement = mover.move(local.displacements);
-    stats = mover.stats();
-  }
+  MPI_Bcast(&radius, 1, MPI_DOUBLE, 0, comm);
+  if (radius > 0.0) config.set("support_radius", format_option_value(radius));
+  const std::unique_ptr<DistributedMover<Dim>> mover = make_distributed_mover(config, parallel);
+  mover->setup(part, local);
+  const Points<Dim> displacement = mover->move(local.displacements);
+  const MoverStats stats = mover->stats();
   double seconds[2] = {stats.setup_seconds, stats.move_seconds};
   MPI_Allreduce(MPI_IN_PLACE, seconds, 2, MPI_DOUBLE, MPI_MAX, comm);
   const Points<Dim> moved_local = part.local.points + displacement;
@@ -162,8 +138,9 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
       JsonWriter w(std::cout);
       w.begin_object().key("input").value(a.input).key("output").value(a.output);
       w.key("ranks").value(ranks).key("threads_per_rank").value(num_threads());
-      if (std::holds_alternative<RbfOptions>(config.options))
-        w.key("support_radius").value(radius).key("boundary_solve").value(name(boundary_solve));
+      if (mover->support_radius() > 0.0) w.key("support_radius").value(mover->support_radius());
+      if (mover->boundary_solve() != "none")
+        w.key("boundary_solve").value(std::string(mover->boundary_solve()));
       else
         w.key("solver").value(name(parallel.elasticity.solver));
       write_json_fields(w, report);
@@ -172,7 +149,7 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
     } else {
       std::cout << "moved " << whole->num_nodes() << " nodes with " << config.method << " on " << ranks << " rank(s) of "
                 << num_threads() << " thread(s)"
-                << (std::holds_alternative<RbfOptions>(config.options) ? std::string(", boundary solve ") + name(boundary_solve) : "")
+                << (mover->boundary_solve() != "none" ? ", boundary solve " + std::string(mover->boundary_solve()) : std::string())
                 << " (times: the slowest rank)\n";
       write_text(std::cout, report, 2);
     }
@@ -197,8 +174,7 @@ int main_body(int argc, char** argv) {
   app.add_option("-o,--output", a.output, "Output mesh (.msh, .su2, .vtu), written by rank 0");
   examples::add_motion_options(app, a.motion);
   examples::add_mover_options(app, a.mover, known_methods<3>());
-  examples::add_option_flags(app, option_docs(BoundarySolveOptions{}), a.parallel, "Distributed RBF (rbf)");
-  examples::add_option_flags(app, option_docs(DistributedElasticityOptions{}), a.parallel, "Distributed elasticity (le, sle)");
+  examples::add_option_flags(app, option_docs(ParallelOptions{}), a.parallel, "Distributed solves (boundary_solve: rbf; petsc_*: le, sle)");
   app.add_option("--threads", a.threads,
                  "threads per rank (0: OMP_NUM_THREADS if set, else the node's cores shared among its ranks)")
       ->capture_default_str()

@@ -12,7 +12,9 @@
 
 #include "mover_keywords.hpp"
 
-#include "meshmotion/parallel.hpp"
+#include "meshmotion/parallel/partition.hpp"
+#include "meshmotion/parallel/petsc.hpp"
+#include "meshmotion/parallel/registry.hpp"
 
 #include <petscsys.h>
 
@@ -58,53 +60,29 @@ py::array_t<T> read_only_view(const std::vector<T>& values, const py::object& ow
   return view;
 }
 
-// A distributed mover chosen by method name: rbf (DistributedRbfMover), le or sle
-// (DistributedElasticityMover), with the calls bind_move_calls binds.
+// A distributed mover chosen by method name through the distributed registry, with the calls
+// bind_move_calls binds; it keeps the arrays of a solver's own partition, which the mover views.
 template <int Dim>
 class DistributedMover {
  public:
   DistributedMover(const std::string& method, const py::kwargs& options) {
-    parallel::BoundarySolveOptions solve;
-    parallel::DistributedElasticityOptions elasticity;
-    std::vector<OptionDoc> docs = option_docs(solve);
-    for (const OptionDoc& d : option_docs(elasticity)) docs.push_back(d);
+    parallel::ParallelOptions parallel;
     const MoverConfig<Dim> config =
-        mover_config_from<Dim>(method, options, docs, [&](const std::string& key, const std::string& text) {
-          return set_option(solve, key, text) || set_option(elasticity, key, text);
-        });
-    if (const auto* rbf = std::get_if<RbfOptions>(&config.options)) {
-      mover_ = std::make_unique<parallel::DistributedRbfMover<Dim>>(*rbf, solve);
-    } else if (const auto* e = std::get_if<ElasticityOptions>(&config.options)) {
-      elasticity.elasticity = *e;
-      mover_ = std::make_unique<parallel::DistributedElasticityMover<Dim>>(elasticity);
-    } else {
-      throw InputError("method '" + config.method + "' has no distributed mover (expected rbf, le or sle)");
-    }
+        mover_config_from<Dim>(method, options, option_docs(parallel),
+                               [&](const std::string& key, const std::string& text) { return set_option(parallel, key, text); });
+    mover_ = parallel::make_distributed_mover(config, parallel);
   }
 
-  void setup(const parallel::DistributedMesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) {
-    if (std::holds_alternative<Rbf>(mover_)) {
-      // PETSc solves the RBF boundary system only when BoundarySolveOptions chooses it.
-      std::get<Rbf>(mover_)->setup(mesh.view(), boundary);
-    } else {
-      std::get<Elasticity>(mover_)->setup(mesh, boundary);
-    }
-  }
-  // A solver's own partition: no cells, so RBF only. The arrays are kept here, as the
-  // distributed RBF views them.
+  void setup(const parallel::DistributedMesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) { mover_->setup(mesh, boundary); }
+  // A solver's own partition: no cells (the registry refuses the methods that need them).
   void setup(MPI_Comm comm, Points<Dim> points, std::vector<std::int64_t> global_ids, std::vector<int> owner,
              const ResolvedBoundary<Dim>& boundary) {
-    if (!std::holds_alternative<Rbf>(mover_))
-      throw InputError("a solver's own partition (local nodes without cells) is moved by rbf only: elasticity needs the "
-                       "cells (partition a mesh read on rank 0 instead)");
     points_ = std::move(points);
     global_ids_ = std::move(global_ids);
     owner_ = std::move(owner);
-    std::get<Rbf>(mover_)->setup(parallel::PartitionView<Dim>{comm, points_, global_ids_, owner_}, boundary);
+    mover_->setup(parallel::PartitionView<Dim>{comm, points_, global_ids_, owner_}, boundary);
   }
-  void move_into(PointsView<Dim> d, Points<Dim>& out) {
-    std::visit([&](auto& m) { m->move_into(d, out); }, mover_);
-  }
+  void move_into(PointsView<Dim> d, Points<Dim>& out) { mover_->move_into(d, out); }
   void move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) {
     move_into(d, out_);
     if (out_.cols() != out.cols())
@@ -112,25 +90,17 @@ class DistributedMover {
                        std::to_string(out_.cols()) + ", one per local node)");
     out = out_;
   }
-  [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) {
-    return std::visit([&](auto& m) { return m->derivative_reverse(v); }, mover_);
-  }
-  /// Both movers are linear in the displacements and give their reverse derivative.
+  [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) { return mover_->derivative_reverse(v); }
+  /// Every distributed mover is linear in the displacements and gives its reverse derivative.
   [[nodiscard]] bool has_derivatives() const { return true; }
-  [[nodiscard]] MoverStats stats() const {
-    return std::visit([](const auto& m) { return m->stats(); }, mover_);
-  }
+  [[nodiscard]] MoverStats stats() const { return mover_->stats(); }
   /// The RBF boundary system is solved through PETSc (false for elasticity, which always is).
-  [[nodiscard]] bool petsc_solve() const { return std::holds_alternative<Rbf>(mover_) && std::get<Rbf>(mover_)->petsc_solve(); }
+  [[nodiscard]] bool petsc_solve() const { return mover_->boundary_solve() == "petsc"; }
   /// Where the RBF boundary system is solved (BoundarySolve's name; elasticity: none).
-  [[nodiscard]] std::string boundary_solve() const {
-    return std::holds_alternative<Rbf>(mover_) ? parallel::name(std::get<Rbf>(mover_)->solved_by()) : "none";
-  }
+  [[nodiscard]] std::string boundary_solve() const { return std::string(mover_->boundary_solve()); }
 
  private:
-  using Rbf = std::unique_ptr<parallel::DistributedRbfMover<Dim>>;
-  using Elasticity = std::unique_ptr<parallel::DistributedElasticityMover<Dim>>;
-  std::variant<Rbf, Elasticity> mover_;
+  std::unique_ptr<parallel::DistributedMover<Dim>> mover_;
   Points<Dim> out_;  ///< move_into's result before it is copied to the caller's array
   Points<Dim> points_;  ///< a solver's own partition (setup from arrays)
   std::vector<std::int64_t> global_ids_;

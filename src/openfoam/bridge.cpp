@@ -7,8 +7,8 @@
 #include "meshmotion/movers/rbf.hpp"
 #include "meshmotion/movers/support_radius.hpp"
 #ifdef MESHMOTION_FOAM_PARALLEL
-#include "meshmotion/parallel/distributed_elasticity.hpp"
-#include "meshmotion/parallel/distributed_rbf.hpp"
+#include "meshmotion/parallel/petsc.hpp"
+#include "meshmotion/parallel/registry.hpp"
 #endif
 
 #include <algorithm>
@@ -22,16 +22,6 @@ namespace meshmotion::foam {
 
 #ifdef MESHMOTION_FOAM_PARALLEL
 namespace {
-
-// The options of a decomposed case's solves (the RBF's boundary system, BoundarySolveOptions;
-// the elasticity's PETSc solver, DistributedElasticityOptions) are taken out of the method's:
-// a case's dictionary runs alike serially, where they do nothing.
-KeyValues take_options(KeyValues& given, parallel::BoundarySolveOptions& solve, parallel::DistributedElasticityOptions& cells) {
-  KeyValues rest;
-  for (auto& [key, text] : given)
-    if (!set_option(solve, key, text) && !set_option(cells, key, text)) rest.emplace_back(std::move(key), std::move(text));
-  return rest;
-}
 
 // Global ids and owners of a decomposed case's auxiliary nodes (to_mesh(): the centres of the
 // faces of more than three points, then of the cells), after the points' own in `ids` and
@@ -252,11 +242,14 @@ struct Bridge::Impl {
   std::vector<std::vector<Index>> centre_entries;  // add_face_centres()
   Points<3> given, moved;                         // with the face centres' entries and nodes; kept between moves
 #ifdef MESHMOTION_FOAM_PARALLEL
-  std::optional<parallel::DistributedRbfMover<3>> distributed;
-  std::optional<parallel::DistributedElasticityMover<3>> distributed_cells;  // le, sle
-  parallel::BoundarySolveOptions solve;
-  parallel::DistributedElasticityOptions cells;
-  Points<3> points;  // the distributed RBF's view of them must outlive its setup
+  // A decomposed case whose method has a distributed mover (the distributed registry's):
+  // through the cells (with the face centres' entries) or through the points alone.
+  std::unique_ptr<parallel::DistributedMover<3>> distributed;
+  bool distributed_cells = false;
+  // The options of a decomposed case's solves, taken out of the method's: a case's dictionary
+  // runs alike serially, where they do nothing.
+  parallel::ParallelOptions parallel;
+  Points<3> points;  // the distributed mover's view of them must outlive its setup
   std::vector<std::int64_t> global_ids;  // with the auxiliary nodes' where the cells are moved
   std::vector<int> owners;
   // A method without a distributed mover: rank 0 moves the whole case (gather_case()) with the
@@ -276,18 +269,14 @@ struct Bridge::Impl {
   bool set_up(const Points<3>& d) {
     boundary.displacements.leftCols(d.cols()) = d;
 #ifdef MESHMOTION_FOAM_PARALLEL
-    if (!global_ids.empty() && needs_cells(config.method) && !gathered) {
-      parallel::DistributedElasticityOptions options = cells;
-      options.elasticity = std::get<ElasticityOptions>(config.options);
-      distributed_cells.emplace(options);
-      distributed_cells->setup(parallel::PartitionView<3>{MPI_COMM_WORLD, mesh.points, global_ids, owners}, mesh, boundary);
-      ++setups;
-      return true;
-    }
     if (!global_ids.empty() && !gathered) {
       const double before = radius;
-      distributed.emplace(std::get<RbfOptions>(config.options), solve);
-      distributed->setup(parallel::PartitionView<3>{MPI_COMM_WORLD, points, global_ids, owners}, boundary);
+      distributed = parallel::make_distributed_mover(config, parallel);
+      distributed_cells = mover_method<3>(config.method).needs_cells;
+      if (distributed_cells)
+        distributed->setup(parallel::PartitionView<3>{MPI_COMM_WORLD, mesh.points, global_ids, owners}, mesh, boundary);
+      else
+        distributed->setup(parallel::PartitionView<3>{MPI_COMM_WORLD, points, global_ids, owners}, boundary);
       radius = distributed->support_radius();
       ++setups;
       return setups == 1 || radius > before;
@@ -397,8 +386,8 @@ struct Bridge::Impl {
   // The cells' mover: the serial one, or on a decomposed case the distributed elasticity.
   void move_cells() {
 #ifdef MESHMOTION_FOAM_PARALLEL
-    if (distributed_cells) {
-      distributed_cells->move_into(given, moved);
+    if (distributed) {
+      distributed->move_into(given, moved);
       return;
     }
 #endif
@@ -406,7 +395,13 @@ struct Bridge::Impl {
   }
 };
 
-bool needs_cells(const std::string& method) { return method != "rbf"; }
+bool needs_cells(const std::string& method) {
+#ifdef MESHMOTION_FOAM_PARALLEL
+  // A decomposed case whose method has no distributed mover is gathered on rank 0, cells and all.
+  if (parallel::find_distributed_method<3>(method) == nullptr) return true;
+#endif
+  return mover_method<3>(method).needs_cells;
+}
 
 Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
   try {
@@ -429,7 +424,7 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
     impl->entries = nb;
     const Eigen::Map<const Points<3>> points(input.points.data(), 3, n);
 #ifdef MESHMOTION_FOAM_PARALLEL
-    const KeyValues rest = take_options(given, impl->solve, impl->cells);
+    const KeyValues rest = parallel::take_parallel_options(given, impl->parallel);
 #else
     if (!input.global_ids.empty())
       throw InputError("this plugin was built without meshmotion's parallel layer (MPI, PETSc, METIS): run the motion serially");
@@ -437,7 +432,7 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
 #endif
     impl->config = mover_config<3>(input.method, rest);
 #ifdef MESHMOTION_FOAM_PARALLEL
-    impl->gathered = !input.global_ids.empty() && needs_cells(input.method) && impl->config.method != "le" && impl->config.method != "sle";
+    impl->gathered = !input.global_ids.empty() && parallel::find_distributed_method<3>(impl->config.method) == nullptr;
 #endif
     if (auto* rbf = std::get_if<RbfOptions>(&impl->config.options)) {
       impl->growing_radius = rbf->support_radius == 0.0 && rbf->support_radii.empty();
@@ -519,7 +514,7 @@ void Bridge::move(const std::vector<double>& boundary_displacements, std::vector
       if (SupportRadiusOptions{}.displacement_factor * largest > m.radius) m.growing_radius = m.set_up(1.5 * d);
     }
 #ifdef MESHMOTION_FOAM_PARALLEL
-    if (m.distributed) {
+    if (m.distributed && !m.distributed_cells) {
       m.distributed->move_into(d, m.moved);
       out.assign(m.moved.data(), m.moved.data() + m.moved.size());
       return;

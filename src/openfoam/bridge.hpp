@@ -34,9 +34,9 @@ struct BridgeInput {
   std::vector<long> coupled_faces;
 };
 
-/// Whether `method` moves the interior through the mesh's cells (every method but rbf). On a
-/// decomposed case le and sle do so through PETSc's distributed elasticity; the others gather
-/// the case on rank 0, which moves it with the serial mover and sends each rank its points.
+/// Whether the plugin hands `method` the cells: the registry's needs_cells, and, where the
+/// plugin moves decomposed cases, every method without a distributed mover (such a case is
+/// gathered on rank 0, which moves it with the serial mover and sends each rank its points).
 bool needs_cells(const std::string& method);
 
 class Bridge {

@@ -36,6 +36,7 @@
 #include "meshmotion/movers/elasticity.hpp"
 #include "meshmotion/parallel/communicator.hpp"
 #include "meshmotion/parallel/distributed_mesh.hpp"
+#include "meshmotion/parallel/parallel_options.hpp"
 #include "meshmotion/parallel/petsc.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 
@@ -50,56 +51,6 @@
 #include <vector>
 
 namespace meshmotion::parallel {
-
-/// PETSc solver of the distributed elasticity system.
-enum class PetscSolverKind {
-  /// MUMPS in 2D, CG + GAMG in 3D: on boundary-layer meshes the stiffened 2D system defeats
-  /// the multigrids (thousands of iterations on the 30P30N) while MUMPS factorizes it in
-  /// seconds; 3D systems outgrow direct factorization first (docs/parallel.md).
-  automatic,
-  cg_gamg,       ///< CG preconditioned by PETSc's algebraic multigrid (rigid-body near null space)
-  cg_hypre,      ///< CG preconditioned by hypre's BoomerAMG
-  direct_mumps,  ///< Cholesky by MUMPS (distributed direct)
-};
-
-[[nodiscard]] constexpr const char* name(PetscSolverKind k) {
-  switch (k) {
-    case PetscSolverKind::automatic: return "automatic";
-    case PetscSolverKind::cg_gamg: return "cg_gamg";
-    case PetscSolverKind::cg_hypre: return "cg_hypre";
-    case PetscSolverKind::direct_mumps: return "mumps";
-  }
-  return "?";
-}
-[[nodiscard]] constexpr std::array<PetscSolverKind, 4> option_choices(PetscSolverKind) {
-  return {PetscSolverKind::automatic, PetscSolverKind::cg_gamg, PetscSolverKind::cg_hypre, PetscSolverKind::direct_mumps};
-}
-
-struct DistributedElasticityOptions {
-  /// Material and Jacobian stiffening as in serial; `solver` there is not used (see below),
-  /// distance_exponent and active_radius must be 0.
-  ElasticityOptions elasticity = {};
-  PetscSolverKind solver = PetscSolverKind::automatic;
-  /// Relative residual of the diagonally scaled system (displacement units) for CG.
-  double tolerance = 1e-10;
-  PetscInt max_iterations = 10000;
-  /// A CG solve that does not converge is solved again by MUMPS instead of raising.
-  bool fallback_to_direct = false;
-  /// Prefix of the PETSc options that refine the solver from the command line or
-  /// PETSC_OPTIONS (e.g. -meshmotion_ksp_monitor).
-  std::string petsc_prefix = "meshmotion_";
-};
-
-/// The options of the distributed solve, as text may set them (the material is the serial
-/// mover's, ElasticityOptions).
-template <class F>
-void visit_options(DistributedElasticityOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "petsc_solver", o.solver, "PETSc solver (automatic: mumps in 2D, cg_gamg in 3D)");
-  f(prefix + "petsc_tolerance", o.tolerance, "relative residual of CG on the scaled system (displacement units)");
-  f(prefix + "petsc_max_iterations", o.max_iterations, "iteration cap of CG");
-  f(prefix + "petsc_fallback_to_direct", o.fallback_to_direct, "solve again with MUMPS when CG does not converge");
-  f(prefix + "petsc_prefix", o.petsc_prefix, "prefix of the PETSc options that refine the solver");
-}
 
 template <int Dim>
 class DistributedElasticityMover {
@@ -227,7 +178,7 @@ void DistributedElasticityMover<Dim>::build_solver(OwnedKsp& ksp, PetscSolverKin
     } else {
       petsc_check(PCSetType(pc, PCGAMG), where, "PCSetType");
     }
-    petsc_check(KSPSetTolerances(ksp.get(), options_.tolerance, 0.0, PETSC_DEFAULT, options_.max_iterations), where, "KSPSetTolerances");
+    petsc_check(KSPSetTolerances(ksp.get(), options_.tolerance, 0.0, PETSC_DEFAULT, static_cast<PetscInt>(options_.max_iterations)), where, "KSPSetTolerances");
     petsc_check(KSPSetNormType(ksp.get(), KSP_NORM_UNPRECONDITIONED), where, "KSPSetNormType");
   }
   petsc_check(KSPSetOptionsPrefix(ksp.get(), options_.petsc_prefix.c_str()), where, "KSPSetOptionsPrefix");
@@ -610,3 +561,11 @@ void DistributedElasticityMover<Dim>::solve_scaled(const char* where) {
 }
 
 }  // namespace meshmotion::parallel
+
+// The compiled parallel library (target meshmotion::parallel, src/parallel.cpp) holds these.
+#ifdef MESHMOTION_PARALLEL_COMPILED
+namespace meshmotion::parallel {
+extern template class DistributedElasticityMover<2>;
+extern template class DistributedElasticityMover<3>;
+}  // namespace meshmotion::parallel
+#endif

@@ -42,6 +42,7 @@
 #include "meshmotion/parallel/communicator.hpp"
 #include "meshmotion/parallel/distributed_mesh.hpp"
 #include "meshmotion/parallel/distributed_partition_of_unity.hpp"
+#include "meshmotion/parallel/parallel_options.hpp"
 #include "meshmotion/parallel/petsc_rbf_system.hpp"
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 
@@ -54,50 +55,6 @@
 #include <vector>
 
 namespace meshmotion::parallel {
-
-/// Where the distributed RBF mover solves its boundary system.
-enum class BoundarySolve {
-  automatic,   ///< patches for a partition of unity; PETSc when the options allow it and the system is big enough (BoundarySolveOptions); else replicated
-  replicated,  ///< factorized on every rank (any option: sliding, radius per node, global kernels)
-  petsc,       ///< factorized once across the ranks by MUMPS (compact kernel, one radius, no sliding, distinct centres)
-  patches,     ///< RbfOptions::partition_of_unity with each patch on one rank (no sliding, distinct centres)
-};
-
-[[nodiscard]] constexpr const char* name(BoundarySolve k) {
-  switch (k) {
-    case BoundarySolve::automatic: return "automatic";
-    case BoundarySolve::replicated: return "replicated";
-    case BoundarySolve::petsc: return "petsc";
-    case BoundarySolve::patches: return "patches";
-  }
-  return "?";
-}
-[[nodiscard]] constexpr std::array<BoundarySolve, 4> option_choices(BoundarySolve) {
-  return {BoundarySolve::automatic, BoundarySolve::replicated, BoundarySolve::petsc, BoundarySolve::patches};
-}
-
-/// How automatic chooses, from the figures of docs/parallel.md: replicated, every rank on a node
-/// factorizes the same system at once, which on a 16-core node made the 2.05M-node box's setup
-/// 5× slower at 8 ranks and 25× at 16 than at one (16,129 centres), while MUMPS's setup fell
-/// with the ranks and its moves were faster from 2 ranks on.
-struct BoundarySolveOptions {
-  BoundarySolve kind = BoundarySolve::automatic;
-  /// Fewest centres for which automatic takes PETSc at any rank count: above, the factor on
-  /// every rank costs too much memory.
-  Index petsc_min_centres = 50000;
-  /// Fewest centres × ranks sharing a node for which automatic takes PETSc on 2 ranks or more:
-  /// the replicated factorizations a node runs at once, counted once more for each further
-  /// round when the node has more ranks than cores (they then run one after another).
-  Index petsc_min_node_centres = 30000;
-};
-
-template <class F>
-void visit_options(BoundarySolveOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "boundary_solve", o.kind, "where the RBF boundary system is solved");
-  f(prefix + "petsc_min_centres", o.petsc_min_centres, "automatic: fewest centres for PETSc at any rank count");
-  f(prefix + "petsc_min_node_centres", o.petsc_min_node_centres,
-    "automatic: fewest centres x ranks per node for PETSc on several ranks");
-}
 
 template <int Dim>
 class DistributedRbfMover {
@@ -552,3 +509,11 @@ Points<Dim> DistributedRbfMover<Dim>::reverse_petsc(const PointsView<Dim>& v) {
 }
 
 }  // namespace meshmotion::parallel
+
+// The compiled parallel library (target meshmotion::parallel, src/parallel.cpp) holds these.
+#ifdef MESHMOTION_PARALLEL_COMPILED
+namespace meshmotion::parallel {
+extern template class DistributedRbfMover<2>;
+extern template class DistributedRbfMover<3>;
+}  // namespace meshmotion::parallel
+#endif

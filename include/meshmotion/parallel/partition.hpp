@@ -309,3 +309,11 @@ template <int Dim>
 }
 
 }  // namespace meshmotion::parallel
+
+// The compiled parallel library (target meshmotion::parallel, src/parallel.cpp) holds these.
+#ifdef MESHMOTION_PARALLEL_COMPILED
+namespace meshmotion::parallel {
+extern template DistributedMesh<2> partition_mesh<2>(MPI_Comm, const Mesh<2>&, std::span<const int>, int);
+extern template DistributedMesh<3> partition_mesh<3>(MPI_Comm, const Mesh<3>&, std::span<const int>, int);
+}  // namespace meshmotion::parallel
+#endif
