@@ -16,9 +16,11 @@
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/curving/curve_mesh.hpp"
 #include "meshmotion/curving/geometry_text.hpp"
+#include "meshmotion/curving/reports.hpp"
 #include "meshmotion/io/mesh_io.hpp"
 #include "meshmotion/io/vtu_writer.hpp"
 #include "meshmotion/movers/step_driver.hpp"
+#include "meshmotion/parallel/parallel_options.hpp"
 #include "meshmotion/quality/svg_picture.hpp"
 
 #include "mover_arguments.hpp"
@@ -262,14 +264,6 @@ std::string cell(const std::string& text) {
   return out.empty() ? "(empty)" : out;
 }
 
-template <class Report>
-void print_fields_table(const char* title, const char* what) {
-  std::printf("\n### %s\n%s\n\n| key | what it is |\n|---|---|\n", title, what);
-  visit_fields(Report{}, [](std::string_view key, const auto&, std::string_view doc) {
-    std::printf("| `%s` | %s |\n", std::string(key).c_str(), std::string(doc).c_str());
-  });
-}
-
 // docs/options.md: every option and report field from the library's one description.
 void print_options_markdown() {
   std::printf("# Options and results\n\n"
@@ -297,18 +291,18 @@ void print_options_markdown() {
     for (const OptionDoc& d : docs)
       std::printf("| `%s` | %s | %s | %s |\n", d.key.c_str(), cell(d.type).c_str(), cell(d.value).c_str(), d.doc.c_str());
   }
+  std::printf("\n## Distributed solves\n\nThe keys of `move_mesh_mpi`, Python's `Warp(comm=...)` and the OpenFOAM plugin on a "
+              "decomposed case, beside those of the method (rbf, le, sle).\n\n| key | type | default | what it does |\n|---|---|---|---|\n");
+  for (const OptionDoc& d : option_docs(parallel::ParallelOptions{}))
+    std::printf("| `%s` | %s | %s | %s |\n", d.key.c_str(), cell(d.type).c_str(), cell(d.value).c_str(), d.doc.c_str());
   std::printf("\n## Reports\n");
-  print_fields_table<CurveResult<3>>("curve_mesh's report",
-                                     "`curve_mesh --json` (beside input, output, vtu, dim, nodes, cells, options) and Python's report dict.");
-  print_fields_table<CurveTimes>("seconds", "Seconds per stage of the pipeline.");
-  print_fields_table<WallLayer>("layers", "One per curved wall whose layer was estimated.");
-  print_fields_table<GeometryDistance>("geometry_distance", "One per curved group: how far its facets are from its geometry.");
-  print_fields_table<UntangleReport>("untangle", "What the untangling did.");
-  print_fields_table<QualityReport>("quality", "A quality report (`mesh_quality --json`, Python's quality_report).");
-  print_fields_table<WorstElement>("worst", "One of the lowest cells.");
-  print_fields_table<TypeQuality>("per_type", "The cells of one element type.");
-  print_fields_table<MoverStats>("mover_steps", "A mover's stats (Python's Mover.stats).");
-  print_fields_table<MoveReport>("move_mesh's report", "`move_mesh --json` (beside input, output, support_radius, options).");
+  for_each_report([]<class Report>(std::string_view key, std::string_view heading, std::string_view what) {
+    std::printf("\n### %s\n%s Its keys in Python: `report_fields(\"%s\")`.\n\n| key | what it is |\n|---|---|\n",
+                std::string(heading).c_str(), std::string(what).c_str(), std::string(key).c_str());
+    visit_fields(Report{}, [](std::string_view field, const auto&, std::string_view doc) {
+      std::printf("| `%s` | %s |\n", std::string(field).c_str(), std::string(doc).c_str());
+    });
+  });
 }
 
 }  // namespace

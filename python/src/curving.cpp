@@ -4,6 +4,7 @@
 
 #include "meshmotion/curving/curve_mesh.hpp"
 #include "meshmotion/curving/geometry_text.hpp"
+#include "meshmotion/curving/reports.hpp"
 #include "meshmotion/io/mesh_summary.hpp"
 
 #include <algorithm>
@@ -71,15 +72,7 @@ void bind_curving(py::module_& m) {
       py::arg("method") = "blend", "curve_mesh's keywords with method `method`: key, type, default (as text) and doc");
   m.def(
       "report_fields",
-      [](const std::string& report) {
-        if (report == "curve") return field_keys(CurveResult<3>{});
-        if (report == "quality") return field_keys(QualityReport{});
-        if (report == "mover_stats") return field_keys(MoverStats{});
-        if (report == "untangle") return field_keys(UntangleReport{});
-        if (report == "summary") return field_keys(MeshSummary{});
-        throw InputError("report_fields: unknown report '" + report +
-                         "' (expected curve, quality, mover_stats, untangle or summary)");
-      },
+      [](const std::string& report) { return report_fields(report); },
       py::arg("report"), "the keys of a report's dict, from its one description");
 }
 
