@@ -10,6 +10,7 @@ namespace meshmotion {
 
 constexpr int D = MESHMOTION_INSTANTIATE_DIM;
 
+template class detail::RbfSystem<D>;
 template class RbfMover<D>;
 template void RbfMover<D>::setup<Mesh<D>>(const Mesh<D>&, const ResolvedBoundary<D>&);
 template DefaultSupportRadius default_support_radius<D>(const Points<D>&, const ResolvedBoundary<D>&, const RbfOptions&);

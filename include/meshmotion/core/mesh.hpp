@@ -352,3 +352,11 @@ Index name_unnamed_facet_groups(Mesh<Dim>& mesh) {
 }
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/core.cpp) holds it.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template void validate<2>(const Mesh<2>&);
+extern template void validate<3>(const Mesh<3>&);
+}  // namespace meshmotion
+#endif

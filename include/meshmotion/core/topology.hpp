@@ -354,3 +354,17 @@ struct BoundaryChain {
 }
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/core.cpp) numbers the sub-entities of
+// block lists, and so of every Mesh<Dim>: the numbering is the heaviest code of the core.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template EdgeTopology detail::edges_of_source<detail::BlockListSource>(const detail::BlockListSource&);
+extern template FacetTopology detail::facets_of_source<2, detail::BlockListSource>(const detail::BlockListSource&, detail::SubEntity);
+extern template FacetTopology detail::facets_of_source<4, detail::BlockListSource>(const detail::BlockListSource&, detail::SubEntity);
+extern template FacetTopology unique_facets<Mesh<2>>(const Mesh<2>&);
+extern template FacetTopology unique_facets<Mesh<3>>(const Mesh<3>&);
+extern template std::vector<ElementBlock> boundary_facets<Mesh<2>>(const Mesh<2>&, const FacetTopology&, int);
+extern template std::vector<ElementBlock> boundary_facets<Mesh<3>>(const Mesh<3>&, const FacetTopology&, int);
+}  // namespace meshmotion
+#endif

@@ -578,3 +578,15 @@ class BoundarySpec {
 };
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/core.cpp) holds these for Dim 2 and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template PlaneFit<2> fit_plane<2>(const Points<2>&, std::span<const Index>);
+extern template PlaneFit<3> fit_plane<3>(const Points<3>&, std::span<const Index>);
+extern template class BoundaryCollector<2>;
+extern template class BoundaryCollector<3>;
+extern template class BoundarySpec<2>;
+extern template class BoundarySpec<3>;
+}  // namespace meshmotion
+#endif

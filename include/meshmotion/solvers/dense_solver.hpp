@@ -97,3 +97,10 @@ using DenseSolver = BasicDenseSolver<>;
 
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/core.cpp) holds it.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template class BasicDenseSolver<>;
+}  // namespace meshmotion
+#endif

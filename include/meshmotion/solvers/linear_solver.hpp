@@ -332,3 +332,12 @@ using LinearSolver = BasicLinearSolver<>;
 
 }  // namespace meshmotion
 
+
+// The compiled library (target meshmotion::compiled, src/core.cpp) holds the solver and its
+// Eigen factorizations: consumers compile none of them.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template std::unique_ptr<detail::SparseBackend> detail::make_backend<0>(const SolverOptions&);
+extern template class BasicLinearSolver<>;
+}  // namespace meshmotion
+#endif

@@ -574,3 +574,12 @@ class RbfSystem {
 };
 
 }  // namespace meshmotion::detail
+
+// The compiled library (target meshmotion::compiled, src/movers_rbf.cpp) holds these for Dim 2
+// and 3.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion::detail {
+extern template class RbfSystem<2>;
+extern template class RbfSystem<3>;
+}  // namespace meshmotion::detail
+#endif
