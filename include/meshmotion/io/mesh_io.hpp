@@ -122,14 +122,12 @@ void apply_orientation(Mesh<Dim>& mesh, const std::filesystem::path& file, ReadO
 
 }  // namespace detail
 
-/// Reads a mesh, choosing the format by extension (.msh, .su2, .cgns or .vtu) or, for a folder, as an
-/// OpenFOAM case. The result is 3D if the file
-/// holds 3D elements (SU2: NDIME 3), else 2D. The mesh is validated, and its orientation
-/// handled as `options` says.
-/// Throws InputError for an unknown extension, IoError for an unreadable file, ParseError (file
-/// and line or byte offset) for malformed content, InputError for an invalid mesh (a 2D mesh
-/// with nonzero z names the first such node) or a negative cell under require_positive.
-[[nodiscard]] inline AnyMesh read_mesh(const std::filesystem::path& file, const ReadOptions& options = {}) {
+namespace detail {
+
+// read_mesh(), a template of nothing: a program built on meshmotion::compiled links every
+// reader from src/io_quality.cpp instead of compiling them all for its one call.
+template <int = 0>
+[[nodiscard]] AnyMesh read_any_mesh(const std::filesystem::path& file, const ReadOptions& options) {
   AnyMesh mesh = [&]() -> AnyMesh {
     std::error_code ec;
     if (std::filesystem::is_directory(file, ec)) return read_openfoam(file);
@@ -146,6 +144,19 @@ void apply_orientation(Mesh<Dim>& mesh, const std::filesystem::path& file, ReadO
   }();
   std::visit([&](auto& m) { detail::apply_orientation(m, file, options.orientation); }, mesh);
   return mesh;
+}
+
+}  // namespace detail
+
+/// Reads a mesh, choosing the format by extension (.msh, .su2, .cgns or .vtu) or, for a folder, as an
+/// OpenFOAM case. The result is 3D if the file
+/// holds 3D elements (SU2: NDIME 3), else 2D. The mesh is validated, and its orientation
+/// handled as `options` says.
+/// Throws InputError for an unknown extension, IoError for an unreadable file, ParseError (file
+/// and line or byte offset) for malformed content, InputError for an invalid mesh (a 2D mesh
+/// with nonzero z names the first such node) or a negative cell under require_positive.
+[[nodiscard]] inline AnyMesh read_mesh(const std::filesystem::path& file, const ReadOptions& options = {}) {
+  return detail::read_any_mesh(file, options);
 }
 
 /// Reads a mesh that must have dimension Dim; throws InputError when the file's differs, and
@@ -241,6 +252,7 @@ inline void write_mesh(const std::filesystem::path& file, const AnyMesh& mesh, c
 // The compiled library (target meshmotion::compiled, src/) holds these for Dim 2 and 3.
 #ifdef MESHMOTION_COMPILED
 namespace meshmotion {
+extern template AnyMesh detail::read_any_mesh<0>(const std::filesystem::path&, const ReadOptions&);
 extern template Mesh<2> read_mesh_as<2>(const std::filesystem::path&, const ReadOptions&);
 extern template Mesh<3> read_mesh_as<3>(const std::filesystem::path&, const ReadOptions&);
 extern template void write_mesh<2>(const std::filesystem::path&, const Mesh<2>&, const WriteOptions&);

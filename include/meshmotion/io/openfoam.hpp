@@ -41,14 +41,12 @@
 
 namespace meshmotion {
 
-/// Writes `moved`, the mesh read from the OpenFOAM case `source` (read_openfoam()) with its
-/// nodes moved: into a case, polyMesh or time folder, its points (write_polymesh_points()); at
-/// a new or empty folder, a whole case holding `source`'s own polyMesh (its cells, not the
-/// tetrahedra a polyhedral case is cut into; its patches with their types and groups; its
-/// zones) with the moved points. Throws as those functions do, and InputError when `moved` does
-/// not have `source`'s point count, or when `target` is another case whose faces, cells or
-/// patches are not `source`'s (nothing is written then).
-inline void write_moved_case(const std::filesystem::path& target, const std::filesystem::path& source, const Mesh<3>& moved) {
+namespace detail {
+
+// write_moved_case(), a template of nothing: a program built on meshmotion::compiled links the
+// writers instead of compiling them.
+template <int = 0>
+void write_moved_case_of(const std::filesystem::path& target, const std::filesystem::path& source, const Mesh<3>& moved) {
   if (!is_new_openfoam_case(target)) {
     // Another case of as many points must hold this mesh: its points would make no sense
     // on other faces (a moved mesh written over its neighbour's case).
@@ -91,4 +89,24 @@ inline void write_moved_case(const std::filesystem::path& target, const std::fil
   write_new_polymesh_case(target, poly);
 }
 
+}  // namespace detail
+
+/// Writes `moved`, the mesh read from the OpenFOAM case `source` (read_openfoam()) with its
+/// nodes moved: into a case, polyMesh or time folder, its points (write_polymesh_points()); at
+/// a new or empty folder, a whole case holding `source`'s own polyMesh (its cells, not the
+/// tetrahedra a polyhedral case is cut into; its patches with their types and groups; its
+/// zones) with the moved points. Throws as those functions do, and InputError when `moved` does
+/// not have `source`'s point count, or when `target` is another case whose faces, cells or
+/// patches are not `source`'s (nothing is written then).
+inline void write_moved_case(const std::filesystem::path& target, const std::filesystem::path& source, const Mesh<3>& moved) {
+  detail::write_moved_case_of(target, source, moved);
+}
+
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/io_quality.cpp) holds it.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template void detail::write_moved_case_of<0>(const std::filesystem::path&, const std::filesystem::path&, const Mesh<3>&);
+}  // namespace meshmotion
+#endif

@@ -267,13 +267,12 @@ void check_closed_cells(const PolyMesh& mesh, Fail&& fail) {
 
 }  // namespace detail
 
-/// Reads an OpenFOAM polyMesh from a case folder (its constant/polyMesh), a polyMesh folder
-/// (a region's: `case/constant/solid/polyMesh`), or a time folder of a case (`case/0.3`, or
-/// `case/0.3/solid` for a region, as OpenFOAM's tools read `-time 0.3 [-region solid]`: the
-/// points of the latest time up to 0.3 where the mesh moved, else the constant ones, on the
-/// constant faces). Throws IoError for a missing file, ParseError for malformed content (file and line
-/// or byte offset), InputError for lists that do not fit together (naming the list and the entry).
-[[nodiscard]] inline PolyMesh read_polymesh(const std::filesystem::path& path) {
+namespace detail {
+
+// read_polymesh(), a template of nothing: a program built on meshmotion::compiled links the
+// reader instead of compiling it.
+template <int = 0>
+[[nodiscard]] PolyMesh read_polymesh_of(const std::filesystem::path& path) {
   std::filesystem::path dir = detail::polymesh_folder(path), points = dir / "points";
   std::error_code ec;
   if (const auto time = dir.empty() && std::filesystem::is_directory(path, ec) ? detail::foam_time_folder(path) : std::nullopt) {
@@ -367,6 +366,16 @@ void check_closed_cells(const PolyMesh& mesh, Fail&& fail) {
   return mesh;
 }
 
+}  // namespace detail
+
+/// Reads an OpenFOAM polyMesh from a case folder (its constant/polyMesh), a polyMesh folder
+/// (a region's: `case/constant/solid/polyMesh`), or a time folder of a case (`case/0.3`, or
+/// `case/0.3/solid` for a region, as OpenFOAM's tools read `-time 0.3 [-region solid]`: the
+/// points of the latest time up to 0.3 where the mesh moved, else the constant ones, on the
+/// constant faces). Throws IoError for a missing file, ParseError for malformed content (file and line
+/// or byte offset), InputError for lists that do not fit together (naming the list and the entry).
+[[nodiscard]] inline PolyMesh read_polymesh(const std::filesystem::path& path) { return detail::read_polymesh_of(path); }
+
 /// Reads an OpenFOAM case or polyMesh folder as a Mesh<3> (read_polymesh, then to_mesh).
 [[nodiscard]] inline Mesh<3> read_openfoam(const std::filesystem::path& path) {
   Mesh<3> mesh = to_mesh(read_polymesh(path));
@@ -375,3 +384,10 @@ void check_closed_cells(const PolyMesh& mesh, Fail&& fail) {
 }
 
 }  // namespace meshmotion
+
+// The compiled library (target meshmotion::compiled, src/io_quality.cpp) holds it.
+#ifdef MESHMOTION_COMPILED
+namespace meshmotion {
+extern template PolyMesh detail::read_polymesh_of<0>(const std::filesystem::path&);
+}  // namespace meshmotion
+#endif
