@@ -403,7 +403,7 @@ bool needs_cells(const std::string& method) {
   return mover_method<3>(method).needs_cells;
 }
 
-Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
+Bridge::Bridge(const BridgeInput& input) {
   try {
     const auto n = static_cast<Index>(input.points.size() / 3), nb = static_cast<Index>(input.boundary.size());
     auto impl = std::make_unique<Impl>();
@@ -472,7 +472,7 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
 #ifdef MESHMOTION_FOAM_PARALLEL
       if (impl->gathered) {
         impl->gather(poly, coupled, input);
-        impl_ = impl.release();
+        impl_ = std::move(impl);
         return;
       }
 #endif
@@ -493,13 +493,14 @@ Bridge::Bridge(const BridgeInput& input) : impl_(nullptr) {
     impl->set_up(Points<3>::Zero(3, nb));
     impl->given.setZero(3, b.size());
     impl->moved.resize(3, impl->mesh.num_nodes());
-    impl_ = impl.release();
+    impl_ = std::move(impl);
   } catch (const std::exception& e) {
     throw std::runtime_error(e.what());
   }
 }
 
-Bridge::~Bridge() { delete impl_; }
+// Here, where Impl is complete.
+Bridge::~Bridge() = default;
 
 double Bridge::support_radius() const { return impl_->radius; }
 

@@ -3,6 +3,7 @@
 // library needs C++20, so each side is its own translation unit and they pass plain arrays.
 // Nothing here names an OpenFOAM or a meshmotion type.
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -59,7 +60,7 @@ class Bridge {
 
  private:
   struct Impl;
-  Impl* impl_;
+  std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace meshmotion::foam
