@@ -1,28 +1,24 @@
 #pragma once
 // The boundary motion options move_mesh and move_mesh_mpi share: the moving group and its
-// rotation, translation or displacement file, the fixed and sliding groups, and the support
-// radius of the methods that take one (a heuristic from the boundary when not given).
+// rotation, translation or displacement file, and the fixed and sliding groups. The mover
+// chooses what is not given (the support radius, the rigid part); the programs report it.
 
 #include "meshmotion/core/extrusion.hpp"
 #include "meshmotion/core/option_text.hpp"
 #include "meshmotion/io/detail/read_file.hpp"
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/motion.hpp"
-#include "meshmotion/movers/rbf.hpp"
-#include "meshmotion/movers/registry.hpp"
-#include "meshmotion/movers/support_radius.hpp"
+#include "meshmotion/movers/mover.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
-#include <concepts>
 #include <cstdint>
 #include <iostream>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
-#include <variant>
 #include <vector>
 
 namespace meshmotion::examples {
@@ -31,7 +27,6 @@ struct MotionArguments {
   std::string group, displacements_file;
   std::vector<std::string> fixed, sliding;
   std::optional<double> rotate;
-  std::optional<std::string> support_radius;
   std::vector<double> center, axis, translate;
 };
 
@@ -51,7 +46,6 @@ inline void add_motion_options(CLI::App& app, MotionArguments& a) {
   app.add_option("--sliding", a.sliding,
                  "Groups sliding in their plane; NAME:NX,NY[,NZ] gives the plane's normal (each node slides in its own "
                  "plane of that normal: an OpenFOAM 'empty' patch holding the front and the back of a 2D case)");
-  app.add_option("--support-radius", a.support_radius, "support radius of rbf (default: heuristic from the boundary)");
 }
 
 /// Throws InputError unless a group and one motion are given.
@@ -204,47 +198,16 @@ BoundarySpec<Dim> boundary_spec(const MotionArguments& a, const Mesh<Dim>& mesh)
   return spec;
 }
 
-/// Sets the support radius of a method that takes one: --support-radius, else an option
-/// given, else the heuristic on the boundary `resolve()` gives on `points`. Returns the radius
-/// (none for methods without one); refuses --support-radius for those.
-template <int Dim, std::invocable Resolve>
-std::optional<double> set_support_radius(MoverConfig<Dim>& config, const MotionArguments& a, const KeyValues& given,
-                                         const Points<Dim>& points, Resolve&& resolve) {
-  std::optional<double> radius;
-  std::visit(
-      [&]<class O>(O& o) {
-        if constexpr (TakesSupportRadius<O>) {
-          if (a.support_radius) {
-            parse_option_value("support_radius", *a.support_radius, o.support_radius);
-          } else if (std::none_of(given.begin(), given.end(), [](const auto& kv) { return kv.first == "support_radius"; })) {
-            const ResolvedBoundary<Dim> b = resolve();
-            if constexpr (std::same_as<O, RbfOptions>) {
-              // The mover's own default, within its memory budget (RbfOptions::max_memory_bytes).
-              const DefaultSupportRadius fitted = default_support_radius(points, b, o);
-              o.support_radius = fitted.radius;
-              // The radius is the one for what the interpolation will carry: the mover, given it,
-              // must take the rigid part out (or not) as decided here.
-              if (o.rigid_part == RigidPart::automatic) o.rigid_part = fitted.rigid_part ? RigidPart::blend : RigidPart::none;
-              if (fitted.rigid_part)
-                std::cerr << "note: the moving group's rigid motion is blended into the volume and the RBF carries "
-                             "the rest (rigid_part=automatic; rigid_part=none interpolates it all; docs/interpolation.md)\n";
-              else if (fitted.reduced)
-                std::cerr << "note: support radius reduced to " << format_option_value(fitted.radius)
-                          << " to keep the system and the evaluation operator within the memory budget "
-                             "(RbfOptions::max_memory_bytes; docs/interpolation.md)\n";
-            } else {
-              Points<Dim> at(Dim, b.size());
-              for (Index k = 0; k < b.size(); ++k) at.col(k) = points.col(b.nodes[static_cast<std::size_t>(k)]);
-              o.support_radius = suggest_support_radius(at, b.displacements);
-            }
-          }
-          radius = o.support_radius;
-        } else if (a.support_radius) {
-          throw InputError("--support-radius: method '" + config.method + "' takes no support radius");
-        }
-      },
-      config.options);
-  return radius;
+/// Says on stderr what the mover chose that changes what a user gets: the rigid part taken
+/// out, a default radius cut to the memory budget.
+inline void note_mover_choices(const MoverStats& stats) {
+  if (stats.rigid_part)
+    std::cerr << "note: the moving group's rigid motion is blended into the volume and the RBF carries the rest "
+                 "(rigid_part; rigid_part=none interpolates it all; docs/interpolation.md)\n";
+  else if (stats.radius_reduced)
+    std::cerr << "note: support radius reduced to " << format_option_value(stats.support_radius)
+              << " to keep the system and the evaluation operator within the memory budget "
+                 "(max_memory_bytes; docs/interpolation.md)\n";
 }
 
 }  // namespace meshmotion::examples

@@ -67,25 +67,25 @@ KeyValues mover_options(const Arguments& a, const examples::MotionArguments& mot
 template <int Dim>
 int move_and_write(const Arguments& a, const Mesh<Dim>& mesh, const examples::MotionArguments& motion,
                    const BoundarySpec<Dim>& spec, const std::pair<Extrusion, SectionBoundary>* section) {
-  std::optional<double> radius;
   KeyValues values;
-  const auto make = [&]<int MoverDim>(const Points<MoverDim>& points, auto&& resolve) {
-    const KeyValues given = mover_options<MoverDim>(a, motion, section != nullptr ? &section->first : nullptr);
-    MoverConfig<MoverDim> config = mover_config<MoverDim>(a.mover.method, given);
-    radius = examples::set_support_radius(config, motion, given, points, resolve);
+  const auto make = [&]<int MoverDim>() {
+    const MoverConfig<MoverDim> config =
+        mover_config<MoverDim>(a.mover.method, mover_options<MoverDim>(a, motion, section != nullptr ? &section->first : nullptr));
     for (const auto& kv : config.values()) values.emplace_back(kv);
     return make_mover(config);
   };
   std::optional<AnyMover<Dim>> mover;
   if constexpr (Dim == 3) {
-    if (section != nullptr)
-      mover.emplace(SectionMover(make.template operator()<2>(section->first.section.points, [&] { return section->second.boundary; }),
-                                 section->first));
+    if (section != nullptr) mover.emplace(SectionMover(make.template operator()<2>(), section->first));
   }
-  if (!mover) mover.emplace(make.template operator()<Dim>(mesh.points, [&] { return spec.resolve(mesh); }));
+  if (!mover) mover.emplace(make.template operator()<Dim>());
   examples::set_stage("moving " + a.input + " with " + a.mover.method);
   const QualityReport before = quality_report(mesh, Metric::skew);
   const StepResult<Dim> result = run_steps(*mover, mesh, spec, StepOptions{a.steps, Metric::skew});
+  // What the mover chose (the default radius, the rigid part), as the last setup took it.
+  const MoverStats& chosen = result.steps.back().stats;
+  examples::note_mover_choices(chosen);
+  const double radius = chosen.support_radius;  // 0: the method has none
   const MoveReport report = move_report(a.mover.method, before, result);
   const QualityReport& after = report.after;
   // A polyhedral OpenFOAM case is judged as checkMesh judges it, on its own cells: the
@@ -111,7 +111,7 @@ int move_and_write(const Arguments& a, const Mesh<Dim>& mesh, const examples::Mo
   if (a.json) {
     JsonWriter w(std::cout);
     w.begin_object().key("input").value(a.input).key("output").value(a.output);
-    if (radius) w.key("support_radius").value(*radius);
+    if (radius > 0.0) w.key("support_radius").value(radius);
     if (section != nullptr) w.key("section_axis").value(std::string(1, section->first.axis_name()));
     w.key("options").begin_object();
     for (const auto& [k, v] : values) w.key(k).value(v);
@@ -125,7 +125,7 @@ int move_and_write(const Arguments& a, const Mesh<Dim>& mesh, const examples::Mo
     std::cout << "\n";
   } else {
     std::cout << "moved " << mesh.num_nodes() << " nodes with " << a.mover.method;
-    if (radius) std::cout << " (support radius " << format_option_value(*radius) << ")";
+    if (radius > 0.0) std::cout << " (support radius " << format_option_value(radius) << ")";
     if (section != nullptr)
       std::cout << " as a 2D case: one cell thick along " << section->first.axis_name() << ", moved in its section (--keep-3d moves it in 3D)";
     std::cout << "\n";

@@ -74,7 +74,6 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
   QualityReport before;
   MoverConfig<Dim> config;
   ParallelOptions parallel;
-  double radius = 0.0;
   collective(comm, [&] {
     KeyValues given = a.parallel;
     for (auto& kv : examples::given_options(a.mover)) given.push_back(std::move(kv));
@@ -93,9 +92,6 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
     examples::handle_orientation(*whole, a.input, a.keep_orientation);
     name_unnamed_facet_groups(*whole);
     const BoundarySpec<Dim> spec = examples::boundary_spec<Dim>(a.motion, *whole);
-    // move_mesh's default radius, found on the whole mesh (with its memory budget, which the
-    // distributed mover does not apply yet), so both programs move a mesh alike.
-    if (const auto r = examples::set_support_radius(config, a.motion, given, whole->points, [&] { return spec.resolve(*whole); })) radius = *r;
     boundary = spec.resolve(*whole);
     examples::note_unlisted_groups(*whole, boundary);
     before = quality_report(*whole, Metric::skew);
@@ -103,8 +99,6 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
   const Mesh<Dim> empty;
   const DistributedMesh<Dim> part = partition_mesh(comm, root ? *whole : empty);
   const ResolvedBoundary<Dim> local = distribute_boundary(part, boundary);
-  MPI_Bcast(&radius, 1, MPI_DOUBLE, 0, comm);
-  if (radius > 0.0) config.set("support_radius", format_option_value(radius));
   const std::unique_ptr<DistributedMover<Dim>> mover = make_distributed_mover(config, parallel);
   mover->setup(part, local);
   const Points<Dim> displacement = mover->move(local.displacements);
@@ -123,6 +117,7 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
   collective(comm, [&] {
     if (!root) return;
     whole->points = moved;
+    examples::note_mover_choices(stats);
     const QualityReport after = quality_report(*whole, Metric::skew);
     const bool invalid = after.num_invalid > 0;
     if (invalid && a.strict)

@@ -62,6 +62,18 @@ def test_rbf_warp_and_gradient_equal_the_serial_ones():
     assert parallel.verify_derivative(verbose=False) < 1e-6
 
 
+def test_the_default_radius_is_the_serial_one_where_the_memory_budget_binds():
+    # No support_radius: each mover takes its default at setup, cut to max_memory_bytes; the
+    # distributed one samples the serial mover's nodes by global id, whatever the partition.
+    serial, parallel = pair(max_memory_bytes=5e5)
+    whole, part = warp_both(serial, parallel)
+    chosen = serial._mover.stats
+    assert chosen["radius_reduced"] and chosen["support_radius"] > 0
+    assert parallel._mover.stats["support_radius"] == chosen["support_radius"]
+    assert parallel._mover.stats["radius_reduced"]
+    np.testing.assert_allclose(part, whole[parallel.node_ids], rtol=0, atol=1e-12 * np.abs(whole - serial.mesh.points).max())
+
+
 def test_warp_returns_a_read_only_view_of_local_coordinates():
     _, parallel = pair(support_radius=0.7)
     parallel.set_surface_coordinates(bump(parallel.surface_coordinates()))

@@ -4,8 +4,8 @@
 
 #include "meshmotion/io/openfoam_polymesh.hpp"
 #include "meshmotion/movers/registry.hpp"
-#include "meshmotion/movers/rbf.hpp"
 #include "meshmotion/movers/support_radius.hpp"
+#include "meshmotion/movers/rbf_options.hpp"
 #ifdef MESHMOTION_FOAM_PARALLEL
 #include "meshmotion/parallel/petsc.hpp"
 #include "meshmotion/parallel/registry.hpp"
@@ -232,8 +232,9 @@ std::vector<std::vector<Index>> add_face_centres(const PolyMesh& poly, const Mes
 // largest boundary displacement, at least ten boundary spacings) sees no displacement and
 // gives the spacing's radius: a plate turned in a box kept its cells valid to 30 degrees with
 // it, to 90 with a radius of the box's size. So when a move's largest prescribed displacement
-// (over all ranks) outgrows the rule, the mover is set up again for twice that displacement:
-// once per doubling of the motion, never for an oscillation within the first period's reach.
+// (over all ranks) outgrows the rule, the mover is set up again for 1.5 times that
+// displacement: once per growth of the motion by half, never for an oscillation within the
+// first period's reach. The mover (serial or distributed: one rule) chooses the radius.
 struct Bridge::Impl {
   std::optional<AnyMover<3>> mover;
   MoverConfig<3> config;
@@ -264,13 +265,13 @@ struct Bridge::Impl {
   double radius = 0.0;
   int setups = 0;
 
-  // Sets the mover up with the boundary displacements `d` (entries × 3) deciding the default
-  // radius; false when it would not grow (the serial rule's memory budget holds it).
+  // Sets the mover up with the boundary displacements `d` (entries × 3), from which the mover
+  // decides its default radius; false when the radius did not grow (the memory budget holds it).
   bool set_up(const Points<3>& d) {
     boundary.displacements.leftCols(d.cols()) = d;
+    const double before = radius;
 #ifdef MESHMOTION_FOAM_PARALLEL
     if (!global_ids.empty() && !gathered) {
-      const double before = radius;
       distributed = parallel::make_distributed_mover(config, parallel);
       distributed_cells = mover_method<3>(config.method).needs_cells;
       if (distributed_cells)
@@ -278,21 +279,13 @@ struct Bridge::Impl {
       else
         distributed->setup(parallel::PartitionView<3>{MPI_COMM_WORLD, points, global_ids, owners}, boundary);
       radius = distributed->support_radius();
-      ++setups;
-      return setups == 1 || radius > before;
+      return ++setups == 1 || radius > before;
     }
 #endif
-    if (growing_radius) {
-      RbfOptions& rbf = std::get<RbfOptions>(config.options);
-      rbf.support_radius = 0.0;
-      const double fitted = default_support_radius(mesh.points, boundary, rbf).radius;
-      if (setups > 0 && !(fitted > radius)) return false;
-      rbf.support_radius = radius = fitted;
-    }
     mover.emplace(make_mover(config));
     mover->setup(mesh, boundary);
-    ++setups;
-    return true;
+    radius = mover->stats().support_radius;
+    return ++setups == 1 || radius > before;
   }
 
   // The largest prescribed displacement of `d` over every rank.

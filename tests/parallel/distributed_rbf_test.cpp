@@ -129,6 +129,30 @@ TEST_CASE("distributed RBF takes the serial default radius, from the whole bound
   }
 }
 
+TEST_CASE("distributed RBF shrinks the default radius to the serial mover's memory budget", "[parallel][rbf][petsc]") {
+  // A bump of the bottom (no rigid part the serial mover could take out instead), and a
+  // budget (about a sixth of the unreduced estimate) that binds: every rank must arrive at
+  // the serial radius, sampling the same nodes whatever the partition.
+  const Mesh<2> mesh = rectangle_mesh({.nx = 24, .ny = 18, .cells = RectangleCells::tri_quad});
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Translation<2>{meshmotion::Vec<2>(0.0, 0.1)}).fixed("top").fixed("left").fixed("right");
+  ResolvedBoundary<2> b = spec.resolve(mesh);
+  for (Index k = 0; k < b.size(); ++k)
+    if (b.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed)
+      b.displacements.col(k) *= 2.0 * std::sin(3.14159 * mesh.points(0, b.nodes[static_cast<std::size_t>(k)]));
+  RbfOptions options;
+  options.max_memory_bytes = 1e5;
+  RbfMover<2> serial(options);
+  serial.setup(mesh, b);
+  REQUIRE(serial.support_radius_reduced());
+  REQUIRE_FALSE(serial.stats().rigid_part);
+  for (const BoundarySolve solve : {BoundarySolve::replicated, BoundarySolve::petsc}) {
+    const Outcome r = compare_with_serial(mesh, b, options, {}, false, {solve});
+    CHECK(r.radius == serial.support_radius());
+    CHECK(r.error <= 1e-12);
+  }
+}
+
 TEST_CASE("distributed RBF with the boundary system factorized across the ranks by MUMPS", "[parallel][rbf][petsc]") {
   const BoundarySolveOptions petsc{BoundarySolve::petsc};
   {

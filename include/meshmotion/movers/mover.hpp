@@ -32,6 +32,11 @@ struct MoverStats {
   bool rigid_part = false;
   /// RBF: centres thinned because the system's condition exceeded RbfOptions::condition_limit.
   Index thinned_centres = 0;
+  /// RBF: the support radius of the last setup, given or the mover's default (0 where the
+  /// method has none). Front ends report it from here: the mover alone chooses it.
+  double support_radius = 0.0;
+  /// RBF: the default radius was reduced to fit the memory budget (RbfOptions::max_memory_bytes).
+  bool radius_reduced = false;
 };
 
 template <class F>
@@ -49,6 +54,8 @@ void visit_fields(const MoverStats& s, F&& f) {
   f("condition", s.condition, "lower bound of the RBF system's condition number (0: not estimated)");
   f("rigid_part", s.rigid_part, "RBF: the rigid part of the boundary's motion was blended in first");
   f("thinned_centres", s.thinned_centres, "RBF: centres thinned because the system's condition exceeded condition_limit");
+  f("support_radius", s.support_radius, "RBF: the support radius of the last setup, given or the default (0: none)");
+  f("radius_reduced", s.radius_reduced, "RBF: the default radius was reduced to fit the memory budget");
 }
 
 /// A mesh mover in Dim = M::dim dimensions.

@@ -60,6 +60,7 @@
 #include <cstddef>
 #include <limits>
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <string>
 #include <utility>
@@ -106,29 +107,39 @@ template <int Dim>
   return machine > 0.0 ? 0.5 * machine : std::numeric_limits<double>::infinity();
 }
 
-/// Estimated peak bytes of a compact RBF of `radius` with its centres at `centres` (`tree`
-/// holds them) evaluated at the other nodes of `points`, from the neighbour counts of a sample
-/// of centres and of nodes. The system: 40 bytes a nonzero while it is assembled (the
-/// neighbour pairs, 16, and the matrix in both storage orders, 12 each) and its factor (fill
-/// taken as 4× the nonzeros, up to a dense triangle), twice when nodes slide. The evaluation
-/// operator: 28 bytes a nonzero (pairs and matrix), or 8 an entry where setup stores it
-/// dense. Measured against the peak resident memory of move_mesh: within a factor of 1.5.
+/// The nodes the memory estimate samples: `count` (≤ 256) of `n`, spread evenly by index
+/// (node index, or global id in a distributed mesh: every partition samples the same nodes).
+[[nodiscard]] inline Index memory_samples(Index n) { return std::min<Index>(n, 256); }
+[[nodiscard]] inline Index sampled_node(Index s, Index n) { return s * n / memory_samples(n); }
+
+/// The mean number of centres of `tree` within `radius` of the sampled nodes of `points`.
 template <int Dim>
-[[nodiscard]] double compact_rbf_bytes(const Points<Dim>& points, const Points<Dim>& centres, const KdTree<Dim>& tree,
-                                       bool sliding, double radius, const RbfOptions& options) {
-  const auto mean_count = [&](const Points<Dim>& at) {
-    const Index n = at.cols(), samples = std::min<Index>(n, 256);
-    std::vector<Neighbor> found;
-    double total = 0.0;
-    for (Index s = 0; s < samples; ++s) total += static_cast<double>(tree.radius_search(Vec<Dim>(at.col(s * n / samples)), radius, found));
-    return samples == 0 ? 0.0 : total / static_cast<double>(samples);
-  };
+[[nodiscard]] double mean_centres_within(const KdTree<Dim>& tree, const Points<Dim>& points, double radius) {
+  const Index n = points.cols(), samples = memory_samples(n);
+  std::vector<Neighbor> found;
+  double total = 0.0;
+  for (Index s = 0; s < samples; ++s) total += static_cast<double>(tree.radius_search(Vec<Dim>(points.col(sampled_node(s, n))), radius, found));
+  return samples == 0 ? 0.0 : total / static_cast<double>(samples);
+}
+
+/// Estimated peak bytes of a compact RBF of `radius` with its centres at `centres` (in node
+/// order; `tree` holds them) evaluated at the other `nodes` of the mesh, `volume_mean(tree,
+/// radius)` giving the mean centre count around the mesh's sampled nodes (mean_centres_within()
+/// where one process holds the mesh). The system: 40 bytes a nonzero while it is assembled
+/// (the neighbour pairs, 16, and the matrix in both storage orders, 12 each) and its factor
+/// (fill taken as 4× the nonzeros, up to a dense triangle), twice when nodes slide. The
+/// evaluation operator: 28 bytes a nonzero (pairs and matrix), or 8 an entry where setup
+/// stores it dense. Measured against the peak resident memory of move_mesh: within a factor
+/// of 1.5.
+template <int Dim, class VolumeMean>
+[[nodiscard]] double compact_rbf_bytes(double nodes, const Points<Dim>& centres, const KdTree<Dim>& tree, bool sliding,
+                                       double radius, const RbfOptions& options, VolumeMean&& volume_mean) {
   const auto k = static_cast<double>(centres.cols());
-  const double evaluated = std::max(0.0, static_cast<double>(points.cols()) - k);
-  const double system_nonzeros = mean_count(centres) * k;
+  const double evaluated = std::max(0.0, nodes - k);
+  const double system_nonzeros = mean_centres_within(tree, centres, radius) * k;
   double bytes = 40.0 * system_nonzeros + 8.0 * std::min(0.5 * k * k, 4.0 * system_nonzeros);
   if (sliding) bytes *= 2.0;
-  const double operator_nonzeros = mean_count(points) * evaluated;
+  const double operator_nonzeros = volume_mean(tree, radius) * evaluated;
   const double dense = 8.0 * evaluated * k;
   const bool cached = operator_nonzeros > 0.5 * evaluated * k && dense <= static_cast<double>(options.max_evaluation_cache_bytes);
   return bytes + (cached ? dense : 28.0 * operator_nonzeros);
@@ -152,27 +163,58 @@ struct DefaultSupportRadius {
 
 namespace detail {
 
-/// default_support_radius() for a boundary whose rigid part is already out (or stays in).
+/// The positions of the boundary's nodes in node order (the order a distributed mover
+/// gathers them in, by global id), so that the memory estimate samples the same centres.
 template <int Dim>
-[[nodiscard]] DefaultSupportRadius budgeted_support_radius(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary,
-                                                           const RbfOptions& options) {
-  const Points<Dim> centres = detail::boundary_positions(points, boundary, "RbfMover::setup");
-  DefaultSupportRadius out{suggest_support_radius(centres, boundary.displacements), false};
-  if (!detail::memory_checked(options)) return out;
-  const double limit = detail::memory_limit(options);
+[[nodiscard]] Points<Dim> centres_in_node_order(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary) {
+  const Points<Dim> at = boundary_positions(points, boundary, "RbfMover::setup");
+  std::vector<Index> order(static_cast<std::size_t>(at.cols()));
+  std::iota(order.begin(), order.end(), Index{0});
+  std::sort(order.begin(), order.end(), [&](Index a, Index b) {
+    return boundary.nodes[static_cast<std::size_t>(a)] < boundary.nodes[static_cast<std::size_t>(b)];
+  });
+  Points<Dim> sorted(Dim, at.cols());
+  for (Index k = 0; k < at.cols(); ++k) sorted.col(k) = at.col(order[static_cast<std::size_t>(k)]);
+  return sorted;
+}
+
+/// The one rule of the default radius, for a mesh held by one process or spread over ranks:
+/// suggest_support_radius() of the boundary's `centres` (node order) and its `largest`
+/// displacement, reduced until the memory estimate for a mesh of `nodes` nodes
+/// (compact_rbf_bytes(), `volume_mean` as there) fits max(1 KiB a node, an eighth of the
+/// machine's memory) and RbfOptions::max_memory_bytes.
+template <int Dim, class VolumeMean>
+[[nodiscard]] DefaultSupportRadius budgeted_support_radius(const Points<Dim>& centres, double largest, double nodes,
+                                                           bool sliding, const RbfOptions& options, VolumeMean&& volume_mean) {
+  DefaultSupportRadius out{suggest_support_radius(centres, largest), false};
+  if (!memory_checked(options)) return out;
+  const double limit = memory_limit(options);
   const double machine = physical_memory_bytes();
   const double floor = machine > 0.0 ? machine / 8.0 : 2.0 * 1024.0 * 1024.0 * 1024.0;
-  const double budget = std::min(limit, std::max(1024.0 * static_cast<double>(points.cols()), floor));
+  const double budget = std::min(limit, std::max(1024.0 * nodes, floor));
   const KdTree<Dim> tree(centres);
-  const bool sliding = detail::any_sliding(boundary);
-  double bytes = detail::compact_rbf_bytes(points, centres, tree, sliding, out.radius, options);
+  double bytes = compact_rbf_bytes(nodes, centres, tree, sliding, out.radius, options, volume_mean);
   // Counts around a surface of centres grow as r²: a few rescaling rounds settle the radius.
   for (int round = 0; round < 8 && bytes > budget; ++round) {
     out.radius *= 0.95 * std::sqrt(budget / bytes);
     out.reduced = true;
-    bytes = detail::compact_rbf_bytes(points, centres, tree, sliding, out.radius, options);
+    bytes = compact_rbf_bytes(nodes, centres, tree, sliding, out.radius, options, volume_mean);
   }
   return out;
+}
+
+/// budgeted_support_radius() of a mesh one process holds (`points`, every node), for a
+/// boundary whose rigid part is already out (or stays in).
+template <int Dim>
+[[nodiscard]] DefaultSupportRadius budgeted_support_radius(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary,
+                                                           const RbfOptions& options) {
+  if (boundary.displacements.cols() != boundary.size())
+    throw InputError("RbfMover::setup: " + std::to_string(boundary.displacements.cols()) + " displacements for " +
+                     std::to_string(boundary.size()) + " boundary entries");
+  const double largest = boundary.size() > 0 ? boundary.displacements.colwise().norm().maxCoeff() : 0.0;
+  return budgeted_support_radius(centres_in_node_order(points, boundary), largest, static_cast<double>(points.cols()),
+                                 any_sliding(boundary), options,
+                                 [&](const KdTree<Dim>& tree, double radius) { return mean_centres_within(tree, points, radius); });
 }
 
 }  // namespace detail
@@ -202,9 +244,10 @@ void check_support_radius_memory(const Points<Dim>& points, const ResolvedBounda
                                  const RbfOptions& options) {
   if (!detail::memory_checked(options) || boundary.size() == 0) return;
   const double limit = detail::memory_limit(options);
-  const Points<Dim> centres = detail::boundary_positions(points, boundary, "RbfMover::setup");
-  const double bytes =
-      detail::compact_rbf_bytes(points, centres, KdTree<Dim>(centres), detail::any_sliding(boundary), radius, options);
+  const Points<Dim> centres = detail::centres_in_node_order(points, boundary);
+  const KdTree<Dim> tree(centres);
+  const double bytes = detail::compact_rbf_bytes(static_cast<double>(points.cols()), centres, tree, detail::any_sliding(boundary),
+                                                 radius, options, [&](const KdTree<Dim>& t, double r) { return detail::mean_centres_within(t, points, r); });
   if (bytes > limit)
     throw InputError("RbfMover::setup: support radius " + format_option_value(radius) + " needs about " +
                      detail::gigabytes(bytes) + " for the system and the evaluation operator, beyond the limit of " +
@@ -572,6 +615,8 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   }
   stats_ = MoverStats{};
   stats_.boundary_nodes = n_centres_;
+  stats_.support_radius = radius_;
+  stats_.radius_reduced = radius_reduced_;
   pending_centres_ = centres;
   pending_kernel_ = kernel;
   pending_ = true;

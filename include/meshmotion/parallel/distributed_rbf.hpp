@@ -77,6 +77,9 @@ class DistributedRbfMover {
   /// The support radius of the last setup (RbfMover::support_radius(): the default one is
   /// proposed from the gathered boundary, as the serial mover does).
   [[nodiscard]] double support_radius() const noexcept { return radius_; }
+  /// The default radius of the last setup was reduced to fit the memory budget
+  /// (RbfMover::support_radius_reduced(), decided alike).
+  [[nodiscard]] bool support_radius_reduced() const noexcept { return radius_reduced_; }
   /// This rank's figures; boundary_nodes counts the whole boundary's centres.
   [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
   /// Entries of the whole boundary (before merging coincident nodes).
@@ -132,6 +135,10 @@ class DistributedRbfMover {
   /// rank when PETSc is demanded and cannot take it.
   [[nodiscard]] bool choose_petsc(const GatheredBoundary& gathered, const Points<Dim>& centres) const;
   /// Why PETSc cannot solve this boundary system (empty: it can).
+  /// Collective: the serial mover's default radius for the whole mesh (`centres`: the
+  /// gathered boundary in global id order).
+  [[nodiscard]] DefaultSupportRadius default_radius(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary,
+                                                    const GatheredBoundary& gathered, const Points<Dim>& centres) const;
   [[nodiscard]] std::string petsc_obstacle(const std::vector<int>& kinds, bool radius_per_entry, const Points<Dim>& centres) const;
   /// move_into() once the boundary was gathered (replicated or PETSc).
   void move_gathered(PointsView<Dim> d, Points<Dim>& out);
@@ -143,6 +150,7 @@ class DistributedRbfMover {
   RbfMover<Dim> inner_;      ///< replicated: over the gathered centres followed by the local interior nodes
   RbfOptions options_;
   double radius_ = 0.0;  ///< the last setup's support radius (options_'s, or the default's)
+  bool radius_reduced_ = false;
   BoundarySolveOptions solve_;
   bool petsc_ = false;
   std::unique_ptr<detail::PetscRbfSystem<Dim>> system_;  ///< PETSc: the boundary system
@@ -193,6 +201,7 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
   owned_.resize(static_cast<std::size_t>(n));
   for (Index i = 0; i < n; ++i) owned_[static_cast<std::size_t>(i)] = part.owns(i) ? 1 : 0;
   patches_.reset();
+  radius_reduced_ = false;
   if (options_.partition_of_unity && (solve_.kind == BoundarySolve::automatic || solve_.kind == BoundarySolve::patches)) {
     // No rank gathers the boundary: patches own it.
     auto patches = std::make_unique<detail::DistributedPartitionOfUnity<Dim>>();
@@ -204,6 +213,7 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
       global_entries_ = patches->global_centres();
       owned_entries_ = patches->entries();
       stats_ = patches->stats();
+      stats_.support_radius = radius_;
       patches_ = std::move(patches);
       ready_ = true;
       stats_.setup_seconds = watch.seconds();
@@ -221,14 +231,11 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
   std::vector<double> radii;
   const ResolvedBoundary<Dim> centres = inner_boundary(part, gathered, points, radii);
 
-  // The default radius from the whole boundary, as the serial mover takes it: the gathered
-  // nodes and the largest displacement over the ranks.
   radius_ = options_.support_radius;
   if (radius_ == 0.0 && !gathered.radius_per_entry) {
-    double largest = 0.0, global_largest = 0.0;
-    for (const Index k : owned_entries_) largest = std::max(largest, boundary.displacements.col(k).norm());
-    MPI_Allreduce(&largest, &global_largest, 1, MPI_DOUBLE, MPI_MAX, comm_);
-    radius_ = suggest_support_radius(Points<Dim>(points.leftCols(m)), global_largest);
+    const DefaultSupportRadius fitted = default_radius(part, boundary, gathered, Points<Dim>(points.leftCols(m)));
+    radius_ = fitted.radius;
+    radius_reduced_ = fitted.reduced;
   }
   gathered_.resize(Dim, m);
   petsc_ = choose_petsc(gathered, points.leftCols(m));
@@ -245,8 +252,42 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
     stats_ = inner_.stats();
     stats_.evaluated_nodes = std::min(stats_.evaluated_nodes, n);
   }
+  stats_.support_radius = radius_;
+  stats_.radius_reduced = radius_reduced_;
   ready_ = true;
   stats_.setup_seconds = watch.seconds();
+}
+
+template <int Dim>
+DefaultSupportRadius DistributedRbfMover<Dim>::default_radius(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary,
+                                                              const GatheredBoundary& gathered, const Points<Dim>& centres) const {
+  // The serial mover's rule (meshmotion::detail::budgeted_support_radius) on the whole mesh:
+  // the gathered centres are in global id order, the largest displacement and the node count
+  // are reduced over the ranks, and the estimate's sampled nodes are counted by their owners.
+  double largest = 0.0, global_largest = 0.0, owned = 0.0, nodes = 0.0;
+  for (const Index k : owned_entries_) largest = std::max(largest, boundary.displacements.col(k).norm());
+  for (Index i = 0; i < part.size(); ++i) owned += part.owns(i) ? 1.0 : 0.0;
+  MPI_Allreduce(&largest, &global_largest, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  MPI_Allreduce(&owned, &nodes, 1, MPI_DOUBLE, MPI_SUM, comm_);
+  const auto n = static_cast<Index>(nodes), samples = meshmotion::detail::memory_samples(n);
+  std::vector<Index> sampled;  // this rank's owned nodes among the sampled global ids
+  for (Index i = 0; i < part.size(); ++i) {
+    const std::int64_t g = part.global_ids[static_cast<std::size_t>(i)];
+    if (!part.owns(i) || g < 0 || g >= n) continue;
+    // g is sampled when some s gives s·n/samples == g: the smallest s with s·n ≥ g·samples.
+    const Index s = (static_cast<Index>(g) * samples + n - 1) / n;
+    if (s < samples && meshmotion::detail::sampled_node(s, n) == g) sampled.push_back(i);
+  }
+  const bool sliding = std::any_of(gathered.kinds.begin(), gathered.kinds.end(),
+                                   [](int k) { return static_cast<BoundaryKind>(k) == BoundaryKind::sliding; });
+  return meshmotion::detail::budgeted_support_radius(
+      centres, global_largest, nodes, sliding, options_, [&](const KdTree<Dim>& tree, double radius) {
+        std::vector<Neighbor> found;
+        double count = 0.0, total = 0.0;
+        for (const Index i : sampled) count += static_cast<double>(tree.radius_search(Vec<Dim>(part.points.col(i)), radius, found));
+        MPI_Allreduce(&count, &total, 1, MPI_DOUBLE, MPI_SUM, comm_);
+        return samples == 0 ? 0.0 : total / static_cast<double>(samples);
+      });
 }
 
 template <int Dim>
