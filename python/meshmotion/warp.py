@@ -138,7 +138,7 @@ class Warp:
         for group in design:
             spec.prescribed(group)
         for group in symmetry:
-            spec.sliding(group, normal=_fit_plane(comm, group, points[local[group][owned[local[group]]]]))
+            spec.sliding(group, normal=_core.sliding_plane_normal(comm, group, points[local[group][owned[local[group]]]]))
         for group in fixed:
             spec.fixed(group)
         failure = None
@@ -443,27 +443,6 @@ def _agree(comm, value, what):
     if any(v != values[0] for v in values):
         raise _core.InputError(f"Warp.from_partition: the ranks disagree on {what} ({values})")
     return values[0]
-
-
-def _fit_plane(comm, group, points):
-    """The unit normal of the least-squares plane through the owned nodes `points` of a
-    symmetry group on every rank (collective), as BoundarySpec fits one on a whole mesh; raises
-    on every rank when they are too few or not planar (1e-8 of their extent)."""
-    dim = points.shape[1]
-    count = comm.allreduce(len(points))
-    if count < dim:
-        raise _core.InputError(f"BoundarySpec::resolve: sliding group '{group}' has {count} nodes, too few to fit a "
-                               "plane")
-    centroid = comm.allreduce(points.sum(axis=0)) / count
-    r = points - centroid
-    scatter = comm.allreduce(r.T @ r)
-    normal = _np.linalg.eigh(scatter)[1][:, 0]
-    extent = comm.allreduce(float(_np.linalg.norm(r, axis=1).max()) if len(r) else 0.0, op=_max())
-    off = comm.allreduce(float(_np.abs(r @ normal).max()) if len(r) else 0.0, op=_max())
-    if off > 1e-8 * max(extent, 1e-300):
-        raise _core.InputError(f"BoundarySpec::resolve: sliding group '{group}' is not planar (a node lies {off:g} off "
-                               "the fitted plane, expected 0)")
-    return normal.tolist()
 
 
 def _gather_owned(comm, ids, values):

@@ -14,11 +14,13 @@
 
 #include "meshmotion/parallel/partition.hpp"
 #include "meshmotion/parallel/petsc.hpp"
+#include "meshmotion/parallel/plane_fit.hpp"
 #include "meshmotion/parallel/registry.hpp"
 
 #include <petscsys.h>
 
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <span>
 #include <string>
@@ -111,6 +113,23 @@ class DistributedMover {
 
 void bind_parallel(py::module_& m) {
   m.attr("have_mpi") = true;
+  m.def(
+      "sliding_plane_normal",
+      [](const py::object& comm, const std::string& group, const py::array& points) {
+        const MPI_Comm c = communicator(comm);
+        const auto normal = [&]<int Dim>() {
+          const Points<Dim> at(rows_of<Dim>(points, "sliding_plane_normal: points"));
+          std::vector<Index> all(static_cast<std::size_t>(at.cols()));
+          std::iota(all.begin(), all.end(), Index{0});
+          py::gil_scoped_release release;
+          const Vec<Dim> n = parallel::sliding_plane_normal<Dim>(c, group, at, all);
+          return std::vector<double>(n.data(), n.data() + Dim);
+        };
+        return points.ndim() == 2 && points.shape(1) == 2 ? normal.template operator()<2>() : normal.template operator()<3>();
+      },
+      py::arg("comm"), py::arg("group"), py::arg("points"),
+      "collective: the normal of a sliding group from its nodes (n, dim) on each rank (each node on one rank), as "
+      "BoundarySpec.resolve fits it on one mesh; the same error on every rank when they are too few or not planar");
   for_each_dimension([&]<int Dim>() {
     const std::string suffix = std::to_string(Dim);
     using M = Mesh<Dim>;

@@ -177,6 +177,20 @@ template <int Dim>
   return fit;
 }
 
+/// The normal of sliding group `group` from the plane fitted through its `count` nodes;
+/// throws InputError when they are too few for a plane or do not lie in one (PlaneFit::planar),
+/// asking for the normal. One message wherever the nodes are (one mesh, or spread over ranks).
+template <int Dim>
+[[nodiscard]] Vec<Dim> sliding_plane_normal(const std::string& group, Index count, const PlaneFit<Dim>& fit) {
+  if (count < Dim)
+    throw InputError("BoundarySpec::resolve: sliding group '" + group + "' has " + std::to_string(count) +
+                     " nodes, too few to fit a plane (give the normal)");
+  if (!fit.planar())
+    throw InputError("BoundarySpec::resolve: sliding group '" + group + "' is not planar (a node lies " +
+                     std::to_string(fit.off_plane) + " off the fitted plane, expected 0; give the normal)");
+  return fit.normal;
+}
+
 /// One node's condition, as BoundarySpec (and other builders of a ResolvedBoundary) collect them.
 template <int Dim>
 struct BoundaryEntry {
@@ -455,14 +469,8 @@ class BoundarySpec {
         throw InputError("BoundarySpec::resolve: sliding group '" + g.name + "' has a zero or non-finite normal");
       return *g.normal / length;
     }
-    if (static_cast<Index>(list.size()) < Dim)
-      throw InputError("BoundarySpec::resolve: sliding group '" + g.name + "' has " + std::to_string(list.size()) +
-                       " nodes, too few to fit a plane (give the normal)");
-    const PlaneFit<Dim> fit = fit_plane(points, list);
-    if (!fit.planar())
-      throw InputError("BoundarySpec::resolve: sliding group '" + g.name + "' is not planar (a node lies " +
-                       std::to_string(fit.off_plane) + " off the fitted plane, expected 0; give the normal)");
-    return fit.normal;
+    const auto count = static_cast<Index>(list.size());
+    return sliding_plane_normal<Dim>(g.name, count, count < Dim ? PlaneFit<Dim>{} : fit_plane(points, list));
   }
 
   // The auxiliary nodes of a polyhedral mesh (the centres to_mesh() cuts its cells around) are
