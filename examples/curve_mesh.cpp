@@ -377,15 +377,19 @@ int main(int argc, char** argv) {
         args.geometry = {"circle:0,0,0.5"};
       }
       examples::check_output({}, args.output, given_curve_options<3>(args).order, args.overwrite);
-      check_output_folder(args.svg);
+      examples::check_side_output(args.svg, {args.options.options_file}, {args.output, with_extension(args.output, ".vtu")});
       return run(o_mesh({}), args);  // 128 x 64 quads, first cell 1e-5 for a 0.025 wall spacing
     }
     if (args.output.empty()) throw InputError("curve_mesh: no output file (expected -o OUTPUT)");
     // The curved mesh is of order --order, and a .vtu goes beside it: both are checked before any work.
     const int order = given_curve_options<3>(args).order;
     examples::check_output(args.input, args.output, order, args.overwrite);
-    examples::check_output(args.input, with_extension(args.output, ".vtu"), order, args.overwrite);
-    if (!args.svg.empty()) check_output_folder(args.svg);
+    // The pictures never replace what the run reads, whatever --overwrite allows the mesh.
+    const std::filesystem::path vtu = with_extension(args.output, ".vtu"), options_file = args.options.options_file,
+                                geometry = cad_geometry(args) ? std::filesystem::path(args.geometry.front()) : std::filesystem::path();
+    check_mesh_output(vtu, order);
+    examples::check_side_output(vtu, {args.input, geometry, options_file}, {args.output});
+    if (!args.svg.empty()) examples::check_side_output(args.svg, {args.input, geometry, options_file}, {args.output, vtu});
     AnyMesh mesh = examples::read_input(args.input);
     return std::visit([&](auto& m) { return run(std::move(m), args); }, mesh);
   });

@@ -130,7 +130,11 @@ int main(int argc, char** argv) {
   if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv)) return *rc;
   return examples::guarded(s.json, [&] {
     s.file = examples::foam_input(s.file, foam).string();
-    if (!s.vtu.empty()) examples::check_output(s.file, s.vtu, 2, false);
+    if (!s.vtu.empty()) {
+      check_mesh_output(s.vtu, 2);
+      examples::check_side_output(s.vtu, {s.file});
+    }
+    if (!s.svg.empty()) examples::check_side_output(s.svg, {s.file}, {s.vtu});
     AnyMesh mesh = examples::read_input(s.file);
     return std::visit([&](auto& m) { return run(m, s); }, mesh);
   });

@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <initializer_list>
 #include <iostream>
 #include <limits>
 #include <new>
@@ -228,6 +229,25 @@ inline void check_output(const std::filesystem::path& input, const std::filesyst
     if (!read.empty() && std::filesystem::weakly_canonical(written, ec) == std::filesystem::weakly_canonical(read, ec))
       throw InputError("output " + output.string() + " replaces the input's points (" + read.string() + "; give --overwrite to replace them)");
   }
+}
+
+/// Refuses, before any work, a side output (a picture, a .vtu of values beside the mesh, a
+/// rank's part) in a missing folder, one that would replace a file the run reads (`inputs`:
+/// the mesh, a geometry or options file; by any path to it — --overwrite lets only the output
+/// mesh replace its input), and one that is another output of the run (`outputs`), which the
+/// later write would replace.
+inline void check_side_output(const std::filesystem::path& output, std::initializer_list<std::filesystem::path> inputs,
+                              std::initializer_list<std::filesystem::path> outputs = {}) {
+  check_output_folder(output);
+  std::error_code ec;
+  for (const auto& input : inputs)
+    if (!input.empty() && std::filesystem::exists(output, ec) && std::filesystem::equivalent(input, output, ec))
+      throw InputError("output " + output.string() + " is " + (input == output ? "an input" : "the input " + input.string()) +
+                       " of this run: no output is written over an input");
+  const std::filesystem::path at = std::filesystem::weakly_canonical(output, ec);
+  for (const auto& other : outputs)
+    if (!other.empty() && std::filesystem::weakly_canonical(other, ec) == at)
+      throw InputError("output " + output.string() + " is also the output " + other.string() + " of this run");
 }
 
 /// A consistently reversed mesh (every cell negative: the file's convention) is mirrored and

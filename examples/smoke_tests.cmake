@@ -324,6 +324,41 @@ endif()
 # Outputs are checked before any work, and an input is never overwritten unasked.
 smoke_test(NAME curve_mesh.svg_in_missing_folder.json EXPECT_RC 1 KEYS error VALUES kind=input
            COMMAND curve_mesh --demo -o "${smoke_dir}/demo_svg_folder.msh" --svg "${smoke_dir}/no_such_folder/demo.svg" --json)
+# The verdict is the certificate's at every order: a P2 file whose mid-edge node lies beyond
+# the opposite vertex (its straight corners are fine) is invalid for every metric, and
+# move_mesh --strict writes nothing.
+set(folded_p2 "${PROJECT_SOURCE_DIR}/tests/quality/data/folded_p2.msh")
+smoke_test(NAME mesh_quality.folded_p2.json KEYS metrics/skew/min
+           VALUES metrics/skew/invalid=1,metrics/scaled_jacobian/invalid=1
+           COMMAND mesh_quality "${folded_p2}" --metric skew --metric jacobian --json)
+smoke_test(NAME move_mesh.folded_p2_strict.json EXPECT_RC 2 KEYS error VALUES kind=invalid_mesh
+           COMMAND move_mesh "${folded_p2}" -o "${smoke_dir}/folded_p2_moved.msh" --group wall --translate 0.01,0
+                   --fixed rest --method none --strict --json)
+add_test(NAME examples.move_mesh.folded_p2_strict_wrote_nothing
+         COMMAND "${CMAKE_COMMAND}" -E cat "${smoke_dir}/folded_p2_moved.msh")
+set_tests_properties(examples.move_mesh.folded_p2_strict_wrote_nothing PROPERTIES LABELS examples WILL_FAIL TRUE
+                     DEPENDS examples.move_mesh.folded_p2_strict.json)
+
+# A picture or a .vtu named as the input (by another path to it), or as another output of the
+# run, is refused before anything is read or written; --overwrite lets only the mesh replace
+# its input. mesh_info then reads the input as the mesh it was.
+smoke_test(NAME mesh_quality.svg_over_input.json REQUIRES examples_demo_mesh SETUP examples_not_overwritten
+           EXPECT_RC 1 KEYS error VALUES kind=input
+           COMMAND mesh_quality "${smoke_dir}/demo.msh" --svg "${smoke_dir}/./demo.msh" --json)
+smoke_test(NAME mesh_quality.vtu_over_input.json REQUIRES examples_demo_mesh SETUP examples_not_overwritten
+           EXPECT_RC 1 KEYS error VALUES kind=input
+           COMMAND mesh_quality "${smoke_dir}/demo.msh" --vtu "${smoke_dir}/../smoke/demo.msh" --json)
+smoke_test(NAME mesh_quality.svg_over_vtu.json REQUIRES examples_demo_mesh EXPECT_RC 1 KEYS error VALUES kind=input
+           COMMAND mesh_quality "${smoke_dir}/demo.msh" --vtu "${smoke_dir}/demo_q.vtu" --svg "${smoke_dir}/demo_q.vtu" --json)
+smoke_test(NAME curve_mesh.svg_over_input.json REQUIRES examples_demo_mesh SETUP examples_not_overwritten
+           EXPECT_RC 1 KEYS error VALUES kind=input
+           COMMAND curve_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/demo_again.msh" --group wall --geometry circle:0,0,0.5
+                   --svg "${smoke_dir}/demo.msh" --json)
+smoke_test(NAME curve_mesh.svg_over_vtu.json EXPECT_RC 1 KEYS error VALUES kind=input
+           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_svg_vtu.msh" --svg "${smoke_dir}/demo_svg_vtu.vtu" --json)
+smoke_test(NAME mesh_info.input_kept.json REQUIRES examples_demo_mesh examples_not_overwritten
+           KEYS mesh/groups VALUES mesh/dim=2
+           COMMAND mesh_info "${smoke_dir}/demo.msh" --json)
 smoke_test(NAME curve_mesh.demo_with_input.json EXPECT_RC 1 KEYS error VALUES kind=usage
            COMMAND curve_mesh "${smoke_dir}/demo.msh" --demo -o "${smoke_dir}/demo_and_input.msh" --json)
 smoke_test(NAME curve_mesh.cgns_order3_output.json EXPECT_RC 1 KEYS error

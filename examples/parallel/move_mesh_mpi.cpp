@@ -194,6 +194,8 @@ int main_body(int argc, char** argv) {
         examples::require_motion(a.motion, "move_mesh_mpi");
         if (!root) return;
         examples::check_output(a.input, a.output, 1, a.overwrite);
+        if (a.rank_files)
+          for (int r = 0; r < size_of(comm); ++r) examples::check_side_output(rank_file(a.output, r), {a.input}, {a.output});
         mesh = std::make_unique<AnyMesh>(examples::read_input(a.input));
         dim = std::holds_alternative<Mesh<2>>(*mesh) ? 2 : 3;
       });

@@ -311,6 +311,25 @@ TEST_CASE("scaled Jacobian flags tangled curved elements", "[quality]") {
   CHECK_FALSE(scaled_jacobian(ElementType::quad9, quad, fast).valid);
 }
 
+TEST_CASE("a Knupp metric takes the certificate's verdict on a high-order cell", "[quality]") {
+  // A P2 triangle whose mid-edge node (1,2) lies beyond vertex 0: its straight corners are a
+  // fine triangle, the curved cell is folded. Beside it a sound P2 triangle.
+  Mesh<2> mesh;
+  mesh.points = columns<2>({{0, 0}, {1, 0}, {0, 1}, {0.5, 0}, {-0.3, -0.3}, {0, 0.5}, {1, 1}, {1, 0.5}, {0.5, 1}, {0.5, 0.5}});
+  mesh.block(ElementType::tri6).add({0, 1, 2, 3, 4, 5});
+  mesh.cells[0].add({1, 6, 2, 7, 8, 9});
+  for (const Metric m : {Metric::skew, Metric::shape, Metric::size_shape, Metric::scaled_jacobian}) {
+    INFO(metric_name(m));
+    const QualityReport r = quality_report(mesh, m);
+    CHECK(r.num_invalid == 1);
+    CHECK(r.min <= 0.0);
+    const std::vector<CellQuality> cells = evaluate_cells(mesh, m);
+    CHECK_FALSE(cells[0].valid);
+    CHECK(cells[1].valid);
+    CHECK(cells[1].value > 0.5);
+  }
+}
+
 TEST_CASE("bad input gives defined results, never NaN", "[quality]") {
   auto tri = columns<2>({{0, 0}, {1, 0}, {0, 1}, {0.5, 0}, {0.5, 0.5}, {0, 0.5}});
   tri(0, 4) = std::nan("");

@@ -13,6 +13,7 @@
 #include "meshmotion/quality/knupp.hpp"
 #include "meshmotion/quality/scaled_jacobian.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -112,7 +113,11 @@ template <int Dim>
 
 /// Value and validity of every cell for `metric`, in cell order. Knupp values lie in [0, 1]
 /// (0 for invalid cells); the scaled Jacobian is the certified minimum, signed (negative for
-/// tangled cells, 0 for degenerate ones). Throws InputError when a cell block has the wrong
+/// tangled cells, 0 for degenerate ones). Validity is the certificate's for every metric: a
+/// Knupp metric measures a high-order cell by its corners, which say nothing of a mid-edge
+/// node folded across the cell (its straight corners are fine) and may call a curved cell
+/// inverted that the certificate finds valid, so its cells take the certified verdict (a
+/// cell it finds invalid measures 0). Throws InputError when a cell block has the wrong
 /// dimension. Precondition: node indices in range (see validate()).
 template <int Dim>
 [[nodiscard]] std::vector<CellQuality> evaluate_cells(const Mesh<Dim>& mesh, Metric metric, const QualityOptions& options = {}) {
@@ -142,6 +147,22 @@ template <int Dim>
       });
     errors.rethrow();
     offset += n;
+  }
+  const bool curved = std::any_of(mesh.cells.begin(), mesh.cells.end(), [](const ElementBlock& b) { return order(b.type) > 1; });
+  if (!curved) return out;
+  ScaledJacobianOptions jacobian = options.jacobian;
+  jacobian.sharp_max = false;
+  jacobian.sharp = false;  // the verdict alone
+  const std::vector<ScaledJacobian> certified = scaled_jacobians(mesh, jacobian);
+  offset = 0;
+  for (const auto& block : mesh.cells) {
+    if (order(block.type) > 1)
+      for (Index e = 0; e < block.size(); ++e) {
+        CellQuality& c = out[static_cast<std::size_t>(offset + e)];
+        c.valid = certified[static_cast<std::size_t>(offset + e)].valid;
+        if (!c.valid) c.value = 0.0;
+      }
+    offset += block.size();
   }
   return out;
 }
