@@ -40,7 +40,6 @@
 #include <filesystem>
 #include <iostream>
 #include <optional>
-#include <set>
 #include <string>
 #include <variant>
 #include <vector>
@@ -66,12 +65,7 @@ struct Arguments {
   examples::MoverArguments options;
 };
 
-// A --geometry naming a STEP, IGES or BREP file (any case) rather than an analytic shape.
-bool is_cad_file(const std::string& text) {
-  const std::string ext = detail::lower_extension(text);
-  return ext == ".step" || ext == ".stp" || ext == ".iges" || ext == ".igs" || ext == ".brep";
-}
-
+// A --geometry naming a STEP, IGES or BREP file rather than an analytic shape.
 bool cad_geometry(const Arguments& args) { return args.geometry.size() == 1 && is_cad_file(args.geometry.front()); }
 
 // The options given, without the geometry (whose text needs the mesh's dimension).
@@ -119,35 +113,15 @@ int run(Mesh<Dim> linear, const Arguments& args) {
 #ifdef MESHMOTION_HAVE_CAD
   // Kept for the whole run: the groups' geometry refers to it.
   static std::optional<CadModel> model;
-  std::vector<CadGroupMatch> matches;
+  CadCurving cad;
 #endif
   if (cad_geometry(args)) {
 #ifdef MESHMOTION_HAVE_CAD
     const auto start = std::chrono::steady_clock::now();
     model.emplace(CadModel::read(args.geometry.front()));
-    name_unnamed_facet_groups(linear);  // as curve_mesh() does: the matches name groups by their tags
-    matches = match_cad_groups(linear, *model, args.cad_tolerance, args.groups);
-    require_cad_fit(linear, *model, matches);
-    // Unless named, a planar group is left to curve_mesh(), which keeps it straight and lets it
-    // slide where it meets a curved group (a symmetry plane): snapping onto a plane moves nothing.
-    const std::set<int> planar =
-        args.groups.empty() && options.slide_planar_groups ? planar_group_tags(linear) : std::set<int>{};
-    // Unless named, a group on the model's planes alone (lines in 2D: a box's far field) has
-    // nothing to curve either and stays straight: projecting its nodes and measuring its facets
-    // took a third of the wing's run (benchmarks/wing_mesh.py) for no change.
-    const auto flat = [&](const CadGroupMatch& m) {
-      return std::all_of(m.entities.begin(), m.entities.end(), [&](int e) { return model->flat(m.dim, e); });
-    };
-    for (const CadGroupMatch& m : matches) {
-      if (!m.matched() || planar.count(linear.group(m.group).tag)) continue;
-      if (args.groups.empty() && flat(m)) {
-        options.geometry.insert_or_assign(m.group, BoundaryGeometry<Dim>::straight());
-        continue;
-      }
-      options.geometry.insert_or_assign(m.group, cad_boundary<Dim>(*model, m, args.cad_tolerance));
-      on_model.push_back(m.group);
-    }
-    cad_report = describe_cad_matches(matches);
+    cad = geometry_on_cad(linear, *model, options, args.cad_tolerance, args.groups);
+    cad_report = cad.report;
+    on_model = cad.on_model;
     cad_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!args.json) std::fprintf(stderr, "CAD model %s:\n%s", args.geometry.front().c_str(), cad_report.c_str());
 #else
@@ -161,7 +135,7 @@ int run(Mesh<Dim> linear, const Arguments& args) {
     // Each node's place on the model goes into the .msh, so the curved mesh goes back into
     // Gmsh's CAD-aware tools (and into this program again) tied to the model.
     const auto start = std::chrono::steady_clock::now();
-    place_on_cad(result.curved, *model, matches, args.cad_tolerance);
+    place_on_cad(result.curved, *model, cad.matches, args.cad_tolerance);
     cad_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 #endif

@@ -106,7 +106,10 @@ def curve_mesh(mesh, **options):
     """Curves a linear mesh into a certified P2 (P3, P4) mesh; returns (curved mesh, report dict).
 
     Keywords: geometry ({group: "spline" | "reconstruct" | "straight" | "bump" | "circle:X,Y,R" |
-    "naca:XXXX[,CHORD,X0,Y0]" | "sphere:X,Y,Z,R"}), and every key of curve_options(method):
+    "naca:XXXX[,CHORD,X0,Y0]" | "sphere:X,Y,Z,R"}, or a CAD file "MODEL.step" (.stp, .iges, .igs,
+    .brep) for every group it fits, as the curve_mesh program chooses them; cad_groups=[...]
+    names them, cad_tolerance sets the matching tolerance; the report then has on_model and
+    cad_groups), and every key of curve_options(method):
     the pipeline's own (order, method, sliding, steps, strict, support_radius, untangle, ...)
     and the typed options of the method's mover (as in Mover()), each with its type, default
     and one line of doc. An unknown key is refused naming the known ones. strict=True raises

@@ -437,6 +437,42 @@ def test_curve_mesh_at_order_3_and_4():
         mm.curve_mesh(mesh, raise_rounds=-1)
 
 
+def test_curve_mesh_on_a_cad_model_takes_the_programs_policy(tmp_path):
+    # A disk's hole in a square, as Gmsh's OpenCASCADE kernel builds, writes (BREP) and meshes
+    # it: the wall goes onto the model's circle, the square (the model's lines alone) stays
+    # straight, as curve_mesh --geometry MODEL.brep decides (geometry_on_cad()).
+    if not mm._core.have_cad:
+        pytest.skip("the module was built without the CAD component (libocct-*-dev)")
+    gmsh = pytest.importorskip("gmsh", reason="python3-gmsh is not installed")
+    model, mesh_file = tmp_path / "hole.brep", tmp_path / "hole.msh"
+    gmsh.initialize(["-noenv"])
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        square = gmsh.model.occ.addRectangle(-2, -2, 0, 4, 4)
+        hole = gmsh.model.occ.addDisk(0, 0, 0, 0.5, 0.5)
+        (surface,), _ = gmsh.model.occ.cut([(2, square)], [(2, hole)])
+        gmsh.model.occ.synchronize()
+        gmsh.write(str(model))
+        curves = [c for _, c in gmsh.model.getBoundary([surface])]
+        circle = [c for c in curves if abs(gmsh.model.occ.getMass(1, abs(c)) - np.pi) < 1e-6]
+        for dim, tags, name in ((1, [abs(c) for c in circle], "wall"), (1, [abs(c) for c in curves if c not in circle], "farfield"),
+                                (2, [surface[1]], "fluid")):
+            gmsh.model.setPhysicalName(dim, gmsh.model.addPhysicalGroup(dim, tags), name)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.3)
+        gmsh.model.mesh.generate(2)
+        gmsh.write(str(mesh_file))
+    finally:
+        gmsh.finalize()
+    curved, report = mm.curve_mesh(mm.read_mesh(str(mesh_file)), geometry=str(model), order=3)
+    assert report["on_model"] == ["wall"] and "wall" in report["cad_groups"]
+    assert report["invalid"] == 0
+    wall = curved.group_nodes("wall")
+    np.testing.assert_allclose(np.linalg.norm(curved.points[wall], axis=1), 0.5, atol=1e-9)
+    assert len(wall) == 3 * len(mm.read_mesh(str(mesh_file)).group_nodes("wall"))  # P3: two nodes an edge
+    with pytest.raises(ValueError, match="cad_groups and cad_tolerance go with"):
+        mm.curve_mesh(curved, cad_tolerance=1e-6)
+
+
 def test_curve_mesh_puts_the_high_order_nodes_on_the_circle():
     mesh = annulus()
     curved, report = mm.curve_mesh(mesh, geometry={"wall": "circle:0,0,0.5"})

@@ -5,6 +5,7 @@
 
 #include "cad_shape.hpp"
 #include "meshmotion/core/error.hpp"
+#include "meshmotion/curving/detail/curving_groups.hpp"
 #include "meshmotion/io/detail/read_file.hpp"
 
 #include <dlfcn.h>
@@ -645,6 +646,33 @@ std::string describe_cad_matches(const std::vector<CadGroupMatch>& matches) {
   return out.str();
 }
 
+template <int Dim>
+CadCurving geometry_on_cad(Mesh<Dim>& mesh, const CadModel& model, CurveOptions<Dim>& options, double tolerance,
+                           const std::vector<std::string>& groups) {
+  name_unnamed_facet_groups(mesh);  // the matches name groups by their tags
+  CadCurving out{match_cad_groups(mesh, model, tolerance, groups), {}, {}};
+  require_cad_fit(mesh, model, out.matches);
+  // Snapping onto a plane moves nothing; projecting a far field's nodes and measuring its
+  // facets took a third of a wing's run (benchmarks/wing_mesh.py) for no change.
+  const std::set<int> planar = groups.empty() && options.slide_planar_groups ? planar_group_tags(mesh) : std::set<int>{};
+  const auto flat = [&](const CadGroupMatch& m) {
+    return std::all_of(m.entities.begin(), m.entities.end(), [&](int e) { return model.flat(m.dim, e); });
+  };
+  for (const CadGroupMatch& m : out.matches) {
+    if (!m.matched() || planar.count(mesh.group(m.group).tag)) continue;
+    if (groups.empty() && flat(m)) {
+      options.geometry.insert_or_assign(m.group, BoundaryGeometry<Dim>::straight());
+      continue;
+    }
+    options.geometry.insert_or_assign(m.group, cad_boundary<Dim>(model, m, tolerance));
+    out.on_model.push_back(m.group);
+  }
+  out.report = describe_cad_matches(out.matches);
+  return out;
+}
+
+template CadCurving geometry_on_cad<2>(Mesh<2>&, const CadModel&, CurveOptions<2>&, double, const std::vector<std::string>&);
+template CadCurving geometry_on_cad<3>(Mesh<3>&, const CadModel&, CurveOptions<3>&, double, const std::vector<std::string>&);
 template void require_cad_fit<2>(const Mesh<2>&, const CadModel&, const std::vector<CadGroupMatch>&);
 template void require_cad_fit<3>(const Mesh<3>&, const CadModel&, const std::vector<CadGroupMatch>&);
 template std::vector<CadGroupMatch> match_cad_groups<2>(const Mesh<2>&, const CadModel&, double, const std::vector<std::string>&);

@@ -21,6 +21,7 @@
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/curving/boundary_snapping.hpp"
+#include "meshmotion/curving/curve_options.hpp"
 
 #include <array>
 #include <filesystem>
@@ -158,5 +159,25 @@ void require_cad_fit(const Mesh<Dim>& mesh, const CadModel& model, const std::ve
 
 /// One line per group: what it matched (or why not), for the programs' reports.
 [[nodiscard]] std::string describe_cad_matches(const std::vector<CadGroupMatch>& matches);
+
+/// The groups curve_mesh() curves on a model, as geometry_on_cad() chose them.
+struct CadCurving {
+  std::vector<CadGroupMatch> matches;  ///< match_cad_groups()'s, for place_on_cad() after curving
+  std::vector<std::string> on_model;   ///< the groups given the model's geometry
+  std::string report;                  ///< describe_cad_matches(): one line per group
+};
+
+/// Which groups of `mesh` go onto `model` (the policy every front end shares: curve_mesh
+/// --geometry FILE, Python's curve_mesh(geometry="FILE")): the groups `groups` names, or every
+/// facet group the model fits (match_cad_groups(), within `tolerance`; require_cad_fit()
+/// refuses a model that fits none). Each gets cad_boundary() in `options.geometry`, except,
+/// unless named, a planar group where `options.slide_planar_groups` (left to curve_mesh(),
+/// which keeps it straight and lets it slide where it meets a curved group: a symmetry plane)
+/// and a group on the model's planes alone (a box's far field: kept straight, nothing to
+/// curve). Names unnamed facet groups by their tags first, as curve_mesh() does. `model` must
+/// outlive the options.
+template <int Dim>
+[[nodiscard]] CadCurving geometry_on_cad(Mesh<Dim>& mesh, const CadModel& model, CurveOptions<Dim>& options,
+                                         double tolerance = 0.0, const std::vector<std::string>& groups = {});
 
 }  // namespace meshmotion

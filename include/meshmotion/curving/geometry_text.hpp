@@ -20,11 +20,22 @@
 #include "meshmotion/curving/geometry.hpp"
 #include "meshmotion/curving/naca_section.hpp"
 
+#include <cctype>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace meshmotion {
+
+/// Whether `text` names a CAD file (.step, .stp, .iges, .igs, .brep, any case) rather than a
+/// geometry of geometry_from_text(): what the CAD component reads (cad/cad_model.hpp).
+[[nodiscard]] inline bool is_cad_file(std::string_view text) {
+  const auto dot = text.rfind('.');
+  if (dot == std::string_view::npos || text.find('/', dot) != std::string_view::npos) return false;
+  std::string ext(text.substr(dot));
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".step" || ext == ".stp" || ext == ".iges" || ext == ".igs" || ext == ".brep";
+}
 
 /// The geometry `spec` names (see the file comment) for a Dim-dimensional mesh. Throws
 /// InputError naming the text for an unknown or wrong-dimension kind, a malformed number or a
