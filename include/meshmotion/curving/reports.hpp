@@ -10,6 +10,7 @@
 #include "meshmotion/curving/curve_mesh.hpp"
 #include "meshmotion/curving/geometry_distance.hpp"
 #include "meshmotion/curving/untangle.hpp"
+#include "meshmotion/io/foam_case_summary.hpp"
 #include "meshmotion/io/mesh_summary.hpp"
 #include "meshmotion/movers/boundary_layer.hpp"
 #include "meshmotion/movers/mover.hpp"
@@ -42,6 +43,10 @@ void for_each_report(F&& f) {
   f.template operator()<MoveReport>("move", "move_mesh's report",
                                     "`move_mesh --json` (beside input, output, support_radius, options).");
   f.template operator()<MeshSummary>("summary", "summary", "What a mesh holds (`mesh_info --json`, Python's Mesh.summary).");
+  f.template operator()<FoamCaseSummary>("openfoam_case", "openfoam",
+                                         "An OpenFOAM case as checkMesh counts it (`mesh_info --json` of a case).");
+  f.template operator()<FoamPatchSummary>("openfoam_patch", "patches", "One patch of the case's boundary file.");
+  f.template operator()<FoamZoneSummary>("openfoam_zone", "zones", "One cell, face or point zone of the case.");
 }
 
 /// The keys of report `key`'s JSON object and Python dict. Throws InputError naming the known
