@@ -832,4 +832,13 @@ TEST_CASE("in-memory parsing entry points name the source in errors", "[io]") {
   CHECK(m.num_cells() == 1);
   CHECK(m.group("wall").tag == 1);
   CHECK(m.group_nodes("wall") == std::vector<Index>{0, 1});
+  // SU2's repository has meshes spelling the keywords MARKERTAG= and MARKERELEMS=, which SU2
+  // reads; another keyword there is still refused.
+  const auto spelled = parse_su2("NDIME= 2\nNPOIN= 3\n0 0\n1 0\n0 1\nNELEM= 1\n5 0 1 2\nNMARK= 2\nMARKERTAG= wall\n"
+                                 "MARKERELEMS= 1\n3 0 1\nMARKER_TAG= far\nMARKER_ELEMS= 1\n3 1 2\n", "memory.su2");
+  CHECK(std::get<Mesh<2>>(spelled).group_nodes("wall") == std::vector<Index>{0, 1});
+  CHECK(std::get<Mesh<2>>(spelled).group_nodes("far") == std::vector<Index>{1, 2});
+  CHECK_THROWS_WITH((void)parse_su2("NDIME= 2\nNPOIN= 3\n0 0\n1 0\n0 1\nNELEM= 1\n5 0 1 2\nNMARK= 1\nMARKER_NAME= wall\n"
+                                    "MARKER_ELEMS= 1\n3 0 1\n", "memory.su2"),
+                    Catch::Contains("memory.su2:9") && Catch::Contains("expected MARKER_TAG= for marker 1"));
 }

@@ -52,7 +52,7 @@ class Su2Parser {
       } else if (key == "NMARK") {
         require_dim();
         read_markers(pending);
-      } else if (key == "MARKER_TAG" || key == "MARKER_ELEMS") {
+      } else if (marker_tag(key) || marker_elems(key)) {
         text_.fail(std::string(key) + "= of a marker beyond NMARK= (the file lists more markers than NMARK= counts)");
       } else {
         skip_section();  // NZONE, IZONE, NPERIODIC/PERIODIC_INDEX, FFD_* boxes: not mesh data
@@ -81,6 +81,12 @@ class Su2Parser {
     std::size_t first;
     std::uint64_t line;
   };
+
+  // SU2's own reader takes the line after NMARK= as a marker's tag and the next as its element
+  // count whatever their keywords say; files from SU2's repository write MARKERTAG= (and
+  // MARKERELEMS=). Both spellings are read, any other keyword there is refused.
+  [[nodiscard]] static bool marker_tag(std::string_view key) { return key == "MARKER_TAG" || key == "MARKERTAG"; }
+  [[nodiscard]] static bool marker_elems(std::string_view key) { return key == "MARKER_ELEMS" || key == "MARKERELEMS"; }
 
   // "KEY=" possibly with spaces around '='; the cursor stops after '='.
   [[nodiscard]] std::string_view keyword() {
@@ -207,14 +213,14 @@ class Su2Parser {
     text_.next_line();
     for (int m = 0; m < count; ++m) {
       skip_comments();
-      if (keyword() != "MARKER_TAG") text_.fail("expected MARKER_TAG= for marker " + std::to_string(m + 1));
+      if (!marker_tag(keyword())) text_.fail("expected MARKER_TAG= for marker " + std::to_string(m + 1));
       PhysicalGroup g;
       g.dim = dim_ - 1;
       g.tag = m + 1;
       g.name = std::string(text_.rest_of_line());
       if (g.name.empty()) text_.fail("empty marker name (expected MARKER_TAG= name)");
       skip_comments();
-      if (keyword() != "MARKER_ELEMS") text_.fail("expected MARKER_ELEMS= for marker '" + g.name + "'");
+      if (!marker_elems(keyword())) text_.fail("expected MARKER_ELEMS= for marker '" + g.name + "'");
       const auto n = text_.integer<std::int64_t>("number of marker elements", 0);
       text_.next_line();
       read_element_lines(n, pending, g.tag, dim_ - 1);
