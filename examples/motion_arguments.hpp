@@ -9,11 +9,15 @@
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/movers/motion.hpp"
 #include "meshmotion/movers/mover.hpp"
+#include "meshmotion/io/openfoam.hpp"
+#include "meshmotion/quality/foam_quality.hpp"
+#include "meshmotion/quality/quality_report.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cstdint>
+#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <sstream>
@@ -196,6 +200,32 @@ BoundarySpec<Dim> boundary_spec(const MotionArguments& a, const Mesh<Dim>& mesh)
               << ") " << (o.nodes == 1 ? "is" : "are") << " also in '" << o.other << "' (" << name(o.other_kind) << "): "
               << name(o.winner_kind) << " wins (prescribed over fixed over sliding)\n";
   return spec;
+}
+
+/// The verdict on a moved mesh: its cells, and how many are invalid. A polyhedral OpenFOAM
+/// case (`input` a case folder whose cells were cut around centres) is judged as checkMesh
+/// judges it, on its own cells (`foam`): the tetrahedra they were cut into are the library's,
+/// and one of them may fold inside a cell that OpenFOAM finds sound (a triangle of a warped
+/// face). Any other mesh by `after` (certified for high-order cells).
+struct MovedVerdict {
+  Index cells = 0, invalid = 0;
+  std::optional<FoamQuality> foam;
+};
+
+template <int Dim>
+[[nodiscard]] MovedVerdict moved_verdict(const Mesh<Dim>& moved, const QualityReport& after, const std::filesystem::path& input) {
+  MovedVerdict out{after.num_elements, after.num_invalid, std::nullopt};
+  if constexpr (Dim == 3) {
+    std::error_code ec;
+    if (moved.num_auxiliary_nodes > 0 && std::filesystem::is_directory(input, ec)) {
+      PolyMesh poly = read_polymesh(input);
+      poly.points = moved.points.leftCols(poly.points.cols());
+      out.foam = foam_quality(poly);
+      out.invalid = out.foam->num_invalid_cells;
+      out.cells = poly.num_cells;
+    }
+  }
+  return out;
 }
 
 /// Says on stderr what the mover chose that changes what a user gets: the rigid part taken

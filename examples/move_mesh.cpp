@@ -88,21 +88,9 @@ int move_and_write(const Arguments& a, const Mesh<Dim>& mesh, const examples::Mo
   const double radius = chosen.support_radius;  // 0: the method has none
   const MoveReport report = move_report(a.mover.method, before, result);
   const QualityReport& after = report.after;
-  // A polyhedral OpenFOAM case is judged as checkMesh judges it, on its own cells: the
-  // tetrahedra they were cut into are the library's, and one of them may fold inside a cell
-  // that OpenFOAM finds sound (a triangle of a warped face).
-  std::optional<FoamQuality> foam_after;
-  Index invalid_cells = after.num_invalid, cells = after.num_elements;
-  if constexpr (Dim == 3) {
-    std::error_code ec;
-    if (mesh.num_auxiliary_nodes > 0 && std::filesystem::is_directory(a.input, ec)) {
-      PolyMesh poly = read_polymesh(a.input);
-      poly.points = result.mesh.points.leftCols(poly.points.cols());
-      foam_after = foam_quality(poly);
-      invalid_cells = foam_after->num_invalid_cells;
-      cells = poly.num_cells;
-    }
-  }
+  const examples::MovedVerdict verdict = examples::moved_verdict(result.mesh, after, a.input);
+  const std::optional<FoamQuality>& foam_after = verdict.foam;
+  const Index invalid_cells = verdict.invalid, cells = verdict.cells;
   const bool invalid = invalid_cells > 0;
   if (invalid && a.strict)
     throw InvalidMeshError("move_mesh: " + std::to_string(invalid_cells) + " of " + std::to_string(cells) +

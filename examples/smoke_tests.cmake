@@ -467,6 +467,21 @@ file(WRITE "${smoke_dir}/foam_poly_wall.txt" "0 0.01 0 0\n5 0.01 0 0\n8 0.01 0 0
 smoke_test(NAME move_mesh.openfoam_polyhedra_displacements_by_label.json KEYS output VALUES after/invalid=0
            COMMAND move_mesh "${smoke_dir}/foam_poly" -o "${smoke_dir}/foam_poly/0.2" --group wall
                    --displacements "${smoke_dir}/foam_poly_wall.txt" --fixed outlet --json)
+# move_mesh_mpi takes a case folder as move_mesh does, judges it on its own cells and writes a
+# time folder into it: the points move_mesh writes, byte for byte.
+if(TARGET move_mesh_mpi)
+  set(poly_motion --group body --translate 0.05,0,0 --fixed "(outlet|sides)" --sliding frontAndBack:0,0,1 --json)
+  smoke_test(NAME move_mesh_mpi.openfoam_case.json SETUP examples_foam_poly_mpi RANKS 2 KEYS checkmesh_after/max_skewness
+             VALUES after/invalid=0,checkmesh_after/invalid_cells=0,ranks=2
+             COMMAND move_mesh_mpi "${smoke_dir}/foam_poly" -o "${smoke_dir}/foam_poly/0.5" ${poly_motion})
+  smoke_test(NAME move_mesh_mpi.openfoam_case_serial_peer.json SETUP examples_foam_poly_mpi_peer KEYS output
+             COMMAND move_mesh "${smoke_dir}/foam_poly" -o "${smoke_dir}/foam_poly/0.6" ${poly_motion})
+  add_test(NAME examples.move_mesh_mpi.openfoam_case_equals_move_mesh
+           COMMAND "${CMAKE_COMMAND}" -E compare_files "${smoke_dir}/foam_poly/0.5/polyMesh/points"
+                   "${smoke_dir}/foam_poly/0.6/polyMesh/points")
+  set_tests_properties(examples.move_mesh_mpi.openfoam_case_equals_move_mesh PROPERTIES LABELS examples
+                       FIXTURES_REQUIRED "examples_foam_poly_mpi;examples_foam_poly_mpi_peer")
+endif()
 # A cell zone moved as a body, written as a new case: the case's own cells, patches and zone.
 file(REMOVE_RECURSE "${smoke_dir}/foam_poly_moved")
 smoke_test(NAME move_mesh.openfoam_zone_to_new_case.json SETUP examples_foam_poly_moved KEYS output

@@ -48,6 +48,7 @@ struct Arguments {
   int threads = 0;
   bool json = false, strict = false, overwrite = false, keep_orientation = false, rank_files = false;
   examples::MoverArguments mover;
+  examples::FoamSelection foam;
 };
 
 // Threads per rank: --threads, else OMP_NUM_THREADS, else the node's cores shared among its ranks.
@@ -119,11 +120,12 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
     whole->points = moved;
     examples::note_mover_choices(stats);
     const QualityReport after = quality_report(*whole, Metric::skew);
-    const bool invalid = after.num_invalid > 0;
+    const examples::MovedVerdict verdict = examples::moved_verdict(*whole, after, a.input);
+    const bool invalid = verdict.invalid > 0;
     if (invalid && a.strict)
-      throw InvalidMeshError("move_mesh_mpi: " + std::to_string(after.num_invalid) + " of " + std::to_string(after.num_elements) +
+      throw InvalidMeshError("move_mesh_mpi: " + std::to_string(verdict.invalid) + " of " + std::to_string(verdict.cells) +
                              " cells invalid after the motion (--strict: nothing written)");
-    write_mesh(a.output, *whole);
+    examples::write_output(a.output, *whole, a.input);
     // move_mesh's report: the slowest rank's times, rank 0's other figures.
     MoverStats step = stats;
     step.setup_seconds = seconds[0];
@@ -139,6 +141,10 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
       else
         w.key("solver").value(name(parallel.elasticity.solver));
       write_json_fields(w, report);
+      if (verdict.foam) {
+        w.key("checkmesh_after");
+        write_json(w, *verdict.foam);
+      }
       w.end_object();
       std::cout << "\n";
     } else {
@@ -147,9 +153,13 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
                 << (mover->boundary_solve() != "none" ? ", boundary solve " + std::string(mover->boundary_solve()) : std::string())
                 << " (times: the slowest rank)\n";
       write_text(std::cout, report, 2);
+      if (verdict.foam) {
+        std::cout << "  the case's own cells (checkMesh's measures; the validity verdict):\n";
+        write_text(std::cout, *verdict.foam, 4);
+      }
     }
     if (invalid) {
-      std::cerr << "wrote " << a.output << " WITH " << after.num_invalid << " INVALID CELLS of " << after.num_elements << "\n";
+      std::cerr << "wrote " << a.output << " WITH " << verdict.invalid << " INVALID CELLS of " << verdict.cells << "\n";
       code = examples::exit_invalid;
     } else if (!a.json) {
       std::cout << "wrote " << a.output << "\n";
@@ -165,8 +175,11 @@ int main_body(int argc, char** argv) {
   CLI::App app{"Move a mesh on MPI ranks: read on rank 0, partitioned by METIS, moved by the distributed movers"};
   examples::add_version_flag(app);
   Arguments a;
-  app.add_option("input", a.input, "Input mesh (.msh, .su2)")->check(CLI::ExistingFile);
-  app.add_option("-o,--output", a.output, "Output mesh (.msh, .su2, .vtu), written by rank 0");
+  app.add_option("input", a.input, "Input mesh (.msh, .su2, .cgns, .vtu) or OpenFOAM case folder")->check(CLI::ExistingPath);
+  app.add_option("-o,--output", a.output,
+                 "Output mesh (.msh, .su2, .cgns, .vtu), or an OpenFOAM case (its points replaced; give --overwrite when it "
+                 "is the input) or a time folder of it (case/0.001), or a new folder (a new case: the input case's cells, "
+                 "patches and zones, moved); written by rank 0");
   examples::add_motion_options(app, a.motion);
   examples::add_mover_options(app, a.mover, known_methods<3>());
   examples::add_option_flags(app, option_docs(ParallelOptions{}), a.parallel, "Distributed solves (boundary_solve: rbf; petsc_*: le, sle)");
@@ -180,6 +193,7 @@ int main_body(int argc, char** argv) {
   app.add_flag("--keep-orientation", a.keep_orientation,
                "refuse a mesh whose cells are all negatively oriented instead of reorienting it");
   app.add_flag("--json", a.json, "Print one JSON object (rank 0)");
+  examples::add_foam_options(app, a.foam);
   // Every rank parses the same words; rank 0 alone prints help or the complaint.
   if (const auto rc = meshmotion::examples::parse_command_line(app, argc, argv, root)) return *rc;
   // Rank 0 reports; every rank gets the same exception from the collective calls.
@@ -192,10 +206,15 @@ int main_body(int argc, char** argv) {
       collective(comm, [&] {
         if (a.input.empty() || a.output.empty()) throw InputError("move_mesh_mpi: give an input mesh and -o OUTPUT (see --help)");
         examples::require_motion(a.motion, "move_mesh_mpi");
+        a.input = examples::foam_input(a.input, a.foam).string();
+        a.output = examples::foam_output(a.output, a.foam).string();
         if (!root) return;
         examples::check_output(a.input, a.output, 1, a.overwrite);
         if (a.rank_files)
-          for (int r = 0; r < size_of(comm); ++r) examples::check_side_output(rank_file(a.output, r), {a.input}, {a.output});
+          for (int r = 0; r < size_of(comm); ++r) {
+            check_mesh_output(rank_file(a.output, r));
+            examples::check_side_output(rank_file(a.output, r), {a.input}, {a.output});
+          }
         mesh = std::make_unique<AnyMesh>(examples::read_input(a.input));
         dim = std::holds_alternative<Mesh<2>>(*mesh) ? 2 : 3;
       });
