@@ -134,11 +134,11 @@ class DistributedRbfMover {
   /// Whether the boundary system goes through PETSc (BoundarySolveOptions); throws on every
   /// rank when PETSc is demanded and cannot take it.
   [[nodiscard]] bool choose_petsc(const GatheredBoundary& gathered, const Points<Dim>& centres) const;
-  /// Why PETSc cannot solve this boundary system (empty: it can).
   /// Collective: the serial mover's default radius for the whole mesh (`centres`: the
   /// gathered boundary in global id order).
   [[nodiscard]] DefaultSupportRadius default_radius(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary,
                                                     const GatheredBoundary& gathered, const Points<Dim>& centres) const;
+  /// Why PETSc cannot solve this boundary system (empty: it can).
   [[nodiscard]] std::string petsc_obstacle(const std::vector<int>& kinds, bool radius_per_entry, const Points<Dim>& centres) const;
   /// move_into() once the boundary was gathered (replicated or PETSc).
   void move_gathered(PointsView<Dim> d, Points<Dim>& out);
