@@ -153,6 +153,44 @@ TEST_CASE("distributed RBF shrinks the default radius to the serial mover's memo
   }
 }
 
+TEST_CASE("distributed RBF set up once with no motion takes the serial budget radius and follows many moves",
+          "[parallel][rbf]") {
+  // As a solver runs it: both movers set up on the reference with zero displacements (the
+  // radius from the boundary's spacing, cut to the budget), then moved again and again.
+  const Mesh<2> mesh = rectangle_mesh({.nx = 24, .ny = 18, .cells = RectangleCells::tri_quad});
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Translation<2>{meshmotion::Vec<2>(0.0, 0.1)}).fixed("top").fixed("left").fixed("right");
+  ResolvedBoundary<2> b = spec.resolve(mesh);
+  const Points<2> bump = b.displacements;
+  b.displacements.setZero();
+  RbfOptions options;
+  options.max_memory_bytes = 1e5;
+  RbfMover<2> serial(options);
+  serial.setup(mesh, b);
+  REQUIRE(serial.support_radius_reduced());
+  const DistributedMesh<2> part = partition_mesh(world(), mesh);
+  ResolvedBoundary<2> local_b = distribute_boundary(part, b);
+  DistributedRbfMover<2> mover(options, {BoundarySolve::replicated});
+  mover.setup(part.view(), local_b);
+  CHECK(mover.support_radius() == serial.support_radius());
+  CHECK(mover.stats().radius_reduced);
+  for (const double scale : {0.5, 1.0, -2.0}) {
+    Points<2> d = bump;
+    for (Index k = 0; k < d.cols(); ++k)
+      d.col(k) *= scale * std::sin(3.14159 * mesh.points(0, b.nodes[static_cast<std::size_t>(k)]));
+    const Points<2> expected = serial.move(d);
+    Points<2> local_d(2, local_b.size());
+    for (Index k = 0; k < local_b.size(); ++k)
+      local_d.col(k) = d.col(b.column(part.global_ids[static_cast<std::size_t>(local_b.nodes[static_cast<std::size_t>(k)])]));
+    const Points<2> got = mover.move(local_d);
+    double worst = 0.0;
+    for (Index i = 0; i < part.local.num_nodes(); ++i)
+      worst = std::max(worst, (got.col(i) - expected.col(part.global_ids[static_cast<std::size_t>(i)])).norm());
+    INFO("scale " << scale);
+    CHECK(global_max(worst) <= 1e-12 * expected.colwise().norm().maxCoeff());
+  }
+}
+
 TEST_CASE("distributed RBF with the boundary system factorized across the ranks by MUMPS", "[parallel][rbf][petsc]") {
   const BoundarySolveOptions petsc{BoundarySolve::petsc};
   {
