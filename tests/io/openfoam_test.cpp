@@ -25,6 +25,10 @@
 #include <string>
 #include <vector>
 
+#ifdef MESHMOTION_HAVE_ZLIB
+#include <zlib.h>
+#endif
+
 using namespace meshmotion;
 namespace fs = std::filesystem;
 
@@ -455,6 +459,59 @@ TEST_CASE("OpenFOAM: corrupt counts, labels and classes are refused before anyth
                                 t.begin() + static_cast<std::ptrdiff_t>(at) + 8);
              }),
              Catch::Contains("cell 0 is open") && Catch::Contains("face 3 points into it"));
+}
+
+TEST_CASE("OpenFOAM: bytes after a list are refused, and a compressed file is decompressed no further than its list needs",
+          "[io][openfoam]") {
+  const fs::path dir = test::scratch_path("foam_appended");
+  const fs::path mesh_dir = dir / "constant" / "polyMesh";
+  const auto message = [&] {
+    try {
+      (void)read_openfoam(dir);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  write_case(dir, hanging_node_case());
+  std::ofstream(mesh_dir / "owner", std::ios::app) << "\n// the end\n3 4 5\n";
+  CHECK_THAT(message(), Catch::Contains("owner:") && Catch::Contains("unexpected content after the owner list ('3')"));
+  write_case(dir, hanging_node_case(), Format::binary);
+  std::ofstream(mesh_dir / "points", std::ios::app | std::ios::binary) << std::string(100, '\0');
+  CHECK_THAT(message(), Catch::Contains("points: byte") && Catch::Contains("after the point list (a NUL byte)"));
+#ifdef MESHMOTION_HAVE_ZLIB
+  // A list, then 64 MiB of NUL bytes: 64 kB compressed. Decompression stops 64 KiB past the
+  // list instead of holding it all.
+  const auto padded = [&](const std::string& file, bool binary, std::size_t pad) {
+    write_polymesh(dir, hanging_node_case(), PolyMeshWriteOptions{binary, true});
+    std::string text = detail::read_foam_file(mesh_dir / file);
+    const std::size_t length = text.size();
+    text.append(pad, '\0');
+    gzFile out = gzopen((mesh_dir / (file + ".gz")).c_str(), "wb");
+    REQUIRE(out != nullptr);
+    REQUIRE(gzwrite(out, text.data(), static_cast<unsigned>(text.size())) == static_cast<int>(text.size()));
+    gzclose(out);
+    return length;
+  };
+  for (const bool binary : {false, true}) {
+    fs::remove_all(dir);
+    const std::size_t length = padded("points", binary, std::size_t{64} << 20);
+    CHECK(fs::file_size(mesh_dir / "points.gz") < (std::size_t{1} << 20));
+    const std::string what = message();
+    CHECK_THAT(what, Catch::Contains("points.gz: byte ") && Catch::Contains("decompresses to more than its list needs (") &&
+                         Catch::Contains("bytes after the list"));
+    // The list ends before the file's closing comment line: within 65 kB of the file's end.
+    const std::size_t at = std::stoul(what.substr(what.find(": byte ") + 7));
+    CHECK(at > 65536);
+    CHECK(at <= length + 65536);
+  }
+  // A few NUL bytes inside the tail: read, then refused as content after the list.
+  (void)padded("owner", false, 10);
+  CHECK_THAT(message(), Catch::Contains("owner:") && Catch::Contains("after the owner list (a NUL byte)"));
+  // The untouched compressed case reads.
+  write_polymesh(dir, hanging_node_case(), PolyMeshWriteOptions{false, true});
+  CHECK(message() == "no error");
+#endif
 }
 
 TEST_CASE("OpenFOAM: checkMesh's measures agree with checkMesh on the shared case, a moved one and a polyhedral one",

@@ -61,6 +61,7 @@ namespace detail {
     }
   }
   in.expect(")");
+  in.expect_end("point list");
   return points;
 }
 
@@ -82,6 +83,7 @@ inline void read_foam_faces(const std::filesystem::path& file, PolyMesh& mesh) {
       if (offsets[k] < offsets[k - 1] + 3) in.fail("face " + std::to_string(k - 1) + " has fewer than 3 vertices");
     mesh.face_offsets = std::move(offsets);
     mesh.face_nodes = std::move(nodes);
+    in.expect_end("face lists");
     return;
   }
   const auto n = in.integer<Index>("face count", 0, std::numeric_limits<Index>::max());
@@ -98,6 +100,7 @@ inline void read_foam_faces(const std::filesystem::path& file, PolyMesh& mesh) {
     mesh.face_offsets.push_back(static_cast<Index>(mesh.face_nodes.size()));
   }
   in.expect(")");
+  in.expect_end("face list");
 }
 
 /// Reads the boundary dictionary list: "N ( name { type T; nFaces N; startFace S; ... } ... )".
@@ -141,6 +144,7 @@ inline void read_foam_faces(const std::filesystem::path& file, PolyMesh& mesh) {
     patches.push_back(std::move(patch));
   }
   in.expect(")");
+  in.expect_end("patch list");
   return patches;
 }
 
@@ -216,6 +220,7 @@ inline void read_foam_faces(const std::filesystem::path& file, PolyMesh& mesh) {
     zones.push_back(std::move(zone));
   }
   in.expect(")");
+  in.expect_end("zone list");
   return zones;
 }
 
@@ -262,7 +267,9 @@ void check_closed_cells(const PolyMesh& mesh, Fail&& fail) {
   FoamCursor in(text, file);
   const FoamHeader h = read_foam_header(in);
   check_foam_class(in, h, {"labelList"});
-  return read_label_list(in, h, what, max_uniform);
+  std::vector<Index> labels = read_label_list(in, h, what, max_uniform);
+  in.expect_end(std::string(what) + " list");
+  return labels;
 }
 
 }  // namespace detail

@@ -51,7 +51,7 @@ class FoamCursor {
         while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
       } else if (text_.compare(pos_, 2, "/*") == 0) {
         const std::size_t end = text_.find("*/", pos_ + 2);
-        if (end == std::string_view::npos) fail("unterminated comment");
+        if (end == std::string_view::npos) run_out("unterminated comment");
         for (std::size_t k = pos_; k < end; ++k)
           if (text_[k] == '\n') ++line_;
         pos_ = end + 2;
@@ -73,7 +73,7 @@ class FoamCursor {
   /// The next token; `what` names it in the message at the end of the file.
   [[nodiscard]] std::string_view token(std::string_view what) {
     skip_space();
-    if (pos_ >= text_.size()) fail("unexpected end of file (expected " + std::string(what) + ")");
+    if (pos_ >= text_.size()) run_out("unexpected end of file (expected " + std::string(what) + ")");
     const std::size_t start = pos_;
     const char c = text_[pos_];
     if (c == '(' || c == ')' || c == '{' || c == '}' || c == ';') {
@@ -82,7 +82,7 @@ class FoamCursor {
     }
     if (c == '"') {
       const std::size_t end = text_.find('"', pos_ + 1);
-      if (end == std::string_view::npos) fail("unterminated string");
+      if (end == std::string_view::npos) run_out("unterminated string");
       pos_ = end + 1;
       return text_.substr(start, pos_ - start);
     }
@@ -120,7 +120,7 @@ class FoamCursor {
   /// `count` raw bytes right after the current position (a binary list body).
   [[nodiscard]] std::string_view raw(std::size_t count, std::string_view what) {
     if (pos_ + count > text_.size())
-      fail("binary " + std::string(what) + " ends after " + std::to_string(text_.size() - pos_) + " of " + std::to_string(count) +
+      run_out("binary " + std::string(what) + " ends after " + std::to_string(text_.size() - pos_) + " of " + std::to_string(count) +
            " bytes");
     const std::string_view bytes = text_.substr(pos_, count);
     pos_ += count;
@@ -129,15 +129,31 @@ class FoamCursor {
   /// Positions from now on are byte offsets (binary content follows).
   void use_byte_offsets() noexcept { binary_ = true; }
   [[nodiscard]] std::size_t offset() const noexcept { return pos_; }
+  /// The last failure was the text ending early (a prefix of a longer file may go on).
+  [[nodiscard]] bool ran_out() const noexcept { return ran_out_; }
 
-
+  /// Refuses anything but spaces and comments after the content `what`: bytes appended to a
+  /// file (a damaged copy, NUL padding) are not part of any mesh.
+  void expect_end(std::string_view what) {
+    skip_space();
+    if (pos_ >= text_.size()) return;
+    const std::string got = text_[pos_] == '\0' ? std::string("a NUL byte") : "'" + shorten_token(token("the end")) + "'";
+    fail("unexpected content after the " + std::string(what) + " (" + got + ")");
+  }
 
  private:
+  [[noreturn]] void run_out(const std::string& what) {
+    ran_out_ = true;
+    fail(what);
+  }
+
+
   std::string_view text_;
   std::filesystem::path file_;
   std::size_t pos_ = 0;
   std::uint64_t line_ = 1;
   bool binary_ = false;
+  bool ran_out_ = false;
 };
 
 /// The FoamFile header entries, and where the data after it starts.
@@ -242,7 +258,51 @@ inline void check_foam_class(FoamCursor& in, const FoamHeader& h, std::initializ
   return out;
 }
 
+/// The bytes a polyMesh list file needs from its start: its header and its list (both lists
+/// of a faceCompactList); nullopt while `prefix` ends before they do, or for a file of
+/// another class (dictionaries and zones, whose nested binary lists only their readers
+/// know). Throws ParseError where `prefix` is no such file.
+[[nodiscard]] inline std::optional<std::size_t> foam_list_extent(std::string_view prefix, const std::filesystem::path& file) {
+  FoamCursor in(prefix, file);
+  try {
+    const FoamHeader h = read_foam_header(in);
+    const auto cls = h.entries.find("class");
+    if (cls == h.entries.end()) return std::nullopt;
+    const bool compact = cls->second == "faceCompactList" || (h.binary && cls->second == "faceList");
+    const bool vectors = cls->second == "vectorField";
+    if (!compact && !vectors && cls->second != "labelList" && cls->second != "faceList") return std::nullopt;
+    const std::size_t width = static_cast<std::size_t>(vectors ? 3 * h.scalar_bytes : h.label_bytes);
+    for (int list = 0; list < (compact ? 2 : 1); ++list) {
+      const auto n = static_cast<std::size_t>(in.integer<std::int64_t>("a list count", 0, std::numeric_limits<std::int64_t>::max() / 16));
+      if (in.peek() == '{') {
+        in.expect("{");
+        (void)in.token("a uniform value");
+        in.expect("}");
+        continue;
+      }
+      in.expect("(");
+      if (h.binary) {
+        in.use_byte_offsets();
+        (void)in.raw(n * width, "list");
+        in.expect(")");
+        continue;
+      }
+      for (int depth = 1; depth > 0;) {
+        const std::string_view t = in.token("')'");
+        if (t == "(") ++depth;
+        if (t == ")") --depth;
+      }
+    }
+    return in.offset();
+  } catch (const ParseError&) {
+    if (in.ran_out()) return std::nullopt;
+    throw;
+  }
+}
+
 /// The whole content of `file`, or of `file`.gz decompressed (zlib) when only that exists.
+/// A compressed list file is decompressed no further than its list needs and a short tail
+/// (comments): a few compressed bytes must not become gigabytes. Throws ParseError for more.
 [[nodiscard]] inline std::string read_foam_file(const std::filesystem::path& file) {
   std::error_code ec;
   if (std::filesystem::exists(file, ec)) return read_whole_file(file);
@@ -250,20 +310,46 @@ inline void check_foam_class(FoamCursor& in, const FoamHeader& h, std::initializ
   gz += ".gz";
   if (!std::filesystem::exists(gz, ec)) throw IoError(file.string() + ": no such file (nor " + gz.filename().string() + ")");
 #ifdef MESHMOTION_HAVE_ZLIB
+  const std::uintmax_t packed = std::filesystem::file_size(gz, ec);
   gzFile in = gzopen(gz.c_str(), "rb");
   if (in == nullptr) throw IoError(gz.string() + ": cannot open for reading");
+  constexpr std::size_t tail = 64 * 1024;
+  // Files of other classes: a ratio no real OpenFOAM file reaches (ASCII compresses ~10:1).
+  std::size_t limit = std::max<std::size_t>(64u << 20, 256 * static_cast<std::size_t>(ec ? 0 : packed));
+  std::size_t next_look = 1 << 16;
+  bool sized = false;
   std::string data;
   std::array<char, 1 << 16> buffer{};
+  const auto refuse = [&](auto&& error) {
+    gzclose(in);
+    throw error;
+  };
   for (;;) {
     const int got = gzread(in, buffer.data(), static_cast<unsigned>(buffer.size()));
     if (got < 0) {
       int code = 0;
-      const std::string message = gzerror(in, &code);
-      gzclose(in);
-      throw IoError(gz.string() + ": decompression failed (" + message + ")");
+      refuse(IoError(gz.string() + ": decompression failed (" + gzerror(in, &code) + ")"));
     }
     if (got == 0) break;
     data.append(buffer.data(), static_cast<std::size_t>(got));
+    if (!sized && data.size() >= next_look) {
+      // Looked at each time the text doubles: linear in all.
+      next_look = 2 * data.size();
+      try {
+        if (const auto extent = foam_list_extent(data, gz)) {
+          limit = *extent + tail;
+          sized = true;
+        }
+      } catch (const ParseError&) {
+        break;  // not a list file: its reader finds the same fault in what is here, and says it
+      }
+    }
+    if (data.size() > limit)
+      refuse(ParseError(gz, limit,
+                        sized ? "decompresses to more than its list needs (" + std::to_string(limit - tail) + " bytes) and a " +
+                                    std::to_string(tail) + "-byte tail: bytes after the list"
+                              : "decompresses to more than " + std::to_string(limit) + " bytes (the larger of 64 MiB and 256 times its compressed size)",
+                        ParseError::Position::byte_offset));
   }
   gzclose(in);
   return data;
