@@ -640,7 +640,7 @@ TEST_CASE("malformed files give ParseError with file, line and what was expected
   write_text(bad, header + "$Nodes\n3\n1 0 0 0\n2 inf 0 0\n3 0 1 0\n$EndNodes\n");
   CHECK(parse_error_position(read, "not finite") == 7);
   write_text(bad, header + nodes + "$Elements\n1\n1 42 2 0 1 1 2 3\n$EndElements\n");
-  CHECK(parse_error_position(read, "unknown element type 42") == 12);
+  CHECK(parse_error_position(read, "unsupported Gmsh element type 42") == 12);
   write_text(bad, header + nodes + "$Elements\n2\n1 2 2 0 1 1 2 3\n$EndElements\n");
   CHECK(parse_error_position(read, "expected element id") == 13);
   write_text(bad, header + nodes + "$Elements\n1\n1 2 2 0 1 1 2 3\n2 2 2 0 1 1 2 3\n$EndElements\n");

@@ -18,6 +18,7 @@
 #include <sstream>
 #include <string>
 #include <utility>
+#include <vector>
 
 using namespace meshmotion;
 namespace fs = std::filesystem;
@@ -216,4 +217,72 @@ TEST_CASE("node ids are each format's own: from 0 in SU2 and VTU, from 1 in a wr
   const Mesh<2> from_msh = read_mesh_as<2>(msh);
   CHECK(from_msh.node_indices(std::vector<std::int64_t>{1, 4}) == std::vector<Index>{0, 3});
   CHECK_THROWS_AS(from_msh.node_indices(std::vector<std::int64_t>{0}), InputError);
+}
+
+namespace {
+
+/// A msh 4.1 square: one line on curve 1 ("wall"), two triangles on surface 1 ("fluid").
+/// `elements` replaces its $Elements body.
+std::string square_msh41(const std::string& elements = "2 3 1 3\n1 1 1 1\n1 1 2\n2 1 2 2\n2 1 2 3\n3 1 3 4\n",
+                         bool entities = true) {
+  return std::string("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n2\n1 1 \"wall\"\n2 2 \"fluid\"\n$EndPhysicalNames\n") +
+         (entities ? "$Entities\n0 1 1 0\n1 0 0 0 1 0 0 1 1 0\n1 0 0 0 1 1 0 1 2 0\n$EndEntities\n" : "") +
+         "$Nodes\n1 4 1 4\n2 1 0 4\n1\n2\n3\n4\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n$EndNodes\n$Elements\n" + elements + "$EndElements\n";
+}
+
+}  // namespace
+
+TEST_CASE("Gmsh 4.1: element blocks must sit on declared entities of their dimension, in one $Elements section", "[io]") {
+  const fs::path file = test::scratch_path("hostile.msh");
+  const auto parse_error = [&](const std::string& text) {
+    write_file(file, text);
+    return test::message_of<ParseError>([&] { (void)read_mesh(file); });
+  };
+  write_file(file, square_msh41());
+  const Mesh<2> square = read_mesh_as<2>(file);
+  CHECK(square.num_cells() == 2);
+  CHECK(square.group_nodes("wall") == std::vector<Index>{0, 1});
+  CHECK(square.group_nodes("fluid").size() == 4);
+  // Each of these once read as a mesh whose groups had lost their elements, or held them twice.
+  CHECK_THAT(parse_error(square_msh41("2 3 1 3\n1 1 1 1\n1 1 2\n2 7 2 2\n2 1 2 3\n3 1 3 4\n")),
+             Catch::Contains("hostile.msh:") && Catch::Contains("element block on entity 7 of dimension 2, which $Entities does not declare"));
+  CHECK_THAT(parse_error(square_msh41("2 3 1 3\n1 1 1 1\n1 1 2\n1 1 2 2\n2 1 2 3\n3 1 3 4\n")),
+             Catch::Contains("element block of tri3 (dimension 2) on an entity of dimension 1"));
+  std::string twice = square_msh41();
+  twice += twice.substr(twice.find("$Elements"));
+  CHECK_THAT(parse_error(twice), Catch::Contains("a second $Elements section"));
+  CHECK_THAT(parse_error(square_msh41("2 3 1 3\n1 1 1 1\n1 1 2\n2 1 2 2\n2 1 2 3\n3 1 3 4\n", false)),
+             Catch::Contains("physical groups are named but there is no $Entities section"));
+  std::string entity_twice = square_msh41();
+  entity_twice.replace(entity_twice.find("0 1 1 0\n"), 8, "0 2 1 0\n1 0 0 0 1 0 0 1 1 0\n");
+  CHECK_THAT(parse_error(entity_twice), Catch::Contains("entity 1 of dimension 1 declared twice"));
+  // Types beyond those read are named with what is read.
+  CHECK_THAT(parse_error(square_msh41("1 1 1 1\n2 1 28 1\n1 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4 1\n")),
+             Catch::Contains("unsupported Gmsh element type 28 (expected"));
+}
+
+TEST_CASE("a cell or facet through one node twice is refused by the SU2 and Gmsh readers, naming file, line and node", "[io]") {
+  const fs::path su2 = test::scratch_path("twice_node.su2"), msh = test::scratch_path("twice_node.msh");
+  write_file(su2, "NDIME= 2\nNELEM= 2\n5 0 1 2 0\n5 0 2 2 1\nNPOIN= 4\n0 0 0\n1 0 1\n1 1 2\n0 1 3\n");
+  CHECK_THAT(test::message_of<ParseError>([&] { (void)read_mesh(su2); }),
+             Catch::Contains("twice_node.su2:4:") && Catch::Contains("tri3 element lists node 2 twice"));
+  write_file(su2, "NDIME= 2\nNELEM= 2\n5 0 2 1 0\n5 0 3 2 1\nNPOIN= 4\n0 0 0\n1 0 1\n1 1 2\n0 1 3\nNMARK= 1\n"
+                  "MARKER_TAG= wall\nMARKER_ELEMS= 1\n3 1 1\n");
+  CHECK_THAT(test::message_of<ParseError>([&] { (void)read_mesh(su2); }), Catch::Contains("line2 element lists node 1 twice"));
+  write_file(msh, square_msh41("2 3 1 3\n1 1 1 1\n1 1 2\n2 1 2 2\n2 1 2 3\n3 1 4 4\n"));
+  CHECK_THAT(test::message_of<ParseError>([&] { (void)read_mesh(msh); }),
+             Catch::Contains("twice_node.msh:32:") && Catch::Contains("element 3 (tri3) lists node 4 twice"));
+  write_file(msh, "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n2 1 0 0\n5 0 1 0\n$EndNodes\n$Elements\n1\n"
+                  "7 2 2 0 1 1 5 1\n$EndElements\n");
+  CHECK_THAT(test::message_of<ParseError>([&] { (void)read_mesh(msh); }),
+             Catch::Contains("twice_node.msh:12:") && Catch::Contains("element 7 (tri3) lists node 1 twice"));
+}
+
+TEST_CASE("SU2: a multi-zone file is refused as such, not as a second NELEM section", "[io]") {
+  const fs::path file = test::scratch_path("zones.su2");
+  write_file(file, "NZONE= 2\nIZONE= 1\n" + square_su2(false) + "IZONE= 2\n" + square_su2(false));
+  CHECK_THAT(test::message_of<ParseError>([&] { (void)read_mesh(file); }),
+             Catch::Contains("zones.su2:1:") && Catch::Contains("NZONE= 2: a multi-zone SU2 file"));
+  write_file(file, "NZONE= 1\n" + square_su2(false));
+  CHECK(read_mesh_as<2>(file).num_cells() > 0);
 }

@@ -487,6 +487,10 @@ class CgnsReader {
                                std::to_string(num_vertices) + " nodes, numbered from 1)");
         nodes[order[static_cast<std::size_t>(k)]] = node_of_vertex[static_cast<std::size_t>(v - 1)];
       }
+      // Cells and facets through a node twice are refused; lower elements (a degenerate edge) are not kept.
+      if (dimension(current) >= cell_dim_ - 1)
+        if (const auto twice = repeated_node(data.data() + at, n))
+          cgns_.fail(path, "element " + std::to_string(number) + " lists node " + std::to_string(*twice) + " twice");
       at += static_cast<std::size_t>(n);
       block->ids.push_back(number + element_offset_);
       const int d = dimension(current);

@@ -25,6 +25,8 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -54,6 +56,11 @@ class GmshParser {
       else text_.fail("expected a section such as $Nodes or $Elements (got '" + TextCursor::shorten(section) + "')");
     }
     if (!have_nodes_) text_.fail("no $Nodes section (expected one)");
+    int cell_dim = 2;
+    for (const auto& b : raw_.blocks)
+      if (dimension(b.type) == 3 && !b.empty()) cell_dim = 3;
+    for (const int d : {cell_dim - 1, cell_dim})
+      if (const auto& first = repeated_[static_cast<std::size_t>(d)]) throw *first;
     if (!node_entity_.empty() && parametric_) raw_.node_params = std::move(node_entity_);
     return std::move(raw_);
   }
@@ -117,6 +124,8 @@ class GmshParser {
   // ---- $Entities (4.1): only the physical tags of each entity matter here.
   void read_entities() {
     if (version_ < 4) return skip_section("Entities");
+    if (have_entities_) text_.fail("a second $Entities section (expected one)");
+    have_entities_ = true;
     if (binary_) {
       BinaryCursor bin = binary_at_line_start();
       std::array<std::uint64_t, 4> counts{};
@@ -132,6 +141,7 @@ class GmshParser {
             const int physical = bin.read<std::int32_t>("physical tag");
             if (p == 0) entity_physical_[{dim, tag}] = physical;
           }
+          declare_entity(dim, tag, bin);
           if (dim > 0) {
             const std::uint64_t num_bounding = bin.read_size(size_bytes_, "number of bounding entities");
             bin.require(num_bounding, 4, "bounding entity tags");
@@ -151,6 +161,7 @@ class GmshParser {
             const int physical = text_.integer<int>("physical tag");
             if (p == 0) entity_physical_[{dim, tag}] = physical;
           }
+          declare_entity(dim, tag, text_);
           if (dim > 0) {
             const auto num_bounding = text_.integer<std::int64_t>("number of bounding entities", 0);
             for (std::int64_t b = 0; b < num_bounding; ++b) (void)text_.integer<int>("bounding entity tag");
@@ -158,6 +169,12 @@ class GmshParser {
         }
     }
     end_section("Entities");
+  }
+
+  template <class Cursor>
+  void declare_entity(int dim, int tag, const Cursor& cursor) {
+    if (!entities_.insert({dim, tag}).second)
+      cursor.fail("entity " + std::to_string(tag) + " of dimension " + std::to_string(dim) + " declared twice in $Entities");
   }
 
   // Binary data starts after the line end that follows the section keyword or count line.
@@ -311,8 +328,9 @@ class GmshParser {
   [[nodiscard]] static ElementType checked_type(int gmsh_type, const Cursor& cursor) {
     try {
       return element_type_from_gmsh(gmsh_type);
-    } catch (const InputError&) {
-      cursor.fail("unknown element type " + std::to_string(gmsh_type) + " (expected a Gmsh type 1 to 19)");
+    } catch (const InputError& e) {
+      const std::string_view what = e.what();
+      cursor.fail(std::string(what.substr(what.find("unsupported"))));
     }
   }
 
@@ -339,13 +357,56 @@ class GmshParser {
     return i;
   }
 
-  void require_nodes() {
+  void begin_elements() {
     if (!have_nodes_) text_.fail("$Elements before $Nodes (expected the nodes first)");
+    if (have_elements_) text_.fail("a second $Elements section (expected one: its cells would be read twice)");
+    have_elements_ = true;
+  }
+
+  /// A 4.1 element block's entity: declared in $Entities, of the elements' dimension. Without
+  /// $Entities no element can be in a physical group, so named groups are refused.
+  template <class Cursor>
+  void check_block_entity(int dim, int entity, ElementType type, const Cursor& cursor) const {
+    if (dimension(type) != dim)
+      cursor.fail("element block of " + std::string(name(type)) + " (dimension " + std::to_string(dimension(type)) +
+                  ") on an entity of dimension " + std::to_string(dim));
+    if (have_entities_) {
+      if (!entities_.contains({dim, entity}))
+        cursor.fail("element block on entity " + std::to_string(entity) + " of dimension " + std::to_string(dim) +
+                    ", which $Entities does not declare");
+    } else if (!raw_.groups.empty()) {
+      cursor.fail("physical groups are named but there is no $Entities section before $Elements (msh 4.1 puts "
+                  "elements in groups through their entities)");
+    }
+  }
+
+  /// Notes element `id` (its nodes end at `end`) when it lists one node twice, naming the node
+  /// by its id in the file: the first of each dimension, refused by parse() when the
+  /// dimension is the mesh's cells' or facets'. Gmsh writes lines through one node twice on a
+  /// degenerate curve (a sphere's pole), which a volume mesh does not keep.
+  template <class Cursor>
+  void check_distinct_nodes(ElementType type, const Index* end, std::int64_t id, const Cursor& cursor) {
+    const int per = num_nodes(type);
+    auto& first = repeated_[static_cast<std::size_t>(dimension(type))];
+    if (first) return;
+    if (const auto twice = repeated_node(end - per, per)) {
+      try {
+        cursor.fail("element " + std::to_string(id) + " (" + std::string(name(type)) + ") lists node " +
+                    std::to_string(raw_.node_ids.empty() ? raw_.first_node_id + *twice : raw_.node_ids[static_cast<std::size_t>(*twice)]) +
+                    " twice");
+      } catch (const ParseError& e) {
+        first = e;
+      }
+    }
+  }
+  template <class Cursor>
+  void check_distinct_nodes(const ElementBlock& block, std::int64_t id, const Cursor& cursor) {
+    check_distinct_nodes(block.type, block.connectivity.data() + block.connectivity.size(), id, cursor);
   }
 
   // ---- $Elements of msh 2.2: id type ntags tags... nodes...
   void read_elements_v2() {
-    require_nodes();
+    begin_elements();
     const auto count = text_.integer<std::int64_t>("number of elements", 0);
     if (binary_) {
       BinaryCursor bin = binary_at_line_start();
@@ -370,6 +431,7 @@ class GmshParser {
           block.tags.push_back(num_tags > 0 ? rec[1] : 0);
           block.entities.push_back(num_tags > 1 ? rec[2] : 0);
           for (int k = 0; k < num_nodes(type); ++k) block.connectivity.push_back(node_index(rec[1 + num_tags + k], rec[0], bin));
+          check_distinct_nodes(block, rec[0], bin);
         }
         done += n;
       }
@@ -390,6 +452,7 @@ class GmshParser {
         block.entities.push_back(entity);
         for (int k = 0; k < block.nodes_per_element(); ++k)
           block.connectivity.push_back(node_index(text_.integer<std::int64_t>("element node"), id));
+        check_distinct_nodes(block, id, text_);
         if (!text_.at_line_end())
           text_.fail("element " + std::to_string(id) + " has more nodes than its type " + std::string(name(block.type)) +
                      " (expected " + std::to_string(block.nodes_per_element()) + ")");
@@ -405,7 +468,7 @@ class GmshParser {
 
   // ---- $Elements of msh 4.1
   void read_elements_v4() {
-    require_nodes();
+    begin_elements();
     if (binary_) {
       BinaryCursor bin = binary_at_line_start();
       const std::uint64_t num_blocks = bin.read_size(size_bytes_, "number of element blocks");
@@ -419,6 +482,7 @@ class GmshParser {
         const int gmsh_type = bin.read<std::int32_t>("element type");
         const std::uint64_t n = bin.read_size(size_bytes_, "number of elements in block");
         const ElementType type = checked_type(gmsh_type, bin);
+        check_block_entity(dim, entity, type, bin);
         ElementBlock& block = block_for(gmsh_type);
         const int physical = physical_tag_of(dim, entity);
         const auto per = static_cast<std::size_t>(num_nodes(type));
@@ -439,6 +503,7 @@ class GmshParser {
             const std::uint64_t node = bin.read_size(size_bytes_, "element node");
             *nodes++ = node_index(node > largest ? -1 : static_cast<std::int64_t>(node), id, bin);
           }
+          check_distinct_nodes(type, nodes, id, bin);
         }
         total += n;
       }
@@ -455,6 +520,7 @@ class GmshParser {
         const int dim = text_.integer<int>("entity dimension", 0, 3);
         const int entity = text_.integer<int>("entity tag");
         ElementBlock& block = block_for(text_.integer<int>("element type"));
+        check_block_entity(dim, entity, block.type, text_);
         const auto n = text_.integer<std::int64_t>("number of elements in block", 0);
         const int physical = physical_tag_of(dim, entity);
         for (std::int64_t e = 0; e < n; ++e) {
@@ -464,6 +530,7 @@ class GmshParser {
           block.entities.push_back(entity);
           for (int k = 0; k < block.nodes_per_element(); ++k)
             block.connectivity.push_back(node_index(text_.integer<std::int64_t>("element node"), id));
+          check_distinct_nodes(block, id, text_);
           if (!text_.at_line_end())
             text_.fail("element " + std::to_string(id) + " has more nodes than its type " + std::string(name(block.type)) +
                        " (expected " + std::to_string(block.nodes_per_element()) + ")");
@@ -484,11 +551,15 @@ class GmshParser {
   bool swap_ = false;
   std::size_t size_bytes_ = 8;
   bool have_nodes_ = false;
+  bool have_entities_ = false;
+  bool have_elements_ = false;
   bool parametric_ = false;
   RawMesh raw_;
   NodeIdMap node_map_;
   std::vector<NodeParametrization> node_entity_;
   std::map<std::pair<int, int>, int> entity_physical_;
+  std::set<std::pair<int, int>> entities_;  ///< every (dimension, tag) $Entities declares
+  std::array<std::optional<ParseError>, 4> repeated_{};  ///< per dimension, the first element through a node twice
   std::array<int, num_element_types> block_of_type_{};
 };
 

@@ -54,8 +54,14 @@ class Su2Parser {
         read_markers(pending);
       } else if (marker_tag(key) || marker_elems(key)) {
         text_.fail(std::string(key) + "= of a marker beyond NMARK= (the file lists more markers than NMARK= counts)");
+      } else if (key == "NZONE") {
+        const auto zones = text_.integer<int>("NZONE", 1);
+        if (zones > 1)
+          text_.fail("NZONE= " + std::to_string(zones) + ": a multi-zone SU2 file (its zones are not read; give each zone "
+                     "as a file of its own)");
+        text_.next_line();
       } else {
-        skip_section();  // NZONE, IZONE, NPERIODIC/PERIODIC_INDEX, FFD_* boxes: not mesh data
+        skip_section();  // IZONE, NPERIODIC/PERIODIC_INDEX, FFD_* boxes: not mesh data
       }
     }
     if (dim_ < 0) text_.fail("no NDIME keyword (expected NDIME= 2 or 3)");
@@ -185,6 +191,8 @@ class Su2Parser {
         const int local = order.empty() ? k : order[static_cast<std::size_t>(k)];
         block.connectivity[first + static_cast<std::size_t>(local)] = text_.integer<Index>("node index", 0);
       }
+      if (const auto twice = repeated_node(block.connectivity.data() + first, nodes))
+        text_.fail(std::string(name(block.type)) + " element lists node " + std::to_string(*twice) + " twice");
       // SU2 lists the element's index after its nodes; more numbers mean that the type code
       // and the nodes disagree (a prism listed as a tetrahedron), which must not pass as a
       // smaller element.

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -23,6 +24,17 @@ void validate_read(const Mesh<Dim>& mesh, const std::filesystem::path& file) {
   } catch (const InputError& e) {
     throw InputError(file.string() + ": invalid mesh after reading: " + e.what());
   }
+}
+
+/// The first value listed twice among an element's `count` nodes `nodes` (its file's numbers
+/// or indices), or nullopt. An element through one node twice has a collapsed edge: no mesher
+/// writes one, and a reader that kept it would hand on a cell of zero volume.
+template <class T>
+[[nodiscard]] std::optional<T> repeated_node(const T* nodes, int count) {
+  for (int a = 1; a < count; ++a)
+    for (int b = 0; b < a; ++b)
+      if (nodes[a] == nodes[b]) return nodes[a];
+  return std::nullopt;
 }
 
 struct RawMesh {
