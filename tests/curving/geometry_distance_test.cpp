@@ -163,7 +163,7 @@ TEST_CASE("geometric certificate: a wall with its nodes on the circle but a face
   CHECK_THROWS_AS(curve_mesh(linear, options), InvalidMeshError);
   CHECK_THROWS_WITH(curve_mesh(linear, options), Catch::Contains("1 curved facets are off their geometry (worst: group 'wall'"));
   options.geometry_tolerance = 0.0;
-  CHECK_THROWS_WITH(curve_mesh(linear, options), Catch::Contains("geometry_tolerance must be a positive number (got 0)"));
+  CHECK_THROWS_WITH(curve_mesh(linear, options), Catch::Contains("curve_mesh: option 'geometry_tolerance': 0 is out of range (expected > 0)"));
 }
 
 TEST_CASE("a cell turned over by moving a vertex onto the geometry is flagged and refused when strict", "[curving]") {

@@ -14,6 +14,8 @@ namespace meshmotion {
 class Error : public std::runtime_error {
  public:
   explicit Error(const std::string& what) : std::runtime_error("meshmotion: " + what) {}
+  /// what() without its "meshmotion: " prefix: for an error that passes the message on.
+  [[nodiscard]] std::string message() const { return std::string(what()).substr(12); }
 };
 
 /// Invalid argument or invalid mesh data given by the caller: out-of-range index, NaN

@@ -20,6 +20,7 @@
 #include <cmath>
 #include <concepts>
 #include <cstddef>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -32,6 +33,50 @@ namespace meshmotion {
 
 /// key=value pairs in the order given.
 using KeyValues = std::vector<std::pair<std::string, std::string>>;
+
+/// The values a number option takes, part of its description in visit_options(): from lo to
+/// hi (each end included unless open), and 0 as well where `or_zero` (the "off" or "from the
+/// mesh" value below the range, as in "0: the mean"). set_option() and check_option_ranges()
+/// refuse any other value, naming the key; listings show text().
+struct OptionRange {
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  bool lo_open = false;
+  bool hi_open = false;
+  bool or_zero = false;
+
+  [[nodiscard]] bool holds(double v) const noexcept {
+    if (!std::isfinite(v)) return false;
+    if (or_zero && v == 0.0) return true;
+    return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+  }
+  /// "> 0", ">= 1 or 0", "in (-1, 0.5)", "1 to 8"; empty when unbounded.
+  [[nodiscard]] std::string text() const;
+};
+
+/// The common ranges, by name.
+namespace range {
+inline constexpr OptionRange positive{0.0, std::numeric_limits<double>::infinity(), true};
+inline constexpr OptionRange non_negative{0.0};
+[[nodiscard]] constexpr OptionRange at_least(double lo) { return {lo}; }
+[[nodiscard]] constexpr OptionRange at_most(double hi) { return {-std::numeric_limits<double>::infinity(), hi}; }
+[[nodiscard]] constexpr OptionRange between(double lo, double hi) { return {lo, hi}; }
+/// `r`, and 0 as well.
+[[nodiscard]] constexpr OptionRange or_zero(OptionRange r) {
+  r.or_zero = true;
+  return r;
+}
+}  // namespace range
+
+/// An option's line of help and its range: what visit_options() hands each visitor as its
+/// third argument (visitors that want the text alone take it as a std::string_view).
+struct OptionHelp {
+  std::string_view text;
+  OptionRange range{};
+  constexpr OptionHelp(const char* t, OptionRange r = {}) : text(t), range(r) {}
+  OptionHelp(const std::string& t, OptionRange r = {}) : text(t), range(r) {}
+  constexpr operator std::string_view() const noexcept { return text; }
+};
 
 namespace detail {
 
@@ -299,6 +344,42 @@ template <class E>
   return out;
 }
 
+inline std::string OptionRange::text() const {
+  const auto number = [](double x) { return format_option_value(x); };
+  const bool has_lo = lo > -std::numeric_limits<double>::infinity(), has_hi = hi < std::numeric_limits<double>::infinity();
+  std::string out;
+  if (has_lo && has_hi) {
+    out = lo_open || hi_open ? std::string("in ") + (lo_open ? "(" : "[") + number(lo) + ", " + number(hi) + (hi_open ? ")" : "]")
+                             : number(lo) + " to " + number(hi);
+  } else if (has_lo) {
+    out = (lo_open ? "> " : ">= ") + number(lo);
+  } else if (has_hi) {
+    out = (hi_open ? "< " : "<= ") + number(hi);
+  }
+  if (or_zero && !out.empty()) out += " or 0";
+  return out;
+}
+
+/// Refuses `value` of option `key` outside `range` (InputError naming both); lists are
+/// checked entry by entry. Fields other than numbers have no range.
+template <class T>
+void check_option_range(std::string_view key, const T& value, const OptionRange& range) {
+  if constexpr (std::is_arithmetic_v<T> && !std::same_as<T, bool>) {
+    if (!range.holds(static_cast<double>(value)))
+      throw InputError("option '" + std::string(key) + "': " + format_option_value(value) + " is out of range (expected " +
+                       range.text() + ")");
+  } else if constexpr (std::same_as<T, std::vector<double>>) {
+    for (const double v : value) check_option_range(key, v, range);
+  }
+}
+
+/// Refuses (InputError naming the key) any field of `o` outside the range its description
+/// gives: for options set in code rather than through set_option().
+template <class Options>
+void check_option_ranges(Options o) {
+  visit_options(o, [](const std::string& key, const auto& field, const OptionHelp& help) { check_option_range(key, field, help.range); });
+}
+
 /// One option as the listings and the docs show it.
 struct OptionDoc {
   std::string key;
@@ -311,20 +392,25 @@ struct OptionDoc {
 template <class Options>
 [[nodiscard]] std::vector<OptionDoc> option_docs(Options o) {
   std::vector<OptionDoc> out;
-  visit_options(o, [&](const std::string& key, auto& field, std::string_view doc) {
-    out.push_back({key, option_type_name(field), format_option_value(field), std::string(doc)});
+  visit_options(o, [&](const std::string& key, auto& field, const OptionHelp& help) {
+    std::string type = option_type_name(field);
+    if (const std::string r = help.range.text(); !r.empty()) type += " " + r;
+    out.push_back({key, std::move(type), format_option_value(field), std::string(help.text)});
   });
   return out;
 }
 
 /// Sets the field of `o` named `key` from `text`; false when `o` has no such key. Throws
-/// InputError (naming the key) for a value the field cannot hold.
+/// InputError (naming the key) for a value the field cannot hold or outside its range.
 template <class Options>
 bool set_option(Options& o, std::string_view key, std::string_view text) {
   bool found = false;
-  visit_options(o, [&](const std::string& k, auto& field, std::string_view) {
+  visit_options(o, [&](const std::string& k, auto& field, const OptionHelp& help) {
     if (found || k != key) return;
-    parse_option_value(key, text, field);
+    auto value = field;
+    parse_option_value(key, text, value);
+    check_option_range(key, value, help.range);
+    field = std::move(value);
     found = true;
   });
   return found;

@@ -24,6 +24,7 @@
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/core/shape_functions.hpp"
 #include "meshmotion/core/topology.hpp"
 #include "meshmotion/core/types.hpp"
@@ -103,11 +104,11 @@ struct SnapOptions {
 
 template <class F>
 void visit_options(SnapOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "corner_angle", o.corner_angle, "spline corners: facet directions differing by more (degrees)");
+  f(prefix + "corner_angle", o.corner_angle, OptionHelp{"spline corners: facet directions differing by more (degrees)", range::between(0, 180)});
   f(prefix + "corner_nodes", o.corner_nodes, "spline corners whatever their angle (node indices, comma-separated)");
   f(prefix + "midpoint", o.midpoint, "spline facet nodes at fractions of its arc_length, or of its parameter (the thesis)");
   f(prefix + "on_geometry_tolerance", o.on_geometry_tolerance,
-    "a vertex closer than this x the mesh diagonal to its projection is on the geometry and stays");
+    OptionHelp{"a vertex closer than this x the mesh diagonal to its projection is on the geometry and stays", range::non_negative});
 }
 
 /// Result of snap_boundary(): the nodes that move and by how much.

@@ -187,24 +187,14 @@ template <int Dim>
   } catch (const InputError& e) {
     throw InputError(detail::curve_mesh_message(e));
   }
-  if (!(options.active_radius_factor >= 0.0))
-    throw InputError("curve_mesh: active_radius_factor must be non-negative (got " +
-                     format_option_value(options.active_radius_factor) + ")");
-  check_untangle_options(options.untangle);
-  // The angle between two facets' directions: 0 to 180 degrees (720 is a slip, not a corner).
-  if (!(options.snap.corner_angle >= 0.0 && options.snap.corner_angle <= 180.0))
-    throw InputError("curve_mesh: corner_angle must be 0 to 180 degrees (got " + format_option_value(options.snap.corner_angle) + ")");
-  if (!(options.geometry_tolerance > 0.0) || !std::isfinite(options.geometry_tolerance))
-    throw InputError("curve_mesh: geometry_tolerance must be a positive number (got " + format_option_value(options.geometry_tolerance) +
-                     ")");
-  if (options.centre_reach < 0.0)
-    throw InputError("curve_mesh: centre_reach must be non-negative (got " + format_option_value(options.centre_reach) + ")");
+  try {
+    check_option_ranges(options);
+  } catch (const InputError& e) {
+    throw InputError(detail::curve_mesh_message(e));
+  }
   CurveResult<Dim> result;
   result.method = options.method;
   result.order = options.order;
-  if (options.order < 2 || options.order > max_element_order)
-    throw InputError("curve_mesh: order must be 2 to " + std::to_string(max_element_order) + " (got " +
-                     std::to_string(options.order) + ")");
   detail::report_progress(options.progress, "converting " + std::to_string(linear.num_cells()) + " cells to P" +
                                                 std::to_string(options.order));
   detail::Stopwatch clock;

@@ -8,6 +8,7 @@
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/fields.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/core/orientation.hpp"
 #include "meshmotion/core/topology.hpp"
 #include "meshmotion/core/types.hpp"
@@ -21,8 +22,8 @@
 #include "meshmotion/movers/boundary_layer.hpp"
 #include "meshmotion/movers/detail/wall_distance.hpp"
 #include "meshmotion/movers/mover.hpp"
-#include "meshmotion/movers/registry.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
+#include "meshmotion/movers/registry.hpp"
 #include "meshmotion/movers/support_radius.hpp"
 #include "meshmotion/quality/cell_quality.hpp"
 #include "meshmotion/quality/quality_report.hpp"
@@ -144,15 +145,15 @@ struct CurveOptions {
 /// geometry_from_text(); `mover_options` takes the keys of the method, MoverConfig).
 template <int Dim, class F>
 void visit_options(CurveOptions<Dim>& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "order", o.order, "order of the curved mesh: 2, 3 or 4 (hexahedra, prisms and pyramids: 2 or 3)");
+  f(prefix + "order", o.order, OptionHelp{"order of the curved mesh: 2, 3 or 4 (hexahedra, prisms and pyramids: 2 or 3)", range::between(2, max_element_order)});
   f(prefix + "method", o.method, "interior regularization: a registered mover (its options are keys too)");
-  f(prefix + "support_radius", o.support_radius, "support radius of the movers with one (0: from each wall's boundary layer)");
-  f(prefix + "support_radius_factor", o.support_radius_factor, "default support radius = this x the wall's layer thickness");
+  f(prefix + "support_radius", o.support_radius, OptionHelp{"support radius of the movers with one (0: from each wall's boundary layer)", range::non_negative});
+  f(prefix + "support_radius_factor", o.support_radius_factor, OptionHelp{"default support radius = this x the wall's layer thickness", range::positive});
   f(prefix + "per_wall_radius", o.per_wall_radius, "default radius: each wall its own (false: the thickest wall's for all)");
-  f(prefix + "max_support_nodes", o.max_support_nodes, "shrink a default radius to this many boundary nodes per support (0: no limit)");
-  f(prefix + "centre_reach", o.centre_reach, "RBF centres only within this x the radius of a moving node (0: every boundary node)");
-  f(prefix + "active_radius_factor", o.active_radius_factor, "le/sle: solve within this x the support radius of the curved walls (0: whole mesh)");
-  f(prefix + "steps", o.steps, "regularize in this many increments");
+  f(prefix + "max_support_nodes", o.max_support_nodes, OptionHelp{"shrink a default radius to this many boundary nodes per support (0: no limit)", range::non_negative});
+  f(prefix + "centre_reach", o.centre_reach, OptionHelp{"RBF centres only within this x the radius of a moving node (0: every boundary node)", range::non_negative});
+  f(prefix + "active_radius_factor", o.active_radius_factor, OptionHelp{"le/sle: solve within this x the support radius of the curved walls (0: whole mesh)", range::non_negative});
+  f(prefix + "steps", o.steps, OptionHelp{"regularize in this many increments", range::at_least(1)});
   f(prefix + "inner_nodes", o.inner_nodes, "re-place the nodes inside faces and cells next to a curved wall from the nodes around them");
   visit_options(o.untangle, f, prefix);
   f(prefix + "spline_by_default", o.spline_by_default, "2D: groups without a geometry get a spline");
@@ -165,19 +166,14 @@ void visit_options(CurveOptions<Dim>& o, F&& f, const std::string& prefix = {}) 
   visit_options(o.layer, f, prefix);
   visit_options(o.report, f, prefix);
   f(prefix + "geometry_tolerance", o.geometry_tolerance,
-    "a curved facet farther than this x its size from its geometry is off it (reported; refused when strict)");
+    OptionHelp{"a curved facet farther than this x its size from its geometry is off it (reported; refused when strict)", range::positive});
   f(prefix + "strict", o.strict, "write nothing when invalid cells, facets off the geometry or turned-over cells remain");
 }
 
 namespace detail {
 
-/// "curve_mesh: " before the message of e, whose own "meshmotion: " prefix InputError adds again.
-[[nodiscard]] inline std::string curve_mesh_message(const Error& e) {
-  std::string_view message = e.what();
-  constexpr std::string_view prefix = "meshmotion: ";
-  if (message.starts_with(prefix)) message.remove_prefix(prefix.size());
-  return "curve_mesh: " + std::string(message);
-}
+/// "curve_mesh: " before the message of e (without the "meshmotion: " InputError adds again).
+[[nodiscard]] inline std::string curve_mesh_message(const Error& e) { return "curve_mesh: " + e.message(); }
 
 }  // namespace detail
 

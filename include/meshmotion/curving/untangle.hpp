@@ -110,15 +110,15 @@ struct UntangleReport {
 template <class F>
 void visit_options(UntangleOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "untangle", o.enabled, "optimize the cells below untangle_threshold after the regularization");
-  f(prefix + "untangle_threshold", o.threshold, "optimize the high-order nodes around cells whose certified scaled Jacobian is below this");
-  f(prefix + "untangle_layers", o.layers, "rings of neighbouring cells that move with a cell below the threshold");
-  f(prefix + "untangle_sweeps", o.max_sweeps, "node sweeps at most per pass");
+  f(prefix + "untangle_threshold", o.threshold, OptionHelp{"optimize the high-order nodes around cells whose certified scaled Jacobian is below this", range::at_most(1)});
+  f(prefix + "untangle_layers", o.layers, OptionHelp{"rings of neighbouring cells that move with a cell below the threshold", range::non_negative});
+  f(prefix + "untangle_sweeps", o.max_sweeps, OptionHelp{"node sweeps at most per pass", range::at_least(1)});
   f(prefix + "untangle_slide", o.slide, "wall nodes off sharp edges, and sliding planes' nodes, move along their geometry while untangling");
-  f(prefix + "raise_rounds", o.raise_rounds, "then rounds raising the worst cells while the minimum rises (0: none)");
-  f(prefix + "raise_cells", o.raise_cells, "worst cells optimized per round");
-  f(prefix + "raise_layers", o.raise_layers, "rings of cells around them that move too");
-  f(prefix + "raise_margin", o.raise_margin, "cells within this of the minimum are the worst; the round aims at minimum + margin");
-  f(prefix + "raise_budget", o.raise_budget, "the rounds' cell evaluations at most, per cell of the mesh");
+  f(prefix + "raise_rounds", o.raise_rounds, OptionHelp{"then rounds raising the worst cells while the minimum rises (0: none)", range::non_negative});
+  f(prefix + "raise_cells", o.raise_cells, OptionHelp{"worst cells optimized per round", range::at_least(1)});
+  f(prefix + "raise_layers", o.raise_layers, OptionHelp{"rings of cells around them that move too", range::non_negative});
+  f(prefix + "raise_margin", o.raise_margin, OptionHelp{"cells within this of the minimum are the worst; the round aims at minimum + margin", range::non_negative});
+  f(prefix + "raise_budget", o.raise_budget, OptionHelp{"the rounds' cell evaluations at most, per cell of the mesh", range::non_negative});
 }
 
 template <class F>
@@ -544,16 +544,6 @@ class PatchOptimizer {
 
 }  // namespace detail
 
-/// Throws InputError naming the key of a negative count, margin or budget.
-inline void check_untangle_options(const UntangleOptions& options) {
-  UntangleOptions copy = options;
-  visit_options(copy, [](const std::string& key, auto& value, std::string_view) {
-    if constexpr (!std::is_same_v<std::remove_cvref_t<decltype(value)>, bool>)
-      if (key != "untangle_threshold" && !(value >= 0))
-        throw InputError("untangle: option '" + key + "' must be non-negative (got " + format_option_value(value) + ")");
-  });
-}
-
 /// Optimizes the nodes around the cells of `mesh` whose value in `quality` (the certified
 /// scaled Jacobian of each cell, in cell order) is below options.threshold, then raises the
 /// worst cells (options.raise_rounds); nodes with fixed[node] set do not move, except the
@@ -567,7 +557,7 @@ UntangleReport untangle(Mesh<Dim>& mesh, std::span<const char> fixed, std::vecto
     throw InputError("untangle: " + std::to_string(quality.size()) + " cell values and " + std::to_string(fixed.size()) +
                      " node flags for a mesh of " + std::to_string(mesh.num_cells()) + " cells and " +
                      std::to_string(mesh.num_nodes()) + " nodes");
-  check_untangle_options(options);
+  check_option_ranges(options);
   UntangleReport report;
   if (quality.empty()) return report;
   const auto minimum = [&] { return *std::min_element(quality.begin(), quality.end()); };

@@ -3,6 +3,7 @@
 /// BlendOptions: the options of BlendMover (movers/blend.hpp).
 /// Light: the options and their one description (visit_options: key, field, doc), no mover.
 
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/movers/boundary_layer_options.hpp"
 
 #include <memory>
@@ -40,9 +41,9 @@ struct BlendOptions {
 // visit_options(o, f) calls f(key, field, help) for every field of `o` that text may set.
 template <class F>
 void visit_options(BlendOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "blending_length", o.blending_length, "blending length of every wall (0: blending_factor x each wall's layer)");
-  f(prefix + "blending_factor", o.blending_factor, "default blending length, in layer thicknesses of each wall");
-  f(prefix + "fallback_spacings", o.fallback_spacings, "walls without a layer: blending length in facet sizes at each node");
+  f(prefix + "blending_length", o.blending_length, OptionHelp{"blending length of every wall (0: blending_factor x each wall's layer)", range::non_negative});
+  f(prefix + "blending_factor", o.blending_factor, OptionHelp{"default blending length, in layer thicknesses of each wall", range::positive});
+  f(prefix + "fallback_spacings", o.fallback_spacings, OptionHelp{"walls without a layer: blending length in facet sizes at each node", range::positive});
   visit_options(o.layer, f, prefix);
 }
 

@@ -3,6 +3,8 @@
 /// BoundaryLayerOptions: how estimate_boundary_layer() (movers/boundary_layer.hpp) recognizes a wall's layer.
 /// Light: the options and their one description (visit_options: key, field, doc), no mover.
 
+#include "meshmotion/core/option_text.hpp"
+
 #include <string>
 
 namespace meshmotion {
@@ -18,7 +20,7 @@ struct BoundaryLayerOptions {
 template <class F>
 void visit_options(BoundaryLayerOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "aspect_ratio_threshold", o.aspect_ratio_threshold,
-    "cells at least this anisotropic (longest/shortest edge) form a wall's boundary layer");
+    OptionHelp{"cells at least this anisotropic (longest/shortest edge) form a wall's boundary layer", range::at_least(1)});
 }
 
 }  // namespace meshmotion

@@ -4,6 +4,7 @@
 /// sections 2.2.1, 2.2.3, 2.2.4): what happens to nodes outside the graph's convex hull, and
 /// the per-simplex RBF interpolation of DGRBF (thesis eqs. 2.15–2.16).
 
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
 
 #include <array>
@@ -53,8 +54,8 @@ struct SimplexRbfOptions {
 template <class F>
 void visit_options(SimplexRbfOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "kernel", o.kernel, "radial function of the per-simplex interpolation");
-  f(prefix + "simplex_support_radius", o.support_radius, "absolute per-simplex support radius (0: relative)");
-  f(prefix + "simplex_support", o.relative_support, "per-simplex support, × the simplex's longest edge");
+  f(prefix + "simplex_support_radius", o.support_radius, OptionHelp{"absolute per-simplex support radius (0: relative)", range::non_negative});
+  f(prefix + "simplex_support", o.relative_support, OptionHelp{"per-simplex support, × the simplex's longest edge", range::positive});
   f(prefix + "normalize", o.normalize, "divide the cardinal weights by their sum");
 }
 

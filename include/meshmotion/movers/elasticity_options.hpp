@@ -3,6 +3,7 @@
 /// ElasticityOptions: the options of ElasticityMover (movers/elasticity.hpp).
 /// Light: the options and their one description (visit_options: key, field, doc), no mover.
 
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/solvers/solver_options.hpp"
 
 #include <string>
@@ -34,13 +35,13 @@ struct ElasticityOptions {
 // visit_options(o, f) calls f(key, field, help) for every field of `o` that text may set.
 template <class F>
 void visit_options(ElasticityOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "youngs_modulus", o.youngs_modulus, "Young's modulus E > 0 (scales K only)");
-  f(prefix + "poisson_ratio", o.poisson_ratio, "Poisson ratio in (-1, 0.5)");
-  f(prefix + "stiffening_exponent", o.stiffening_exponent, "chi of the Jacobian stiffening (J0/J)^chi");
+  f(prefix + "youngs_modulus", o.youngs_modulus, OptionHelp{"Young's modulus E (scales K only)", range::positive});
+  f(prefix + "poisson_ratio", o.poisson_ratio, OptionHelp{"Poisson ratio", OptionRange{-1.0, 0.5, true, true}});
+  f(prefix + "stiffening_exponent", o.stiffening_exponent, OptionHelp{"chi of the Jacobian stiffening (J0/J)^chi", range::non_negative});
   f(prefix + "reference_jacobian", o.reference_jacobian, "J0 (<= 0: the mean cell measure)");
-  f(prefix + "distance_exponent", o.distance_exponent, "psi of the wall-distance stiffening");
+  f(prefix + "distance_exponent", o.distance_exponent, OptionHelp{"psi of the wall-distance stiffening", range::non_negative});
   visit_options(o.solver, f, prefix);
-  f(prefix + "active_radius", o.active_radius, "solve only within this distance of the moving walls (0: whole mesh)");
+  f(prefix + "active_radius", o.active_radius, OptionHelp{"solve only within this distance of the moving walls (0: whole mesh)", range::non_negative});
 }
 
 }  // namespace meshmotion

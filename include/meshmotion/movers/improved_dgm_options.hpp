@@ -3,6 +3,7 @@
 /// ImprovedDgmOptions: the options of ImprovedDgmMover (movers/improved_dgm.hpp).
 /// Light: the options and their one description (visit_options: key, field, doc), no mover.
 
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/movers/dgm_options.hpp"
 #include "meshmotion/movers/rbf_options.hpp"
 
@@ -32,10 +33,10 @@ struct ImprovedDgmOptions {
 template <class F>
 void visit_options(ImprovedDgmOptions& o, F&& f, const std::string& prefix = {}) {
   visit_options(o.dgm, f, prefix);
-  f(prefix + "layer_offset", o.layer_offset, "layer distance from the wall, in wall spacings");
-  f(prefix + "layer_spacing", o.layer_spacing, "thinning of the layer, in wall spacings");
+  f(prefix + "layer_offset", o.layer_offset, OptionHelp{"layer distance from the wall, in wall spacings", range::non_negative});
+  f(prefix + "layer_spacing", o.layer_spacing, OptionHelp{"thinning of the layer, in wall spacings", range::positive});
   f(prefix + "auto_support_radius", o.auto_support_radius, "the layer RBF's radius from the layer's reach");
-  f(prefix + "relative_support_radius", o.relative_support_radius, "factor of the automatic radius");
+  f(prefix + "relative_support_radius", o.relative_support_radius, OptionHelp{"factor of the automatic radius", range::positive});
   visit_options(o.rbf, f, prefix + "rbf.");
 }
 

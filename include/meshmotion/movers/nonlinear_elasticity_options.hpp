@@ -3,6 +3,7 @@
 /// NonlinearElasticityOptions: the options of NonlinearElasticityMover (movers/nonlinear_elasticity.hpp).
 /// Light: the options and their one description (visit_options: key, field, doc), no mover.
 
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/solvers/solver_options.hpp"
 
 #include <string>
@@ -26,12 +27,12 @@ struct NonlinearElasticityOptions {
 // visit_options(o, f) calls f(key, field, help) for every field of `o` that text may set.
 template <class F>
 void visit_options(NonlinearElasticityOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "youngs_modulus", o.youngs_modulus, "Young's modulus E > 0 (scales the energy only)");
-  f(prefix + "poisson_ratio", o.poisson_ratio, "Poisson ratio in (-1, 0.5)");
-  f(prefix + "load_steps", o.load_steps, "equal boundary increments");
-  f(prefix + "newton_iterations", o.max_newton_iterations, "Newton iterations per load step");
-  f(prefix + "newton_tolerance", o.tolerance, "largest update / bounding-box diagonal that stops Newton");
-  f(prefix + "min_step", o.min_step, "smallest line-search step");
+  f(prefix + "youngs_modulus", o.youngs_modulus, OptionHelp{"Young's modulus E (scales the energy only)", range::positive});
+  f(prefix + "poisson_ratio", o.poisson_ratio, OptionHelp{"Poisson ratio", OptionRange{-1.0, 0.5, true, true}});
+  f(prefix + "load_steps", o.load_steps, OptionHelp{"equal boundary increments", range::at_least(1)});
+  f(prefix + "newton_iterations", o.max_newton_iterations, OptionHelp{"Newton iterations per load step", range::at_least(1)});
+  f(prefix + "newton_tolerance", o.tolerance, OptionHelp{"largest update / bounding-box diagonal that stops Newton", range::positive});
+  f(prefix + "min_step", o.min_step, OptionHelp{"smallest line-search step", OptionRange{0.0, 1.0, true}});
   visit_options(o.solver, f, prefix);
 }
 

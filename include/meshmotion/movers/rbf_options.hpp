@@ -3,6 +3,7 @@
 /// RbfOptions: the options of RbfMover (movers/rbf.hpp), and RigidPart.
 /// Light: the options and their one description (visit_options: key, field, doc), no mover.
 
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
 #include "meshmotion/solvers/solver_options.hpp"
@@ -113,22 +114,22 @@ struct RbfOptions {
 template <class F>
 void visit_options(RbfOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "kernel", o.kernel, "radial function");
-  f(prefix + "support_radius", o.support_radius, "support radius (scale of global kernels), mesh units; 0: from the boundary");
-  f(prefix + "support_radii", o.support_radii, "a radius per boundary entry (comma-separated), replacing support_radius");
+  f(prefix + "support_radius", o.support_radius, OptionHelp{"support radius (scale of global kernels), mesh units; 0: from the boundary", range::non_negative});
+  f(prefix + "support_radii", o.support_radii, OptionHelp{"a radius per boundary entry (comma-separated), replacing support_radius", range::positive});
   f(prefix + "polynomial", o.polynomial, "add a linear polynomial (affine motions exact)");
   visit_options(o.solver, f, prefix);
   f(prefix + "dense_solver", o.dense_solver, "factorization of the dense system of global kernels");
-  f(prefix + "max_dense_centres", o.max_dense_centres, "largest centre count of a global kernel");
-  f(prefix + "coincidence_tolerance", o.coincidence_tolerance, "boundary nodes closer than this × the diagonal are one");
-  f(prefix + "max_evaluation_cache_bytes", o.max_evaluation_cache_bytes, "largest dense evaluation matrix kept");
+  f(prefix + "max_dense_centres", o.max_dense_centres, OptionHelp{"largest centre count of a global kernel", range::at_least(1)});
+  f(prefix + "coincidence_tolerance", o.coincidence_tolerance, OptionHelp{"boundary nodes closer than this × the diagonal are one", range::non_negative});
+  f(prefix + "max_evaluation_cache_bytes", o.max_evaluation_cache_bytes, OptionHelp{"largest dense evaluation matrix kept", range::between(0, 0x1p50)});
   f(prefix + "partition_of_unity", o.partition_of_unity, "local systems on overlapping patches (boundaries of ~100k+ nodes)");
-  f(prefix + "patch_centres", o.patch_centres, "partition of unity: most centres per patch before the overlap");
-  f(prefix + "patch_overlap", o.patch_overlap, "partition of unity: overlap, x each patch's radius (at least the support radius)");
+  f(prefix + "patch_centres", o.patch_centres, OptionHelp{"partition of unity: most centres per patch before the overlap", range::at_least(1)});
+  f(prefix + "patch_overlap", o.patch_overlap, OptionHelp{"partition of unity: overlap, x each patch's radius (at least the support radius)", range::non_negative});
   f(prefix + "max_memory_bytes", o.max_memory_bytes,
-    "compact kernels: estimated memory allowed, bytes (0: half the machine's); a default radius is reduced to fit");
+    OptionHelp{"compact kernels: estimated memory allowed, bytes (0: half the machine's); a default radius is reduced to fit", range::non_negative});
   f(prefix + "rigid_part", o.rigid_part, "blend a large rigid motion into the volume before interpolating the rest");
   f(prefix + "condition_limit", o.condition_limit,
-    "compact kernels: thin centres closer than the radius resolves when the condition exceeds this (0: never)");
+    OptionHelp{"compact kernels: thin centres closer than the radius resolves when the condition exceeds this (0: never)", range::or_zero(range::at_least(1))});
 }
 
 }  // namespace meshmotion

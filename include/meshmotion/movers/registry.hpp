@@ -147,11 +147,13 @@ struct MoverConfig {
   void set(const KeyValues& values) {
     for (const auto& [k, v] : values) set(k, v);
   }
-  /// Throws InputError when `options` is not the options type of `method`.
+  /// Throws InputError when `options` is not the options type of `method`, or a field is
+  /// outside its range (check_option_ranges()).
   void check() const {
     const MoverMethod<Dim>& m = mover_method<Dim>(method);
     if (m.defaults().index() != options.index())
       throw InputError("MoverConfig: the options given are not those of method '" + method + "'");
+    std::visit([](const auto& o) { check_option_ranges(o); }, options);
   }
 
  private:

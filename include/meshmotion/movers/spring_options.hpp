@@ -3,6 +3,7 @@
 /// SpringOptions: the options of SpringMover (movers/spring.hpp).
 /// Light: the options and their one description (visit_options: key, field, doc), no mover.
 
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/solvers/solver_options.hpp"
 
 #include <string>
@@ -20,7 +21,7 @@ struct SpringOptions {
 // visit_options(o, f) calls f(key, field, help) for every field of `o` that text may set.
 template <class F>
 void visit_options(SpringOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "length_exponent", o.length_exponent, "p in k = length^-p");
+  f(prefix + "length_exponent", o.length_exponent, OptionHelp{"p in k = length^-p", range::non_negative});
   visit_options(o.solver, f, prefix);
 }
 

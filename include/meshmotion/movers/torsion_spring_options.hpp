@@ -3,6 +3,7 @@
 /// TorsionSpringOptions: the options of TorsionSpringMover (movers/torsion_spring.hpp).
 /// Light: the options and their one description (visit_options: key, field, doc), no mover.
 
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/solvers/solver_options.hpp"
 
 #include <string>
@@ -24,7 +25,7 @@ struct TorsionSpringOptions {
 // visit_options(o, f) calls f(key, field, help) for every field of `o` that text may set.
 template <class F>
 void visit_options(TorsionSpringOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "torsion_weight", o.torsion_weight, "factor of every torsional stiffness");
+  f(prefix + "torsion_weight", o.torsion_weight, OptionHelp{"factor of every torsional stiffness", range::non_negative});
   f(prefix + "coupled_lineal", o.coupled_lineal, "lineal springs in the coupled truss form");
   f(prefix + "vertex_facet_springs", o.vertex_facet_springs, "3D: vertex-facet springs too");
   visit_options(o.solver, f, prefix);

@@ -56,9 +56,9 @@ struct BoundarySolveOptions {
 template <class F>
 void visit_options(BoundarySolveOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "boundary_solve", o.kind, "where the RBF boundary system is solved");
-  f(prefix + "petsc_min_centres", o.petsc_min_centres, "automatic: fewest centres for PETSc at any rank count");
+  f(prefix + "petsc_min_centres", o.petsc_min_centres, OptionHelp{"automatic: fewest centres for PETSc at any rank count", range::non_negative});
   f(prefix + "petsc_min_node_centres", o.petsc_min_node_centres,
-    "automatic: fewest centres x ranks per node for PETSc on several ranks");
+    OptionHelp{"automatic: fewest centres x ranks per node for PETSc on several ranks", range::non_negative});
 }
 
 /// PETSc solver of the distributed elasticity system.
@@ -105,8 +105,8 @@ struct DistributedElasticityOptions {
 template <class F>
 void visit_options(DistributedElasticityOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "petsc_solver", o.solver, "PETSc solver (automatic: mumps in 2D, cg_gamg in 3D)");
-  f(prefix + "petsc_tolerance", o.tolerance, "relative residual of CG on the scaled system (displacement units)");
-  f(prefix + "petsc_max_iterations", o.max_iterations, "iteration cap of CG");
+  f(prefix + "petsc_tolerance", o.tolerance, OptionHelp{"relative residual of CG on the scaled system (displacement units)", range::positive});
+  f(prefix + "petsc_max_iterations", o.max_iterations, OptionHelp{"iteration cap of CG", range::at_least(1)});
   f(prefix + "petsc_fallback_to_direct", o.fallback_to_direct, "solve again with MUMPS when CG does not converge");
   f(prefix + "petsc_prefix", o.petsc_prefix, "prefix of the PETSc options that refine the solver");
 }

@@ -8,6 +8,7 @@
 #include "meshmotion/core/fields.hpp"
 #include "meshmotion/core/mesh.hpp"
 #include "meshmotion/core/mesh_like.hpp"
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/core/types.hpp"
 #include "meshmotion/quality/cell_quality.hpp"
 
@@ -99,16 +100,16 @@ void visit_options(ScaledJacobianOptions& o, F&& f, const std::string& prefix = 
   f(prefix + "certify", o.certify, "certified Bezier bounds (false: sampled extremes only)");
   f(prefix + "sharp", o.sharp, "refine both bounds to the tolerance (false: stop once validity is decided)");
   f(prefix + "sharp_max", o.sharp_max, "with sharp: refine the upper bound too");
-  f(prefix + "tolerance", o.tolerance, "gap between a Bezier bound and the sampled extreme");
-  f(prefix + "max_depth", o.max_depth, "deepest subdivision level");
-  f(prefix + "max_leaves", o.max_leaves, "subdomains per cell at most");
+  f(prefix + "tolerance", o.tolerance, OptionHelp{"gap between a Bezier bound and the sampled extreme", range::positive});
+  f(prefix + "max_depth", o.max_depth, OptionHelp{"deepest subdivision level", range::non_negative});
+  f(prefix + "max_leaves", o.max_leaves, OptionHelp{"subdomains per cell at most", range::at_least(1)});
 }
 
 template <class F>
 void visit_options(ReportOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "histogram_bins", o.bins, "bins of the quality histogram");
-  f(prefix + "num_worst", o.num_worst, "worst cells listed");
-  f(prefix + "reference_measure", o.quality.reference_measure, "size metrics: the measure of relative size 1 (0: the mean)");
+  f(prefix + "histogram_bins", o.bins, OptionHelp{"bins of the quality histogram", range::at_least(1)});
+  f(prefix + "num_worst", o.num_worst, OptionHelp{"worst cells listed", range::non_negative});
+  f(prefix + "reference_measure", o.quality.reference_measure, OptionHelp{"size metrics: the measure of relative size 1 (0: the mean)", range::non_negative});
   visit_options(o.quality.jacobian, f, prefix + "jacobian_");
 }
 

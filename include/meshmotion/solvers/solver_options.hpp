@@ -3,6 +3,7 @@
 /// SolverOptions: which of Eigen's sparse solvers a LinearSolver uses, with its tolerances,
 /// and SolverReport: what the solver did.
 
+#include "meshmotion/core/option_text.hpp"
 #include "meshmotion/core/types.hpp"
 
 #include <array>
@@ -128,8 +129,8 @@ enum class DenseSolverKind {
 template <class F>
 void visit_options(SolverOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "solver", o.kind, "sparse solver of the system");
-  f(prefix + "tolerance", o.tolerance, "relative residual an iterative solver must reach");
-  f(prefix + "max_iterations", o.max_iterations, "iteration cap of an iterative solver (0: twice the size)");
+  f(prefix + "tolerance", o.tolerance, OptionHelp{"relative residual an iterative solver must reach", range::positive});
+  f(prefix + "max_iterations", o.max_iterations, OptionHelp{"iteration cap of an iterative solver (0: twice the size)", range::non_negative});
   f(prefix + "fallback_to_direct", o.fallback_to_direct, "solve with sparse LU when an iterative solver fails");
   f(prefix + "diagonal_scaling", o.diagonal_scaling, "solve the diagonally scaled system");
 }
