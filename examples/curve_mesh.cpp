@@ -11,6 +11,7 @@
 // (nothing written), 2 written with invalid cells or facets off the geometry (the last lines
 // say so) or refused by --strict.
 
+#include "meshmotion/core/detail/atomic_file.hpp"
 #include "meshmotion/core/json.hpp"
 #include "meshmotion/core/option_text.hpp"
 #include "meshmotion/core/generators.hpp"
@@ -142,13 +143,16 @@ int run(Mesh<Dim> linear, const Arguments& args) {
   result.seconds.cad = cad_seconds;
   result.seconds.total += cad_seconds;
   const std::vector<double>& values = result.cell_quality;
-  examples::write_output(args.output, result.curved);
+  // The mesh, its .vtu and the picture are written as a set: all of them, or on an error none.
+  detail::OutputSet outputs;
+  examples::set_stage("writing " + args.output);
+  outputs.stage(args.output, [&](const std::filesystem::path& file) { write_mesh(file, result.curved); });
   const std::filesystem::path vtu = with_extension(args.output, ".vtu");
   VtuFields fields;
   fields.cell_data.emplace_back("scaled_jacobian",
                                 Eigen::Map<const Eigen::MatrixXd>(values.data(), 1, static_cast<Index>(values.size())));
   examples::set_stage("writing " + vtu.string());
-  write_vtu(vtu, result.curved, fields);
+  outputs.stage(vtu, [&](const std::filesystem::path& file) { write_vtu(file, result.curved, fields); });
   if constexpr (Dim == 2) {
     if (!args.svg.empty()) {
       SvgOptions svg;
@@ -162,9 +166,11 @@ int run(Mesh<Dim> linear, const Arguments& args) {
       // stretching down to the worst negative value (which left every valid cell one colour).
       svg.mark_invalid = !args.svg_no_markers;
       svg.value_min = svg.mark_invalid ? 0.0 : std::min(0.0, result.quality.min);
-      write_svg(args.svg, result.curved, values, svg);
+      examples::set_stage("writing " + args.svg);
+      outputs.stage(args.svg, [&](const std::filesystem::path& file) { write_svg(file, result.curved, values, svg); });
     }
   }
+  outputs.commit();
   const QualityReport& q = result.quality;
   if (args.json) {
     JsonWriter w(std::cout);

@@ -5,6 +5,7 @@
 //
 //   mesh_quality wing.msh --metric shape --metric jacobian --svg q.svg --zoom 0.9,1.1,-0.05,0.05
 
+#include "meshmotion/core/detail/atomic_file.hpp"
 #include "meshmotion/core/json.hpp"
 #include "meshmotion/io.hpp"
 #include "meshmotion/quality.hpp"
@@ -54,7 +55,9 @@ int run(Mesh<Dim>& mesh, const Settings& s) {
     if (first_values.empty())
       for (const auto& c : cells) first_values.push_back(c.value);
   }
-  if (!s.vtu.empty()) write_vtu(s.vtu, mesh, fields);
+  // The .vtu and the picture are written as a set: both, or on an error neither.
+  detail::OutputSet outputs;
+  if (!s.vtu.empty()) outputs.stage(s.vtu, [&](const std::filesystem::path& file) { write_vtu(file, mesh, fields); });
   if (!s.svg.empty()) {
     if constexpr (Dim == 2) {
       SvgOptions svg;
@@ -64,11 +67,12 @@ int run(Mesh<Dim>& mesh, const Settings& s) {
       }
       svg.title = std::string(metric_name(metrics.front()));
       svg.mark_invalid = !s.svg_no_markers;
-      write_svg(s.svg, mesh, first_values, svg);
+      outputs.stage(s.svg, [&](const std::filesystem::path& file) { write_svg(file, mesh, first_values, svg); });
     } else {
       std::cerr << "mesh_quality: --svg is for 2D meshes; " << s.file << " is 3D, no picture written\n";
     }
   }
+  outputs.commit();
   // An OpenFOAM case: checkMesh's measures on its cells as they are (polyhedra included).
   std::optional<FoamQuality> foam;
   if (std::filesystem::is_directory(s.file)) foam = foam_quality(read_polymesh(s.file));

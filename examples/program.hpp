@@ -240,6 +240,7 @@ inline void check_side_output(const std::filesystem::path& output, std::initiali
                               std::initializer_list<std::filesystem::path> outputs = {}) {
   check_output_folder(output);
   std::error_code ec;
+  if (std::filesystem::is_directory(output, ec)) throw InputError("output " + output.string() + " is a folder (expected a file name)");
   for (const auto& input : inputs)
     if (!input.empty() && std::filesystem::exists(output, ec) && std::filesystem::equivalent(input, output, ec))
       throw InputError("output " + output.string() + " is " + (input == output ? "an input" : "the input " + input.string()) +

@@ -324,6 +324,14 @@ endif()
 # Outputs are checked before any work, and an input is never overwritten unasked.
 smoke_test(NAME curve_mesh.svg_in_missing_folder.json EXPECT_RC 1 KEYS error VALUES kind=input
            COMMAND curve_mesh --demo -o "${smoke_dir}/demo_svg_folder.msh" --svg "${smoke_dir}/no_such_folder/demo.svg" --json)
+# A picture named as a folder cannot be written: refused before the mesh and its .vtu are
+# written (the outputs of a run are written as a set: all, or on an error none).
+smoke_test(NAME curve_mesh.svg_is_folder.json EXPECT_RC 1 KEYS error VALUES kind=input
+           COMMAND curve_mesh --demo -o "${smoke_dir}/demo_svg_is_folder.msh" --svg "${smoke_dir}" --json)
+add_test(NAME examples.curve_mesh.svg_is_folder_wrote_nothing
+         COMMAND "${CMAKE_COMMAND}" -E cat "${smoke_dir}/demo_svg_is_folder.vtu")
+set_tests_properties(examples.curve_mesh.svg_is_folder_wrote_nothing PROPERTIES LABELS examples WILL_FAIL TRUE
+                     DEPENDS examples.curve_mesh.svg_is_folder.json)
 # The verdict is the certificate's at every order: a P2 file whose mid-edge node lies beyond
 # the opposite vertex (its straight corners are fine) is invalid for every metric, and
 # move_mesh --strict writes nothing.

@@ -16,7 +16,10 @@
 
 #include <catch2/catch.hpp>
 
+#include <sys/resource.h>
+
 #include <algorithm>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -512,6 +515,48 @@ TEST_CASE("OpenFOAM: bytes after a list are refused, and a compressed file is de
   write_polymesh(dir, hanging_node_case(), PolyMeshWriteOptions{false, true});
   CHECK(message() == "no error");
 #endif
+}
+
+TEST_CASE("OpenFOAM: points that cannot be written whole (a full disk) leave the case as it was, no empty time folder",
+          "[io][openfoam]") {
+  const fs::path dir = test::scratch_path("foam_full_disk");
+  for (const auto format : formats()) {
+    INFO("format " << static_cast<int>(format));
+    write_case(dir, hanging_node_case(), format);
+    const std::string suffix = format == Format::compressed ? ".gz" : "";
+    const fs::path points = dir / "constant" / "polyMesh" / ("points" + suffix);
+    const std::string before = read_text(points);
+    Mesh<3> mesh = read_openfoam(dir);
+    mesh.points *= 2.0;
+    // The disk is full: no file may grow past 64 bytes (RLIMIT_FSIZE, its signal ignored: a
+    // write fails with EFBIG, as on a full disk with ENOSPC).
+    const auto written_on_full_disk = [&](const fs::path& target) {
+      rlimit old{};
+      REQUIRE(getrlimit(RLIMIT_FSIZE, &old) == 0);
+      rlimit tiny = old;
+      tiny.rlim_cur = 64;
+      const auto previous = std::signal(SIGXFSZ, SIG_IGN);
+      REQUIRE(setrlimit(RLIMIT_FSIZE, &tiny) == 0);
+      std::string what = "no error";
+      try {
+        write_mesh(target, mesh);
+      } catch (const Error& e) {
+        what = e.what();
+      }
+      setrlimit(RLIMIT_FSIZE, &old);
+      std::signal(SIGXFSZ, previous);
+      return what;
+    };
+    CHECK_THAT(written_on_full_disk(dir / "0.5"), Catch::Contains("points"));
+    CHECK_FALSE(fs::exists(dir / "0.5"));  // once an empty 0.5/polyMesh, which -latestTime took
+    CHECK_THAT(written_on_full_disk(dir), Catch::Contains("points"));
+    CHECK(read_text(points) == before);
+    std::size_t files = 0;
+    for ([[maybe_unused]] const auto& e : fs::directory_iterator(points.parent_path())) ++files;
+    CHECK(files == 5);  // no temporary left behind
+    write_mesh(dir / "0.5", mesh);
+    CHECK(read_openfoam(dir / "0.5").points.leftCols(16) == mesh.points.leftCols(16));
+  }
 }
 
 TEST_CASE("OpenFOAM: checkMesh's measures agree with checkMesh on the shared case, a moved one and a polyhedral one",

@@ -6,6 +6,7 @@
 #include "meshmotion/core/orientation.hpp"
 #include "meshmotion/io.hpp"
 #include "meshmotion/quality/quality_report.hpp"
+#include "meshmotion/quality/svg_picture.hpp"
 
 #include "test_data.hpp"
 
@@ -13,6 +14,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -285,4 +287,40 @@ TEST_CASE("SU2: a multi-zone file is refused as such, not as a second NELEM sect
              Catch::Contains("zones.su2:1:") && Catch::Contains("NZONE= 2: a multi-zone SU2 file"));
   write_file(file, "NZONE= 1\n" + square_su2(false));
   CHECK(read_mesh_as<2>(file).num_cells() > 0);
+}
+
+TEST_CASE("the outputs of one run are written as a set: all of them, or on an error none and the old files kept", "[io]") {
+  const fs::path dir = test::scratch_path("output_set");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path mesh_file = dir / "out.msh", picture = dir / "out.svg";
+  write_file(picture, "old picture");
+  const Mesh<2> square = rectangle_mesh();
+  const auto files = [&] {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  };
+  {
+    detail::OutputSet outputs;
+    outputs.stage(mesh_file, [&](const fs::path& file) {
+      CHECK(file.extension() == ".msh");  // the writer chooses the format by it
+      write_mesh(file, square);
+    });
+    CHECK_THROWS_WITH(outputs.stage(picture, [](const fs::path& file) { throw IoError(file.string() + ": write failed (disk full?)"); }),
+                      "meshmotion: " + picture.string() + ": write failed (disk full?)");  // the output's name, not the temporary's
+  }
+  CHECK(files() == std::vector<std::string>{"out.svg"});
+  std::ifstream old(picture);
+  CHECK(std::string(std::istreambuf_iterator<char>(old), {}) == "old picture");
+  {
+    detail::OutputSet outputs;
+    outputs.stage(mesh_file, [&](const fs::path& file) { write_mesh(file, square); });
+    outputs.stage(picture, [&](const fs::path& file) { write_svg(file, square, std::vector<double>(static_cast<std::size_t>(square.num_cells()), 1.0)); });
+    CHECK(files().size() == 3);  // the old picture and two temporaries, until the commit
+    outputs.commit();
+  }
+  CHECK(files() == std::vector<std::string>{"out.msh", "out.svg"});
+  CHECK(read_mesh_as<2>(mesh_file).num_cells() == square.num_cells());
 }

@@ -92,15 +92,9 @@ inline void append_foam_points(std::string& out, const Eigen::Ref<const Points<3
   return 0;
 }
 
-/// Writes `text` to `file` (or `file`.gz, compressed) through a temporary file and a rename.
-inline void write_foam_file(const std::filesystem::path& file, const std::string& text, bool compressed) {
-  if (!compressed) {
-    write_file_atomically(file, text);
-    return;
-  }
+/// Writes `text` gzip-compressed to `gz` through a temporary file and a rename.
+inline void write_gzip_file(const std::filesystem::path& gz, const std::string& text) {
 #ifdef MESHMOTION_HAVE_ZLIB
-  std::filesystem::path gz = file;
-  gz += ".gz";
   write_through_temporary(gz, [&](const std::filesystem::path& tmp) {
     gzFile out = gzopen(tmp.c_str(), "wb");
     if (out == nullptr) throw IoError(gz.string() + ": cannot create the temporary file " + tmp.string());
@@ -114,8 +108,17 @@ inline void write_foam_file(const std::filesystem::path& file, const std::string
     if (gzclose(out) != Z_OK || !ok) throw IoError(gz.string() + ": compressed write failed");
   });
 #else
-  throw InputError(file.string() + ".gz: compressed OpenFOAM files need zlib (meshmotion was built without it)");
+  (void)text;
+  throw InputError(gz.string() + ": compressed OpenFOAM files need zlib (meshmotion was built without it)");
 #endif
+}
+
+/// Writes `text` to `file` (or `file`.gz, compressed) through a temporary file and a rename.
+inline void write_foam_file(const std::filesystem::path& file, const std::string& text, bool compressed) {
+  if (!compressed) return write_file_atomically(file, text);
+  std::filesystem::path gz = file;
+  gz += ".gz";
+  write_gzip_file(gz, text);
 }
 
 
@@ -260,11 +263,32 @@ inline void write_polymesh_points(const std::filesystem::path& target, const Mes
                                                   local, precision, processor.string()));
     }
   }
-  for (const detail::PreparedPoints& f : files) {
-    std::error_code ec;
-    std::filesystem::create_directories(f.file.parent_path(), ec);
-    if (ec) throw IoError(f.file.parent_path().string() + ": cannot create the folder (" + ec.message() + ")");
-    detail::write_foam_file(f.file, f.text, f.compressed);
+  // Written as a set: a failed write (a full disk) leaves every points file as it was and
+  // removes the folders it made, so no empty time folder is left for -latestTime to take.
+  detail::OutputSet outputs;
+  std::vector<std::filesystem::path> created;
+  try {
+    for (const detail::PreparedPoints& f : files) {
+      std::error_code ec;
+      std::filesystem::path first_new;
+      for (std::filesystem::path p = f.file.parent_path(); !p.empty() && !std::filesystem::exists(p, ec); p = p.parent_path()) first_new = p;
+      std::filesystem::create_directories(f.file.parent_path(), ec);
+      if (!first_new.empty()) created.push_back(first_new);
+      if (ec) throw IoError(f.file.parent_path().string() + ": cannot create the folder (" + ec.message() + ")");
+      std::filesystem::path file = f.file;
+      if (f.compressed) file += ".gz";
+      outputs.stage(file, [&](const std::filesystem::path& tmp) {
+        if (f.compressed) detail::write_gzip_file(tmp, f.text);
+        else detail::write_file_atomically(tmp, f.text);
+      });
+    }
+    outputs.commit();
+  } catch (...) {
+    for (const auto& folder : created) {
+      std::error_code ignored;
+      std::filesystem::remove_all(folder, ignored);
+    }
+    throw;
   }
 }
 

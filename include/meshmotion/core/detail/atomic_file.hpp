@@ -13,6 +13,8 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <utility>
+#include <vector>
 
 #if defined(__linux__)
 #include <fcntl.h>  // AT_FDCWD
@@ -21,13 +23,24 @@
 
 namespace meshmotion::detail {
 
-/// A name for the temporary file beside `file` (same folder, so rename is atomic).
-[[nodiscard]] inline std::filesystem::path temporary_path_for(const std::filesystem::path& file) {
+/// ".tmp<stamp>_<counter>": what names a temporary file, new at each call.
+[[nodiscard]] inline std::string temporary_suffix() {
   static std::atomic<unsigned> counter{0};
   const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
+  return ".tmp" + std::to_string(stamp % 1000000007) + "_" + std::to_string(counter++);
+}
+
+/// A name for the temporary file beside `file` (same folder, so rename is atomic).
+[[nodiscard]] inline std::filesystem::path temporary_path_for(const std::filesystem::path& file) {
   std::filesystem::path tmp = file;
-  tmp += ".tmp" + std::to_string(stamp % 1000000007) + "_" + std::to_string(counter++);
+  tmp += temporary_suffix();
   return tmp;
+}
+
+/// A temporary name beside `file` that keeps its extension ("out.tmp<stamp>_<counter>.msh"),
+/// for writers that choose the format by it.
+[[nodiscard]] inline std::filesystem::path temporary_path_keeping_extension(const std::filesystem::path& file) {
+  return file.parent_path() / (file.stem().string() + temporary_suffix() + file.extension().string());
 }
 
 /// Moves the complete temporary file `tmp` onto `file`; removes `tmp` and throws IoError when
@@ -58,21 +71,25 @@ inline void rename_into_place(const std::filesystem::path& tmp, const std::files
   }
 }
 
-/// Removes what a killed run left of its temporaries for `file` (temporary_path_for()'s names,
-/// files or folders) once they are an hour old: a run still writing one is younger.
+/// Removes what a killed run left of its temporaries for `file` (the names of
+/// temporary_path_for() and temporary_path_keeping_extension(), files or folders) once they are
+/// an hour old: a run still writing one is younger.
 inline void remove_stale_temporaries(const std::filesystem::path& file) {
-  const std::string prefix = file.filename().string() + ".tmp";
   const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
   const auto old = std::filesystem::file_time_type::clock::now() - std::chrono::hours(1);
+  // "<prefix><stamp>_<counter><suffix>", digits only between: nothing else of this name is ours.
+  const auto ours = [](std::string_view name, const std::string& prefix, const std::string& suffix) {
+    if (name.size() <= prefix.size() + suffix.size() || !name.starts_with(prefix) || !name.ends_with(suffix)) return false;
+    const std::string_view tail = name.substr(prefix.size(), name.size() - prefix.size() - suffix.size());
+    const std::size_t cut = tail.find('_');
+    const auto digits = [](std::string_view t) { return !t.empty() && t.find_first_not_of("0123456789") == std::string_view::npos; };
+    return cut != std::string_view::npos && digits(tail.substr(0, cut)) && digits(tail.substr(cut + 1));
+  };
+  const std::string whole = file.filename().string() + ".tmp", stem = file.stem().string() + ".tmp", extension = file.extension().string();
   std::error_code ec;
   for (std::filesystem::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
-    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
-    // "<stamp>_<counter>", digits only: nothing else of this name is ours.
-    const std::string_view tail = std::string_view(name).substr(prefix.size());
-    const std::size_t cut = tail.find('_');
-    const auto digits = [](std::string_view t) { return !t.empty() && t.find_first_not_of("0123456789") == std::string_view::npos; };
-    if (cut == std::string_view::npos || !digits(tail.substr(0, cut)) || !digits(tail.substr(cut + 1))) continue;
+    if (!ours(name, whole, "") && !(!extension.empty() && ours(name, stem, extension))) continue;
     std::error_code ignored;
     if (std::filesystem::last_write_time(it->path(), ignored) < old && !ignored) std::filesystem::remove_all(it->path(), ignored);
   }
@@ -94,6 +111,51 @@ void write_through_temporary(const std::filesystem::path& file, Write&& write) {
   }
   rename_into_place(tmp, file);
 }
+
+/// The outputs of one run, written as a set: each is written whole at a temporary path beside
+/// it that keeps its extension (the writers choose the format by it), and commit() renames
+/// them all into place. Outputs not committed — a later one failed, the disk filled — are
+/// removed, so a run that fails leaves none of its outputs and every old file as it was.
+/// (The renames themselves, in one folder, do not fail short of the folder vanishing.)
+class OutputSet {
+ public:
+  OutputSet() = default;
+  OutputSet(const OutputSet&) = delete;
+  OutputSet& operator=(const OutputSet&) = delete;
+  ~OutputSet() { discard(); }
+
+  /// Has `write(path)` write the file `file` at a temporary path beside it; errors name `file`.
+  template <class Write>
+  void stage(const std::filesystem::path& file, Write&& write) {
+    remove_stale_temporaries(file);
+    const std::filesystem::path tmp = temporary_path_keeping_extension(file);
+    staged_.emplace_back(tmp, file);
+    try {
+      write(tmp);
+    } catch (const IoError& e) {
+      std::string what = e.message();
+      for (std::size_t at = what.find(tmp.string()); at != std::string::npos; at = what.find(tmp.string(), at + file.string().size()))
+        what.replace(at, tmp.string().size(), file.string());
+      throw IoError(what);
+    }
+  }
+  /// Renames every staged output into place (rename_into_place()).
+  void commit() {
+    for (auto& [tmp, file] : staged_) rename_into_place(tmp, file);
+    staged_.clear();
+  }
+
+ private:
+  void discard() noexcept {
+    for (const auto& staged : staged_) {
+      std::error_code ignored;
+      std::filesystem::remove(staged.first, ignored);
+    }
+    staged_.clear();
+  }
+
+  std::vector<std::pair<std::filesystem::path, std::filesystem::path>> staged_;  ///< (temporary, output)
+};
 
 /// Has `write(std::ofstream&)` write `file`'s content into a temporary file beside it, then
 /// renames it into place. Throws IoError (leaving neither `file` changed nor the temporary
