@@ -226,15 +226,37 @@ template <int Dim>
 /// max(1 KiB per node, an eighth of the machine's memory) and that limit (compact kernels, one
 /// system). The programs and Python take it from here too. Throws InputError as
 /// suggest_support_radius() and rigid_blend() do, or for a boundary node outside `points`.
+namespace detail {
+
+/// What a setup decides from its boundary's motion: the default radius (when `default_radius`;
+/// none for a given one) and the rigid part's blend, taken out first when RbfOptions::rigid_part
+/// says so. The radius is that of what the interpolation then carries.
+template <int Dim>
+struct RadiusAndBlend {
+  std::optional<DefaultSupportRadius> radius;
+  std::optional<RigidBlend<Dim>> blend;
+};
+
+template <int Dim>
+[[nodiscard]] RadiusAndBlend<Dim> radius_and_blend(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary,
+                                                   const RbfOptions& options, bool default_radius) {
+  RadiusAndBlend<Dim> out;
+  if (default_radius) out.radius = budgeted_support_radius(points, boundary, options);
+  // automatic blends where the budget cut the whole motion's radius (or nothing is held).
+  out.blend = rigid_blend(points, boundary, options.rigid_part, out.radius && out.radius->reduced);
+  if (default_radius && out.blend) {
+    out.radius = budgeted_support_radius(points, without_rigid_part(boundary, *out.blend), options);
+    out.radius->rigid_part = true;
+  }
+  return out;
+}
+
+}  // namespace detail
+
 template <int Dim>
 [[nodiscard]] DefaultSupportRadius default_support_radius(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary,
                                                           const RbfOptions& options) {
-  const DefaultSupportRadius whole = detail::budgeted_support_radius(points, boundary, options);
-  const auto blend = rigid_blend(points, boundary, options.rigid_part, whole.reduced);
-  if (!blend) return whole;
-  DefaultSupportRadius out = detail::budgeted_support_radius(points, without_rigid_part(boundary, *blend), options);
-  out.rigid_part = true;
-  return out;
+  return *detail::radius_and_blend(points, boundary, options, true).radius;
 }
 
 /// Refuses (InputError with the estimate and the limit) a given `radius` whose memory
@@ -588,16 +610,10 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   rigid_.resize(Dim, 0);
   if (!points.allFinite()) throw InputError("RbfMover::setup: mesh has a non-finite coordinate");
   detail::check_boundary<Dim>("RbfMover::setup", boundary, points.cols(), false);
-  const bool default_radius = options_.support_radii.empty() && radius_ == 0.0;
-  std::optional<DefaultSupportRadius> whole;
-  if (default_radius && options_.rigid_part != RigidPart::none) whole = detail::budgeted_support_radius(points, boundary, options_);
-  auto blend = rigid_blend(points, boundary, options_.rigid_part, whole && whole->reduced);
-  if (default_radius) {
-    const DefaultSupportRadius fitted =
-        blend ? detail::budgeted_support_radius(points, without_rigid_part(boundary, *blend), options_)
-              : (whole ? *whole : detail::budgeted_support_radius(points, boundary, options_));
-    radius_ = fitted.radius;
-    radius_reduced_ = fitted.reduced;
+  auto [fitted, blend] = detail::radius_and_blend(points, boundary, options_, options_.support_radii.empty() && radius_ == 0.0);
+  if (fitted) {
+    radius_ = fitted->radius;
+    radius_reduced_ = fitted->reduced;
   } else if (options_.support_radii.empty()) {
     check_support_radius_memory(points, boundary, radius_, options_);
   }
