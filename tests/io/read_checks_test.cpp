@@ -14,6 +14,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -323,4 +325,24 @@ TEST_CASE("the outputs of one run are written as a set: all of them, or on an er
   }
   CHECK(files() == std::vector<std::string>{"out.msh", "out.svg"});
   CHECK(read_mesh_as<2>(mesh_file).num_cells() == square.num_cells());
+}
+
+TEST_CASE("a path that is no regular file is refused naming why: a loop of links, a link to nothing, a pipe", "[io]") {
+  const fs::path dir = test::scratch_path("odd_paths");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto io_error = [](const fs::path& file) { return test::message_of<IoError>([&] { (void)read_mesh(file); }); };
+  fs::create_symlink("b.msh", dir / "a.msh");
+  fs::create_symlink("a.msh", dir / "b.msh");
+  CHECK_THAT(io_error(dir / "a.msh"), Catch::Contains("a.msh: cannot read: Too many levels of symbolic links"));
+  fs::create_symlink("gone.su2", dir / "link.su2");
+  CHECK_THAT(io_error(dir / "link.su2"), Catch::Contains("link.su2: a symbolic link to nothing (gone.su2)"));
+  CHECK_THAT(io_error(dir / "none.su2"), Catch::Contains("none.su2: no such file"));
+  REQUIRE(mkfifo((dir / "pipe.su2").c_str(), 0600) == 0);
+  CHECK_THAT(io_error(dir / "pipe.su2"), Catch::Contains("pipe.su2: cannot read: not a regular file (a device, pipe or socket)"));
+  if (have_cgns) {
+    REQUIRE(mkfifo((dir / "pipe.cgns").c_str(), 0600) == 0);
+    CHECK_THAT(io_error(dir / "pipe.cgns"), Catch::Contains("pipe.cgns: cannot read: not a regular file (a device, pipe or socket)"));
+    CHECK_THAT(io_error(dir / "a.cgns"), Catch::Contains("a.cgns: no such file"));
+  }
 }

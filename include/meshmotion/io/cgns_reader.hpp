@@ -10,6 +10,7 @@
 #include "meshmotion/io/any_mesh.hpp"
 #include "meshmotion/io/detail/cgns_file.hpp"
 #include "meshmotion/io/detail/raw_mesh.hpp"
+#include "meshmotion/io/detail/read_file.hpp"
 
 #include <algorithm>
 #include <array>
@@ -827,8 +828,7 @@ class CgnsReader {
 /// path for content meshmotion does not take, and InputError when built without CGNS.
 [[nodiscard]] inline AnyMesh read_cgns(const std::filesystem::path& file) {
 #ifdef MESHMOTION_HAVE_CGNS
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw IoError(file.string() + ": no such file");
+  detail::check_regular_file(file);
   return detail::to_any_mesh(detail::CgnsReader(file).read(), file);
 #else
   throw InputError(file.string() + ": reading CGNS needs the CGNS library (meshmotion was built without it: install "
