@@ -595,7 +595,18 @@ TEST_CASE("coincident boundary nodes are merged, conflicting displacements are n
   const Points<2> u = mover.move(d);
   CHECK(u(0, 5) > 0.0);
   d(0, 4) = 0.2;
-  CHECK_THROWS_WITH(mover.move(d), Catch::Contains("nodes 0 and 4 coincide"));
+  CHECK_THROWS_WITH(mover.move(d), Catch::Contains("nodes 0 and 4 coincide") && Catch::Contains("(they are 0 apart"));
+  // A node at x = 2^31 stretches the boundary's diagonal, and with it the tolerance, until
+  // nodes 0.5 apart count as one: the message gives the distance and the diagonal that did it.
+  Mesh<2> far = mesh;
+  far.points(0, 3) = 2147483648.0;
+  far.points(0, 1) = 0.1;
+  RbfMover<2> stretched(RbfOptions{RbfKernel::wendland2, 2.0});
+  stretched.setup(far, spec.resolve(far.points, GroupNodes{{"walls", {0, 1, 2, 3, 4}}}));
+  Points<2> apart = Points<2>::Zero(2, 5);
+  apart(0, 0) = apart(0, 4) = 0.1;
+  CHECK_THROWS_WITH(stretched.move(apart), Catch::Contains("nodes 0 and 1 coincide but get different displacements (they are 0.1 apart") &&
+                                               Catch::Contains("x the boundary's diagonal 2147483648"));
 }
 
 TEST_CASE("bad inputs raise InputError", "[movers]") {

@@ -471,10 +471,16 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
       if (kinds_[static_cast<std::size_t>(b)] == BoundaryKind::sliding || c >= n_constrained_) continue;
       const Index first = source_[static_cast<std::size_t>(c)];
       const double scale = std::max({1.0, d.col(b).norm(), d.col(first).norm()});
-      if ((d.col(b) - d.col(first)).norm() > 1e-12 * scale)
-        throw InputError("RbfMover::move: boundary nodes " + std::to_string(boundary_nodes_[static_cast<std::size_t>(first)]) +
-                         " and " + std::to_string(boundary_nodes_[static_cast<std::size_t>(b)]) +
-                         " coincide but get different displacements");
+      if ((d.col(b) - d.col(first)).norm() > 1e-12 * scale) {
+        // Coincident within coincidence_tolerance × the boundary's diagonal, which one node far
+        // from the others (a coordinate of 2^31) stretches: the figures say which it was.
+        const Index u = boundary_nodes_[static_cast<std::size_t>(first)], v = boundary_nodes_[static_cast<std::size_t>(b)];
+        throw InputError("RbfMover::move: boundary nodes " + std::to_string(u) + " and " + std::to_string(v) +
+                         " coincide but get different displacements (they are " +
+                         format_option_value((points_.col(u) - points_.col(v)).norm()) + " apart, within coincidence_tolerance " +
+                         format_option_value(options_.coincidence_tolerance) + " x the boundary's diagonal " +
+                         format_option_value(boundary_diagonal_) + ")");
+      }
     }
     if (k > n_constrained_) {
       with_constrained([&](auto& system) { system.solve(values_.topRows(n_constrained_), alpha_, beta_); });
@@ -570,6 +576,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   bool ready_ = false;
   Points<Dim> points_;                      ///< reference coordinates, Dim × n
   Index n_centres_ = 0;                     ///< boundary centres (merged coincident nodes)
+  double boundary_diagonal_ = 0.0;          ///< of the boundary's bounding box: the coincidence tolerance's scale
   std::vector<Index> boundary_nodes_;       ///< as given to setup
   std::vector<BoundaryKind> kinds_;
   std::vector<Index> centre_of_;            ///< boundary entry → centre
@@ -696,8 +703,8 @@ Points<Dim> RbfMover<Dim>::merge_centres(const ResolvedBoundary<Dim>& boundary) 
   const Index m = boundary.size();
   Points<Dim> positions(Dim, m);
   for (Index b = 0; b < m; ++b) positions.col(b) = points_.col(boundary_nodes_[static_cast<std::size_t>(b)]);
-  const double diagonal = m > 0 ? (positions.rowwise().maxCoeff() - positions.rowwise().minCoeff()).norm() : 0.0;
-  const auto rep = detail::coincident_representatives(positions, options_.coincidence_tolerance * diagonal);
+  boundary_diagonal_ = m > 0 ? (positions.rowwise().maxCoeff() - positions.rowwise().minCoeff()).norm() : 0.0;
+  const auto rep = detail::coincident_representatives(positions, options_.coincidence_tolerance * boundary_diagonal_);
   std::vector<bool> constrained(static_cast<std::size_t>(m), false);
   for (Index b = 0; b < m; ++b)
     if (kinds_[static_cast<std::size_t>(b)] != BoundaryKind::sliding) constrained[static_cast<std::size_t>(rep[static_cast<std::size_t>(b)])] = true;
