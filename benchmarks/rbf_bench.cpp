@@ -5,6 +5,11 @@
 // 2. Scaling on a 3D hex box family (bottom face moving as a bump, support radius = 6 grid
 //    spacings): setup and move time against node count, peak memory, and the speed-up over
 //    the direct O(N_volume × N_boundary) evaluation measured in the same run (smaller sizes).
+// 3. One setup, many moves: a ring whose whole boundary turns 56° (with a ±0.15 rad swirl),
+//    stretches by 1.16 and translates by 0.31 of its radius, in 10 moves from one setup made
+//    before anything moved, as solvers run it. The defaults (radius growing with the motion)
+//    beside the radius held at the setup's; how often the mover set up again; a move without a
+//    set-up again against a mover given that radius (no growth rule), timed in the same run.
 // Prints a table and one JSON line per case. Usage: rbf_bench [max_box_cells_per_axis=126]
 // (sizes 20, 40, 80, 126, 160 cells per axis up to the maximum; 126 gives 2.05M nodes).
 
@@ -120,6 +125,93 @@ void scaling(int max_cells) {
   }
 }
 
+/// Boundary displacements of step s ∈ [0, 1] of the ring's whole-boundary motion.
+Points<2> ring_step(const Mesh<2>& ring, const ResolvedBoundary<2>& boundary, double s) {
+  Points<2> d(2, boundary.size());
+  for (Index k = 0; k < d.cols(); ++k) {
+    const Vec<2> x = ring.points.col(boundary.nodes[static_cast<std::size_t>(k)]);
+    const double turn = s * (radians(56.0) + 0.15 * std::cos(2.0 * std::atan2(x.y(), x.x())));
+    d.col(k) = Eigen::Rotation2Dd(turn) * Vec<2>(std::pow(1.16, s) * x.x(), std::pow(1.16, -s) * x.y()) +
+               Vec<2>(s * 0.31 * 1.5, 0.0) - x;
+  }
+  return d;
+}
+
+struct OneSetupRun {
+  int invalid = 0;           // cells invalid over every step
+  double min_quality = 1.0;  // smallest scaled Jacobian over every step
+  Index growths = 0;
+  double radius = 0.0;
+};
+
+OneSetupRun ten_moves(RbfMover<2>& mover, const Mesh<2>& ring, const ResolvedBoundary<2>& boundary) {
+  OneSetupRun run;
+  mover.setup(ring, boundary);
+  Mesh<2> moved = ring;
+  for (int step = 1; step <= 10; ++step) {
+    moved.points = ring.points + mover.move(ring_step(ring, boundary, 0.1 * step));
+    const QualityReport q = quality_report(moved, Metric::scaled_jacobian);
+    run.invalid += static_cast<int>(q.num_invalid);
+    run.min_quality = std::min(run.min_quality, q.min);
+  }
+  run.growths = mover.stats().radius_growths;
+  run.radius = mover.support_radius();
+  return run;
+}
+
+void one_setup_many_moves() {
+  const Mesh<2> ring = annulus_mesh({.n_around = 512});
+  BoundarySpec<2> spec;
+  spec.moving("inner", Translation<2>{Vec<2>::Zero()}).moving("outer", Translation<2>{Vec<2>::Zero()});
+  const ResolvedBoundary<2> boundary = spec.resolve(ring);
+  RbfMover<2> defaults;
+  const OneSetupRun grown = ten_moves(defaults, ring, boundary);
+  RbfOptions held_options;
+  {
+    RbfMover<2> first;
+    first.setup(ring, boundary);
+    held_options.support_radius = first.support_radius();
+  }
+  RbfMover<2> held(held_options);
+  const OneSetupRun kept = ten_moves(held, ring, boundary);
+  // A move the growth rule lets through, against the same radius given (no rule), alternately.
+  RbfOptions given_options;
+  given_options.support_radius = grown.radius;
+  RbfMover<2> given(given_options);
+  given.setup(ring, boundary);
+  const Points<2> last = ring_step(ring, boundary, 1.0);
+  Points<2> out;
+  double with_rule = 1e300, without = 1e300;
+  for (int round = 0; round < 5; ++round) {
+    detail::Stopwatch a;
+    defaults.move_into(last, out);
+    with_rule = std::min(with_rule, a.seconds());
+    detail::Stopwatch b;
+    given.move_into(last, out);
+    without = std::min(without, b.seconds());
+  }
+  std::printf("\none setup, many moves: a ring of %ld nodes (%ld on its boundary), its whole boundary turned 56 deg, "
+              "stretched and translated in 10 moves\n",
+              static_cast<long>(ring.num_nodes()), static_cast<long>(boundary.size()));
+  std::printf("%-34s %8s %10s %8s %10s\n", "options", "invalid", "min_sj", "setups", "radius");
+  for (const auto& [name, run] : {std::pair{"(defaults)", grown}, std::pair{"support_radius held at the setup's", kept}}) {
+    std::printf("%-34s %8d %10.4f %8ld %10.4f\n", name, run.invalid, run.min_quality, static_cast<long>(1 + run.growths), run.radius);
+    std::printf("{\"case\":\"one_setup_many_moves\",\"options\":\"%s\",\"nodes\":%ld,\"steps\":10,\"invalid\":%d,"
+                "\"min_scaled_jacobian\":%.6f,\"setups_again\":%ld,\"support_radius\":%.6f}\n",
+                name, static_cast<long>(ring.num_nodes()), run.invalid, run.min_quality, static_cast<long>(run.growths), run.radius);
+  }
+  // doublings: how often the motion doubled past what the setup's radius covers (5 × the
+  // largest displacement against it), the set-ups again it allows.
+  const double largest = last.colwise().norm().maxCoeff();
+  std::printf("a move without a set-up again: %.6f s, with the radius given: %.6f s (ratio %.3f)\n", with_rule, without,
+              with_rule / without);
+  std::printf("{\"case\":\"one_setup_move_cost\",\"nodes\":%ld,\"move_seconds\":%.6f,\"given_radius_move_seconds\":%.6f,"
+              "\"ratio\":%.4f,\"largest_displacement\":%.6f,\"setup_radius\":%.6f,\"setups_again\":%ld,"
+              "\"doublings\":%.3f}\n",
+              static_cast<long>(ring.num_nodes()), with_rule, without, with_rule / without, largest, held_options.support_radius,
+              static_cast<long>(grown.growths), std::log2(5.0 * largest / held_options.support_radius));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -127,4 +219,5 @@ int main(int argc, char** argv) {
   const int max_cells = argc > 1 ? std::atoi(argv[1]) : 126;
   rotating_object();
   scaling(max_cells);
+  one_setup_many_moves();
 }

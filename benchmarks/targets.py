@@ -10,6 +10,7 @@ run skips the full sizes; ../shared/data may be absent) is listed as "not run".
 """
 import argparse
 import json
+import math
 import statistics
 import sys
 
@@ -91,6 +92,15 @@ def rbf_gradient_error(rows, build):
 
 
 # (name, rows' fields to match or a function of (rows, build), field, "<=" or ">=", limit, unit)
+def setups_per_doubling(rows, build):
+    """rbf_bench's one-setup run: set-ups again over the doublings of the motion past what the
+    setup's radius covered (at most one each)."""
+    for row in rows:
+        if row.get("build", "current") == build and row.get("case") == "one_setup_move_cost":
+            return row["setups_again"] / max(1.0, math.ceil(row["doublings"]))
+    return None
+
+
 TARGETS = [
     ("P1->P2 30P30N quads (median)", {"bench": "conversion", "case": "30p30n-quads"}, "median_s", "<=", 0.015, "s"),
     ("P1->P2 30P30N quads (first call)", {"bench": "conversion", "case": "30p30n-quads"}, "first_s", "<=", 0.015, "s"),
@@ -119,6 +129,11 @@ TARGETS = [
     ("Python over MPI / the C++ distributed mover, per call, worst rank count", python_mpi_overhead, None, "<=", 1.05,
      "x"),
     ("RBF gradient on a RANS grid, default limit, worst radius: error", rbf_gradient_error, None, "<=", 1e-6, ""),
+    ("one RBF setup, 10 moves turning a ring's whole boundary 56 deg: invalid cells, defaults",
+     {"case": "one_setup_many_moves", "options": "(defaults)"}, "invalid", "<=", 0, ""),
+    ("one RBF setup: a move without a set-up again / the same radius given", {"case": "one_setup_move_cost"}, "ratio",
+     "<=", 1.2, "x"),
+    ("one RBF setup: set-ups again per doubling of the motion", setups_per_doubling, None, "<=", 1.0, ""),
     ("PU RBF, 1M centres and 10M nodes: peak", {"bench": "pu_rbf", "mesh": "flat-707", "method": "pu"}, "peak_mb",
      "<=", 24576, "MB"),
 ]

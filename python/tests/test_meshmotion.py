@@ -403,6 +403,27 @@ def annulus(n_around=48, n_radial=8, inner=0.5, outer=2.0):
     return mm.from_arrays(points, {"quad4": quads}, {"wall": ("line2", ring(0)), "farfield": ("line2", ring(n_radial))})
 
 
+def test_a_mover_set_up_once_follows_a_whole_boundary_turning_56_degrees():
+    # As a time loop uses it: set up on the reference with no displacement, moved from the
+    # reference ten times. The default radius grows with the motion inside the mover (held at
+    # the setup's, the ring folded at the last steps).
+    mesh = annulus()
+    b = mm.Boundary(2).prescribed("wall").prescribed("farfield").resolve(mesh)
+    x = mesh.points[b.nodes]
+    mover = mm.Mover("rbf", 2)
+    mover.setup(mesh, b)
+    for step in range(1, 11):
+        s = 0.1 * step
+        turn = s * (np.radians(56.0) + 0.15 * np.cos(2.0 * np.arctan2(x[:, 1], x[:, 0])))
+        sx, sy = 1.16 ** s * x[:, 0], 1.16 ** -s * x[:, 1]
+        target = np.column_stack([np.cos(turn) * sx - np.sin(turn) * sy + s * 0.31 * 2.0, np.sin(turn) * sx + np.cos(turn) * sy])
+        moved = mm.from_arrays(mesh.points + mover.move(target - x), {"quad4": mesh.cells[0][1]}, {})
+        report = mm.quality_report(moved, "scaled_jacobian")
+        assert report["invalid"] == 0 and report["min"] > 0.5, (step, report["min"])
+    assert mover.stats["moves"] == 10
+    assert 1 <= mover.stats["radius_growths"] <= 4
+
+
 def test_quality_report_has_per_cell_arrays():
     mesh = grid()
     report = mm.quality_report(mesh, "jacobian")

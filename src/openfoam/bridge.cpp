@@ -4,7 +4,6 @@
 
 #include "meshmotion/io/openfoam_polymesh.hpp"
 #include "meshmotion/movers/registry.hpp"
-#include "meshmotion/movers/support_radius.hpp"
 #include "meshmotion/movers/rbf_options.hpp"
 #ifdef MESHMOTION_FOAM_PARALLEL
 #include "meshmotion/parallel/petsc.hpp"
@@ -227,14 +226,6 @@ std::vector<std::vector<Index>> add_face_centres(const PolyMesh& poly, const Mes
   return out;
 }
 
-// The RBF's default support radius (no support_radius or support_radii given) follows the
-// motion. A motion solver is set up before it moves, where the library's rule (five times the
-// largest boundary displacement, at least ten boundary spacings) sees no displacement and
-// gives the spacing's radius: a plate turned in a box kept its cells valid to 30 degrees with
-// it, to 90 with a radius of the box's size. So when a move's largest prescribed displacement
-// (over all ranks) outgrows the rule, the mover is set up again for 1.5 times that
-// displacement: once per growth of the motion by half, never for an oscillation within the
-// first period's reach. The mover (serial or distributed: one rule) chooses the radius.
 struct Bridge::Impl {
   std::optional<AnyMover<3>> mover;
   MoverConfig<3> config;
@@ -261,15 +252,11 @@ struct Bridge::Impl {
   std::vector<std::vector<std::int64_t>> rank_points;
 #endif
   Index points_count = 0, entries = 0;
-  bool growing_radius = false;
-  double radius = 0.0;
-  int setups = 0;
 
-  // Sets the mover up with the boundary displacements `d` (entries × 3), from which the mover
-  // decides its default radius; false when the radius did not grow (the memory budget holds it).
-  bool set_up(const Points<3>& d) {
-    boundary.displacements.leftCols(d.cols()) = d;
-    const double before = radius;
+  // Sets the mover up on the reference, before anything moves: the mover's default radius
+  // then follows the motion by itself (RbfMover's "set up once, moved many times").
+  void set_up() {
+    boundary.displacements.setZero();
 #ifdef MESHMOTION_FOAM_PARALLEL
     if (!global_ids.empty() && !gathered) {
       distributed = parallel::make_distributed_mover(config, parallel);
@@ -278,25 +265,19 @@ struct Bridge::Impl {
         distributed->setup(parallel::PartitionView<3>{MPI_COMM_WORLD, mesh.points, global_ids, owners}, mesh, boundary);
       else
         distributed->setup(parallel::PartitionView<3>{MPI_COMM_WORLD, points, global_ids, owners}, boundary);
-      radius = distributed->support_radius();
-      return ++setups == 1 || radius > before;
+      return;
     }
 #endif
     mover.emplace(make_mover(config));
     mover->setup(mesh, boundary);
-    radius = mover->stats().support_radius;
-    return ++setups == 1 || radius > before;
   }
 
-  // The largest prescribed displacement of `d` over every rank.
-  [[nodiscard]] double largest(const Points<3>& d) const {
-    double out = 0.0;
-    for (Index k = 0; k < d.cols(); ++k)
-      if (boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed) out = std::max(out, d.col(k).norm());
+  // The mover's figures (none on the ranks of a gathered case other than rank 0).
+  [[nodiscard]] MoverStats stats() const {
 #ifdef MESHMOTION_FOAM_PARALLEL
-    if (!global_ids.empty()) MPI_Allreduce(MPI_IN_PLACE, &out, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    if (distributed) return distributed->stats();
 #endif
-    return out;
+    return mover ? mover->stats() : MoverStats{};
   }
 
   // The given displacements: the boundary entries' `d`, then the face centres' entries.
@@ -349,11 +330,10 @@ struct Bridge::Impl {
         rank_points.emplace_back(all_points.begin() + static_cast<std::ptrdiff_t>(at), all_points.begin() + static_cast<std::ptrdiff_t>(at + static_cast<std::size_t>(count)));
         at += static_cast<std::size_t>(count);
       }
-      set_up(Points<3>::Zero(3, nb));
+      set_up();
       given.setZero(3, b.size());
       moved.resize(3, mesh.num_nodes());
     });
-    setups = 1;
   }
 
   // A move of the gathered case: the entries' displacements to rank 0, the serial mover's
@@ -428,7 +408,6 @@ Bridge::Bridge(const BridgeInput& input) {
     impl->gathered = !input.global_ids.empty() && parallel::find_distributed_method<3>(impl->config.method) == nullptr;
 #endif
     if (auto* rbf = std::get_if<RbfOptions>(&impl->config.options)) {
-      impl->growing_radius = rbf->support_radius == 0.0 && rbf->support_radii.empty();
       // One setup serves many time steps: a rigid part blended from one step's motion would
       // be wrong for the next, so the whole motion is interpolated.
       if (rbf->rigid_part == RigidPart::blend)
@@ -483,7 +462,7 @@ Bridge::Bridge(const BridgeInput& input) {
     } else if (input.global_ids.empty()) {
       impl->mesh.points = points;
     }
-    impl->set_up(Points<3>::Zero(3, nb));
+    impl->set_up();
     impl->given.setZero(3, b.size());
     impl->moved.resize(3, impl->mesh.num_nodes());
     impl_ = std::move(impl);
@@ -495,18 +474,14 @@ Bridge::Bridge(const BridgeInput& input) {
 // Here, where Impl is complete.
 Bridge::~Bridge() = default;
 
-double Bridge::support_radius() const { return impl_->radius; }
+double Bridge::support_radius() const { return impl_->stats().support_radius; }
 
-int Bridge::setups() const { return impl_->setups; }
+int Bridge::setups() const { return 1 + static_cast<int>(impl_->stats().radius_growths); }
 
 void Bridge::move(const std::vector<double>& boundary_displacements, std::vector<double>& out) {
   try {
     Impl& m = *impl_;
     const Eigen::Map<const Points<3>> d(boundary_displacements.data(), 3, m.entries);
-    if (m.growing_radius) {
-      const double largest = m.largest(d);
-      if (SupportRadiusOptions{}.displacement_factor * largest > m.radius) m.growing_radius = m.set_up(1.5 * d);
-    }
 #ifdef MESHMOTION_FOAM_PARALLEL
     if (m.distributed && !m.distributed_cells) {
       m.distributed->move_into(d, m.moved);

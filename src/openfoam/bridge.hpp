@@ -52,10 +52,10 @@ class Bridge {
   /// displacement (3 × n). Collective on a decomposed case, where each entry's owner gives it.
   void move(const std::vector<double>& boundary_displacements, std::vector<double>& out);
   /// The RBF's support radius (0 for other methods). Without a given one it grows with the
-  /// motion: a move whose largest prescribed displacement needs a larger one sets the mover
-  /// up again (bridge.cpp says when).
+  /// motion: a move whose largest prescribed displacement outgrew it sets the mover up again
+  /// (RbfMover's radius_outgrown()).
   [[nodiscard]] double support_radius() const;
-  /// How many times the mover was set up.
+  /// How many times the mover was set up: once here, then once per growth of its radius.
   [[nodiscard]] int setups() const;
 
  private:

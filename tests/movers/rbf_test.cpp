@@ -915,40 +915,126 @@ TEST_CASE("rbf: the memory is estimated before assembly, a default radius shrink
   CHECK_THROWS_AS(negative.setup(g.mesh, boundary), InputError);
 }
 
-TEST_CASE("a mesh whose whole boundary turns 56 degrees, stretches and swirls stays valid with the default RBF",
+namespace {
+
+/// The boundary of every facet of `mesh`, prescribed, with no displacement yet.
+template <int Dim>
+ResolvedBoundary<Dim> whole_boundary(const Mesh<Dim>& mesh) {
+  ResolvedBoundary<Dim> boundary;
+  for (const auto& block : boundary_facets(mesh)) boundary.nodes.insert(boundary.nodes.end(), block.connectivity.begin(), block.connectivity.end());
+  std::sort(boundary.nodes.begin(), boundary.nodes.end());
+  boundary.nodes.erase(std::unique(boundary.nodes.begin(), boundary.nodes.end()), boundary.nodes.end());
+  const auto m = static_cast<Index>(boundary.nodes.size());
+  boundary.kinds.assign(boundary.nodes.size(), BoundaryKind::prescribed);
+  boundary.displacements = boundary.normals = boundary.directions = Points<Dim>::Zero(Dim, m);
+  return boundary;
+}
+
+/// Step s ∈ [0, 1] of a whole-boundary motion of the ring (3 across): turned by 56° with a
+/// swirl of ±0.15 rad round it, stretched by 1.16 and 1/1.16, translated by 0.31 of its radius.
+Vec<2> ring_motion(const Vec<2>& x, double s) {
+  const double swirl = 0.15 * std::cos(2.0 * std::atan2(x.y(), x.x()));
+  const double turn = s * (56.0 * std::numbers::pi / 180.0 + swirl);
+  const Vec<2> stretched(std::pow(1.16, s) * x.x(), std::pow(1.16, -s) * x.y());
+  return Eigen::Rotation2Dd(turn) * stretched + Vec<2>(s * 0.31 * 1.5, 0.0);
+}
+
+}  // namespace
+
+TEST_CASE("set up once on the reference, the default RBF follows a whole boundary turning 56 degrees in 10 moves",
           "[movers]") {
-  // Nothing holds the mesh: the default radius (5 × the largest displacement) reaches across
-  // the whole ring, so the interior follows the boundary instead of staying behind (with a
-  // radius of 1, the old Python default, 688 and 396 cells here are invalid). A ring with
-  // boundary-layer cells on its inner circle, at P1 and P2.
+  // As a time loop runs it: set up before anything moves (the default radius is then ten
+  // boundary spacings), moved from the reference at every step. With that radius held, the
+  // ring's interior stayed behind its boundary and folded (min scaled Jacobian -36.7 at the
+  // last step); the radius now grows with the motion, at most once per doubling of it, and an
+  // oscillation within the motion seen sets nothing up again. P1 and P2 (boundary-layer cells
+  // on the inner circle).
   const Mesh<2> ring = annulus_mesh();
-  const auto map = [](const Vec<2>& x) {
-    const double turn = (56.0 + 20.0 * x.squaredNorm() / 2.25) * std::numbers::pi / 180.0;  // swirl: more turn outside
-    return Vec<2>(Eigen::Rotation2Dd(turn) * Vec<2>(1.3 * x[0], 0.8 * x[1]));
-  };
   for (const Mesh<2>& mesh : {ring, convert_to_quadratic(ring).mesh}) {
     CAPTURE(mesh.num_nodes());
-    ResolvedBoundary<2> boundary;
-    for (const auto& block : boundary_facets(mesh)) boundary.nodes.insert(boundary.nodes.end(), block.connectivity.begin(), block.connectivity.end());
-    std::sort(boundary.nodes.begin(), boundary.nodes.end());
-    boundary.nodes.erase(std::unique(boundary.nodes.begin(), boundary.nodes.end()), boundary.nodes.end());
-    const auto m = static_cast<Index>(boundary.nodes.size());
-    boundary.kinds.assign(boundary.nodes.size(), BoundaryKind::prescribed);
-    boundary.displacements.resize(2, m);
-    boundary.normals = boundary.directions = Points<2>::Zero(2, m);
-    for (Index k = 0; k < m; ++k) {
-      const Vec<2> x = mesh.points.col(boundary.nodes[static_cast<std::size_t>(k)]);
-      boundary.displacements.col(k) = map(x) - x;
-    }
+    ResolvedBoundary<2> boundary = whole_boundary(mesh);
     RbfMover<2> mover;
     mover.setup(mesh, boundary);
-    Mesh<2> moved = mesh;
-    moved.points += mover.move(boundary.displacements);
-    CHECK(mover.support_radius() > 3.0);  // the ring is 3 across
-    const QualityReport q = quality_report(moved, Metric::scaled_jacobian);
-    CHECK(q.num_invalid == 0);
-    CHECK(q.min > 0.8);  // 0.959 and 0.970 measured
+    const double first_radius = mover.support_radius();
+    CHECK(first_radius < 1.0);  // the spacing's radius: nothing moved yet
+    const auto displacements = [&](double s) {
+      Points<2> d(2, boundary.size());
+      for (Index k = 0; k < d.cols(); ++k) {
+        const Vec<2> x = mesh.points.col(boundary.nodes[static_cast<std::size_t>(k)]);
+        d.col(k) = ring_motion(x, s) - x;
+      }
+      return d;
+    };
+    std::vector<double> grown_at;  // the largest displacement of each move that set up again
+    Index growths = 0;
+    for (int step = 1; step <= 10; ++step) {
+      CAPTURE(step);
+      const Points<2> d = displacements(0.1 * step);
+      Mesh<2> moved = mesh;
+      moved.points += mover.move(d);
+      CHECK(mover.stats().moves == step);
+      if (mover.stats().radius_growths > growths) {
+        grown_at.push_back(d.colwise().norm().maxCoeff());
+        growths = mover.stats().radius_growths;
+        // Set up for twice the motion: the radius covers it with room to double.
+        CHECK(mover.support_radius() == Approx(10.0 * grown_at.back()).epsilon(1e-12));
+      }
+      for (Index k = 0; k < boundary.size(); ++k)
+        CHECK((moved.points.col(boundary.nodes[static_cast<std::size_t>(k)]) - mesh.points.col(boundary.nodes[static_cast<std::size_t>(k)]) - d.col(k)).norm() < 1e-12);
+      const QualityReport q = quality_report(moved, Metric::scaled_jacobian);
+      CHECK(q.num_invalid == 0);
+      CHECK(q.min > 0.9);  // 0.95 at the last step measured
+    }
+    REQUIRE(grown_at.size() >= 2);
+    for (std::size_t g = 1; g < grown_at.size(); ++g) CHECK(grown_at[g] > 2.0 * grown_at[g - 1]);
+    const double radius = mover.support_radius();
+    // Back and forth within the motion seen: nothing set up again, the same map as before.
+    const Points<2> half = mover.move(displacements(0.5));
+    CHECK(mover.move(displacements(1.0)).allFinite());
+    CHECK(mover.stats().radius_growths == growths);
+    CHECK(mover.support_radius() == radius);
+    CHECK((mover.move(displacements(0.5)) - half).norm() == 0.0);
+    // Linear between growths: the derivative is the map of the last move.
+    const Points<2> w = displacements(0.3);
+    CHECK((mover.derivative_forward(w) - mover.move(w)).norm() <= 1e-12 * w.norm());
+    // The setup's radius held folds the ring.
+    RbfOptions held;
+    held.support_radius = first_radius;
+    RbfMover<2> folding(held);
+    folding.setup(mesh, boundary);
+    Mesh<2> folded = mesh;
+    folded.points += folding.move(displacements(1.0));
+    CHECK(quality_report(folded, Metric::scaled_jacobian).num_invalid > 0);
   }
+}
+
+TEST_CASE("a given radius, or one the memory budget holds, does not grow", "[movers]") {
+  const Mesh<2> ring = annulus_mesh();
+  ResolvedBoundary<2> boundary = whole_boundary(ring);
+  Points<2> d(2, boundary.size());
+  for (Index k = 0; k < d.cols(); ++k) {
+    const Vec<2> x = ring.points.col(boundary.nodes[static_cast<std::size_t>(k)]);
+    d.col(k) = ring_motion(x, 1.0) - x;
+  }
+  RbfOptions given;
+  given.support_radius = 0.4;
+  RbfMover<2> fixed_radius(given);
+  fixed_radius.setup(ring, boundary);
+  (void)fixed_radius.move(d);
+  CHECK(fixed_radius.support_radius() == 0.4);
+  CHECK(fixed_radius.stats().radius_growths == 0);
+
+  RbfOptions budget;
+  budget.max_memory_bytes = 2e5;  // room for the spacing's radius, not for the motion's
+  RbfMover<2> held(budget);
+  held.setup(ring, boundary);
+  const double radius = held.support_radius();
+  (void)held.move(d);
+  (void)held.move(d);
+  CHECK(held.stats().radius_growths <= 1);
+  CHECK(held.support_radius() < 5.0 * d.colwise().norm().maxCoeff());
+  if (held.stats().radius_growths == 1) CHECK(held.support_radius_reduced());
+  CHECK(held.support_radius() >= radius);
 }
 
 namespace {

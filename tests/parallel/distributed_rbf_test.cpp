@@ -191,6 +191,57 @@ TEST_CASE("distributed RBF set up once with no motion takes the serial budget ra
   }
 }
 
+TEST_CASE("distributed RBF set up before the motion grows its radius with it as the serial mover does",
+          "[parallel][rbf][petsc]") {
+  // A ring whose whole boundary turns and stretches, moved from the reference in growing
+  // steps after a setup with no motion: the ranks decide to set up again together, for the
+  // same radius as the serial mover, and move every node as it does.
+  const Mesh<2> ring = annulus_mesh({.n_around = 48});
+  BoundarySpec<2> spec;
+  spec.moving("inner", Translation<2>{meshmotion::Vec<2>::Zero()}).moving("outer", Translation<2>{meshmotion::Vec<2>::Zero()});
+  const ResolvedBoundary<2> b = spec.resolve(ring);
+  const auto motion = [&](double s) {
+    Points<2> d(2, b.size());
+    for (Index k = 0; k < d.cols(); ++k) {
+      const meshmotion::Vec<2> x = ring.points.col(b.nodes[static_cast<std::size_t>(k)]);
+      d.col(k) = Eigen::Rotation2Dd(s) * meshmotion::Vec<2>((1.0 + 0.2 * s) * x.x(), x.y()) - x;
+    }
+    return d;
+  };
+  for (const BoundarySolve solve : {BoundarySolve::replicated, BoundarySolve::petsc}) {
+    CAPTURE(static_cast<int>(solve));
+    RbfMover<2> serial;
+    serial.setup(ring, b);
+    const DistributedMesh<2> part = partition_mesh(world(), ring);
+    const ResolvedBoundary<2> local_b = distribute_boundary(part, b);
+    DistributedRbfMover<2> mover({}, {solve});
+    {
+      // The mover keeps its own copy of the part: the caller's arrays may go.
+      Points<2> points = part.local.points;
+      std::vector<std::int64_t> ids = part.global_ids;
+      std::vector<int> owners = part.owner;
+      mover.setup(PartitionView<2>{world(), points, ids, owners}, local_b);
+    }
+    for (const double s : {0.05, 0.2, 0.5, 0.9, 0.3, 0.9, 2.0}) {
+      CAPTURE(s);
+      const Points<2> d = motion(s);
+      const Points<2> expected = serial.move(d);
+      Points<2> local_d(2, local_b.size());
+      for (Index k = 0; k < local_b.size(); ++k)
+        local_d.col(k) = d.col(b.column(part.global_ids[static_cast<std::size_t>(local_b.nodes[static_cast<std::size_t>(k)])]));
+      const Points<2> got = mover.move(local_d);
+      CHECK(mover.support_radius() == serial.support_radius());
+      CHECK(mover.stats().radius_growths == serial.stats().radius_growths);
+      double worst = 0.0;
+      for (Index i = 0; i < part.local.num_nodes(); ++i)
+        worst = std::max(worst, (got.col(i) - expected.col(part.global_ids[static_cast<std::size_t>(i)])).norm());
+      CHECK(global_max(worst) <= 1e-10 * expected.colwise().norm().maxCoeff());
+    }
+    CHECK(serial.stats().radius_growths >= 2);
+    CHECK(serial.stats().radius_growths <= 3);  // at 0.5 and 2.0 (the ring's spacing radius is 1.96)
+  }
+}
+
 TEST_CASE("distributed RBF with the boundary system factorized across the ranks by MUMPS", "[parallel][rbf][petsc]") {
   const BoundarySolveOptions petsc{BoundarySolve::petsc};
   {

@@ -37,6 +37,9 @@ struct MoverStats {
   double support_radius = 0.0;
   /// RBF: the default radius was reduced to fit the memory budget (RbfOptions::max_memory_bytes).
   bool radius_reduced = false;
+  /// RBF: times a move outgrew the default radius and set the mover up again since the setup
+  /// the caller made (radius_outgrown()); `moves` counts on through them.
+  Index radius_growths = 0;
 };
 
 template <class F>
@@ -56,6 +59,7 @@ void visit_fields(const MoverStats& s, F&& f) {
   f("thinned_centres", s.thinned_centres, "RBF: centres thinned because the system's condition exceeded condition_limit");
   f("support_radius", s.support_radius, "RBF: the support radius of the last setup, given or the default (0: none)");
   f("radius_reduced", s.radius_reduced, "RBF: the default radius was reduced to fit the memory budget");
+  f("radius_growths", s.radius_growths, "RBF: moves that outgrew the default radius and set the mover up again");
 }
 
 /// A mesh mover in Dim = M::dim dimensions.

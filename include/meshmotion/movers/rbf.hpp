@@ -25,6 +25,13 @@
 ///   (ResolvedBoundary::project), and the projected values join the constraints of a second
 ///   interpolant over all nodes; both systems are factorized once in setup, so sliding nodes
 ///   end exactly on their planes and lines.
+/// - Set up once, moved many times: with the default radius (no support_radius or
+///   support_radii given), a move whose largest prescribed displacement outgrew it
+///   (radius_outgrown(): a solver sets the mover up before anything moves, where the default
+///   is ten boundary spacings) sets the interpolation up again for radius_growth_margin × that
+///   displacement, at most once per doubling of the motion (MoverStats::radius_growths), until
+///   the memory budget holds the radius. The map is then that of the grown radius; the
+///   derivatives are those of the last move's map.
 /// - Optional linear polynomial augmentation reproduces affine motions exactly.
 /// - A radius per boundary node (RbfOptions::support_radii), e.g. each wall's own
 ///   boundary-layer thickness: s(x) = Σ_j α_j φ(|x − c_j| / ρ_j), still interpolating.
@@ -360,6 +367,11 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   void build_evaluation();
   /// factorize() and build_evaluation() of the pending centres, once after each setup.
   void build_interpolation();
+  /// Merges boundary_'s centres and makes their interpolation with `radius` pending.
+  void prepare_interpolation(double radius);
+  /// Sets the interpolation up again for `d` when it outgrew the default radius (the file
+  /// comment); the rigid part, when setup took one out, stays.
+  void follow_motion(PointsView<Dim> d);
 
   /// f(the system over every centre), global or patched; likewise over the constrained ones.
   template <class F>
@@ -430,6 +442,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   template <class Out>
   void timed_apply(PointsView<Dim> d, Out& out) {
     detail::timed_move<Dim>("RbfMover::move", ready_, d, boundary_nodes_, stats_, [&] {
+      follow_motion(d);
       if (rigid_.size() == 0) {
         apply(d, out);
       } else {
@@ -579,6 +592,8 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   double boundary_diagonal_ = 0.0;          ///< of the boundary's bounding box: the coincidence tolerance's scale
   std::vector<Index> boundary_nodes_;       ///< as given to setup
   std::vector<BoundaryKind> kinds_;
+  ResolvedBoundary<Dim> boundary_;          ///< as given to setup: what a set up again needs
+  bool grows_ = false;                      ///< the default radius follows the motion (follow_motion())
   std::vector<Index> centre_of_;            ///< boundary entry → centre
   std::vector<Index> source_;               ///< centre → boundary entry giving its value
   Index n_constrained_ = 0;                 ///< centres 0..n_constrained_-1 are prescribed/fixed
@@ -624,25 +639,13 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   } else if (options_.support_radii.empty()) {
     check_support_radius_memory(points, boundary, radius_, options_);
   }
+  grows_ = fitted && !fitted->reduced;
   points_ = std::move(points);
   boundary_nodes_ = boundary.nodes;
   kinds_ = boundary.kinds;
-  const Points<Dim> centres = merge_centres(boundary);
-  detail::RbfKernelSettings kernel{options_.kernel, radius_, options_.polynomial};
-  if (!options_.support_radii.empty()) {
-    kernel.radii.resize(static_cast<std::size_t>(n_centres_));
-    for (Index c = 0; c < n_centres_; ++c)
-      kernel.radii[static_cast<std::size_t>(c)] = options_.support_radii[static_cast<std::size_t>(source_[static_cast<std::size_t>(c)])];
-    kernel.radius = n_centres_ > 0 ? *std::max_element(kernel.radii.begin(), kernel.radii.end()) : radius_;
-    radius_ = kernel.radius;
-  }
+  boundary_ = boundary;
   stats_ = MoverStats{};
-  stats_.boundary_nodes = n_centres_;
-  stats_.support_radius = radius_;
-  stats_.radius_reduced = radius_reduced_;
-  pending_centres_ = centres;
-  pending_kernel_ = kernel;
-  pending_ = true;
+  prepare_interpolation(radius_);
   if (blend) {
     rigid_ = std::move(blend->displacement);
     rigid_scale_ = boundary.displacements.colwise().norm().maxCoeff();
@@ -653,6 +656,55 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   }
   ready_ = true;
   stats_.setup_seconds = watch.seconds();
+}
+
+template <int Dim>
+void RbfMover<Dim>::prepare_interpolation(double radius) {
+  radius_ = radius;
+  pending_centres_ = merge_centres(boundary_);
+  pending_kernel_ = detail::RbfKernelSettings{options_.kernel, radius_, options_.polynomial};
+  if (!options_.support_radii.empty()) {
+    auto& radii = pending_kernel_.radii;
+    radii.resize(static_cast<std::size_t>(n_centres_));
+    for (Index c = 0; c < n_centres_; ++c)
+      radii[static_cast<std::size_t>(c)] = options_.support_radii[static_cast<std::size_t>(source_[static_cast<std::size_t>(c)])];
+    radius_ = pending_kernel_.radius = n_centres_ > 0 ? *std::max_element(radii.begin(), radii.end()) : radius_;
+  }
+  stats_.boundary_nodes = n_centres_;
+  stats_.support_radius = radius_;
+  stats_.radius_reduced = radius_reduced_;
+  pending_ = true;
+}
+
+template <int Dim>
+void RbfMover<Dim>::follow_motion(PointsView<Dim> d) {
+  if (!grows_) return;
+  // What the interpolation carries: the motion less the rigid part setup took out.
+  const auto carried = [&](std::size_t b) {
+    Vec<Dim> out = d.col(static_cast<Index>(b));
+    if (rigid_.size() > 0) out -= rigid_.col(boundary_nodes_[b]);
+    return out;
+  };
+  double largest = 0.0;
+  for (std::size_t b = 0; b < boundary_nodes_.size(); ++b)
+    if (kinds_[b] == BoundaryKind::prescribed) largest = std::max(largest, carried(b).norm());
+  if (!radius_outgrown(largest, radius_)) return;
+  ResolvedBoundary<Dim> grown = boundary_;
+  grown.displacements.setZero(Dim, grown.size());
+  for (std::size_t b = 0; b < boundary_nodes_.size(); ++b)
+    if (kinds_[b] == BoundaryKind::prescribed) grown.displacements.col(static_cast<Index>(b)) = radius_growth_margin * carried(b);
+  const DefaultSupportRadius fitted = detail::budgeted_support_radius(points_, grown, options_);
+  if (!(fitted.radius > radius_)) {
+    grows_ = false;  // the memory budget holds the radius where it is
+    return;
+  }
+  const detail::Stopwatch watch;
+  radius_reduced_ = fitted.reduced;
+  grows_ = !fitted.reduced;
+  prepare_interpolation(fitted.radius);
+  ++stats_.radius_growths;
+  if (rigid_.size() == 0) build_interpolation();
+  stats_.setup_seconds += watch.seconds();
 }
 
 template <int Dim>

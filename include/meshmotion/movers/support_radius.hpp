@@ -33,6 +33,20 @@ struct SupportRadiusOptions {
   return radius;
 }
 
+/// How a default radius follows a motion its mover was not set up for. A solver sets a mover
+/// up once, before anything moves, where the rule above sees no displacement and gives the
+/// spacing's radius; a later move whose largest prescribed displacement L has outgrown it
+/// (displacement_factor × L > radius) sets the mover up again, inside the library, for
+/// radius_growth_margin × L. The margin 2 makes that at most once per doubling of the motion
+/// and never again for an oscillation within the largest amplitude seen; a radius the memory
+/// budget holds where it was stops the growth.
+inline constexpr double radius_growth_margin = 2.0;
+
+/// Whether a move whose largest prescribed displacement is `largest` outgrew `radius`.
+[[nodiscard]] inline bool radius_outgrown(double largest, double radius, const SupportRadiusOptions& options = {}) {
+  return options.displacement_factor * largest > radius;
+}
+
 /// suggest_support_radius() given the largest boundary displacement instead of every one (a
 /// distributed boundary reduces it over the ranks). Throws InputError when m < 2 or no
 /// positive radius follows.

@@ -27,6 +27,12 @@
 /// operator of its local nodes. What grows with the boundary is replicated; what grows with
 /// the volume is split (docs/parallel.md measures both).
 ///
+/// - Set up once, moved many times: the serial mover's rule (radius_outgrown()) on the largest
+///   prescribed displacement over the ranks sets the mover up again, collectively, when a move
+///   outgrew the default radius; the mover keeps its own copy of the part for that (a
+///   position, a global id and an owner per local node), so the caller's arrays need not
+///   outlive setup().
+///
 /// The whole motion is interpolated (RbfOptions::rigid_part as none; blend is refused): a large
 /// rigid motion, which the serial mover blends into the volume first, is not (yet) distributed.
 ///
@@ -121,7 +127,11 @@ class DistributedRbfMover {
     std::vector<double> geometry;  ///< per entry: position, normal, direction, radius
     bool radius_per_entry = false;  ///< some rank was given support_radii
   };
-  // setup()'s stages, in order.
+  /// setup() on the mover's own copy of the part (part_).
+  void set_up(const ResolvedBoundary<Dim>& boundary);
+  /// Collective: sets the mover up again for `d` when it outgrew the default radius.
+  void follow_motion(PointsView<Dim> d);
+  // set_up()'s stages, in order.
   /// Gathers the owned entries (owned_entries_, counts_) and sorts them by global id
   /// (sorted_ids_, slot_of_gathered_); throws on every rank for no entry or a twice-owned node.
   [[nodiscard]] GatheredBoundary gather_boundary(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary);
@@ -147,6 +157,11 @@ class DistributedRbfMover {
   [[nodiscard]] Points<Dim> reverse_petsc(const PointsView<Dim>& v);
 
   MPI_Comm comm_ = MPI_COMM_NULL;
+  Points<Dim> part_points_;  ///< the part setup() was given, and its boundary: what a set up again needs
+  std::vector<std::int64_t> part_ids_;
+  std::vector<int> part_owners_;
+  ResolvedBoundary<Dim> boundary_;
+  bool grows_ = false;  ///< the default radius follows the motion (follow_motion())
   RbfMover<Dim> inner_;      ///< replicated: over the gathered centres followed by the local interior nodes
   RbfOptions options_;
   double radius_ = 0.0;  ///< the last setup's support radius (options_'s, or the default's)
@@ -179,9 +194,43 @@ class DistributedRbfMover {
 
 template <int Dim>
 void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary) {
-  const meshmotion::detail::Stopwatch watch;
   ready_ = false;
   comm_ = part.comm;
+  part_points_ = part.points;
+  part_ids_.assign(part.global_ids.begin(), part.global_ids.end());
+  part_owners_.assign(part.owner.begin(), part.owner.end());
+  boundary_ = boundary;
+  set_up(boundary);
+}
+
+template <int Dim>
+void DistributedRbfMover<Dim>::follow_motion(PointsView<Dim> d) {
+  if (!grows_) return;
+  double largest = 0.0;
+  for (const Index k : owned_entries_)
+    if (boundary_.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed) largest = std::max(largest, d.col(k).norm());
+  MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  if (!radius_outgrown(largest, radius_)) return;
+  ResolvedBoundary<Dim> grown = boundary_;
+  grown.displacements.setZero(Dim, grown.size());
+  for (const Index k : owned_entries_)
+    if (boundary_.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed) grown.displacements.col(k) = radius_growth_margin * d.col(k);
+  const double before = radius_;
+  const Index moves = stats_.moves, growths = stats_.radius_growths;
+  set_up(grown);
+  stats_.moves = moves;
+  stats_.radius_growths = growths;
+  if (radius_ > before)
+    ++stats_.radius_growths;
+  else
+    grows_ = false;  // the memory budget holds the radius where it is
+}
+
+template <int Dim>
+void DistributedRbfMover<Dim>::set_up(const ResolvedBoundary<Dim>& boundary) {
+  const meshmotion::detail::Stopwatch watch;
+  ready_ = false;
+  const PartitionView<Dim> part{comm_, part_points_, part_ids_, part_owners_};
   const Index n = part.size();
   collective(comm_, [&] {
     part.check("DistributedRbfMover::setup");
@@ -214,6 +263,7 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
       owned_entries_ = patches->entries();
       stats_ = patches->stats();
       stats_.support_radius = radius_;
+      grows_ = options_.support_radius == 0.0;
       patches_ = std::move(patches);
       ready_ = true;
       stats_.setup_seconds = watch.seconds();
@@ -254,6 +304,7 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
   }
   stats_.support_radius = radius_;
   stats_.radius_reduced = radius_reduced_;
+  grows_ = options_.support_radius == 0.0 && !gathered.radius_per_entry && !radius_reduced_;
   ready_ = true;
   stats_.setup_seconds = watch.seconds();
 }
@@ -414,6 +465,7 @@ void DistributedRbfMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& out) {
       if (!d.col(k).allFinite())
         throw InputError("DistributedRbfMover::move: boundary entry " + std::to_string(k) + " has a non-finite displacement");
   });
+  follow_motion(d);
   if (patches_) {
     patches_->move_into(d, out);
   } else {
