@@ -2,7 +2,8 @@
 // displacementMotionSolver that constant/dynamicMeshDict selects as `motionSolver meshmotion;`.
 // The boundary motion is 0/pointDisplacement's, so every point patch field drives it; the mover
 // is set up once from points0 (again when the topology changes) and moves the interior at each
-// solve().
+// solve(). Each patch's points are prescribed, slide or move with the interior as its point
+// patch field says (patch_role()); a type the plugin does not know stops the run, naming it.
 
 #include "bridge.hpp"
 
@@ -10,12 +11,15 @@
 #include "displacementMotionSolver.H"
 #include "globalIndex.H"
 #include "globalMeshData.H"
+#include "IStringStream.H"
 #include "mapPolyMesh.H"
+#include "memInfo.H"
 #include "meshTools.H"
 #include "OStringStream.H"
 #include "Pstream.H"
 #include "syncTools.H"
 
+#include <chrono>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -34,6 +38,9 @@ class meshmotionMotionSolver
     // Points on a patch of this rank that fixes their value: their value is this rank's to give
     // (a point of a decomposed case may be on a fixed patch only on another rank).
     std::vector<char> fixedHere_;
+    // Some patch's points slide on a surface (surfaceSlipDisplacement): its field projects them
+    // onto it after each move, as it does after displacementLaplacian's solve.
+    bool projected_ = false;
 
     void setup();
 
@@ -71,26 +78,76 @@ addToRunTimeSelectionTable(motionSolver, meshmotionMotionSolver, dictionary);
 namespace
 {
 
-// The patch types whose points slide in the patch's plane.
-bool slides(const word& type)
+// What the mover does with a patch's points.
+enum class PatchRole
 {
-    return type == "slip" || type == "symmetryPlane" || type == "symmetry";
+    prescribed,  // the field fixes their value (the fixedValue family)
+    sliding,     // in the plane of the patch's faces at each point (two planes: along their line)
+    normal,      // fixedNormalSlip: in the plane normal to the field's n
+    surface,     // surfaceSlipDisplacement: in the faces' plane, then projected by the field
+    interior     // moved with the interior: zeroGradient (as displacementLaplacian moves them),
+                 // and a 2D case's front and back (curPoints() keeps them 2D as OpenFOAM's own
+                 // solvers do; as centres they made every point of the case one)
+};
+
+// The role of a patch's points from its point patch field `field` and its patch type; a type
+// the plugin does not know stops the run (a boundary treated as interior in silence moved
+// fixedNormalSlip sides out of their planes).
+PatchRole patch_role(const pointPatchVectorField& field, const polyPatch& patch)
+{
+    const word& type = field.type();
+    if (field.fixesValue()) return PatchRole::prescribed;
+    if (patch.type() == "empty" || patch.type() == "wedge") return PatchRole::interior;
+    for (const word& slip : {"slip", "symmetry", "symmetryPlane"})
+    {
+        if (type == slip || patch.type() == slip) return PatchRole::sliding;
+    }
+    if (type == "fixedNormalSlip") return PatchRole::normal;
+    if (type == "surfaceSlipDisplacement") return PatchRole::surface;
+    if (type == "zeroGradient") return PatchRole::interior;
+    FatalErrorInFunction << "meshmotion: patch " << patch.name() << " has pointDisplacement type " << type
+        << " (patch type " << patch.type() << "), which the plugin does not know: give a fixedValue type to "
+        << "prescribe its points; slip, symmetry, symmetryPlane, fixedNormalSlip or surfaceSlipDisplacement to "
+        << "slide them; zeroGradient to move them with the interior" << exit(FatalError);
+    return PatchRole::interior;
 }
 
-// A 2D case's front and back: their points are interior to the mover (as centres they made
-// every point of the case one), and curPoints() keeps them 2D as OpenFOAM's own solvers do.
-bool two_dimensional(const word& type)
+// fixedNormalSlip's unit normal: its `n`, as the field writes it.
+vector fixed_normal(const pointPatchVectorField& field)
 {
-    return type == "empty" || type == "wedge";
+    OStringStream written;
+    field.write(written);
+    IStringStream read(written.str());
+    const dictionary entries(read);
+    const vector n = entries.get<vector>("n");
+    if (mag(n) == 0)
+    {
+        FatalErrorInFunction << "meshmotion: patch " << field.patch().name() << ": fixedNormalSlip's n is zero"
+            << exit(FatalError);
+    }
+    return n / mag(n);
 }
 
-// Every entry of meshmotionCoeffs but `method`, as the library's "key=value" text.
-std::string option_text(const dictionary& coeffs)
+// The entries of dynamicMeshDict that are OpenFOAM's, not options, where there is no
+// meshmotionCoeffs and the options are read from the top level (as OpenFOAM's own motion
+// solvers read theirs).
+bool openfoam_entry(const entry& e)
+{
+    for (const word& key : {"dynamicFvMesh", "motionSolverLibs", "motionSolver", "solver", "libs"})
+    {
+        if (e.keyword() == key) return true;
+    }
+    return e.isDict();  // other solvers' coefficients
+}
+
+// Every entry of `coeffs` (meshmotionCoeffs, or dynamicMeshDict itself when `top`) but `method`
+// and, at the top, OpenFOAM's own, as the library's "key=value" text.
+std::string option_text(const dictionary& coeffs, bool top)
 {
     std::string text;
     for (const entry& e : coeffs)
     {
-        if (e.keyword() == "method") continue;
+        if (e.keyword() == "method" || (top && openfoam_entry(e))) continue;
         if (!e.isStream())
         {
             FatalIOErrorInFunction(coeffs) << "meshmotion: option '" << e.keyword()
@@ -117,7 +174,7 @@ void meshmotionMotionSolver::setup()
     const dictionary& coeffs = coeffDict();
     meshmotion::foam::BridgeInput input;
     input.method = coeffs.lookupOrDefault<word>("method", "rbf");
-    input.options = option_text(coeffs);
+    input.options = option_text(coeffs, !found(typeName + "Coeffs"));
 
     // Each boundary point: prescribed when a patch fixes its value, else sliding on the planes
     // of its sliding patches (two planes: along their common line). A plane's normal at a point
@@ -126,28 +183,33 @@ void meshmotionMotionSolver::setup()
     const label n = m.nPoints();
     labelList prescribed(n, 0);
     fixedHere_.assign(n, 0);
-    DynamicList<label> slidingPatches;
     PtrList<vectorField> normalSums;
+    projected_ = false;
     forAll(m.boundaryMesh(), patchi)
     {
         const pointPatchVectorField& field = pointDisplacement_.boundaryField()[patchi];
         const polyPatch& patch = m.boundaryMesh()[patchi];
         if (patch.coupled()) continue;  // processor and cyclic patches: not walls
         const labelList& points = patch.meshPoints();
-        if (field.fixesValue())
+        const PatchRole role = patch_role(field, patch);
+        if (role == PatchRole::prescribed)
         {
             forAll(points, i) prescribed[points[i]] = fixedHere_[points[i]] = 1;
         }
-        else if (!two_dimensional(patch.type()) && (slides(field.type()) || slides(patch.type())))
+        else if (role != PatchRole::interior)
         {
             // On every rank alike: the patches are the same, in the same order, on all of them.
-            slidingPatches.append(patchi);
+            projected_ = projected_ || role == PatchRole::surface;
             normalSums.append(new vectorField(n, Zero));
             vectorField& sum = normalSums.last();
             const vectorField& faceNormals = patch.faceNormals();
+            const vector given = role == PatchRole::normal ? fixed_normal(field) : vector::zero;
             forAll(patch, facei)
             {
-                for (const label p : patch.localFaces()[facei]) sum[points[p]] += faceNormals[facei];
+                for (const label p : patch.localFaces()[facei])
+                {
+                    sum[points[p]] += role == PatchRole::normal ? given : faceNormals[facei];
+                }
             }
         }
     }
@@ -269,6 +331,7 @@ void meshmotionMotionSolver::solve()
     }
     std::vector<double> out;
     const int setups = bridge_->setups();
+    const auto start = std::chrono::steady_clock::now();
     try
     {
         bridge_->move(d, out);
@@ -277,16 +340,21 @@ void meshmotionMotionSolver::solve()
     {
         FatalErrorInFunction << e.what() << exit(FatalError);
     }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (bridge_->setups() > setups)
     {
         Info<< "meshmotion: set up again for the motion's size (support radius " << bridge_->support_radius() << ")"
             << endl;
     }
+    // Where the time goes, as OpenFOAM's solvers log their residuals: this rank's.
+    Info<< "meshmotion: moved in " << seconds << " s (set-ups again included), resident memory "
+        << memInfo().update().rss() / 1024 << " MB" << endl;
     vectorField& displacement = pointDisplacement_.primitiveFieldRef();
     forAll(displacement, i)
     {
         displacement[i] = vector(out[3 * i], out[3 * i + 1], out[3 * i + 2]);
     }
+    if (projected_) pointDisplacement_.correctBoundaryConditions();
     // A 2D case moves in its plane: the movers through cells see a slab one cell thick, whose
     // front and back would follow the elasticity's Poisson effect out of it.
     meshTools::constrainDirection(mesh(), mesh().solutionD(), displacement);

@@ -8,9 +8,12 @@
 # ranks share identical; pimpleFoam running a 2D channel whose wall turns, serially and on 2
 # ranks; stiffened elasticity through the cube's hexahedra and through the polyhedra of its
 # dual mesh; a sphere cut out of a box by snappyHexMesh, translated and swung, serially and on
-# 2 ranks; stiffened elasticity through hexahedra and polyhedra on 2 ranks as serial; an unknown
-# option refused with its name, and a method through the cells that has no distributed mover
-# refused on a decomposed case.
+# 2 ranks; stiffened elasticity through hexahedra and polyhedra on 2 ranks as serial; the
+# front as fixedNormalSlip and as surfaceSlipDisplacement kept in its plane, a point patch field
+# type the plugin does not know refused naming the patch, the options read from
+# dynamicMeshDict's top level without meshmotionCoeffs, each step's time and memory logged; an
+# unknown option refused with its name, and a method through the cells that has no distributed
+# mover refused on a decomposed case.
 #
 #   plugin_test.sh LIBMESHMOTIONFOAM WORK_DIR [MPIEXEC [FLAGS...]]
 #
@@ -192,6 +195,40 @@ rm -rf 1 2 3 4
 move "method sle;" "sle set up on .* boundary points of 1331"
 cube_check 0.5
 parallel_equals_serial moveDynamicMesh 1e-8
+# The front as fixedNormalSlip (n along y): it slides in its plane under stiffened elasticity
+# too (read as interior before, elasticity's Poisson effect pushed it out), and a point patch
+# field type the plugin does not know stops the run naming the patch and the type.
+rm -rf 1 2 3 4
+sed -i 's/front { type slip; }/front { type fixedNormalSlip; n (0 2 0); }/' 0/pointDisplacement
+move "method sle;" "sle set up on .* boundary points of 1331"
+cube_check 0.5
+grep -q "meshmotion: moved in .* s (set-ups again included), resident memory [0-9]* MB" log.move \
+  || { echo "FAIL: no per-step time and memory in the log"; grep meshmotion log.move; exit 1; }
+# The front as surfaceSlipDisplacement on the plane y = 0: sliding, then projected by its field.
+rm -rf 1 2 3 4
+surface='front { type surfaceSlipDisplacement; projectMode nearest; projectDirection (0 1 0); geometry { frontPlane { type searchablePlane; planeType pointAndNormal; pointAndNormalDict { point (0 0 0); normal (0 1 0); } } } }'
+sed -i "s/front { type fixedNormalSlip; n (0 2 0); }/$surface/" 0/pointDisplacement
+move "method sle;" "sle set up on .* boundary points of 1331"
+cube_check 0.5
+rm -rf 1 2 3 4
+sed -i "s/$surface/front { type calculated; value uniform (0 0 0); }/" 0/pointDisplacement
+if moveDynamicMesh > log.bad 2>&1; then echo "FAIL: a point patch field type the plugin does not know was accepted"; exit 1; fi
+grep -q "patch front has pointDisplacement type calculated" log.bad \
+  || { echo "FAIL: the error does not name the patch and its type"; tail -20 log.bad; exit 1; }
+sed -i 's/front { type calculated; value uniform (0 0 0); }/front { type slip; }/' 0/pointDisplacement
+# dynamicMeshDict without meshmotionCoeffs: the options from its top level, OpenFOAM's own
+# entries and other solvers' coefficients left to OpenFOAM; the minimal dictionary runs.
+cat > constant/dynamicMeshDict <<EOD
+$header dynamicMeshDict; }
+dynamicFvMesh dynamicMotionSolverFvMesh;
+motionSolverLibs ("libfvMotionSolvers.so" "$lib");
+motionSolver meshmotion;
+method sle;
+displacementLaplacianCoeffs { diffusivity uniform; }
+EOD
+moveDynamicMesh > log.move 2>&1 || { echo "FAIL: the options at dynamicMeshDict's top level were not taken"; tail -20 log.move; exit 1; }
+grep -q "meshmotion: sle set up" log.move || { echo "FAIL: method sle at the top level was not taken"; grep meshmotion log.move; exit 1; }
+cube_check 0.5
 # An option the mover does not have: OpenFOAM's fatal error, naming it.
 rm -rf 1 2 3 4
 write_dynamic "method rbf; no_such_option 1;"
