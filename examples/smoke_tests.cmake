@@ -123,6 +123,12 @@ smoke_test(NAME tutorial_1_time_loop.json
 smoke_test(NAME tutorial_2_optimization_loop.json
            KEYS objective_start,objective_final,iterations/0/reverse,iterations/0/finite_difference,max_relative_difference,gradient_check_passed
            COMMAND tutorial_2_optimization_loop --n-around 32 --n-radial 10 --iterations 2 --json)
+smoke_test(NAME tutorial_3_grid_velocity.json
+           KEYS method,steps,nodes,max_speed,velocity_vs_difference,min_scaled_jacobian
+           COMMAND tutorial_3_grid_velocity --steps 10 --period-steps 20 --json)
+smoke_test(NAME tutorial_3_grid_velocity.spring.json
+           KEYS method,velocity_vs_difference
+           COMMAND tutorial_3_grid_velocity --steps 4 --method spring --json)
 smoke_test(NAME adapt_solver_mesh.json
            KEYS nodes,triangles,edges,boundary_edges,max_node_degree,copied_cells
            COMMAND adapt_solver_mesh --nx 8 --ny 4 --json)

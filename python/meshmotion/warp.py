@@ -362,19 +362,27 @@ class Warp:
 
     def warp_derivative_forward(self, dXs):
         """dXv for a change dXs (n_design, dim, surface order) of the design surface: J dXs,
-        (n_nodes, dim). Over MPI, collective; the distributed RBF is linear in the surface, so
-        its forward derivative is a move of dXs."""
+        (n_nodes, dim). Over MPI, collective."""
+        return self._through_map(dXs, "warp_derivative_forward")
+
+    def velocity(self, dXs_dt):
+        """The grid velocities (n_nodes, dim) an ALE solver needs for the design surface's
+        velocities dXs_dt (n_design, dim, surface order): J dXs_dt through the map of the last
+        warp, the rate of change of the warped coordinates (docs/python.md). Over MPI,
+        collective."""
+        return self._through_map(dXs_dt, "velocity")
+
+    def _through_map(self, values, where):
+        # The mover's map of the current warp, linear in the surface: never a move, which could
+        # set the mover up again for a seed's size.
         if self._derivative_note:
-            raise _core.InputError("warp_derivative_forward: " + self._derivative_note)
-        w = real_array(dXs, "warp_derivative_forward")
+            raise _core.InputError(where + ": " + self._derivative_note)
+        w = real_array(values, where)
         if w.shape != (len(self._design), self._dim):
-            raise _core.InputError(
-                f"warp_derivative_forward: expected shape ({len(self._design)}, {self._dim}) (got {w.shape})")
+            raise _core.InputError(f"{where}: expected shape ({len(self._design)}, {self._dim}) (got {w.shape})")
         seed = _np.zeros_like(self._input)
         seed[self._columns[self._order]] = w
-        if self._comm is None:
-            return self._mover.derivative_forward(seed)
-        return self._mover.move(seed)
+        return self._mover.velocity(seed)
 
     def verify_derivative(self, h=1e-6, seed=0, verbose=True):
         """Compares warp_derivative with central finite differences of I = <dI_dXv, Xv> along a

@@ -189,6 +189,18 @@ void bind_move_calls(py::class_<A, Extra...>& c) {
              a.move_into(in, target);
            },
            py::arg("displacements"), py::arg("out"), "move() into a caller's (n, dim) C-contiguous float64 array")
+      .def("velocity",
+           [](A& a, const py::array& v) {
+             const Eigen::Map<const Points<Dim>> in = rows_of<Dim>(v, "velocity: boundary velocities");
+             Points<Dim> out;
+             {
+               py::gil_scoped_release release;
+               out = a.velocity(in);
+             }
+             return to_rows<Dim>(std::move(out));
+           },
+           py::arg("boundary_velocities"),
+           "grid velocities (n, dim) for boundary velocities (boundary size, dim): J v through the current move's map")
       .def_property_readonly("stats", [](const A& a) { return to_py(a.stats()); })
       .def_property_readonly("has_derivatives", &A::has_derivatives)
       .def("derivative_reverse",

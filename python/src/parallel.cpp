@@ -93,6 +93,7 @@ class DistributedMover {
     out = out_;
   }
   [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) { return mover_->derivative_reverse(v); }
+  [[nodiscard]] Points<Dim> velocity(PointsView<Dim> v) { return mover_->velocity(v); }
   /// Every distributed mover is linear in the displacements and gives its reverse derivative.
   [[nodiscard]] bool has_derivatives() const { return true; }
   [[nodiscard]] MoverStats stats() const { return mover_->stats(); }

@@ -422,6 +422,16 @@ def test_a_mover_set_up_once_follows_a_whole_boundary_turning_56_degrees():
         assert report["invalid"] == 0 and report["min"] > 0.5, (step, report["min"])
     assert mover.stats["moves"] == 10
     assert 1 <= mover.stats["radius_growths"] <= 4
+    # The grid velocity of a uniform boundary velocity through the last move's map.
+    v = np.tile([0.5, -0.25], (b.size, 1))
+    u = mover.velocity(v)
+    assert u.shape == mesh.points.shape
+    np.testing.assert_allclose(u[b.nodes], v, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(u, mover.derivative_forward(v), rtol=0, atol=0)
+    with pytest.raises(mm.InputError, match="not linear"):
+        nonlinear = mm.Mover("nle", 2)
+        nonlinear.setup(mesh, b)
+        nonlinear.velocity(v)
 
 
 def test_quality_report_has_per_cell_arrays():

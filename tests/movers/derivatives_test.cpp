@@ -12,6 +12,7 @@
 #include <catch2/catch.hpp>
 
 #include <limits>
+#include <numbers>
 #include <string>
 
 using namespace meshmotion;
@@ -78,6 +79,48 @@ TEST_CASE("derivatives of every linear mover agree with finite differences (3D t
   spec.prescribed("bottom").fixed("top").sliding("left").fixed("right").fixed("front").fixed("back");
   const auto boundary = spec.resolve(mesh);
   for (const std::string method : {"rbf", "spring", "torsion", "le", "sle", "dgm", "idgm", "dgrbf"}) check_derivatives(mesh, boundary, method);
+}
+
+TEST_CASE("grid velocities: every linear mover's velocity() is the rate of change of its positions in time",
+          "[movers]") {
+  // An ALE solver's protocol: set up once with no motion, then per step the positions
+  // X + move(d(t)) and the velocities velocity(ḋ(t)); these must be the positions' rate of
+  // change (the geometric conservation law), here against a central difference in time. The
+  // inner wall of a ring pitches, θ(t) = 0.4 sin(2π t), the outer one is held; the RBF with
+  // its default radius, which grows with the motion at the first steps.
+  const Mesh<2> ring = annulus_mesh({.n_around = 32});
+  BoundarySpec<2> spec;
+  spec.moving("inner", Translation<2>{Vec<2>::Zero()}).fixed("outer");
+  const ResolvedBoundary<2> boundary = spec.resolve(ring);
+  const auto wall = [&](double t, bool rate) {
+    const double angle = 0.4 * std::sin(2.0 * std::numbers::pi * t);
+    const double speed = 0.4 * 2.0 * std::numbers::pi * std::cos(2.0 * std::numbers::pi * t);
+    Points<2> out = Points<2>::Zero(2, boundary.size());
+    for (Index k = 0; k < boundary.size(); ++k) {
+      if (boundary.kinds[static_cast<std::size_t>(k)] != BoundaryKind::prescribed) continue;
+      const Vec<2> r = Eigen::Rotation2Dd(angle) * Vec<2>(ring.points.col(boundary.nodes[static_cast<std::size_t>(k)]));
+      out.col(k) = rate ? Vec<2>(speed * Vec<2>(-r.y(), r.x())) : Vec<2>(r - ring.points.col(boundary.nodes[static_cast<std::size_t>(k)]));
+    }
+    return out;
+  };
+  for (const std::string method : {"rbf", "spring", "le", "dgm"}) {
+    CAPTURE(method);
+    AnyMover<2> mover = make_mover<2>(method);
+    mover.setup(ring, boundary);
+    for (const double t : {0.05, 0.15, 0.3, 0.6}) {
+      CAPTURE(t);
+      (void)mover.move(wall(t, false));  // the step's move (the RBF may set up again here)
+      const Points<2> velocity = mover.velocity(wall(t, true));
+      const double h = 1e-5;
+      const Points<2> difference = (mover.move(wall(t + h, false)) - mover.move(wall(t - h, false))) / (2.0 * h);
+      CHECK((velocity - difference).colwise().norm().maxCoeff() <= 1e-8 * velocity.colwise().norm().maxCoeff());
+      for (Index k = 0; k < boundary.size(); ++k)  // the wall's nodes at their own velocity, the held ones still
+        CHECK((velocity.col(boundary.nodes[static_cast<std::size_t>(k)]) - wall(t, true).col(k)).norm() <= 1e-12);
+    }
+  }
+  AnyMover<2> nonlinear = make_mover<2>("nle");
+  nonlinear.setup(ring, boundary);
+  CHECK_THROWS_WITH(nonlinear.velocity(wall(0.1, true)), Catch::Contains("not linear in the displacements"));
 }
 
 TEST_CASE("movers that are not linear in the displacements have no derivatives", "[movers]") {

@@ -236,6 +236,19 @@ TEST_CASE("distributed RBF set up before the motion grows its radius with it as 
       for (Index i = 0; i < part.local.num_nodes(); ++i)
         worst = std::max(worst, (got.col(i) - expected.col(part.global_ids[static_cast<std::size_t>(i)])).norm());
       CHECK(global_max(worst) <= 1e-10 * expected.colwise().norm().maxCoeff());
+      // The grid velocity through the same map: the serial one, and no set-up again.
+      const Points<2> expected_velocity = serial.derivative_forward(motion(0.3 * s));
+      const Index growths = mover.stats().radius_growths;
+      Points<2> local_v(2, local_b.size());
+      const Points<2> v = motion(0.3 * s);
+      for (Index k = 0; k < local_b.size(); ++k)
+        local_v.col(k) = v.col(b.column(part.global_ids[static_cast<std::size_t>(local_b.nodes[static_cast<std::size_t>(k)])]));
+      const Points<2> velocity = mover.velocity(local_v);
+      double velocity_gap = 0.0;
+      for (Index i = 0; i < part.local.num_nodes(); ++i)
+        velocity_gap = std::max(velocity_gap, (velocity.col(i) - expected_velocity.col(part.global_ids[static_cast<std::size_t>(i)])).norm());
+      CHECK(global_max(velocity_gap) <= 1e-10 * expected_velocity.colwise().norm().maxCoeff());
+      CHECK(mover.stats().radius_growths == growths);
     }
     CHECK(serial.stats().radius_growths >= 2);
     CHECK(serial.stats().radius_growths <= 3);  // at 0.5 and 2.0 (the ring's spacing radius is 1.96)

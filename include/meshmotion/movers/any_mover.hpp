@@ -74,6 +74,21 @@ class AnyMover {
     const Exclusive use(*self_, "derivative_forward");
     return self_->derivative_forward(w);
   }
+  /// The grid velocity an ALE solver needs: every node's velocity (Dim × n_nodes) for the
+  /// boundary nodes' velocities `boundary_velocities` (Dim × boundary size), through the map of
+  /// the current move: for positions x(t) = X + move(d(t)) of a mover linear in the
+  /// displacements, dx/dt = J ḋ(t), exactly (no difference of positions; the RBF's map between
+  /// two growths of its default radius, the last move's). Sliding nodes get their projected
+  /// velocity. Throws InputError for a mover whose move is not linear in the displacements
+  /// (nle, dgrbf2): their grid velocity is a difference of positions.
+  [[nodiscard]] Points<Dim> velocity(PointsView<Dim> boundary_velocities) {
+    const Exclusive use(*self_, "velocity");
+    if (!self_->has_derivatives())
+      throw InputError("AnyMover::velocity: this mover's move is not linear in the displacements (nle, dgrbf2): take the "
+                       "grid velocity as a difference of positions in time, or use a mover with derivatives (rbf, spring, "
+                       "torsion, le, sle, dgm, idgm, dgrbf)");
+    return self_->derivative_forward(boundary_velocities);
+  }
   /// Jᵀ v for v (Dim × n_nodes): the gradient of ⟨v, move(d)⟩ with respect to d.
   /// Throws InputError when the mover has no derivatives.
   [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) {

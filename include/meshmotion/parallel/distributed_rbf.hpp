@@ -109,6 +109,11 @@ class DistributedRbfMover {
     return out;
   }
 
+  /// Collective. The grid velocity (Dim × part.size()) of every local node for the velocities
+  /// `v` of this rank's boundary entries (RbfMover::move's map, linear: J v, without a set-up
+  /// again); only owned entries are read.
+  [[nodiscard]] Points<Dim> velocity(PointsView<Dim> v);
+
   /// Collective. For v (Dim × part.size()), the gradient of Σ over ranks of ⟨v, move(d)⟩ on
   /// owned nodes with respect to this rank's boundary entries (Dim × boundary.size()): owned
   /// entries carry it, ghost and sliding entries are zero, so the ranks' gradients add up to
@@ -131,6 +136,15 @@ class DistributedRbfMover {
   void set_up(const ResolvedBoundary<Dim>& boundary);
   /// Collective: sets the mover up again for `d` when it outgrew the default radius.
   void follow_motion(PointsView<Dim> d);
+  /// Collective: refuses (on every rank) `d` of the wrong shape or with a non-finite owned entry.
+  void check_entries(const char* where, PointsView<Dim> d);
+  /// Collective: the map of the current setup applied to `d`.
+  void apply(PointsView<Dim> d, Points<Dim>& out) {
+    if (patches_)
+      patches_->move_into(d, out);
+    else
+      move_gathered(d, out);
+  }
   // set_up()'s stages, in order.
   /// Gathers the owned entries (owned_entries_, counts_) and sorts them by global id
   /// (sorted_ids_, slot_of_gathered_); throws on every rank for no entry or a twice-owned node.
@@ -453,26 +467,36 @@ bool DistributedRbfMover<Dim>::choose_petsc(const GatheredBoundary& gathered, co
 }
 
 template <int Dim>
-void DistributedRbfMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& out) {
-  const meshmotion::detail::Stopwatch watch;
+void DistributedRbfMover<Dim>::check_entries(const char* where, PointsView<Dim> d) {
   collective(comm_, [&] {
-    require_ready("move");
+    require_ready(where);
     const Index expected = n_entries_;
     if (d.cols() != expected)
-      throw InputError("DistributedRbfMover::move: got " + std::to_string(d.cols()) + " displacements (expected " +
-                       std::to_string(expected) + ", one per local boundary entry)");
+      throw InputError(std::string("DistributedRbfMover::") + where + ": got " + std::to_string(d.cols()) +
+                       " boundary values (expected " + std::to_string(expected) + ", one per local boundary entry)");
     for (const Index k : owned_entries_)
       if (!d.col(k).allFinite())
-        throw InputError("DistributedRbfMover::move: boundary entry " + std::to_string(k) + " has a non-finite displacement");
+        throw InputError(std::string("DistributedRbfMover::") + where + ": boundary entry " + std::to_string(k) +
+                         " has a non-finite value");
   });
+}
+
+template <int Dim>
+void DistributedRbfMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& out) {
+  const meshmotion::detail::Stopwatch watch;
+  check_entries("move", d);
   follow_motion(d);
-  if (patches_) {
-    patches_->move_into(d, out);
-  } else {
-    move_gathered(d, out);
-  }
+  apply(d, out);
   ++stats_.moves;
   stats_.move_seconds = watch.seconds();
+}
+
+template <int Dim>
+Points<Dim> DistributedRbfMover<Dim>::velocity(PointsView<Dim> v) {
+  check_entries("velocity", v);
+  Points<Dim> out;
+  apply(v, out);
+  return out;
 }
 
 template <int Dim>

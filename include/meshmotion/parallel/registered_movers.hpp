@@ -30,6 +30,7 @@ class DistributedRbf final : public DistributedMover<Dim> {
   void setup(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary) override { mover_.setup(part, boundary); }
   void move_into(PointsView<Dim> d, Points<Dim>& out) override { mover_.move_into(d, out); }
   [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) override { return mover_.derivative_reverse(v); }
+  [[nodiscard]] Points<Dim> velocity(PointsView<Dim> v) override { return mover_.velocity(v); }
   [[nodiscard]] MoverStats stats() const override { return mover_.stats(); }
   [[nodiscard]] double support_radius() const override { return mover_.support_radius(); }
   [[nodiscard]] std::string_view boundary_solve() const override { return name(mover_.solved_by()); }
@@ -53,6 +54,7 @@ class DistributedElasticity final : public DistributedMover<Dim> {
   }
   void move_into(PointsView<Dim> d, Points<Dim>& out) override { mover_.move_into(d, out); }
   [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) override { return mover_.derivative_reverse(v); }
+  [[nodiscard]] Points<Dim> velocity(PointsView<Dim> v) override { return mover_.derivative_forward(v); }
   [[nodiscard]] MoverStats stats() const override { return mover_.stats(); }
   [[nodiscard]] double support_radius() const override { return 0.0; }
   [[nodiscard]] std::string_view boundary_solve() const override { return "none"; }

@@ -55,6 +55,9 @@ class DistributedMover {
   /// Jᵀ v: the gradient of ⟨v, move(d)⟩ over the local boundary entries (every method is
   /// linear in the displacements).
   [[nodiscard]] virtual Points<Dim> derivative_reverse(PointsView<Dim> v) = 0;
+  /// The grid velocity of every local node for the local boundary entries' velocities
+  /// (AnyMover::velocity(): J v through the map of the current move).
+  [[nodiscard]] virtual Points<Dim> velocity(PointsView<Dim> boundary_velocities) = 0;
   [[nodiscard]] virtual MoverStats stats() const = 0;
   /// The support radius the last setup took (the default one when none was given); 0 for a
   /// method without one.
