@@ -163,6 +163,21 @@ inline py::array_t<Index> connectivity_view(ElementBlock& b, const py::object& o
   return view;
 }
 
+// A mover's call `call(a, x)` of one (rows, dim) array to another, as a Python method: the
+// input read in place, the GIL released while the library works. `what` names the input in errors.
+template <int Dim, class A, class Call>
+auto array_call(Call call, const char* what) {
+  return [call, what](A& a, const py::array& x) {
+    const Eigen::Map<const Points<Dim>> in = rows_of<Dim>(x, what);
+    Points<Dim> out;
+    {
+      py::gil_scoped_release release;
+      out = call(a, in);
+    }
+    return to_rows<Dim>(std::move(out));
+  };
+}
+
 // What every mover class of the module offers (the serial AnyMover and the distributed one):
 // move, move into the caller's array, the reverse derivative, its figures. Inputs are read in
 // place and the GIL is released while the library works.
@@ -190,29 +205,13 @@ void bind_move_calls(py::class_<A, Extra...>& c) {
            },
            py::arg("displacements"), py::arg("out"), "move() into a caller's (n, dim) C-contiguous float64 array")
       .def("velocity",
-           [](A& a, const py::array& v) {
-             const Eigen::Map<const Points<Dim>> in = rows_of<Dim>(v, "velocity: boundary velocities");
-             Points<Dim> out;
-             {
-               py::gil_scoped_release release;
-               out = a.velocity(in);
-             }
-             return to_rows<Dim>(std::move(out));
-           },
+           array_call<Dim, A>([](A& a, PointsView<Dim> v) { return a.velocity(v); }, "velocity: boundary velocities"),
            py::arg("boundary_velocities"),
            "grid velocities (n, dim) for boundary velocities (boundary size, dim): J v through the current move's map")
       .def_property_readonly("stats", [](const A& a) { return to_py(a.stats()); })
       .def_property_readonly("has_derivatives", &A::has_derivatives)
       .def("derivative_reverse",
-           [](A& a, const py::array& v) {
-             const Eigen::Map<const Points<Dim>> seed = rows_of<Dim>(v, "derivative_reverse: v");
-             Points<Dim> out;
-             {
-               py::gil_scoped_release release;
-               out = a.derivative_reverse(seed);
-             }
-             return to_rows<Dim>(std::move(out));
-           },
+           array_call<Dim, A>([](A& a, PointsView<Dim> v) { return a.derivative_reverse(v); }, "derivative_reverse: v"),
            py::arg("v"), "Jᵀ v: the gradient (boundary size, dim) of <v, move(d)> for v (n, dim)");
 }
 

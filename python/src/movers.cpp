@@ -27,15 +27,7 @@ void bind_movers(py::module_& m) {
         .def("setup", [](A& a, const M& mesh, const B& b) { a.setup(mesh, b); }, py::arg("mesh"), py::arg("boundary"),
              py::call_guard<py::gil_scoped_release>())
         .def("derivative_forward",
-             [](A& a, const py::array& w) {
-               const Eigen::Map<const Points<Dim>> in = rows_of<Dim>(w, "derivative_forward: w");
-               Points<Dim> out;
-               {
-                 py::gil_scoped_release release;
-                 out = a.derivative_forward(in);
-               }
-               return to_rows<Dim>(std::move(out));
-             },
+             array_call<Dim, A>([](A& a, PointsView<Dim> w) { return a.derivative_forward(w); }, "derivative_forward: w"),
              py::arg("w"), "J w: node displacement changes (n, dim) for boundary changes w (boundary size, dim)");
     bind_move_calls<Dim>(c);
   });
