@@ -711,6 +711,21 @@ TEST_CASE("CGNS: each kind of bad file gets a clear error naming the node path",
     require_input_error([&] { (void)read_mesh(file); }, {"/Base/dom/GridCoordinates", "no CoordinateX", "CoordinateR"});
   }
 
+  // A file that cannot be created: the user's path and the reason in the user's terms, not the
+  // temporary file's name or HDF5's words.
+  {
+    const Mesh<2> square = rectangle_mesh({.nx = 2, .ny = 2});
+    for (const auto& [target, reason] : {std::pair{dir / "missing" / "out.cgns", std::string("does not exist")},
+                                         std::pair{dir / "no_y.cgns" / "out.cgns", std::string("is not a folder")}}) {
+      const std::string message = test::message_of<IoError>([&] { write_cgns(target, square); });
+      INFO(message);
+      CHECK(message.find(target.string() + ": cannot write: ") != std::string::npos);
+      CHECK(message.find(reason) != std::string::npos);
+      CHECK(message.find(".tmp") == std::string::npos);
+      CHECK(message.find("HDF5") == std::string::npos);
+    }
+  }
+
   // A group name CGNS cannot hold: nothing written, an existing file untouched.
   Mesh<2> mesh = rectangle_mesh({.nx = 2, .ny = 2});
   const fs::path out = dir / "named.cgns";

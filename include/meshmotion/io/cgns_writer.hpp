@@ -50,8 +50,9 @@ class CgnsWriter {
     plan_sections();
   }
 
-  void write(const std::filesystem::path& tmp) {
-    CgnsFile f(tmp, CG_MODE_WRITE);
+  /// Writes the file at `tmp`, the temporary path of `file` (which errors name).
+  void write(const std::filesystem::path& tmp, const std::filesystem::path& file) {
+    CgnsFile f(tmp, CG_MODE_WRITE, file);
     const int fn = f.id();
     int B = 0, Z = 0;
     f.check(cgns_api().cg_base_write(fn, "Base", Dim, Dim, &B), "/Base");
@@ -232,7 +233,7 @@ template <int Dim>
 void write_cgns(const std::filesystem::path& file, const Mesh<Dim>& mesh) {
 #ifdef MESHMOTION_HAVE_CGNS
   detail::CgnsWriter<Dim> writer(mesh);
-  detail::write_through_temporary(file, [&](const std::filesystem::path& tmp) { writer.write(tmp); });
+  detail::write_through_temporary(file, [&](const std::filesystem::path& tmp) { writer.write(tmp, file); });
 #else
   (void)mesh;
   throw InputError(file.string() + ": writing CGNS needs the CGNS library (meshmotion was built without it: install "
@@ -258,7 +259,7 @@ void write_cgns_coordinates(const std::filesystem::path& source, const std::file
   if (!mesh.points.allFinite()) throw InputError("write_cgns_coordinates: a coordinate of the mesh is not finite");
   detail::write_through_temporary(file, [&](const std::filesystem::path& tmp) {
     std::filesystem::copy_file(source, tmp, std::filesystem::copy_options::overwrite_existing);
-    detail::CgnsFile cgns(tmp, CG_MODE_MODIFY);
+    detail::CgnsFile cgns(tmp, CG_MODE_MODIFY, file);
     static constexpr const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
     const std::vector<std::vector<Index>>& zones = reader.zone_nodes();
     for (std::size_t z = 0; z < zones.size(); ++z) {

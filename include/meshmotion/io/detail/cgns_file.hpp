@@ -8,8 +8,11 @@
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/io/detail/cgns_library.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -122,12 +125,28 @@ inline constexpr CGNS_ENUMT(ElementType_t) cgns_types[num_element_types] = {
 
 /// An open CGNS file, closed on scope exit; check() turns a library status into an exception
 /// naming the file, the node path and the library's message.
+/// Why a file cannot be created at `file`, in the user's terms (the CGNS library reports HDF5's):
+/// its folder missing, not a folder or not writable, or else the library's own words.
+[[nodiscard]] inline std::string creation_obstacle(const std::filesystem::path& file) {
+  const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  std::error_code ec;
+  const auto status = std::filesystem::status(folder, ec);
+  if (!std::filesystem::exists(status)) return "its folder " + folder.string() + " does not exist";
+  if (!std::filesystem::is_directory(status)) return folder.string() + " is not a folder";
+  if (::access(folder.c_str(), W_OK) != 0) return "its folder " + folder.string() + " is not writable (" + std::strerror(errno) + ")";
+  return std::string("the CGNS library cannot create it (") + cgns_api().cg_get_error() + ")";
+}
+
 class CgnsFile {
  public:
-  CgnsFile(const std::filesystem::path& file, int mode) : file_(file) {
+  /// `file` opened in `mode`; errors name `shown` when given (the user's path, where `file` is
+  /// its temporary), and a file that cannot be created says why in the user's terms.
+  CgnsFile(const std::filesystem::path& file, int mode, const std::filesystem::path& shown = {})
+      : file_(shown.empty() ? file : shown) {
     if (cgns_api().cg_open(file.c_str(), mode, &fn_) != CG_OK) {
       fn_ = -1;
-      throw IoError(file.string() + ": cannot open as a CGNS file (" + cgns_api().cg_get_error() + ")");
+      if (mode == CG_MODE_WRITE) throw IoError(file_.string() + ": cannot write: " + creation_obstacle(file));
+      throw IoError(file_.string() + ": cannot open as a CGNS file (" + cgns_api().cg_get_error() + ")");
     }
   }
   CgnsFile(const CgnsFile&) = delete;
