@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <random>
 #include <sstream>
 #include <string>
@@ -327,6 +328,35 @@ TEST_CASE("a Knupp metric takes the certificate's verdict on a high-order cell",
     CHECK_FALSE(cells[0].valid);
     CHECK(cells[1].valid);
     CHECK(cells[1].value > 0.5);
+  }
+}
+
+TEST_CASE("a Knupp metric calls valid a curved cell the certificate finds valid, however folded its corners", "[quality]") {
+  // The converse: a P2 and a P3 quadrilateral covering 200 degrees of a ring (radii 1 to 2).
+  // Their four corners make a quadrilateral that folds over itself (its area is negative),
+  // so a verdict from the corners called them invalid; the curved cells are sound.
+  for (const ElementType type : {ElementType::quad9, ElementType::quad16}) {
+    INFO(name(type));
+    Mesh<2> mesh;
+    const auto reference = reference_nodes(type);
+    mesh.points.resize(2, static_cast<Index>(reference.size()));
+    std::vector<Index> nodes;
+    for (std::size_t k = 0; k < reference.size(); ++k) {
+      const double r = 1.5 + 0.5 * reference[k][0], angle = (reference[k][1] + 1.0) * std::numbers::pi * 200.0 / 360.0;
+      mesh.points.col(static_cast<Index>(k)) = Vec<2>(r * std::cos(angle), r * std::sin(angle));
+      nodes.push_back(static_cast<Index>(k));
+    }
+    mesh.block(type).add(nodes);
+    Eigen::Matrix<double, 2, 4> corners = mesh.points.leftCols(4);
+    double twice_area = 0.0;
+    for (int c = 0; c < 4; ++c) twice_area += corners(0, c) * corners(1, (c + 1) % 4) - corners(0, (c + 1) % 4) * corners(1, c);
+    REQUIRE(twice_area < 0.0);  // the straight corners fold
+    REQUIRE(scaled_jacobian(type, mesh.points).valid);
+    for (const Metric m : {Metric::skew, Metric::shape, Metric::size_shape, Metric::scaled_jacobian}) {
+      INFO(metric_name(m));
+      CHECK(quality_report(mesh, m).num_invalid == 0);
+      CHECK(evaluate_cells(mesh, m)[0].valid);
+    }
   }
 }
 
