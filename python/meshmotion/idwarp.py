@@ -31,7 +31,7 @@ import numpy as _np
 
 from . import _core
 from ._arrays import index_array, real_array
-from .warp import Warp, _raise_any, _raise_everywhere
+from .warp import Warp, _raise_any, _raise_everywhere, same_file
 
 _FILE_TYPES = ("CGNS", "OpenFOAM", "SU2")
 _INVERSE_DISTANCE_OPTIONS = ("aExp", "bExp", "LdefFact", "alpha", "errTol", "evalMode", "symmTol", "useRotations",
@@ -286,7 +286,7 @@ class USMesh:
         if self._decomposed:
             raise _core.InputError("writeGrid: a decomposed OpenFOAM case is written by its solver (getSolverGrid gives "
                                    "this rank's points in its processor folder's order)")
-        if os.path.abspath(str(fileName)) == os.path.abspath(str(self.gridFile)):
+        if same_file(fileName, self.gridFile):
             raise _core.InputError(f"writeGrid: {fileName} is the grid file (write the warped grid elsewhere)")
         same_format = str(self.gridFile).endswith(".cgns") and str(fileName).endswith(".cgns")
         self._warp.write_mesh(fileName, like=self.gridFile if same_format else None)

@@ -28,6 +28,7 @@ its reverse derivative. The result equals the serial Warp's to round-off (RBF), 
 solve's tolerance (le, sle).
 """
 
+import os as _os
 import warnings as _warnings
 
 import numpy as _np
@@ -36,8 +37,21 @@ from . import _core
 from ._arrays import index_array, real_array
 
 
+def _is_path(mesh):
+    return isinstance(mesh, (str, bytes)) or hasattr(mesh, "__fspath__")
+
+
+def same_file(a, b):
+    """Whether the paths a and b name one existing file (by any path to it: a link, another
+    spelling)."""
+    try:
+        return _os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
 def _read(mesh, orientation):
-    if isinstance(mesh, (str, bytes)) or hasattr(mesh, "__fspath__"):
+    if _is_path(mesh):
         mesh = _core.read_mesh(mesh, orientation)
     if not isinstance(mesh, (_core.Mesh2, _core.Mesh3)):
         raise _core.InputError("Warp: mesh must be a file name or a meshmotion mesh")
@@ -66,6 +80,7 @@ class Warp:
     def __init__(self, mesh, design, symmetry=(), fixed=(), method="rbf", orientation="fix_reversed", comm=None,
                  cell_ranks=None, **options):
         self._comm = comm
+        self._source = mesh if _is_path(mesh) else None  # what write_mesh() must not replace unasked
         if not design:
             raise _core.InputError("Warp: give at least one design group")
         if comm is None:
@@ -100,6 +115,7 @@ class Warp:
         surface is the design nodes it owns, by ascending global id. RBF only (elasticity
         needs the cells: Warp(mesh, comm=...) partitions a mesh read on rank 0)."""
         self = cls.__new__(cls)
+        self._source = None
         self._comm = comm
         _check_comm(comm)
         self._part = self._whole = self._mesh = None
@@ -315,12 +331,19 @@ class Warp:
             return self._part.gather_owned(self._volume)
         return _gather_owned(self._comm, self._ids[self._owned], self._volume[self._owned])
 
-    def write_mesh(self, file, like=None):
+    def write_mesh(self, file, like=None, overwrite=False):
         """Writes the mesh at the last warp() (format by extension). Over MPI, collective: rank 0
         gathers the owned nodes and writes the whole mesh in its numbering. like: the CGNS file
         the mesh was read from, written again with the new coordinates (its structured blocks,
-        BCs and solutions kept)."""
+        BCs and solutions kept). The file the Warp was read from is replaced only with
+        overwrite=True; `like` never is (by any path to either)."""
         from . import write_mesh as _write_mesh
+
+        if like is not None and same_file(file, like):
+            raise _core.InputError(f"write_mesh: {file} is the file given as like= (write the warped mesh elsewhere)")
+        if not overwrite and self._source is not None and same_file(file, self._source):
+            raise _core.InputError(f"write_mesh: {file} is the mesh this Warp was read from (give overwrite=True to "
+                                   "replace it)")
 
         if self._comm is not None and self._part is None:
             raise _core.InputError("write_mesh: a Warp on a solver's own partition holds no cells to write; "

@@ -283,6 +283,32 @@ def test_warp_in_an_optimization_loop():
         w.set_surface_coordinates(bump[:-1])
 
 
+def test_warp_never_writes_over_its_input_unasked():
+    # The mesh file a Warp was read from, by any path to it, is replaced only with
+    # overwrite=True; the file given as like= never is.
+    source = scratch("python_warp_source.msh")
+    mm.write_mesh(source, grid())
+    link = scratch("python_warp_source_link.msh")
+    if os.path.lexists(link):
+        os.remove(link)
+    os.symlink(source, link)
+    w = mm.Warp(str(source), design=["bottom"], fixed=["top"], support_radius=0.6)
+    xs = w.surface_coordinates()
+    w.set_surface_coordinates(xs + [0.0, 0.01])
+    w.warp()
+    before = pathlib.Path(source).read_bytes()
+    for target in (source, link):
+        with pytest.raises(mm.InputError, match="overwrite=True"):
+            w.write_mesh(target)
+    assert pathlib.Path(source).read_bytes() == before
+    other = scratch("python_warp_other.msh")
+    mm.write_mesh(other, grid())
+    with pytest.raises(mm.InputError, match="like="):
+        w.write_mesh(other, like=other)
+    w.write_mesh(source, overwrite=True)
+    np.testing.assert_allclose(mm.read_mesh(str(source)).points, w.volume_coordinates(), rtol=0, atol=1e-12)
+
+
 def test_warp_takes_groups_named_by_patterns_as_openfoam_names_patches():
     mesh = grid()
     by_name = mm.Warp(mesh, design=["bottom"], symmetry=["left", "right"], fixed=["top"], support_radius=0.6)
