@@ -441,16 +441,16 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   /// rigid part, when setup took it out, interpolated no more and added whole.
   template <class Out>
   void timed_apply(PointsView<Dim> d, Out& out) {
-    detail::timed_move<Dim>("RbfMover::move", ready_, d, boundary_nodes_, stats_, [&] {
+    detail::timed_move<Dim>("RbfMover::move", ready_, d, boundary_.nodes, stats_, [&] {
       follow_motion(d);
       if (rigid_.size() == 0) {
         apply(d, out);
       } else {
         Points<Dim> rest = d;
         double off = 0.0;
-        for (std::size_t b = 0; b < boundary_nodes_.size(); ++b) {
-          rest.col(static_cast<Index>(b)) -= rigid_.col(boundary_nodes_[b]);
-          if (kinds_[b] != BoundaryKind::sliding) off = std::max(off, rest.col(static_cast<Index>(b)).norm());
+        for (std::size_t b = 0; b < boundary_.nodes.size(); ++b) {
+          rest.col(static_cast<Index>(b)) -= rigid_.col(boundary_.nodes[b]);
+          if (boundary_.kinds[b] != BoundaryKind::sliding) off = std::max(off, rest.col(static_cast<Index>(b)).norm());
         }
         // What the rigid fit leaves of its own motion is round-off: nothing to interpolate.
         if (off > 1e-10 * rigid_scale_) {
@@ -461,8 +461,8 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
           shape_output(out);
           out = rigid_;
         }
-        for (std::size_t b = 0; b < boundary_nodes_.size(); ++b)
-          if (kinds_[b] != BoundaryKind::sliding) out.col(boundary_nodes_[b]) = d.col(static_cast<Index>(b));
+        for (std::size_t b = 0; b < boundary_.nodes.size(); ++b)
+          if (boundary_.kinds[b] != BoundaryKind::sliding) out.col(boundary_.nodes[b]) = d.col(static_cast<Index>(b));
       }
       const SolverReport& r = with_all([](auto& system) -> const SolverReport& { return system.report(); });
       stats_.iterations = r.iterations;
@@ -476,18 +476,18 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   template <class Out>
   void apply(PointsView<Dim> d, Out& out) {
     const Index k = n_centres_;
-    const auto m = static_cast<Index>(boundary_nodes_.size());
+    const auto m = static_cast<Index>(boundary_.nodes.size());
     values_.resize(k, Dim);
     for (Index c = 0; c < n_constrained_; ++c) values_.row(c) = d.col(source_[static_cast<std::size_t>(c)]).transpose();
     for (Index b = 0; b < m; ++b) {
       const Index c = centre_of_[static_cast<std::size_t>(b)];
-      if (kinds_[static_cast<std::size_t>(b)] == BoundaryKind::sliding || c >= n_constrained_) continue;
+      if (boundary_.kinds[static_cast<std::size_t>(b)] == BoundaryKind::sliding || c >= n_constrained_) continue;
       const Index first = source_[static_cast<std::size_t>(c)];
       const double scale = std::max({1.0, d.col(b).norm(), d.col(first).norm()});
       if ((d.col(b) - d.col(first)).norm() > 1e-12 * scale) {
         // Coincident within coincidence_tolerance × the boundary's diagonal, which one node far
         // from the others (a coordinate of 2^31) stretches: the figures say which it was.
-        const Index u = boundary_nodes_[static_cast<std::size_t>(first)], v = boundary_nodes_[static_cast<std::size_t>(b)];
+        const Index u = boundary_.nodes[static_cast<std::size_t>(first)], v = boundary_.nodes[static_cast<std::size_t>(b)];
         throw InputError("RbfMover::move: boundary nodes " + std::to_string(u) + " and " + std::to_string(v) +
                          " coincide but get different displacements (they are " +
                          format_option_value((points_.col(u) - points_.col(v)).norm()) + " apart, within coincidence_tolerance " +
@@ -509,8 +509,8 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
     out.setZero();
     evaluate_interior(out);
     for (Index b = 0; b < m; ++b) {
-      const Index node = boundary_nodes_[static_cast<std::size_t>(b)];
-      out.col(node) = kinds_[static_cast<std::size_t>(b)] == BoundaryKind::sliding
+      const Index node = boundary_.nodes[static_cast<std::size_t>(b)];
+      out.col(node) = boundary_.kinds[static_cast<std::size_t>(b)] == BoundaryKind::sliding
                           ? Vec<Dim>(values_.row(centre_of_[static_cast<std::size_t>(b)]).transpose())
                           : Vec<Dim>(d.col(b));
     }
@@ -590,9 +590,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   Points<Dim> points_;                      ///< reference coordinates, Dim × n
   Index n_centres_ = 0;                     ///< boundary centres (merged coincident nodes)
   double boundary_diagonal_ = 0.0;          ///< of the boundary's bounding box: the coincidence tolerance's scale
-  std::vector<Index> boundary_nodes_;       ///< as given to setup
-  std::vector<BoundaryKind> kinds_;
-  ResolvedBoundary<Dim> boundary_;          ///< as given to setup: what a set up again needs
+  ResolvedBoundary<Dim> boundary_;          ///< as given to setup (its nodes and kinds; a set up again starts from it)
   bool grows_ = false;                      ///< the default radius follows the motion (follow_motion())
   std::vector<Index> centre_of_;            ///< boundary entry → centre
   std::vector<Index> source_;               ///< centre → boundary entry giving its value
@@ -641,8 +639,6 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   }
   grows_ = fitted && !fitted->reduced;
   points_ = std::move(points);
-  boundary_nodes_ = boundary.nodes;
-  kinds_ = boundary.kinds;
   boundary_ = boundary;
   stats_ = MoverStats{};
   prepare_interpolation(radius_);
@@ -650,7 +646,7 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
     rigid_ = std::move(blend->displacement);
     rigid_scale_ = boundary.displacements.colwise().norm().maxCoeff();
     stats_.rigid_part = true;
-    stats_.evaluated_nodes = points_.cols() - static_cast<Index>(boundary_nodes_.size());
+    stats_.evaluated_nodes = points_.cols() - static_cast<Index>(boundary_.nodes.size());
   } else {
     build_interpolation();
   }
@@ -682,17 +678,17 @@ void RbfMover<Dim>::follow_motion(PointsView<Dim> d) {
   // What the interpolation carries: the motion less the rigid part setup took out.
   const auto carried = [&](std::size_t b) {
     Vec<Dim> out = d.col(static_cast<Index>(b));
-    if (rigid_.size() > 0) out -= rigid_.col(boundary_nodes_[b]);
+    if (rigid_.size() > 0) out -= rigid_.col(boundary_.nodes[b]);
     return out;
   };
   double largest = 0.0;
-  for (std::size_t b = 0; b < boundary_nodes_.size(); ++b)
-    if (kinds_[b] == BoundaryKind::prescribed) largest = std::max(largest, carried(b).norm());
+  for (std::size_t b = 0; b < boundary_.nodes.size(); ++b)
+    if (boundary_.kinds[b] == BoundaryKind::prescribed) largest = std::max(largest, carried(b).norm());
   if (!radius_outgrown(largest, radius_)) return;
   ResolvedBoundary<Dim> grown = boundary_;
   grown.displacements.setZero(Dim, grown.size());
-  for (std::size_t b = 0; b < boundary_nodes_.size(); ++b)
-    if (kinds_[b] == BoundaryKind::prescribed) grown.displacements.col(static_cast<Index>(b)) = radius_growth_margin * carried(b);
+  for (std::size_t b = 0; b < boundary_.nodes.size(); ++b)
+    if (boundary_.kinds[b] == BoundaryKind::prescribed) grown.displacements.col(static_cast<Index>(b)) = radius_growth_margin * carried(b);
   const DefaultSupportRadius fitted = detail::budgeted_support_radius(points_, grown, options_);
   if (!(fitted.radius > radius_)) {
     grows_ = false;  // the memory budget holds the radius where it is
@@ -754,12 +750,12 @@ template <int Dim>
 Points<Dim> RbfMover<Dim>::merge_centres(const ResolvedBoundary<Dim>& boundary) {
   const Index m = boundary.size();
   Points<Dim> positions(Dim, m);
-  for (Index b = 0; b < m; ++b) positions.col(b) = points_.col(boundary_nodes_[static_cast<std::size_t>(b)]);
+  for (Index b = 0; b < m; ++b) positions.col(b) = points_.col(boundary_.nodes[static_cast<std::size_t>(b)]);
   boundary_diagonal_ = m > 0 ? (positions.rowwise().maxCoeff() - positions.rowwise().minCoeff()).norm() : 0.0;
   const auto rep = detail::coincident_representatives(positions, options_.coincidence_tolerance * boundary_diagonal_);
   std::vector<bool> constrained(static_cast<std::size_t>(m), false);
   for (Index b = 0; b < m; ++b)
-    if (kinds_[static_cast<std::size_t>(b)] != BoundaryKind::sliding) constrained[static_cast<std::size_t>(rep[static_cast<std::size_t>(b)])] = true;
+    if (boundary_.kinds[static_cast<std::size_t>(b)] != BoundaryKind::sliding) constrained[static_cast<std::size_t>(rep[static_cast<std::size_t>(b)])] = true;
   centre_of_.assign(static_cast<std::size_t>(m), -1);
   source_.clear();
   std::vector<Index> sliding_reps;
@@ -780,7 +776,7 @@ Points<Dim> RbfMover<Dim>::merge_centres(const ResolvedBoundary<Dim>& boundary) 
   for (Index b = 0; b < m; ++b) centre_of_[static_cast<std::size_t>(b)] = centre_of_[static_cast<std::size_t>(rep[static_cast<std::size_t>(b)])];
   // A constrained centre takes its value from its first constrained member node.
   for (Index b = m - 1; b >= 0; --b)
-    if (kinds_[static_cast<std::size_t>(b)] != BoundaryKind::sliding && centre_of_[static_cast<std::size_t>(b)] < n_constrained_)
+    if (boundary_.kinds[static_cast<std::size_t>(b)] != BoundaryKind::sliding && centre_of_[static_cast<std::size_t>(b)] < n_constrained_)
       source_[static_cast<std::size_t>(centre_of_[static_cast<std::size_t>(b)])] = b;
   n_centres_ = static_cast<Index>(source_.size());
   Points<Dim> centres(Dim, n_centres_);
@@ -834,7 +830,7 @@ void RbfMover<Dim>::build_evaluation() {
   // kernels); the polynomial part reaches every non-boundary node.
   const Index n = points_.cols(), k = n_centres_;
   std::vector<bool> is_boundary(static_cast<std::size_t>(n), false);
-  for (const Index v : boundary_nodes_) is_boundary[static_cast<std::size_t>(v)] = true;
+  for (const Index v : boundary_.nodes) is_boundary[static_cast<std::size_t>(v)] = true;
   interior_.clear();
   for (Index i = 0; i < n; ++i)
     if (!is_boundary[static_cast<std::size_t>(i)]) interior_.push_back(i);
@@ -889,7 +885,7 @@ void RbfMover<Dim>::move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) {
 template <int Dim>
 Points<Dim> RbfMover<Dim>::derivative_forward(PointsView<Dim> w) {
   require_ready("derivative_forward");
-  detail::check_displacements<Dim>("RbfMover::derivative_forward", w, boundary_nodes_);
+  detail::check_displacements<Dim>("RbfMover::derivative_forward", w, boundary_.nodes);
   build_interpolation();
   Points<Dim> out;
   apply(w, out);
@@ -901,14 +897,14 @@ Points<Dim> RbfMover<Dim>::derivative_reverse(PointsView<Dim> v) {
   require_ready("derivative_reverse");
   detail::check_node_field<Dim>("RbfMover::derivative_reverse", v, points_.cols());
   build_interpolation();
-  const Index m = static_cast<Index>(boundary_nodes_.size());
+  const Index m = static_cast<Index>(boundary_.nodes.size());
   const Index k = n_centres_;
   Points<Dim> grad = Points<Dim>::Zero(Dim, m);
   // Boundary nodes output their target directly.
   Eigen::MatrixXd values_bar = Eigen::MatrixXd::Zero(k, Dim);
   for (Index b = 0; b < m; ++b) {
-    const Index node = boundary_nodes_[static_cast<std::size_t>(b)];
-    if (kinds_[static_cast<std::size_t>(b)] != BoundaryKind::sliding)
+    const Index node = boundary_.nodes[static_cast<std::size_t>(b)];
+    if (boundary_.kinds[static_cast<std::size_t>(b)] != BoundaryKind::sliding)
       grad.col(b) += v.col(node);
     else
       values_bar.row(centre_of_[static_cast<std::size_t>(b)]) += v.col(node).transpose();
