@@ -97,6 +97,26 @@ Outcome compare_with_serial(const Mesh<Dim>& whole, const ResolvedBoundary<Dim>&
   return out;
 }
 
+// The whole boundary's values `d` (serial entry order of `b`) for this rank's entries `local`.
+template <int Dim>
+Points<Dim> local_values(const DistributedMesh<Dim>& part, const ResolvedBoundary<Dim>& b, const ResolvedBoundary<Dim>& local,
+                         const Points<Dim>& d) {
+  Points<Dim> out(Dim, local.size());
+  for (Index k = 0; k < local.size(); ++k)
+    out.col(k) = d.col(b.column(part.global_ids[static_cast<std::size_t>(local.nodes[static_cast<std::size_t>(k)])]));
+  return out;
+}
+
+// The largest distance over every rank between a local node's value in `got` and its node's
+// value in the serial `expected`.
+template <int Dim>
+double largest_gap(const DistributedMesh<Dim>& part, const Points<Dim>& got, const Points<Dim>& expected) {
+  double worst = 0.0;
+  for (Index i = 0; i < part.local.num_nodes(); ++i)
+    worst = std::max(worst, (got.col(i) - expected.col(part.global_ids[static_cast<std::size_t>(i)])).norm());
+  return global_max(worst);
+}
+
 }  // namespace
 
 TEST_CASE("distributed RBF equals serial on a 2D mesh partitioned by METIS", "[parallel][rbf]") {
@@ -179,15 +199,9 @@ TEST_CASE("distributed RBF set up once with no motion takes the serial budget ra
     for (Index k = 0; k < d.cols(); ++k)
       d.col(k) *= scale * std::sin(3.14159 * mesh.points(0, b.nodes[static_cast<std::size_t>(k)]));
     const Points<2> expected = serial.move(d);
-    Points<2> local_d(2, local_b.size());
-    for (Index k = 0; k < local_b.size(); ++k)
-      local_d.col(k) = d.col(b.column(part.global_ids[static_cast<std::size_t>(local_b.nodes[static_cast<std::size_t>(k)])]));
-    const Points<2> got = mover.move(local_d);
-    double worst = 0.0;
-    for (Index i = 0; i < part.local.num_nodes(); ++i)
-      worst = std::max(worst, (got.col(i) - expected.col(part.global_ids[static_cast<std::size_t>(i)])).norm());
+    const Points<2> got = mover.move(local_values(part, b, local_b, d));
     INFO("scale " << scale);
-    CHECK(global_max(worst) <= 1e-12 * expected.colwise().norm().maxCoeff());
+    CHECK(largest_gap(part, got, expected) <= 1e-12 * expected.colwise().norm().maxCoeff());
   }
 }
 
@@ -226,28 +240,16 @@ TEST_CASE("distributed RBF set up before the motion grows its radius with it as 
       CAPTURE(s);
       const Points<2> d = motion(s);
       const Points<2> expected = serial.move(d);
-      Points<2> local_d(2, local_b.size());
-      for (Index k = 0; k < local_b.size(); ++k)
-        local_d.col(k) = d.col(b.column(part.global_ids[static_cast<std::size_t>(local_b.nodes[static_cast<std::size_t>(k)])]));
-      const Points<2> got = mover.move(local_d);
+      const Points<2> got = mover.move(local_values(part, b, local_b, d));
       CHECK(mover.support_radius() == serial.support_radius());
       CHECK(mover.stats().radius_growths == serial.stats().radius_growths);
-      double worst = 0.0;
-      for (Index i = 0; i < part.local.num_nodes(); ++i)
-        worst = std::max(worst, (got.col(i) - expected.col(part.global_ids[static_cast<std::size_t>(i)])).norm());
-      CHECK(global_max(worst) <= 1e-10 * expected.colwise().norm().maxCoeff());
+      CHECK(largest_gap(part, got, expected) <= 1e-10 * expected.colwise().norm().maxCoeff());
       // The grid velocity through the same map: the serial one, and no set-up again.
-      const Points<2> expected_velocity = serial.derivative_forward(motion(0.3 * s));
-      const Index growths = mover.stats().radius_growths;
-      Points<2> local_v(2, local_b.size());
       const Points<2> v = motion(0.3 * s);
-      for (Index k = 0; k < local_b.size(); ++k)
-        local_v.col(k) = v.col(b.column(part.global_ids[static_cast<std::size_t>(local_b.nodes[static_cast<std::size_t>(k)])]));
-      const Points<2> velocity = mover.velocity(local_v);
-      double velocity_gap = 0.0;
-      for (Index i = 0; i < part.local.num_nodes(); ++i)
-        velocity_gap = std::max(velocity_gap, (velocity.col(i) - expected_velocity.col(part.global_ids[static_cast<std::size_t>(i)])).norm());
-      CHECK(global_max(velocity_gap) <= 1e-10 * expected_velocity.colwise().norm().maxCoeff());
+      const Points<2> expected_velocity = serial.derivative_forward(v);
+      const Index growths = mover.stats().radius_growths;
+      const Points<2> velocity = mover.velocity(local_values(part, b, local_b, v));
+      CHECK(largest_gap(part, velocity, expected_velocity) <= 1e-10 * expected_velocity.colwise().norm().maxCoeff());
       CHECK(mover.stats().radius_growths == growths);
     }
     CHECK(serial.stats().radius_growths >= 2);
