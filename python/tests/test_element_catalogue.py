@@ -11,11 +11,13 @@ import pytest
 mm = pytest.importorskip("meshmotion", reason="the meshmotion module was not built (pybind11 absent?)")
 
 GMSH_IDS = {
-    "line2": 1, "line3": 8, "line4": 26, "line5": 27,
-    "tri3": 2, "tri6": 9, "tri10": 21, "tri15": 23,
-    "quad4": 3, "quad8": 16, "quad9": 10, "quad16": 36, "quad25": 37,
-    "tet4": 4, "tet10": 11, "tet20": 29, "tet35": 30,
-    "hex8": 5, "hex20": 17, "hex27": 12, "hex64": 92,
+    "line2": 1, "line3": 8, "line4": 26, "line5": 27, "line6": 28, "line7": 62, "line8": 63, "line9": 64,
+    "tri3": 2, "tri6": 9, "tri10": 21, "tri15": 23, "tri21": 25, "tri28": 42, "tri36": 43, "tri45": 44,
+    "quad4": 3, "quad8": 16, "quad9": 10, "quad16": 36, "quad25": 37, "quad36": 38, "quad49": 47, "quad64": 48,
+    "quad81": 49,
+    "tet4": 4, "tet10": 11, "tet20": 29, "tet35": 30, "tet56": 31, "tet84": 71,
+    "hex8": 5, "hex20": 17, "hex27": 12, "hex64": 92, "hex125": 93, "hex216": 94, "hex343": 95, "hex512": 96,
+    "hex729": 97,
     "prism6": 6, "prism15": 18, "prism18": 13, "prism40": 90,
     "pyramid5": 7, "pyramid13": 19, "pyramid14": 14, "pyramid30": 118,
 }
@@ -89,8 +91,9 @@ def test_reference_nodes_are_gmsh_s(gmsh, type_name):
 
 LAGRANGE = {"line": "vtkLagrangeCurve", "tri": "vtkLagrangeTriangle", "quad": "vtkLagrangeQuadrilateral",
             "tet": "vtkLagrangeTetra", "hex": "vtkLagrangeHexahedron", "prism": "vtkLagrangeWedge"}
-VTK_TYPES = ["line3", "line4", "line5", "tri6", "tri10", "tri15", "quad9", "quad16", "quad25", "tet10", "tet20",
-             "tet35", "hex27", "hex64", "prism18", "prism40"]
+VTK_TYPES = ["line3", "line4", "line5", "line6", "line9", "tri6", "tri10", "tri15", "tri21", "tri28", "tri36", "tri45",
+             "quad9", "quad16", "quad25", "quad36", "quad49", "quad64", "quad81", "tet10", "tet20", "tet35", "tet56",
+             "tet84", "hex27", "hex64", "hex125", "hex216", "hex729", "prism18", "prism40"]
 
 
 def to_vtk_parametric(type_name, x):
@@ -125,7 +128,7 @@ def test_vtk_lagrange_order_is_vtk_s(type_name):
     parametric = cell.GetParametricCoords()
     theirs = np.array([parametric[k] for k in range(3 * n)]).reshape(n, 3)
     expected = to_vtk_parametric(type_name, ours[order])
-    if type_name in ("hex27", "hex64"):
+    if family(type_name) == "hex":
         # VTK 9.1 reads files older than version 2.2 (ours declare 1.0) with the vertical
         # edges (2,6) and (3,7) swapped, so the table holds them swapped: swap them back.
         k = 8 + 10 * (p - 1)

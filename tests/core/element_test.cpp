@@ -1,4 +1,5 @@
 #include "meshmotion/core/element.hpp"
+#include "meshmotion/core/shape_functions.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -77,14 +78,20 @@ TEST_CASE("facet nodes of quadratic elements follow Gmsh's face node numbering",
 TEST_CASE("orders the catalogue does not hold are refused by name", "[core]") {
   CHECK(element_type(Shape::tetrahedron, 4) == ElementType::tet35);
   CHECK(element_type(Shape::pyramid, 3) == ElementType::pyramid30);
-  CHECK_THROWS_WITH(element_type(Shape::hexahedron, 4), Catch::Contains("no hexahedron of order 4"));
-  CHECK_THROWS_WITH(element_type(Shape::triangle, 5), Catch::Contains("no triangle of order 5"));
+  CHECK(element_type(Shape::triangle, 8) == ElementType::tri45);
+  CHECK(element_type(Shape::quadrilateral, 8) == ElementType::quad81);
+  CHECK(element_type(Shape::tetrahedron, 6) == ElementType::tet84);
+  CHECK_THROWS_WITH(element_type(Shape::triangle, 9), Catch::Contains("no triangle of order 9"));
+  CHECK_THROWS_WITH(element_type(Shape::tetrahedron, 7), Catch::Contains("no tetrahedron of order 7 (orders 1 to 6"));
   CHECK_THROWS_WITH(element_type(Shape::quadrilateral, 3, false), Catch::Contains("serendipity"));
-  CHECK_THROWS_WITH(element_type_from_gmsh(93), Catch::Contains("93"));  // hex125
+  CHECK(element_type(Shape::hexahedron, 8) == ElementType::hex729);
+  CHECK_THROWS_WITH(element_type(Shape::prism, 4), Catch::Contains("no prism of order 4"));
+  CHECK_THROWS_WITH(element_type_from_gmsh(91), Catch::Contains("91"));  // prism75
 }
 
 TEST_CASE("unknown type numbers and names are errors", "[core]") {
-  CHECK_THROWS_AS(element_type_from_gmsh(42), InputError);
+  CHECK_THROWS_AS(element_type_from_gmsh(45), InputError);  // tri55, order 9
+  CHECK_THROWS_WITH(element_type_from_gmsh(72), Catch::Contains("a tetrahedron of order 1 to 6"));  // tet120
   CHECK_THROWS_AS(element_type_from_vtk(99), InputError);
   CHECK_THROWS_WITH(element_type_from_name("tri7"), Catch::Contains("tri7"));
 }

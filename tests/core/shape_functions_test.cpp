@@ -2,6 +2,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -131,21 +132,29 @@ TEST_CASE("shape functions: partition of unity, derivatives, polynomial reproduc
       return f_lin(x) + quad[0] * x[0] * x[0] + quad[1] * x[0] * x[1] + quad[2] * x[1] * x[1] +
              quad[3] * x[0] * x[2] + quad[4] * x[1] * x[2] + quad[5] * x[2] * x[2];
     };
-    // Pyramid spaces reproduce linear functions; complete P2 types also reproduce quadratics.
+    // Pyramid spaces reproduce linear functions; complete P2 types also reproduce quadratics,
+    // and every complete type of the other shapes a polynomial of its own degree (at P8 a test
+    // of the basis's digits: the monomial one lost 1e-11 on a tri45, 1e-9 on a hex729).
     const bool reproduces_quadratics = order(t) == 2 && element_info(t).complete && shape(t) != Shape::pyramid;
+    const bool reproduces_own_degree = element_info(t).complete && shape(t) != Shape::pyramid;
+    const auto f_own = [&](const RefPoint& x) {
+      return std::pow(0.3 + 0.5 * x[0] - 0.4 * x[1] + 0.2 * x[2], order(t)) + lin[1] * x[0];
+    };
     for (int trial = 0; trial < 10; ++trial) {
       const RefPoint x = random_inside(t, rng);
       const auto v = values_at(t, x);
-      double sum = 0, interp_lin = 0, interp_quad = 0;
+      double sum = 0, interp_lin = 0, interp_quad = 0, interp_own = 0;
       for (int i = 0; i < n; ++i) {
         const auto ii = static_cast<std::size_t>(i);
         sum += v[ii];
         interp_lin += v[ii] * f_lin(nodes[ii]);
         interp_quad += v[ii] * f_quad(nodes[ii]);
+        interp_own += v[ii] * f_own(nodes[ii]);
       }
       CHECK(sum == Approx(1.0).margin(1e-12));
       CHECK(interp_lin == Approx(f_lin(x)).margin(1e-12));
       if (reproduces_quadratics) CHECK(interp_quad == Approx(f_quad(x)).margin(1e-12));
+      if (reproduces_own_degree) CHECK(interp_own == Approx(f_own(x)).margin(1e-12));
 
       std::vector<std::array<double, 3>> g(static_cast<std::size_t>(n));
       shape_derivatives(t, x, g);

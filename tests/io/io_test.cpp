@@ -228,7 +228,7 @@ TEST_CASE("msh text formatted by several threads is the text of one thread", "[i
 }
 
 TEST_CASE("elements of every type and order round-trip with non-contiguous ids", "[io]") {
-  for (const int element_order : {1, 2, 3, 4}) {
+  for (const int element_order : {1, 2, 3, 4, 5, 6, 7, 8}) {
     for (const auto& options : msh_variants) {
       INFO("order " << element_order << " msh " << (options.msh_version == MshVersion::v2_2 ? "2.2" : "4.1") << (options.binary ? " binary" : " ascii"));
       const auto mesh3 = all_types_mesh<3>(element_order);
@@ -236,8 +236,9 @@ TEST_CASE("elements of every type and order round-trip with non-contiguous ids",
       write_mesh(out3, mesh3, options);
       const auto back3 = read_mesh_as<3>(out3);
       require_same_mesh(mesh3, back3);
-      // P2: complete and serendipity types; P3: tet20, hex64, prism40, pyramid30; P4: tet35.
-      CHECK(back3.cells.size() == std::vector<std::size_t>{4, 7, 4, 1}[static_cast<std::size_t>(element_order - 1)]);
+      // P2: complete and serendipity types; P3: tet20, hex64, prism40, pyramid30; P4: tet35,
+      // hex125; P5, P6: a tetrahedron and a hexahedron; P7, P8: a hexahedron.
+      CHECK(back3.cells.size() == std::vector<std::size_t>{4, 7, 4, 2, 2, 2, 1, 1}[static_cast<std::size_t>(element_order - 1)]);
       CHECK(back3.lower.size() == 2);  // lines and the point (Gmsh type 15)
 
       const auto mesh2 = all_types_mesh<2>(element_order);
@@ -275,7 +276,8 @@ TEST_CASE("SU2's DG-FEM lattice: element numbers and node rows as SU2 lists them
   CHECK(su2_id(ElementType::quad8) == -1);
   CHECK(element_type_from_su2(205) == ElementType::tri10);
   CHECK(element_type_from_su2(30212) == ElementType::hex64);  // solution degree 2 ahead of the type
-  CHECK_THROWS_WITH(element_type_from_su2(312), Catch::Contains("no hexahedron of order 4"));
+  CHECK(element_type_from_su2(712) == ElementType::hex729);
+  CHECK_THROWS_WITH(element_type_from_su2(313), Catch::Contains("no prism of order 4"));
   CHECK_THROWS_WITH(element_type_from_su2(7), Catch::Contains("unknown SU2 element type 7"));
   // SU2's own tables (its CGNS converter lists, per SU2 node, the CGNS node; CGNS and Gmsh
   // agree on these: vertices, then edges, then faces): a quad16's rows are 0 4 5 1 / 11 12 13 6
@@ -295,8 +297,9 @@ TEST_CASE("SU2's DG-FEM lattice: element numbers and node rows as SU2 lists them
   }
 }
 
-TEST_CASE("orientation: reference elements are positive and fix_orientation mirrors P2 nodes consistently", "[io]") {
-  for (const int element_order : {1, 2}) {
+TEST_CASE("orientation: reference elements are positive and fix_orientation mirrors the nodes of every order consistently", "[io]") {
+  for (const int element_order : {1, 2, 3, 4, 5, 6, 8}) {
+    INFO("order " << element_order);
     auto mesh = all_types_mesh<3>(element_order);
     auto mesh2 = all_types_mesh<2>(element_order);
     CHECK(orientation_report(mesh).num_negative == 0);
@@ -490,7 +493,7 @@ TEST_CASE("VTU input: every type and order round-trips through .vtu, binary and 
       }
     }
   };
-  for (const int element_order : {1, 2, 3, 4})
+  for (const int element_order : {1, 2, 3, 4, 5, 6, 7, 8})
     for (const auto encoding : {VtuEncoding::binary, VtuEncoding::ascii}) {
       INFO("order " << element_order << (encoding == VtuEncoding::binary ? " binary" : " ascii"));
       check(all_types_mesh<3>(element_order), encoding);
@@ -639,8 +642,8 @@ TEST_CASE("malformed files give ParseError with file, line and what was expected
   CHECK(parse_error_position(read, "not finite") == 7);
   write_text(bad, header + "$Nodes\n3\n1 0 0 0\n2 inf 0 0\n3 0 1 0\n$EndNodes\n");
   CHECK(parse_error_position(read, "not finite") == 7);
-  write_text(bad, header + nodes + "$Elements\n1\n1 42 2 0 1 1 2 3\n$EndElements\n");
-  CHECK(parse_error_position(read, "unsupported Gmsh element type 42") == 12);
+  write_text(bad, header + nodes + "$Elements\n1\n1 45 2 0 1 1 2 3\n$EndElements\n");
+  CHECK(parse_error_position(read, "unsupported Gmsh element type 45") == 12);
   write_text(bad, header + nodes + "$Elements\n2\n1 2 2 0 1 1 2 3\n$EndElements\n");
   CHECK(parse_error_position(read, "expected element id") == 13);
   write_text(bad, header + nodes + "$Elements\n1\n1 2 2 0 1 1 2 3\n2 2 2 0 1 1 2 3\n$EndElements\n");

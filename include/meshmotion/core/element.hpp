@@ -30,19 +30,25 @@ enum class ElementType : std::uint8_t {
   // Order 3 and 4 (complete Lagrange elements): appended so that the numbers above stay.
   line4, tri10, quad16, tet20, hex64, prism40, pyramid30,
   line5, tri15, quad25, tet35,
+  // Orders 5 to 8 (lines, triangles and quadrilaterals; tetrahedra to 6), then hexahedra of
+  // orders 4 to 8.
+  line6, tri21, quad36, tet56,
+  line7, tri28, quad49, tet84,
+  line8, tri36, quad64,
+  line9, tri45, quad81,
+  hex125, hex216, hex343, hex512, hex729,
 };
 
-inline constexpr int num_element_types = 30;
+inline constexpr int num_element_types = 49;
 
-/// Most nodes of any element type (hex64).
-inline constexpr int max_element_nodes = 64;
+/// Most nodes of any element type (hex729).
+inline constexpr int max_element_nodes = 729;
 
-/// Most nodes of any element facet (the quad16 face of a hex64).
-inline constexpr int max_facet_nodes = 16;
+/// Most nodes of any element facet (the quad81 face of a hex729).
+inline constexpr int max_facet_nodes = 81;
 
-/// Highest element order of the catalogue, and per shape (hexahedra, prisms and pyramids stop
-/// at 3; Gmsh's pyramids of order 3 have 30 nodes).
-inline constexpr int max_element_order = 4;
+/// Highest element order of the catalogue; max_order() gives it per shape.
+inline constexpr int max_element_order = 8;
 
 /// Geometric shape of an element, independent of its order.
 enum class Shape : std::uint8_t { point, line, triangle, quadrilateral, tetrahedron, hexahedron, prism, pyramid };
@@ -61,7 +67,7 @@ struct ElementInfo {
   std::string_view name;    ///< "tri6", "hex27", ...
   Shape shape;
   int dim;                  ///< topological dimension
-  int order;                ///< 1 to 4 (0 for a point)
+  int order;                ///< 1 to max_element_order (0 for a point)
   int num_nodes;
   int num_vertices;
   bool complete;            ///< all Lagrange nodes present (quad9, hex27, ...), not serendipity
@@ -103,7 +109,25 @@ inline constexpr std::array<ElementInfo, num_element_types> element_table{{
     {ElementType::line5, "line5", Shape::line, 1, 4, 5, 2, true, 27, -1, 68},
     {ElementType::tri15, "tri15", Shape::triangle, 2, 4, 15, 3, true, 23, -1, 69},
     {ElementType::quad25, "quad25", Shape::quadrilateral, 2, 4, 25, 4, true, 37, -1, 70},
-    {ElementType::tet35, "tet35", Shape::tetrahedron, 3, 4, 35, 4, true, 30, -1, 71},
+    {ElementType::tet35, "tet35", Shape::tetrahedron, 3, 4, 35, 4, true, 30, -1, 71},    {ElementType::line6, "line6", Shape::line, 1, 5, 6, 2, true, 28, -1, 68},
+    {ElementType::tri21, "tri21", Shape::triangle, 2, 5, 21, 3, true, 25, -1, 69},
+    {ElementType::quad36, "quad36", Shape::quadrilateral, 2, 5, 36, 4, true, 38, -1, 70},
+    {ElementType::tet56, "tet56", Shape::tetrahedron, 3, 5, 56, 4, true, 31, -1, 71},
+    {ElementType::line7, "line7", Shape::line, 1, 6, 7, 2, true, 62, -1, 68},
+    {ElementType::tri28, "tri28", Shape::triangle, 2, 6, 28, 3, true, 42, -1, 69},
+    {ElementType::quad49, "quad49", Shape::quadrilateral, 2, 6, 49, 4, true, 47, -1, 70},
+    {ElementType::tet84, "tet84", Shape::tetrahedron, 3, 6, 84, 4, true, 71, -1, 71},
+    {ElementType::line8, "line8", Shape::line, 1, 7, 8, 2, true, 63, -1, 68},
+    {ElementType::tri36, "tri36", Shape::triangle, 2, 7, 36, 3, true, 43, -1, 69},
+    {ElementType::quad64, "quad64", Shape::quadrilateral, 2, 7, 64, 4, true, 48, -1, 70},
+    {ElementType::line9, "line9", Shape::line, 1, 8, 9, 2, true, 64, -1, 68},
+    {ElementType::tri45, "tri45", Shape::triangle, 2, 8, 45, 3, true, 44, -1, 69},
+    {ElementType::quad81, "quad81", Shape::quadrilateral, 2, 8, 81, 4, true, 49, -1, 70},
+    {ElementType::hex125, "hex125", Shape::hexahedron, 3, 4, 125, 8, true, 93, -1, 72},
+    {ElementType::hex216, "hex216", Shape::hexahedron, 3, 5, 216, 8, true, 94, -1, 72},
+    {ElementType::hex343, "hex343", Shape::hexahedron, 3, 6, 343, 8, true, 95, -1, 72},
+    {ElementType::hex512, "hex512", Shape::hexahedron, 3, 7, 512, 8, true, 96, -1, 72},
+    {ElementType::hex729, "hex729", Shape::hexahedron, 3, 8, 729, 8, true, 97, -1, 72},
 }};
 
 using Edge = std::array<int, 2>;
@@ -159,9 +183,6 @@ inline constexpr std::array<int, 10> tet10_vtk{0, 1, 2, 3, 4, 5, 6, 7, 9, 8};
 inline constexpr std::array<int, 20> hex20_vtk{0, 1, 2, 3, 4, 5, 6, 7, 8, 11, 13, 9, 16, 18, 19, 17, 10, 12, 14, 15};
 inline constexpr std::array<int, 27> hex27_vtk{0,  1,  2,  3,  4,  5,  6,  7,  8,  11, 13, 9,  16, 18,
                                                19, 17, 10, 12, 14, 15, 22, 23, 21, 24, 20, 25, 26};
-// VTK_LAGRANGE_HEXAHEDRON lists the vertical edges as (0,4) (1,5) (3,7) (2,6).
-inline constexpr std::array<int, 27> hex27_vtk_lagrange{0,  1,  2,  3,  4,  5,  6,  7,  8,  11, 13, 9,  16, 18,
-                                                        19, 17, 10, 12, 15, 14, 22, 23, 21, 24, 20, 25, 26};
 // VTK's classic wedges (linear, quadratic, biquadratic) turn their base (0,1,2) the other way:
 // by the right-hand rule its normal points away from (3,4,5), Gmsh's towards it. VTK vertex i
 // is our vertex {0,2,1,3,5,4}[i]; its edges (0,1) (1,2) (2,0) (3,4) (4,5) (5,3) (0,3) (1,4)
@@ -172,23 +193,23 @@ inline constexpr std::array<int, 6> prism6_vtk{0, 2, 1, 3, 5, 4};
 inline constexpr std::array<int, 15> prism15_vtk{0, 2, 1, 3, 5, 4, 7, 9, 6, 13, 14, 12, 8, 11, 10};
 inline constexpr std::array<int, 18> prism18_vtk{0, 2, 1, 3, 5, 4, 7, 9, 6, 13, 14, 12, 8, 11, 10, 16, 17, 15};
 inline constexpr std::array<int, 18> prism18_vtk_lagrange{0, 1, 2, 3, 4, 5, 6, 9, 7, 12, 14, 13, 8, 10, 11, 15, 17, 16};
-// VTK's Lagrange cells past order 2, tabulated from VTK 9.1's own parametric coordinates
-// (python/tests/test_vtk_orientation.py checks them against VTK). Lines and triangles list
-// their nodes as Gmsh does. The hexahedron's vertical edges (2,6) and (3,7) are listed in the
-// order of .vtu files before version 2.2, which is what the writer declares (as hex27's).
-inline constexpr std::array<int, 16> quad16_vtk{0, 1, 2, 3, 4, 5, 6, 7, 9, 8, 11, 10, 12, 13, 15, 14};
-inline constexpr std::array<int, 25> quad25_vtk{0,  1,  2,  3,  4,  5,  6,  7,  8,  9,  12, 11, 10,
-                                                15, 14, 13, 16, 20, 17, 23, 24, 21, 19, 22, 18};
+// VTK's Lagrange tetrahedra and wedges past order 2, tabulated from VTK 9.1's own parametric
+// coordinates (python/tests/test_element_catalogue.py checks them against VTK). Lines and
+// triangles list their nodes as Gmsh does; quadrilaterals and hexahedra follow a rule
+// (vtk_order() in core/shape_functions.hpp).
 inline constexpr std::array<int, 20> tet20_vtk{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 10, 15, 14, 13, 12, 17, 19, 18, 16};
 inline constexpr std::array<int, 35> tet35_vtk{0,  1,  2,  3,  4,  5,  6,  7,  8,  9,  10, 11, 12, 15, 14, 13, 21, 20,
                                                19, 18, 17, 16, 25, 26, 27, 33, 31, 32, 28, 29, 30, 22, 23, 24, 34};
-inline constexpr std::array<int, 64> hex64_vtk{
-    0,  1,  2,  3,  4,  5,  6,  7,  8,  9,  14, 15, 19, 18, 10, 11, 24, 25, 28, 29, 31, 30,
-    26, 27, 12, 13, 16, 17, 22, 23, 20, 21, 40, 43, 41, 42, 44, 45, 47, 46, 36, 37, 39, 38,
-    49, 48, 50, 51, 32, 35, 33, 34, 52, 53, 55, 54, 56, 57, 59, 58, 60, 61, 63, 62};
 inline constexpr std::array<int, 40> prism40_vtk{0,  1,  2,  3,  4,  5,  6,  7,  12, 13, 9,  8,  18, 19,
                                                  22, 23, 21, 20, 10, 11, 14, 15, 16, 17, 24, 25, 26, 27,
                                                  29, 28, 34, 35, 37, 36, 33, 30, 32, 31, 38, 39};
+inline constexpr std::array<int, 56> tet56_vtk{
+    0,  1,  2,  3,  4,  5,  6,  7,  8,  9,  10, 11, 12, 13, 14, 15, 19, 18, 17, 16, 27, 26, 25, 24, 23, 22, 21, 20,
+    34, 35, 36, 37, 38, 39, 48, 46, 47, 51, 49, 50, 40, 41, 42, 43, 44, 45, 28, 29, 30, 31, 32, 33, 52, 53, 54, 55};
+inline constexpr std::array<int, 84> tet84_vtk{
+    0,  1,  2,  3,  4,  5,  6,  7,  8,  9,  10, 11, 12, 13, 14, 15, 16, 17, 18, 23, 22, 21, 20, 19, 33, 32, 31, 30,
+    29, 28, 27, 26, 25, 24, 44, 45, 46, 47, 48, 49, 50, 51, 52, 53, 66, 64, 65, 71, 72, 67, 68, 69, 70, 73, 54, 55,
+    56, 57, 58, 59, 60, 61, 62, 63, 34, 35, 36, 37, 38, 39, 40, 41, 42, 43, 74, 75, 76, 77, 78, 79, 80, 81, 83, 82};
 inline constexpr std::array<int, 13> pyramid13_vtk{0, 1, 2, 3, 4, 5, 8, 10, 6, 7, 9, 11, 12};
 
 template <class T, std::size_t N>
@@ -256,44 +277,36 @@ constexpr std::span<const T> as_span(const std::array<T, N>& a) {
   return "?";
 }
 
+/// Highest order of the catalogue's elements of a shape: 8 for lines, triangles,
+/// quadrilaterals and hexahedra, 6 for tetrahedra, 3 for prisms and pyramids. (The
+/// certificate's Bézier tables of a tetrahedron grow as the cube of its order: at order 8,
+/// 2,024 coefficients and a quarter of a gigabyte of subdivision tables. Gmsh lays out the
+/// inside of prisms past order 3, and of pyramids past order 3, in ways the catalogue's
+/// lattice does not reproduce yet.)
+[[nodiscard]] constexpr int max_order(Shape s) {
+  switch (s) {
+    case Shape::point: return 0;
+    case Shape::tetrahedron: return 6;
+    case Shape::prism:
+    case Shape::pyramid: return 3;
+    default: return max_element_order;
+  }
+}
+
 /// The element type of a given shape and order; `complete` picks quad9/hex27/prism18/pyramid14
 /// over the serendipity quad8/hex20/prism15/pyramid13. Orders past 2 are complete Lagrange
-/// elements, up to 4 for lines, triangles, quadrilaterals and tetrahedra and up to 3 for
-/// hexahedra, prisms and pyramids; throws InputError for an order the catalogue does not hold.
+/// elements up to max_order(s); throws InputError for an order the catalogue does not hold.
 [[nodiscard]] constexpr ElementType element_type(Shape s, int element_order, bool complete = true) {
-  constexpr ElementType none = ElementType::point1;
-  const auto pick = [element_order](ElementType p1, ElementType p2, ElementType p3, ElementType p4) {
-    switch (element_order) {
-      case 1: return p1;
-      case 2: return p2;
-      case 3: return p3;
-      case 4: return p4;
-      default: return none;
-    }
-  };
-  ElementType t = none;
+  if (s == Shape::point) return ElementType::point1;
   if (element_order > 2 && !complete)
     throw InputError("element_type: serendipity elements stop at order 2 (asked for order " + std::to_string(element_order) + ")");
-  switch (s) {
-    case Shape::point: return ElementType::point1;
-    case Shape::line: t = pick(ElementType::line2, ElementType::line3, ElementType::line4, ElementType::line5); break;
-    case Shape::triangle: t = pick(ElementType::tri3, ElementType::tri6, ElementType::tri10, ElementType::tri15); break;
-    case Shape::quadrilateral:
-      t = pick(ElementType::quad4, complete ? ElementType::quad9 : ElementType::quad8, ElementType::quad16, ElementType::quad25);
-      break;
-    case Shape::tetrahedron: t = pick(ElementType::tet4, ElementType::tet10, ElementType::tet20, ElementType::tet35); break;
-    case Shape::hexahedron: t = pick(ElementType::hex8, complete ? ElementType::hex27 : ElementType::hex20, ElementType::hex64, none); break;
-    case Shape::prism: t = pick(ElementType::prism6, complete ? ElementType::prism18 : ElementType::prism15, ElementType::prism40, none); break;
-    case Shape::pyramid:
-      t = pick(ElementType::pyramid5, complete ? ElementType::pyramid14 : ElementType::pyramid13, ElementType::pyramid30, none);
-      break;
-  }
-  if (t == none) {
-    throw InputError("element_type: no " + std::string(shape_name(s)) + " of order " +
-                     std::to_string(element_order) + " (orders 1 to 4 for lines, triangles, quadrilaterals and " +
-                     "tetrahedra, 1 to 3 for hexahedra, prisms and pyramids)");
-  }
-  return t;
+  // The table lists each serendipity type before its complete sibling, and shapes without
+  // one (triangles, tetrahedra) answer both requests.
+  for (const ElementInfo& e : detail::element_table)
+    if (e.shape == s && e.order == element_order && (e.complete || !complete)) return e.type;
+  throw InputError("element_type: no " + std::string(shape_name(s)) + " of order " + std::to_string(element_order) +
+                   " (orders 1 to " + std::to_string(max_order(s)) + " for " + std::string(shape_name(s)) +
+                   "s; 1 to 8 for lines, triangles, quadrilaterals and hexahedra, 1 to 6 for tetrahedra, 1 to 3 for prisms and pyramids)");
 }
 
 /// The linear element of the same shape.
@@ -363,6 +376,27 @@ constexpr std::span<const T> as_span(const std::array<T, N>& a) {
   return n;
 }
 
+namespace detail {
+
+// The inside nodes of a face, numbered from `first` in Gmsh's layout (an element of the face's
+// shape and order q on its inner corners, recursively; q = 0 is one centre node), appended as
+// seen from the face's vertex `shift`: corners and edges rotate by `shift`, edges keep their
+// direction (a rotation keeps the cycle's sense), and every inner ring does the same.
+constexpr void append_rotated_face(Shape face, int q, int shift, int first, std::array<int, max_facet_nodes>& out, int& n) {
+  if (q < 0) return;
+  if (q == 0) {
+    out[static_cast<std::size_t>(n++)] = first;
+    return;
+  }
+  const int nv = face == Shape::triangle ? 3 : 4;
+  for (int k = 0; k < nv; ++k) out[static_cast<std::size_t>(n++)] = first + (k + shift) % nv;
+  for (int k = 0; k < nv; ++k)
+    for (int j = 0; j < q - 1; ++j) out[static_cast<std::size_t>(n++)] = first + nv + ((k + shift) % nv) * (q - 1) + j;
+  append_rotated_face(face, q - (face == Shape::triangle ? 3 : 2), shift, first + nv * q, out, n);
+}
+
+}  // namespace detail
+
 /// All local nodes of local facet f of an element of type t, in the facet type's own order
 /// (vertices from facets(t)[f].vertices[0], edges, inside nodes). Returns the number written.
 constexpr int facet_nodes(ElementType t, int f, std::array<int, max_facet_nodes>& out) {
@@ -381,9 +415,7 @@ constexpr int facet_nodes(ElementType t, int f, std::array<int, max_facet_nodes>
     for (int j = 0; j < p - 1; ++j) out[static_cast<std::size_t>(n++)] = nv + e * (p - 1) + (forward ? j : p - 2 - j);
   }
   if (facet.shape == Shape::line || !element_info(t).complete) return n;
-  // The face's inside nodes, rotated from face_order()'s start to the facet's. Inside nodes
-  // form at most one ring (one node per corner, or a single centre node) at every order of
-  // the catalogue, so a rotation is the whole permutation.
+  // The face's inside nodes, rotated from face_order()'s start to the facet's.
   const auto faces = face_order(shape(t));
   for (std::size_t g = 0; g < faces.size(); ++g) {
     const LocalFacet& face = faces[g];
@@ -395,36 +427,37 @@ constexpr int facet_nodes(ElementType t, int f, std::array<int, max_facet_nodes>
       if (same) shift = r;
     }
     if (shift < 0) continue;
-    const int inside = face_nodes_per_face(face.shape, p);
-    const int first = first_face_node(t, static_cast<int>(g));
-    for (int k = 0; k < inside; ++k) out[static_cast<std::size_t>(n++)] = first + (inside == 1 ? 0 : (shift + k) % inside);
+    detail::append_rotated_face(face.shape, p - (face.shape == Shape::triangle ? 3 : 2), shift,
+                                first_face_node(t, static_cast<int>(g)), out, n);
     return n;
   }
   return n;
 }
 
-/// VTK node order: VTK's node i is our local node vtk_order(t)[i]. Empty span means identity.
-/// `lagrange` selects the order of the VTK Lagrange cell where it differs from the classic one
-/// (types past order 2 exist only as Lagrange cells).
-[[nodiscard]] constexpr std::span<const int> vtk_order(ElementType t, bool lagrange = false) {
+namespace detail {
+
+// The tabulated part of vtk_order() (core/shape_functions.hpp): every classic cell, and the
+// Lagrange tetrahedra and wedges.
+[[nodiscard]] constexpr std::span<const int> tabulated_vtk_order(ElementType t, bool lagrange) {
   switch (t) {
     case ElementType::tet10: return detail::as_span(detail::tet10_vtk);
     case ElementType::hex20: return detail::as_span(detail::hex20_vtk);
-    case ElementType::hex27: return lagrange ? detail::as_span(detail::hex27_vtk_lagrange) : detail::as_span(detail::hex27_vtk);
+    case ElementType::hex27: return detail::as_span(detail::hex27_vtk);
     case ElementType::prism6: return detail::as_span(detail::prism6_vtk);
     case ElementType::prism15: return detail::as_span(detail::prism15_vtk);
     case ElementType::prism18: return lagrange ? detail::as_span(detail::prism18_vtk_lagrange) : detail::as_span(detail::prism18_vtk);
     case ElementType::pyramid13:
     case ElementType::pyramid14: return detail::as_span(detail::pyramid13_vtk);
-    case ElementType::quad16: return detail::as_span(detail::quad16_vtk);
-    case ElementType::quad25: return detail::as_span(detail::quad25_vtk);
     case ElementType::tet20: return detail::as_span(detail::tet20_vtk);
     case ElementType::tet35: return detail::as_span(detail::tet35_vtk);
-    case ElementType::hex64: return detail::as_span(detail::hex64_vtk);
     case ElementType::prism40: return detail::as_span(detail::prism40_vtk);
+    case ElementType::tet56: return detail::as_span(detail::tet56_vtk);
+    case ElementType::tet84: return detail::as_span(detail::tet84_vtk);
     default: return {};
   }
 }
+
+}  // namespace detail
 
 /// SU2's element number: VTK's type number for linear elements (nodes in VTK's order), and
 /// for the high-order elements of SU2's DG-FEM solver the linear element's number plus
@@ -442,8 +475,8 @@ constexpr int facet_nodes(ElementType t, int f, std::array<int, max_facet_nodes>
   for (const auto& e : detail::element_table)
     if (e.gmsh_id == gmsh_id) return e.type;
   throw InputError("element_type_from_gmsh: unsupported Gmsh element type " + std::to_string(gmsh_id) +
-                   " (expected a point or a line, triangle, quadrilateral or tetrahedron of order 1 to 4, or a hexahedron, " +
-                   "prism or pyramid of order 1 to 3; the serendipity elements stop at order 2)");
+                   " (expected a point, a line, triangle, quadrilateral or hexahedron of order 1 to 8, a tetrahedron of order " +
+                   "1 to 6, or a prism or pyramid of order 1 to 3; the serendipity elements stop at order 2)");
 }
 
 /// The linear type with the given VTK/SU2 number; throws InputError for unknown numbers.

@@ -7,6 +7,7 @@
 
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/shape_functions.hpp"
 #include "meshmotion/core/types.hpp"
 
 #include <Eigen/Core>
@@ -14,6 +15,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -99,56 +101,22 @@ template <int Dim>
 
 namespace detail {
 
-inline constexpr std::array<int, 3> mirror_triangle{0, 2, 1};
-inline constexpr std::array<int, 4> mirror_quadrilateral{0, 3, 2, 1};
-inline constexpr std::array<int, 4> mirror_tetrahedron{0, 2, 1, 3};
-inline constexpr std::array<int, 8> mirror_hexahedron{0, 3, 2, 1, 4, 7, 6, 5};
-inline constexpr std::array<int, 6> mirror_prism{0, 2, 1, 3, 5, 4};
-inline constexpr std::array<int, 5> mirror_pyramid{0, 3, 2, 1, 4};
-
-/// Vertex permutation that mirrors an element of the shape (new vertex k = old vertex mirror[k]).
-[[nodiscard]] constexpr std::span<const int> mirror_vertices(Shape s) {
-  switch (s) {
-    case Shape::triangle: return mirror_triangle;
-    case Shape::quadrilateral: return mirror_quadrilateral;
-    case Shape::tetrahedron: return mirror_tetrahedron;
-    case Shape::hexahedron: return mirror_hexahedron;
-    case Shape::prism: return mirror_prism;
-    case Shape::pyramid: return mirror_pyramid;
-    default: return {};
-  }
-}
-
-/// Full node permutation (vertices, edge nodes, face nodes, centre) mirroring an element of
-/// type t: new local node k is old local node result[k]. Edge and face nodes follow their
-/// edges and faces, so high-order nodes stay where they are in space.
+/// Full node permutation (vertices, edge, face and inside nodes) mirroring an element of type
+/// t: new local node k is old local node result[k]. Every reference element is symmetric under
+/// swapping its first two coordinates, which exchanges vertices 1 and 2 of simplices and prisms
+/// and 1 and 3 of quadrilaterals, hexahedra and pyramids; new node k sits where the old node at
+/// the swapped reference point did, so high-order nodes stay where they are in space.
 [[nodiscard]] inline std::vector<int> mirror_permutation(ElementType t) {
-  const auto vertices = mirror_vertices(shape(t));
-  std::vector<int> perm(vertices.begin(), vertices.end());
-  if (order(t) < 2) return perm;
-  const int nv = num_vertices(t);
-  for (const auto& e : edges(t)) perm.push_back(nv + local_edge(t, vertices[static_cast<std::size_t>(e[0])], vertices[static_cast<std::size_t>(e[1])]));
-  if (has_face_nodes(t)) {
-    // Quadrilateral faces carry nodes in facets() order: match them by vertex set.
-    std::vector<int> quad_faces;
-    for (int f = 0; f < static_cast<int>(facets(t).size()); ++f)
-      if (facets(t)[static_cast<std::size_t>(f)].shape == Shape::quadrilateral) quad_faces.push_back(f);
-    const int first_face_node = nv + static_cast<int>(edges(t).size());
-    const auto vertex_set = [&](int f, bool mapped) {
-      std::array<int, 4> v{};
-      for (int k = 0; k < 4; ++k) {
-        const int local = facets(t)[static_cast<std::size_t>(f)].vertices[static_cast<std::size_t>(k)];
-        v[static_cast<std::size_t>(k)] = mapped ? vertices[static_cast<std::size_t>(local)] : local;
-      }
-      std::sort(v.begin(), v.end());
-      return v;
-    };
-    for (const int f : quad_faces)
-      for (std::size_t g = 0; g < quad_faces.size(); ++g)
-        if (vertex_set(quad_faces[g], false) == vertex_set(f, true)) perm.push_back(first_face_node + static_cast<int>(g));
+  const auto nodes = reference_nodes(t);
+  std::vector<int> perm;
+  perm.reserve(nodes.size());
+  for (const RefPoint& x : nodes) {
+    const RefPoint swapped{x[1], x[0], x[2]};
+    const auto at = std::find_if(nodes.begin(), nodes.end(), [&](const RefPoint& y) {
+      return std::abs(y[0] - swapped[0]) + std::abs(y[1] - swapped[1]) + std::abs(y[2] - swapped[2]) < 1e-9;
+    });
+    perm.push_back(static_cast<int>(at - nodes.begin()));
   }
-  // The centre node (quad9, hex27) stays.
-  while (static_cast<int>(perm.size()) < num_nodes(t)) perm.push_back(static_cast<int>(perm.size()));
   return perm;
 }
 

@@ -18,6 +18,7 @@
 ///   û = u/(1-w), v̂ = v/(1-w), k ≤ p - max(i,j); pyramid13 drops (i,j) = (2,2).
 /// Since the interpolant in a space is unique, these are the functions Gmsh uses.
 
+#include "meshmotion/core/detail/per_type_cache.hpp"
 #include "meshmotion/core/detail/table_kernels.hpp"
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/types.hpp"
@@ -39,9 +40,16 @@ using RefPoint = std::array<double, 3>;
 
 namespace detail {
 
-// u^a v^b w^c (1-w)^e; e < 0 only for the rational pyramid terms.
+// One term of a function space: u^a v^b w^c (1-w)^e (e < 0 only for the rational pyramid
+// terms), or, on lines, quadrilaterals and hexahedra, the product of Legendre polynomials
+// P_a(u) P_b(v) P_c(w). Both span the same spaces, but past order 4 the monomials' nodal
+// systems lose digits on [-1, 1]^3: the hex729's Vandermonde matrix has a condition number of
+// 4e9 in monomials, 4e3 in Legendre products, and its shape functions summed to 1 only within
+// 1e-9 (now 3e-14). On simplices, whose coordinates lie in [0, 1], Legendre products of 2x - 1
+// gained nothing (tri45 2e-11 either way, tet84 worse), so they keep the monomials.
 struct Monomial {
   int a = 0, b = 0, c = 0, e = 0;
+  bool legendre = false;
 };
 
 inline double int_pow(double x, int n) {
@@ -51,17 +59,65 @@ inline double int_pow(double x, int n) {
   return r;
 }
 
+// Coefficients of s^j in the Legendre polynomial P_n(s), n ≤ max_element_order.
+inline const std::array<std::array<double, max_element_order + 1>, max_element_order + 1>& legendre_coefficients() {
+  static const auto table = [] {
+    std::array<std::array<double, max_element_order + 1>, max_element_order + 1> c{};
+    c[0][0] = 1.0;
+    c[1][1] = 1.0;
+    for (std::size_t n = 1; n < max_element_order; ++n)
+      for (std::size_t j = 0; j <= n + 1; ++j)
+        c[n + 1][j] = ((j > 0 ? static_cast<double>(2 * n + 1) * c[n][j - 1] : 0.0) - static_cast<double>(n) * c[n - 1][j]) /
+                      static_cast<double>(n + 1);
+    return c;
+  }();
+  return table;
+}
+
+// The k-th derivative of P_n at s.
+inline double legendre_derivative(int n, int k, double s) {
+  if (k > n) return 0.0;
+  const auto& c = legendre_coefficients()[static_cast<std::size_t>(n)];
+  double r = 0.0;
+  for (int j = n; j >= k; --j) {
+    double f = c[static_cast<std::size_t>(j)];
+    for (int i = 0; i < k; ++i) f *= j - i;
+    r = r * s + f;
+  }
+  return r;
+}
+
+// ∂^(du,dv,dw) of a term at x (the pyramid's terms without their (1-w)^e factor).
+inline double term_derivative(const Monomial& m, const RefPoint& x, int du, int dv, int dw) {
+  const std::array<int, 3> degree{m.a, m.b, m.c}, times{du, dv, dw};
+  double r = 1.0;
+  for (std::size_t d = 0; d < 3 && r != 0.0; ++d) {
+    const int n = degree[d], k = times[d];
+    if (k > n) return 0.0;
+    if (m.legendre) {
+      r *= legendre_derivative(n, k, x[d]);
+    } else {
+      double f = 1.0;
+      for (int j = 0; j < k; ++j) f *= n - j;
+      r *= f * int_pow(x[d], n - k);
+    }
+  }
+  return r;
+}
+
 // At the pyramid apex (1-w = 0) the rational terms are direction dependent; like Gmsh we
 // take û = v̂ = 0 there, which makes them (and their derivatives) vanish.
 inline bool at_apex_singularity(const Monomial& m, double s) { return m.e < 0 && std::abs(s) < 1e-14; }
 
 inline double monomial_value(const Monomial& m, const RefPoint& x) {
+  if (m.legendre) return term_derivative(m, x, 0, 0, 0);
   const double s = 1.0 - x[2];
   if (at_apex_singularity(m, s)) return 0.0;
   return int_pow(x[0], m.a) * int_pow(x[1], m.b) * int_pow(x[2], m.c) * int_pow(s, m.e);
 }
 
 inline std::array<double, 3> monomial_gradient(const Monomial& m, const RefPoint& x) {
+  if (m.legendre) return {term_derivative(m, x, 1, 0, 0), term_derivative(m, x, 0, 1, 0), term_derivative(m, x, 0, 0, 1)};
   const double s = 1.0 - x[2];
   if (at_apex_singularity(m, s)) return {0.0, 0.0, 0.0};
   const double pu = int_pow(x[0], m.a), pv = int_pow(x[1], m.b), pw = int_pow(x[2], m.c), ps = int_pow(s, m.e);
@@ -117,6 +173,8 @@ inline std::vector<Monomial> function_space(ElementType t) {
         }
       break;
   }
+  const bool tensor = shape(t) == Shape::line || shape(t) == Shape::quadrilateral || shape(t) == Shape::hexahedron;
+  for (Monomial& term : m) term.legendre = tensor;
   return m;
 }
 
@@ -251,30 +309,68 @@ inline std::vector<RefPoint> make_reference_nodes(ElementType t) {
 }
 
 /// The nodal basis of one element type: N_i(x) = Σ_k coefficients(k, i) m_k(x).
+/// Simplices also keep each node's barycentric lattice index (α_0 .. α_d, summing to the
+/// order), which shape_functions() and shape_derivatives() evaluate in Silvester's form.
 struct ShapeBasis {
   std::vector<RefPoint> nodes;
   std::vector<Monomial> monomials;
   Eigen::MatrixXd coefficients;
+  std::vector<std::array<int, 4>> simplex_index;
 };
 
 inline ShapeBasis make_shape_basis(ElementType t) {
-  ShapeBasis basis{make_reference_nodes(t), function_space(t), {}};
+  ShapeBasis basis{make_reference_nodes(t), function_space(t), {}, {}};
   const auto n = static_cast<Index>(basis.nodes.size());
   Eigen::MatrixXd vandermonde(n, n);
   for (Index i = 0; i < n; ++i)
     for (Index k = 0; k < n; ++k)
       vandermonde(i, k) = monomial_value(basis.monomials[static_cast<std::size_t>(k)], basis.nodes[static_cast<std::size_t>(i)]);
   basis.coefficients = table_inverse(vandermonde);
+  if (shape(t) == Shape::triangle || shape(t) == Shape::tetrahedron) {
+    const int p = order(t), d = dimension(t);
+    for (const RefPoint& x : basis.nodes) {
+      std::array<int, 4> alpha{p, 0, 0, 0};
+      for (int k = 0; k < d; ++k) {
+        alpha[static_cast<std::size_t>(k + 1)] = static_cast<int>(std::lround(p * x[static_cast<std::size_t>(k)]));
+        alpha[0] -= alpha[static_cast<std::size_t>(k + 1)];
+      }
+      basis.simplex_index.push_back(alpha);
+    }
+  }
   return basis;
 }
 
+// Silvester's Lagrange functions of a complete simplex of order p on its equispaced lattice:
+// node α has N_α = Π_j ℓ(α_j, λ_j) with ℓ(a, t) = Π_{k<a} (p t − k) / (k + 1), λ the
+// barycentric coordinates (λ_0 = 1 − Σ ξ, λ_j = ξ_{j−1}). Exact and stable at every order,
+// where the monomials' Vandermonde inverse lost digits with it (a tri45's functions were 3e-11
+// off at its own nodes). `value(a, t)` and `slope(a, t)`, for every α_j, by one recurrence.
+struct SilvesterFactor {
+  double value = 1.0, slope = 0.0;
+};
+
+inline SilvesterFactor silvester_factor(int a, int p, double t) {
+  SilvesterFactor f;
+  for (int k = 0; k < a; ++k) {
+    const double term = (p * t - k) / (k + 1);
+    f.slope = f.slope * term + f.value * p / (k + 1);
+    f.value *= term;
+  }
+  return f;
+}
+
+inline std::array<double, 4> barycentric(int d, const RefPoint& xi) {
+  std::array<double, 4> lambda{1.0, 0.0, 0.0, 0.0};
+  for (int k = 0; k < d; ++k) {
+    lambda[static_cast<std::size_t>(k + 1)] = xi[static_cast<std::size_t>(k)];
+    lambda[0] -= xi[static_cast<std::size_t>(k)];
+  }
+  return lambda;
+}
+
 inline const ShapeBasis& shape_basis(ElementType t) {
-  static const std::array<ShapeBasis, num_element_types> bases = [] {
-    std::array<ShapeBasis, num_element_types> b;
-    for (int i = 0; i < num_element_types; ++i) b[static_cast<std::size_t>(i)] = make_shape_basis(static_cast<ElementType>(i));
-    return b;
-  }();
-  return bases[static_cast<std::size_t>(t)];
+  static PerTypeCache<ShapeBasis> bases;
+  return bases.get(t, make_shape_basis);
 }
 
 }  // namespace detail
@@ -292,6 +388,76 @@ inline const ShapeBasis& shape_basis(ElementType t) {
   for (int i = 0; i < nv; ++i)
     for (std::size_t d = 0; d < 3; ++d) c[d] += x[static_cast<std::size_t>(i)][d] / nv;
   return c;
+}
+
+namespace detail {
+
+// The lattice (integer coordinates, 0 to p per axis) of VTK's Lagrange quadrilateral or
+// hexahedron of order p: vertices; edge nodes in the direction of increasing coordinate, edges
+// (0,1) (1,2) (3,2) (0,3), then for hexahedra (4,5) (5,6) (7,6) (4,7) (0,4) (1,5) (3,7) (2,6)
+// (the vertical edges (3,7) and (2,6) in the order of .vtu files before version 2.2, which is
+// what the writer declares); the hexahedron's faces x = 0, x = p, y = 0, y = p, z = 0, z = p,
+// each first free axis fastest; then the inside, x fastest.
+inline std::vector<std::array<int, 3>> vtk_tensor_lattice(int dim, int p) {
+  static constexpr std::array<std::array<int, 3>, 8> corner{{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                                             {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}}};
+  static constexpr std::array<std::array<int, 2>, 12> edge{
+      {{0, 1}, {1, 2}, {3, 2}, {0, 3}, {4, 5}, {5, 6}, {7, 6}, {4, 7}, {0, 4}, {1, 5}, {3, 7}, {2, 6}}};
+  std::vector<std::array<int, 3>> out;
+  const std::size_t nv = dim == 2 ? 4 : 8, ne = dim == 2 ? 4 : 12;
+  for (std::size_t v = 0; v < nv; ++v) out.push_back({corner[v][0] * p, corner[v][1] * p, corner[v][2] * p});
+  for (std::size_t e = 0; e < ne; ++e)
+    for (int j = 1; j < p; ++j) {
+      const auto& a = corner[static_cast<std::size_t>(edge[e][0])];
+      const auto& b = corner[static_cast<std::size_t>(edge[e][1])];
+      out.push_back({a[0] * p + (b[0] - a[0]) * j, a[1] * p + (b[1] - a[1]) * j, a[2] * p + (b[2] - a[2]) * j});
+    }
+  if (dim == 3)
+    for (int axis = 0; axis < 3; ++axis)
+      for (const int side : {0, p}) {
+        const int first = axis == 0 ? 1 : 0, second = axis == 2 ? 1 : 2;
+        for (int t = 1; t < p; ++t)
+          for (int s = 1; s < p; ++s) {
+            std::array<int, 3> q{};
+            q[static_cast<std::size_t>(axis)] = side;
+            q[static_cast<std::size_t>(first)] = s;
+            q[static_cast<std::size_t>(second)] = t;
+            out.push_back(q);
+          }
+      }
+  for (int k = dim == 3 ? 1 : 0; k < (dim == 3 ? p : 1); ++k)
+    for (int j = 1; j < p; ++j)
+      for (int i = 1; i < p; ++i) out.push_back({i, j, k});
+  return out;
+}
+
+// Our local node at each point of VTK's lattice of a complete quadrilateral or hexahedron.
+inline std::vector<int> make_vtk_tensor_order(ElementType t) {
+  const auto ours = reference_nodes(t);
+  const int p = order(t);
+  std::vector<int> out;
+  for (const auto& q : vtk_tensor_lattice(dimension(t), p)) {
+    const auto at = std::find_if(ours.begin(), ours.end(), [&](const RefPoint& x) {
+      double gap = 0.0;
+      for (std::size_t d = 0; d < static_cast<std::size_t>(dimension(t)); ++d) gap += std::abs(x[d] - (2.0 * q[d] / p - 1.0));
+      return gap < 1e-9;
+    });
+    out.push_back(static_cast<int>(at - ours.begin()));
+  }
+  return out;
+}
+
+}  // namespace detail
+
+/// VTK node order: VTK's node i is our local node vtk_order(t)[i]. Empty span means identity.
+/// `lagrange` selects the order of the VTK Lagrange cell where it differs from the classic one
+/// (types past order 2 exist only as Lagrange cells).
+[[nodiscard]] inline std::span<const int> vtk_order(ElementType t, bool lagrange = false) {
+  const bool tensor = shape(t) == Shape::quadrilateral || shape(t) == Shape::hexahedron;
+  const bool lagrange_cell = order(t) > 2 || (lagrange && order(t) == 2);
+  if (!tensor || !element_info(t).complete || !lagrange_cell) return detail::tabulated_vtk_order(t, lagrange);
+  static detail::PerTypeCache<std::vector<int>> orders;
+  return orders.get(t, detail::make_vtk_tensor_order);
 }
 
 namespace detail {
@@ -363,18 +529,25 @@ inline std::vector<int> make_su2_node_order(ElementType t) {
 /// elements: VTK's order (vtk_order(), empty for the identity); high-order elements: the
 /// lattice of SU2's DG-FEM solver (vertex 0 first, rows along the edge to vertex 1).
 [[nodiscard]] inline std::span<const int> su2_node_order(ElementType type) {
-  static const std::array<std::vector<int>, num_element_types> orders = [] {
-    std::array<std::vector<int>, num_element_types> all;
-    for (int i = 0; i < num_element_types; ++i) all[static_cast<std::size_t>(i)] = detail::make_su2_node_order(static_cast<ElementType>(i));
-    return all;
-  }();
-  return orders[static_cast<std::size_t>(type)];
+  static detail::PerTypeCache<std::vector<int>> orders;
+  return orders.get(type, detail::make_su2_node_order);
 }
 
 /// Shape function values N_i(xi), i < num_nodes(type), written to `values` (size ≥ num_nodes).
 inline void shape_functions(ElementType type, const RefPoint& xi, std::span<double> values) {
   const auto& basis = detail::shape_basis(type);
   const auto n = static_cast<Index>(basis.nodes.size());
+  if (!basis.simplex_index.empty()) {
+    const int p = order(type), d = dimension(type);
+    const auto lambda = detail::barycentric(d, xi);
+    for (std::size_t i = 0; i < basis.simplex_index.size(); ++i) {
+      double v = 1.0;
+      for (int j = 0; j <= d; ++j)
+        v *= detail::silvester_factor(basis.simplex_index[i][static_cast<std::size_t>(j)], p, lambda[static_cast<std::size_t>(j)]).value;
+      values[i] = v;
+    }
+    return;
+  }
   for (Index i = 0; i < n; ++i) values[static_cast<std::size_t>(i)] = 0.0;
   for (Index k = 0; k < n; ++k) {
     const double m = detail::monomial_value(basis.monomials[static_cast<std::size_t>(k)], xi);
@@ -387,6 +560,26 @@ inline void shape_functions(ElementType type, const RefPoint& xi, std::span<doub
 inline void shape_derivatives(ElementType type, const RefPoint& xi, std::span<std::array<double, 3>> gradients) {
   const auto& basis = detail::shape_basis(type);
   const auto n = static_cast<Index>(basis.nodes.size());
+  if (!basis.simplex_index.empty()) {
+    // ∂N/∂ξ_k = ∂N/∂λ_{k+1} − ∂N/∂λ_0, each the product with one factor's slope.
+    const int p = order(type), d = dimension(type);
+    const auto lambda = detail::barycentric(d, xi);
+    for (std::size_t i = 0; i < basis.simplex_index.size(); ++i) {
+      std::array<detail::SilvesterFactor, 4> f{};
+      for (int j = 0; j <= d; ++j)
+        f[static_cast<std::size_t>(j)] = detail::silvester_factor(basis.simplex_index[i][static_cast<std::size_t>(j)], p, lambda[static_cast<std::size_t>(j)]);
+      std::array<double, 4> by_lambda{};
+      for (int j = 0; j <= d; ++j) {
+        double g = f[static_cast<std::size_t>(j)].slope;
+        for (int m = 0; m <= d; ++m)
+          if (m != j) g *= f[static_cast<std::size_t>(m)].value;
+        by_lambda[static_cast<std::size_t>(j)] = g;
+      }
+      gradients[i] = {0.0, 0.0, 0.0};
+      for (int k = 0; k < d; ++k) gradients[i][static_cast<std::size_t>(k)] = by_lambda[static_cast<std::size_t>(k + 1)] - by_lambda[0];
+    }
+    return;
+  }
   for (Index i = 0; i < n; ++i) gradients[static_cast<std::size_t>(i)] = {0.0, 0.0, 0.0};
   for (Index k = 0; k < n; ++k) {
     const auto g = detail::monomial_gradient(basis.monomials[static_cast<std::size_t>(k)], xi);
@@ -403,7 +596,7 @@ jacobian(ElementType type, const Eigen::MatrixBase<Derived>& coords, const RefPo
   constexpr int space_dim = Derived::RowsAtCompileTime;
   static_assert(space_dim >= 1 && space_dim <= 3, "jacobian: coords needs a fixed number of rows (1 to 3)");
   const int n = num_nodes(type), rd = dimension(type);
-  std::array<std::array<double, 3>, max_element_nodes> grads{};
+  std::array<std::array<double, 3>, max_element_nodes> grads;  // the first n written below; zeroing 729 would cost more
   shape_derivatives(type, xi, std::span<std::array<double, 3>>(grads.data(), static_cast<std::size_t>(n)));
   Eigen::Matrix<double, space_dim, Eigen::Dynamic, 0, space_dim, 3> jac =
       Eigen::Matrix<double, space_dim, Eigen::Dynamic, 0, space_dim, 3>::Zero(space_dim, rd);
@@ -426,7 +619,7 @@ template <class Derived>
 [[nodiscard]] Eigen::Matrix<double, Derived::RowsAtCompileTime, 1> map_to_physical(ElementType type,
                                                                                   const Eigen::MatrixBase<Derived>& coords,
                                                                                   const RefPoint& xi) {
-  std::array<double, max_element_nodes> values{};
+  std::array<double, max_element_nodes> values;  // the first num_nodes(type) written below
   shape_functions(type, xi, std::span<double>(values.data(), static_cast<std::size_t>(num_nodes(type))));
   Eigen::Matrix<double, Derived::RowsAtCompileTime, 1> x = Eigen::Matrix<double, Derived::RowsAtCompileTime, 1>::Zero(coords.rows());
   for (int i = 0; i < num_nodes(type); ++i) x += coords.col(i) * values[static_cast<std::size_t>(i)];

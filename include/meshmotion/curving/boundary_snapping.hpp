@@ -132,21 +132,17 @@ struct FacetNodeWeights {
 };
 
 inline const FacetNodeWeights& facet_node_weights(ElementType t) {
-  static const std::array<FacetNodeWeights, num_element_types> tables = [] {
-    std::array<FacetNodeWeights, num_element_types> all;
-    for (int i = 0; i < num_element_types; ++i) {
-      const auto type = static_cast<ElementType>(i);
-      auto& table = all[static_cast<std::size_t>(i)];
-      const auto x = reference_nodes(type);
-      table.reference.assign(x.begin(), x.end());
-      for (const RefPoint& r : x) {
-        auto& w = table.weights.emplace_back(static_cast<std::size_t>(num_vertices(type)));
-        shape_functions(linear_type(type), r, w);
-      }
+  static PerTypeCache<FacetNodeWeights> tables;
+  return tables.get(t, [](ElementType type) {
+    FacetNodeWeights table;
+    const auto x = reference_nodes(type);
+    table.reference.assign(x.begin(), x.end());
+    for (const RefPoint& r : x) {
+      auto& w = table.weights.emplace_back(static_cast<std::size_t>(num_vertices(type)));
+      shape_functions(linear_type(type), r, w);
     }
-    return all;
-  }();
-  return tables[static_cast<std::size_t>(t)];
+    return table;
+  });
 }
 
 /// 3D reconstruction of group `tag`: every edge node of its triangle facets to the

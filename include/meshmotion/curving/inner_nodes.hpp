@@ -36,23 +36,12 @@ namespace detail {
   return num_vertices(t) + static_cast<int>(edges(t).size()) * (order(t) - 1);
 }
 
-// ∂^(du,dv,dw) of a polynomial monomial (no pyramid term) at x.
-inline double monomial_derivative(const Monomial& m, const RefPoint& x, int du, int dv, int dw) {
-  const auto part = [](double t, int a, int k) {
-    if (k > a) return 0.0;
-    double f = 1.0;
-    for (int j = 0; j < k; ++j) f *= a - j;
-    return f * int_pow(t, a - k);
-  };
-  return part(x[0], m.a, du) * part(x[1], m.b, dv) * part(x[2], m.c, dw);
-}
-
 // Row vector of ∂^(du,dv,dw) N_i(x) over the nodes i of `type`.
 inline Eigen::RowVectorXd shape_derivative_row(ElementType type, const RefPoint& x, int du, int dv, int dw) {
   const ShapeBasis& basis = shape_basis(type);
   Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(static_cast<Index>(basis.nodes.size()));
   for (std::size_t k = 0; k < basis.monomials.size(); ++k) {
-    const double d = monomial_derivative(basis.monomials[k], x, du, dv, dw);
+    const double d = term_derivative(basis.monomials[k], x, du, dv, dw);
     if (d != 0.0) row += d * basis.coefficients.row(static_cast<Index>(k));
   }
   return row;
@@ -72,25 +61,30 @@ inline std::vector<std::array<int, 3>> direction_tuples(int dims, int count) {
   return out;
 }
 
-// The derivatives of order p - j (j = 0, 1) of the nodal basis of a simplex of order p at its
-// centroid: row r is ∂^tuple N_i for the ordered direction tuple r of direction_tuples(d, p - j).
+// How many orders below p the energy of a simplex of order p adds (simplex_energy()): one
+// from order 4, and down to the lowest degree of the element's inside functions (the bubble
+// λ0λ1λ2, degree 3, of a triangle; λ0λ1λ2λ3, degree 4, of a tetrahedron), below which none of
+// them has a derivative to penalize.
+inline int lower_energy_orders(ElementType type) {
+  const int p = order(type);
+  return std::max(p >= 4 ? 1 : 0, p - dimension(type) - 1);
+}
+
+// The derivatives of order p - j (j = 0 .. lower_energy_orders()) of the nodal basis of a
+// simplex of order p at its centroid: row r is ∂^tuple N_i for the ordered direction tuple r
+// of direction_tuples(d, p - j).
 inline const Eigen::MatrixXd& simplex_derivatives(ElementType type, int j) {
-  static const std::array<std::array<Eigen::MatrixXd, 2>, num_element_types> all = [] {
-    std::array<std::array<Eigen::MatrixXd, 2>, num_element_types> out;
-    for (int i = 0; i < num_element_types; ++i) {
-      const auto t = static_cast<ElementType>(i);
-      if ((shape(t) != Shape::triangle && shape(t) != Shape::tetrahedron) || order(t) < 2) continue;
-      for (int k = 0; k < 2; ++k) {
-        const auto tuples = direction_tuples(dimension(t), order(t) - k);
-        Eigen::MatrixXd rows(static_cast<Index>(tuples.size()), num_nodes(t));
-        for (std::size_t r = 0; r < tuples.size(); ++r)
-          rows.row(static_cast<Index>(r)) = shape_derivative_row(t, reference_centroid(t), tuples[r][0], tuples[r][1], tuples[r][2]);
-        out[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)] = std::move(rows);
-      }
+  static PerTypeCache<std::vector<Eigen::MatrixXd>> all;
+  return all.get(type, [](ElementType t) {
+    std::vector<Eigen::MatrixXd> out;
+    for (int k = 0; k <= lower_energy_orders(t); ++k) {
+      const auto tuples = direction_tuples(dimension(t), order(t) - k);
+      Eigen::MatrixXd& rows = out.emplace_back(static_cast<Index>(tuples.size()), num_nodes(t));
+      for (std::size_t r = 0; r < tuples.size(); ++r)
+        rows.row(static_cast<Index>(r)) = shape_derivative_row(t, reference_centroid(t), tuples[r][0], tuples[r][1], tuples[r][2]);
     }
     return out;
-  }();
-  return all[static_cast<std::size_t>(type)][static_cast<std::size_t>(j)];
+  })[static_cast<std::size_t>(j)];
 }
 
 // The energy of a tensor shape or prism in reference coordinates (fixed per type): the
@@ -119,15 +113,8 @@ inline Eigen::MatrixXd reference_energy(ElementType type) {
 }
 
 inline const Eigen::MatrixXd& cached_reference_energy(ElementType type) {
-  static const std::array<Eigen::MatrixXd, num_element_types> all = [] {
-    std::array<Eigen::MatrixXd, num_element_types> out;
-    for (int i = 0; i < num_element_types; ++i) {
-      const auto t = static_cast<ElementType>(i);
-      if (order(t) >= 2 && element_info(t).complete) out[static_cast<std::size_t>(i)] = reference_energy(t);
-    }
-    return out;
-  }();
-  return all[static_cast<std::size_t>(type)];
+  static PerTypeCache<Eigen::MatrixXd> all;
+  return all.get(type, [](ElementType t) { return order(t) >= 2 && element_info(t).complete ? reference_energy(t) : Eigen::MatrixXd{}; });
 }
 
 // The straight element's Laplacian (the fallback on pyramids, whose rational space has no
@@ -171,7 +158,9 @@ inline Eigen::MatrixXd tensor_energy(Eigen::MatrixXd tensor, const Eigen::Matrix
 // On a simplex of order p: the squared norm of the p-th derivatives in the straight element's
 // coordinates (invariant under its symmetries), whose minimizer reproduces the boundary data of
 // a polynomial of degree p - 1. From order 4 the cubic bubble has no p-th derivative, so a
-// small share of the (p-1)-th derivatives' norm picks the lowest-degree one among the minimizers.
+// small share of the lower derivatives' norms (orders p - 1 down to the lowest bubble's degree,
+// each scaled to the same trace) picks a low-degree one among the minimizers; past order 4 a
+// single order below p would leave the bubbles of lower degree free.
 template <int Dim>
 Eigen::MatrixXd simplex_energy(ElementType type, const Eigen::Matrix<double, Dim, Eigen::Dynamic>& straight) {
   const int n = num_nodes(type), d = dimension(type);
@@ -184,9 +173,10 @@ Eigen::MatrixXd simplex_energy(ElementType type, const Eigen::Matrix<double, Dim
   if (!(metric.determinant() > 0.0)) return {};
   const Eigen::MatrixXd factor = Eigen::LLT<Eigen::MatrixXd>(metric.inverse()).matrixL();
   Eigen::MatrixXd energy = tensor_energy(simplex_derivatives(type, 0), factor);
-  if (order(type) >= 4) {
-    const Eigen::MatrixXd lower = tensor_energy(simplex_derivatives(type, 1), factor);
-    energy += 1e-8 * energy.trace() / lower.trace() * lower;
+  const double share = 1e-8 * energy.trace();
+  for (int j = 1; j <= lower_energy_orders(type); ++j) {
+    const Eigen::MatrixXd lower = tensor_energy(simplex_derivatives(type, j), factor);
+    energy += share / lower.trace() * lower;
   }
   return energy;
 }

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// Conversion to any order of the catalogue: P1 → Pk (straight-sided, k = 2 to 4), and Pk →
+/// Conversion to any order of the catalogue: P1 → Pk (straight-sided, k = 2 to 8), and Pk →
 /// Pk' for k' ≥ k (raising the order of a curved mesh, exact: the map of order k lies in the
 /// space of order k').
 ///
@@ -45,7 +45,7 @@ namespace detail {
 // A shared node's place between the linear vertices: the vertices of the edge or face it lies
 // on (at most 4; the nodes inside a cell are its own and have no key) and their weights,
 // sorted by vertex, the weights scaled to integers. The scale is divisible by every
-// denominator of the catalogue's lattices (powers of 2, 3 and 5 up to order 4), so equal
+// denominator of the catalogue's lattices (the orders 2 to 8 and their powers), so equal
 // places give equal keys, and below 2^31. Keys are kept small: the table holds one per edge
 // and face node, and filling fresh memory for larger ones dominated the conversion past P2.
 struct LatticeKey {
@@ -68,7 +68,7 @@ struct LatticeKeyHash {
   }
 };
 
-inline constexpr double lattice_key_scale = 4096.0 * 729.0 * 25.0;
+inline constexpr double lattice_key_scale = 4096.0 * 729.0 * 25.0 * 7.0;
 
 // The key of a node on an edge or face from its local vertex weights and the element's
 // nodes, sorted by inserting each term in place.
@@ -131,7 +131,7 @@ NodeParametrization weighted_parameters(const std::vector<NodeParametrization>& 
 }  // namespace detail
 
 /// Converts `input` (any mix of element types of order ≤ `target_order`; cells, facets and
-/// lower-dimensional blocks) to elements of order `target_order` (1 to 4; see element_type()
+/// lower-dimensional blocks) to elements of order `target_order` (1 to 8; see max_order()
 /// for the orders each shape has), keeping block order, element order, tags, element ids and
 /// groups. New nodes lie on the input's elements: straight-sided for a linear input. node_ids
 /// of new nodes continue after the largest input id; node_params of a new node are the

@@ -8,6 +8,7 @@
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/core/shape_functions.hpp"
 #include "meshmotion/core/detail/atomic_file.hpp"
 #include "meshmotion/io/detail/number_format.hpp"
 

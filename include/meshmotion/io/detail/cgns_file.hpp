@@ -5,6 +5,7 @@
 /// path (io/cgns_reader.hpp, io/cgns_writer.hpp).
 
 #include "meshmotion/core/element.hpp"
+#include "meshmotion/core/detail/per_type_cache.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/io/detail/cgns_library.hpp"
 
@@ -113,14 +114,10 @@ inline constexpr CGNS_ENUMT(ElementType_t) cgns_types[num_element_types] = {
   return -1;
 }
 
-/// The permutations of every type, computed once.
+/// The permutation of a type, computed on its first use.
 [[nodiscard]] inline const std::vector<int>& cgns_order_of(ElementType t) {
-  static const std::array<std::vector<int>, num_element_types> orders = [] {
-    std::array<std::vector<int>, num_element_types> o;
-    for (int k = 0; k < num_element_types; ++k) o[static_cast<std::size_t>(k)] = cgns_order(static_cast<ElementType>(k));
-    return o;
-  }();
-  return orders[static_cast<std::size_t>(t)];
+  static PerTypeCache<std::vector<int>> orders;
+  return orders.get(t, cgns_order);
 }
 
 /// An open CGNS file, closed on scope exit; check() turns a library status into an exception

@@ -184,17 +184,12 @@ struct QuadratureTable {
   return t;
 }
 
-/// The default table of a cell type (built once, thread-safe).
+/// The default table of a cell type (built on its first use, thread-safe).
 [[nodiscard]] inline const QuadratureTable& quadrature_table(ElementType type) {
-  static const std::array<QuadratureTable, num_element_types> tables = [] {
-    std::array<QuadratureTable, num_element_types> all;
-    for (int i = 0; i < num_element_types; ++i) {
-      const auto t = static_cast<ElementType>(i);
-      if (dimension(t) >= 2) all[static_cast<std::size_t>(i)] = make_quadrature_table(t, default_quadrature_degree(t));
-    }
-    return all;
-  }();
-  return tables[static_cast<std::size_t>(type)];
+  static PerTypeCache<QuadratureTable> tables;
+  return tables.get(type, [](ElementType t) {
+    return dimension(t) >= 2 ? make_quadrature_table(t, default_quadrature_degree(t)) : QuadratureTable{};
+  });
 }
 
 /// Node coordinates of one element: Dim × n (n ≤ 27), on the stack.

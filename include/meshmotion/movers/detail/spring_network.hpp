@@ -25,35 +25,32 @@ namespace meshmotion::detail {
 /// Local node pairs of `type` joined by a spring: pairs whose reference offset is ±1/order
 /// of a reference edge vector (for linear types exactly the edges).
 [[nodiscard]] inline const std::vector<std::array<int, 2>>& spring_pairs(ElementType type) {
-  static const std::array<std::vector<std::array<int, 2>>, num_element_types> table = [] {
-    std::array<std::vector<std::array<int, 2>>, num_element_types> all;
-    for (int t = 0; t < num_element_types; ++t) {
-      const auto type_t = static_cast<ElementType>(t);
-      if (dimension(type_t) < 1) continue;
-      const auto x = reference_nodes(type_t);
-      const double p = order(type_t);
-      const auto offset_matches = [&](int i, int j, const std::array<int, 2>& e) {
-        double plus = 0.0, minus = 0.0;
-        for (std::size_t d = 0; d < 3; ++d) {
-          const double edge = (x[static_cast<std::size_t>(e[1])][d] - x[static_cast<std::size_t>(e[0])][d]) / p;
-          const double offset = x[static_cast<std::size_t>(j)][d] - x[static_cast<std::size_t>(i)][d];
-          plus = std::max(plus, std::abs(offset - edge));
-          minus = std::max(minus, std::abs(offset + edge));
-        }
-        return std::min(plus, minus) < 1e-12;
-      };
-      const int n = num_nodes(type_t);
-      for (int i = 0; i < n; ++i)
-        for (int j = i + 1; j < n; ++j)
-          for (const auto& e : edges(type_t))
-            if (offset_matches(i, j, e)) {
-              all[static_cast<std::size_t>(t)].push_back({i, j});
-              break;
-            }
-    }
-    return all;
-  }();
-  return table[static_cast<std::size_t>(type)];
+  static PerTypeCache<std::vector<std::array<int, 2>>> table;
+  return table.get(type, [](ElementType type_t) {
+    std::vector<std::array<int, 2>> pairs;
+    if (dimension(type_t) < 1) return pairs;
+    const auto x = reference_nodes(type_t);
+    const double p = order(type_t);
+    const auto offset_matches = [&](int i, int j, const std::array<int, 2>& e) {
+      double plus = 0.0, minus = 0.0;
+      for (std::size_t d = 0; d < 3; ++d) {
+        const double edge = (x[static_cast<std::size_t>(e[1])][d] - x[static_cast<std::size_t>(e[0])][d]) / p;
+        const double offset = x[static_cast<std::size_t>(j)][d] - x[static_cast<std::size_t>(i)][d];
+        plus = std::max(plus, std::abs(offset - edge));
+        minus = std::max(minus, std::abs(offset + edge));
+      }
+      return std::min(plus, minus) < 1e-12;
+    };
+    const int n = num_nodes(type_t);
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j)
+        for (const auto& e : edges(type_t))
+          if (offset_matches(i, j, e)) {
+            pairs.push_back({i, j});
+            break;
+          }
+    return pairs;
+  });
 }
 
 /// Unique springs (node pairs, smaller index first) of the cells of `mesh`, sorted.
