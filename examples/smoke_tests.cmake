@@ -185,15 +185,47 @@ else()
              COMMAND mesh_info "${smoke_dir}/sphere_p3.msh" --json)
 endif()
 
-# Orders 3 and 4: the demo curved at order 3 (and its .su2 in SU2's DG-FEM format read back
-# by mesh_info); order 5 is refused before any work.
+# Orders past 2: the demo curved at order 3 (and its .su2 in SU2's DG-FEM format read back
+# by mesh_info) and at orders 5, 6 and 8, certified valid with a minimum of 0.5 or more;
+# order 9 is refused before any work.
 smoke_test(NAME curve_mesh.order3.json
            KEYS output,order,min_scaled_jacobian,invalid,untangle/cells_below,seconds/untangle
            VALUES order=3,invalid=0
            COMMAND curve_mesh --demo --order 3 -o "${smoke_dir}/demo_p3.su2" --json)
-smoke_test(NAME curve_mesh.order5 EXPECT_RC 1
+foreach(order 5 6 8)
+  smoke_test(NAME curve_mesh.order${order}.json
+             KEYS output,order,min_scaled_jacobian,invalid
+             VALUES order=${order},invalid=0
+             AT_LEAST min_scaled_jacobian=0.5
+             COMMAND curve_mesh --demo --order ${order} -o "${smoke_dir}/demo_p${order}.msh" --json)
+endforeach()
+# A P5 quadrilateral disk meshed by Gmsh (its element types 38 and 28), turned 20 degrees by
+# move_mesh's defaults: certified valid by move_mesh, and by mesh_quality on what it wrote.
+find_program(MESHMOTION_GMSH gmsh)
+if(MESHMOTION_GMSH)
+  file(WRITE "${smoke_dir}/disk_quads_p5.geo"
+       "SetFactory(\"OpenCASCADE\");\nDisk(1) = {0, 0, 0, 1};\nPhysical Curve(\"rim\") = {1};\n"
+       "Physical Surface(\"disk\") = {1};\nMesh.MeshSizeMax = 0.25;\nMesh.RecombineAll = 1;\n"
+       "Mesh.SubdivisionAlgorithm = 1;\nMesh.ElementOrder = 5;\n")
+  add_test(NAME examples.gmsh.disk_quads_p5
+           COMMAND "${MESHMOTION_GMSH}" -2 disk_quads_p5.geo -o disk_quads_p5.msh -v 1
+           WORKING_DIRECTORY "${smoke_dir}")
+  set_tests_properties(examples.gmsh.disk_quads_p5 PROPERTIES LABELS examples FIXTURES_SETUP examples_disk_p5)
+  smoke_test(NAME move_mesh.disk_p5_turned.json REQUIRES examples_disk_p5 SETUP examples_disk_p5_turned
+             KEYS output,after/min,after/invalid
+             VALUES after/invalid=0
+             COMMAND move_mesh "${smoke_dir}/disk_quads_p5.msh" -o "${smoke_dir}/disk_quads_p5_turned.msh" --group rim
+                     --rotate 20 --json)
+  smoke_test(NAME mesh_quality.disk_p5_turned.json REQUIRES examples_disk_p5_turned
+             KEYS elements,metrics/scaled_jacobian/min,metrics/scaled_jacobian/invalid
+             VALUES metrics/scaled_jacobian/invalid=0
+             COMMAND mesh_quality "${smoke_dir}/disk_quads_p5_turned.msh" --metric jacobian --json)
+else()
+  message(STATUS "meshmotion: gmsh not found; the smoke tests on Gmsh's P5 disk are skipped")
+endif()
+smoke_test(NAME curve_mesh.order9 EXPECT_RC 1
            KEYS error
-           COMMAND curve_mesh --demo --order 5 -o "${smoke_dir}/demo_p5.msh" --json)
+           COMMAND curve_mesh --demo --order 9 -o "${smoke_dir}/demo_p9.msh" --json)
 
 # The mechanics knobs reach the mover: stiffened elasticity as curve_mesh's regularizer and
 # as move_mesh's mover, and a bad Poisson ratio is refused.

@@ -700,8 +700,10 @@ TEST_CASE("pipeline: a reconstructed wall meeting the inlet and the symmetry pla
     CHECK(curved.curved_groups == std::vector<std::string>{"wall"});
     CHECK(curved.invalid() == 0);
     CHECK(curved.quality.min > 0.8);
-    for (const Index v : curved.curved.group_nodes("inlet")) CHECK(curved.curved.points(0, v) == 0.0);
-    for (const Index v : curved.curved.group_nodes("symmetry")) CHECK(curved.curved.points(1, v) == 0.0);
+    // On their planes to round-off: the raise rounds slide nodes along the fitted plane's
+    // tangents, whose components off the plane are round-off (1e-17), not zero.
+    for (const Index v : curved.curved.group_nodes("inlet")) CHECK(std::abs(curved.curved.points(0, v)) <= 1e-15);
+    for (const Index v : curved.curved.group_nodes("symmetry")) CHECK(std::abs(curved.curved.points(1, v)) <= 1e-15);
   }
 }
 

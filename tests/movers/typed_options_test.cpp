@@ -146,7 +146,7 @@ TEST_CASE("option ranges: every default is inside its range, and values outside 
   CurveOptions<2> curve;
   CHECK_THROWS_WITH(set_curve_options(curve, {{"support_radius", "-1"}}),
                     Catch::Contains("option 'support_radius': -1 is out of range (expected >= 0)"));
-  CHECK_THROWS_WITH(set_curve_options(curve, {{"order", "5"}}), Catch::Contains("option 'order': 5 is out of range (expected 2 to 4)"));
+  CHECK_THROWS_WITH(set_curve_options(curve, {{"order", "9"}}), Catch::Contains("option 'order': 9 is out of range (expected 2 to 8)"));
   bool shown = false;
   for (const OptionDoc& d : option_docs(RbfOptions{}))
     if (d.key == "patch_overlap") shown = d.type == "number >= 0";

@@ -145,7 +145,7 @@ struct CurveOptions {
 /// geometry_from_text(); `mover_options` takes the keys of the method, MoverConfig).
 template <int Dim, class F>
 void visit_options(CurveOptions<Dim>& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "order", o.order, OptionHelp{"order of the curved mesh: 2, 3 or 4 (hexahedra, prisms and pyramids: 2 or 3)", range::between(2, max_element_order)});
+  f(prefix + "order", o.order, OptionHelp{"order of the curved mesh: 2 to 8 (tetrahedra to 6; hexahedra, prisms and pyramids to 3)", range::between(2, max_element_order)});
   f(prefix + "method", o.method, "interior regularization: a registered mover (its options are keys too)");
   f(prefix + "support_radius", o.support_radius, OptionHelp{"support radius of the movers with one (0: from each wall's boundary layer)", range::non_negative});
   f(prefix + "support_radius_factor", o.support_radius_factor, OptionHelp{"default support radius = this x the wall's layer thickness", range::positive});

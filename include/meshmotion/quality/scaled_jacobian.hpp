@@ -70,7 +70,7 @@ namespace detail {
 
 template <int D>
 using ElementCoords = Eigen::Matrix<double, D, Eigen::Dynamic, 0, D, max_element_nodes>;
-using LatticeVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 729, 1>;  // up to a hex64's 9³ lattice
+using LatticeVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_lattice_points, 1>;
 
 // One pass of apply_factors: to[o, r, i] = Σ_b f(r, b) from[o, b, i], as whole rows over i (the
 // compiler vectorizes them) or, on the last axis (inner = 1), as sums kept in a register. The

@@ -15,6 +15,7 @@
 
 #include "meshmotion/core/detail/table_kernels.hpp"
 #include "meshmotion/core/element.hpp"
+#include "meshmotion/core/error.hpp"
 #include "meshmotion/core/shape_functions.hpp"
 #include "meshmotion/core/types.hpp"
 
@@ -24,7 +25,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <mutex>
+#include <numbers>
+#include <string>
 #include <vector>
 
 namespace meshmotion::detail {
@@ -159,6 +161,17 @@ inline std::vector<AffineChild> make_children(const JacobianSpace& s) {
   return all;
 }
 
+// Point i of the line lattice of degree m on [-1, 1]: equispaced, and past degree 11 the
+// Chebyshev–Lobatto points (-cos(π i / m)). The Bernstein conversion from equispaced values
+// loses digits as 2^m: at degree 23 (a hex729's det J) three passes of it turned a det J of 1
+// into bounds of -1.5 and 10.2; the Lobatto points keep it at round-off. Any points give the
+// same Bézier coefficients in exact arithmetic, and both sets hold the ends (the vertices).
+inline double line_point(int i, int m) {
+  if (m == 0) return 0.0;
+  if (m < 12) return 2.0 * i / m - 1.0;
+  return -std::cos(std::numbers::pi * i / m);
+}
+
 inline void add_lattice(JacobianSpace& s) {
   std::vector<std::array<int, 4>> simplex;
   const int sd = s.simplex_dim, n = s.simplex_degree;
@@ -179,7 +192,7 @@ inline void add_lattice(JacobianSpace& s) {
       for (int d = 0; d < sd; ++d)
         x[static_cast<std::size_t>(d)] = n == 0 ? 1.0 / (sd + 1) : static_cast<double>(alpha[static_cast<std::size_t>(d + 1)]) / n;
       for (int l = 0; l < s.line_dims; ++l)
-        x[static_cast<std::size_t>(sd + l)] = m == 0 ? 0.0 : 2.0 * line[static_cast<std::size_t>(l)] / m - 1.0;
+        x[static_cast<std::size_t>(sd + l)] = line_point(line[static_cast<std::size_t>(l)], m);
       s.points.push_back(x);
       // A vertex of the element: its Bézier coefficient is the function's value there.
       const bool simplex_vertex = sd == 0 || n == 0 || std::find(alpha.begin(), alpha.begin() + sd + 1, n) != alpha.begin() + sd + 1;
@@ -217,7 +230,7 @@ inline void add_tensor_tables(JacobianSpace& s, ElementType t, int p) {
   s.line_values.resize(m + 1, p + 1);
   s.line_derivatives.resize(m + 1, p + 1);
   for (int r = 0; r <= m; ++r) {
-    const double x = 2.0 * r / m - 1.0;
+    const double x = line_point(r, m);
     for (int a = 0; a <= p; ++a) {
       double value = 1.0, derivative = 0.0;
       for (int b = 0; b <= p; ++b) {
@@ -322,14 +335,21 @@ inline JacobianSpace make_jacobian_space(ElementType t) {
 // Each type's tables on its first use: those of every type at once (the P4 tetrahedron's Bézier
 // inverse and its subdivision products among them) took 25 ms of curving the 30P30N's
 // triangles, an eighth of the whole program.
+// Most lattice points of a det J the certificate holds (a tet84's, degree 15). The lattice
+// values live in fixed storage on the stack: sized for a hex729's 13,824 points, the
+// certificate of a P2 cell was 6 times slower (its 110 KiB frames), so hexahedra past order 3
+// (1,728 points at order 4) are refused by name until the storage grows with the cell.
+inline constexpr int max_lattice_points = 816;
+
 inline const JacobianSpace& jacobian_space(ElementType t) {
-  static std::array<JacobianSpace, num_element_types> spaces;
-  static std::array<std::once_flag, num_element_types> built;
-  const auto i = static_cast<std::size_t>(t);
-  std::call_once(built[i], [&] {
-    if (dimension(t) >= 2) spaces[i] = make_jacobian_space(t);
-  });
-  return spaces[i];
+  static PerTypeCache<JacobianSpace> spaces;
+  const JacobianSpace& s =
+      spaces.get(t, [](ElementType type) { return dimension(type) >= 2 ? make_jacobian_space(type) : JacobianSpace{}; });
+  if (s.num_points > max_lattice_points)
+    throw InputError("the certified scaled Jacobian takes hexahedra up to order 3 (a " + std::string(name(t)) +
+                     "'s det J has " + std::to_string(s.num_points) + " lattice points, more than the " +
+                     std::to_string(max_lattice_points) + " it holds)");
+  return s;
 }
 
 }  // namespace meshmotion::detail
