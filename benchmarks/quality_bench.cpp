@@ -4,11 +4,17 @@
 // count; the target is certified ≤ 5× sampled on valid meshes. The thesis gives no timing for
 // this step (it ran Gmsh's plugin).
 //
+// Then the cost per element by order: triangles and quadrilaterals at P2 to P8, tetrahedra at
+// P2 to P6, curved by moving every node past the vertices; each row's ratio is to the same
+// shape's P2 row of the same run.
+//
 //   quality_bench [--quick]     (--quick: ~100k elements)
 
 #include "bench_memory.hpp"
+#include "meshmotion/core/generators.hpp"
 #include "meshmotion/core/json.hpp"
 #include "meshmotion/core/mesh.hpp"
+#include "meshmotion/curving/order_conversion.hpp"
 #include "meshmotion/quality/scaled_jacobian.hpp"
 
 #if defined(_OPENMP)
@@ -156,6 +162,42 @@ void run_cases(const char* mesh_name, const Mesh<Dim>& mesh) {
   }
 }
 
+// Seconds per element of the certified validity check (single thread, best of three) on
+// `linear` raised to each order, its non-vertex nodes moved by up to 10% of the node spacing.
+template <int Dim>
+void run_orders(const char* shape_name, const Mesh<Dim>& linear, double spacing) {
+#if defined(_OPENMP)
+  omp_set_num_threads(1);
+#endif
+  ScaledJacobianOptions validity;
+  validity.sharp = false;
+  double p2 = 0.0;
+  for (int p = 2; p <= max_order(shape(linear.cells.front().type)); ++p) {
+    OrderConversion<Dim> conversion = convert_to_order(linear, p);
+    Mesh<Dim>& mesh = conversion.mesh;
+    for (Index i = conversion.num_kept_nodes; i < mesh.num_nodes(); ++i)
+      for (int d = 0; d < Dim; ++d) mesh.points(d, i) += 0.1 * spacing / p * jitter(i, d);
+    double sec = 1e300;
+    std::vector<ScaledJacobian> r;
+    for (int repeat = 0; repeat < 3; ++repeat) {
+      const auto t0 = std::chrono::steady_clock::now();
+      r = scaled_jacobians(mesh, validity);
+      sec = std::min(sec, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
+    Index invalid = 0;
+    for (const auto& s : r) invalid += s.valid ? 0 : 1;
+    const double per_element = sec / static_cast<double>(r.size());
+    if (p == 2) p2 = per_element;
+    std::printf("%-14s P%d %8lld el  %9.3f us/el  ratio to P2 %6.2f  invalid %lld\n", shape_name, p,
+                static_cast<long long>(r.size()), 1e6 * per_element, per_element / p2, static_cast<long long>(invalid));
+    JsonWriter w(std::cout);
+    w.begin_object().key("benchmark").value("quality_order").key("shape").value(shape_name).key("order").value(p);
+    w.key("elements").value(r.size()).key("seconds_per_element").value(per_element);
+    w.key("ratio_to_p2").value(per_element / p2).key("invalid").value(invalid).end_object();
+    std::cout << std::endl;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -166,4 +208,8 @@ int main(int argc, char** argv) {
   run_cases("tri6", tri);
   const Mesh<3> tet = tet10_mesh(quick ? 26 : 56, 0.05);   // 6 m^3 ≥ 1M
   run_cases("tet10", tet);
+  const Index n2 = quick ? 40 : 120, n3 = quick ? 6 : 12;
+  run_orders("triangle", rectangle_mesh({.nx = n2, .ny = n2, .cells = RectangleCells::tri3}), 1.0 / static_cast<double>(n2));
+  run_orders("quadrilateral", rectangle_mesh({.nx = n2, .ny = n2}), 1.0 / static_cast<double>(n2));
+  run_orders("tetrahedron", box_mesh({.nx = n3, .ny = n3, .nz = n3, .cells = BoxCells::tet4}), 1.0 / static_cast<double>(n3));
 }

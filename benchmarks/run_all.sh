@@ -18,7 +18,7 @@
 # table shows its figures and the ratios. A benchmark that does not compile against the older
 # library is reported and skipped.
 #
-# --only runs the named benchmarks alone (e.g. --only conversion_bench,io_bench,curve_mesh_program,move_mesh_section,defaults_bench,conditioning_bench,openfoam_plugin).
+# --only runs the named benchmarks alone (e.g. --only conversion_bench,io_bench,curve_mesh_program,demo_orders,move_mesh_section,defaults_bench,conditioning_bench,openfoam_plugin).
 #
 # Programs and benchmarks run with glibc's huge-page heap (GLIBC_TUNABLES, see
 # include/meshmotion/core/process_memory.hpp) for both builds; MESHMOTION_HUGE_PAGES=0 runs
@@ -179,6 +179,32 @@ program_case() {
   printf '{"bench":"program","case":"curve_mesh-30p30n","median_s":%d.%06d}\n' $((median / 1000000)) $((median % 1000000))
 }
 
+# curve_mesh on its built-in demo at orders 2 and 4 to 8 (the whole program, .msh and .vtu
+# written; order 4 first, the reference of the ratios): the median of 3 runs each, its ratio
+# to order 4's, and the certified minimum and invalid count the program reports, one JSON
+# line per order.
+demo_orders_case() {
+  local program="$1" work p4=0
+  work="$(mktemp -d)"
+  for order in 4 2 5 6 7 8; do
+    local times=() median report
+    for _ in 1 2 3; do
+      local start=$(date +%s%N)
+      report=$("$program" --demo --order "$order" -o "$work/demo.msh" --json) || { rm -rf "$work"; return 1; }
+      times+=($(( ($(date +%s%N) - start) / 1000 )))
+    done
+    median=$(printf '%s\n' "${times[@]}" | sort -n | sed -n 2p)
+    [[ $order == 4 ]] && p4=$median
+    read -r min invalid < <(printf '%s' "$report" | python3 -c \
+      'import json, sys; r = json.load(sys.stdin); print(r["min_scaled_jacobian"], r["invalid"])')
+    printf 'curve_mesh --demo --order %d: median of 3 runs %d.%06d s, %d.%03d x order 4, min %s, invalid %s\n' "$order" \
+      $((median / 1000000)) $((median % 1000000)) $((median / p4)) $(( (median * 1000 / p4) % 1000 )) "$min" "$invalid"
+    printf '{"bench":"program","case":"curve_mesh-demo-p%d","median_s":%d.%06d,"ratio_to_p4":%d.%03d,"min_scaled_jacobian":%s,"invalid":%s}\n' \
+      "$order" $((median / 1000000)) $((median % 1000000)) $((median / p4)) $(( (median * 1000 / p4) % 1000 )) "$min" "$invalid"
+  done
+  rm -rf "$work"
+}
+
 # move_mesh on the airFoil2D case (one cell thick, OpenFOAM's 2D), walls turned 15 degrees with
 # linear elasticity: as its 2D section (the default) and in 3D (--keep-3d), in turn, 3 runs
 # each; the medians and the median of the paired ratios, as one JSON line.
@@ -225,6 +251,9 @@ if [[ -x "$build_dir/examples/curve_mesh" && ( -z "$only" || "$only" == *",curve
   run curve_mesh_program program_case "$build_dir/examples/curve_mesh"
   [[ -n "$baseline" && -x "$baseline_dir/examples/curve_mesh" ]] \
     && run "baseline:curve_mesh_program" program_case "$baseline_dir/examples/curve_mesh"
+fi
+if [[ -x "$build_dir/examples/curve_mesh" && ( -z "$only" || "$only" == *",demo_orders,"* ) ]]; then
+  run demo_orders demo_orders_case "$build_dir/examples/curve_mesh"
 fi
 if [[ -x "$build_dir/examples/move_mesh" && ( -z "$only" || "$only" == *",move_mesh_section,"* ) ]]; then
   run move_mesh_section section_case "$build_dir/examples/move_mesh"

@@ -136,6 +136,14 @@ TARGETS = [
     ("one RBF setup: set-ups again per doubling of the motion", setups_per_doubling, None, "<=", 1.0, ""),
     ("PU RBF, 1M centres and 10M nodes: peak", {"bench": "pu_rbf", "mesh": "flat-707", "method": "pu"}, "peak_mb",
      "<=", 24576, "MB"),
+    ("curve_mesh demo P5: min scaled Jacobian", {"bench": "program", "case": "curve_mesh-demo-p5"}, "min_scaled_jacobian",
+     ">=", 0.5, ""),
+    ("curve_mesh demo P6: min scaled Jacobian", {"bench": "program", "case": "curve_mesh-demo-p6"}, "min_scaled_jacobian",
+     ">=", 0.5, ""),
+    ("curve_mesh demo P8: min scaled Jacobian", {"bench": "program", "case": "curve_mesh-demo-p8"}, "min_scaled_jacobian",
+     ">=", 0.5, ""),
+    ("curve_mesh demo P6 / P4, whole program", {"bench": "program", "case": "curve_mesh-demo-p6"}, "ratio_to_p4", "<=",
+     5.0, "x"),
 ]
 
 
