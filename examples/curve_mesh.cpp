@@ -244,6 +244,9 @@ std::string cell(const std::string& text) {
   return out.empty() ? "(empty)" : out;
 }
 
+// An option's "what it does" cell: its whole description, or its line where that is all.
+std::string what(const OptionDoc& d) { return d.details.empty() ? d.doc : d.details; }
+
 // docs/options.md: every option and report field from the library's one description.
 void print_options_markdown() {
   std::printf("# Options and results\n\n"
@@ -257,7 +260,7 @@ void print_options_markdown() {
   const std::vector<OptionDoc> plane = option_docs(CurveOptions<2>{}), space = option_docs(CurveOptions<3>{});
   for (std::size_t k = 0; k < plane.size(); ++k) {
     const std::string value = plane[k].value == space[k].value ? cell(plane[k].value) : cell(plane[k].value) + " (3D: " + cell(space[k].value) + ")";
-    std::printf("| `%s` | %s | %s | %s |\n", plane[k].key.c_str(), cell(plane[k].type).c_str(), value.c_str(), plane[k].doc.c_str());
+    std::printf("| `%s` | %s | %s | %s |\n", plane[k].key.c_str(), cell(plane[k].type).c_str(), value.c_str(), cell(what(plane[k])).c_str());
   }
   std::printf("\n## Movers (`--method`)\n");
   for (const auto& m : mover_methods<3>()) {
@@ -269,12 +272,12 @@ void print_options_markdown() {
     }
     std::printf("\n| key | type | default | what it does |\n|---|---|---|---|\n");
     for (const OptionDoc& d : docs)
-      std::printf("| `%s` | %s | %s | %s |\n", d.key.c_str(), cell(d.type).c_str(), cell(d.value).c_str(), d.doc.c_str());
+      std::printf("| `%s` | %s | %s | %s |\n", d.key.c_str(), cell(d.type).c_str(), cell(d.value).c_str(), cell(what(d)).c_str());
   }
   std::printf("\n## Distributed solves\n\nThe keys of `move_mesh_mpi`, Python's `Warp(comm=...)` and the OpenFOAM plugin on a "
               "decomposed case, beside those of the method (rbf, le, sle).\n\n| key | type | default | what it does |\n|---|---|---|---|\n");
   for (const OptionDoc& d : option_docs(parallel::ParallelOptions{}))
-    std::printf("| `%s` | %s | %s | %s |\n", d.key.c_str(), cell(d.type).c_str(), cell(d.value).c_str(), d.doc.c_str());
+    std::printf("| `%s` | %s | %s | %s |\n", d.key.c_str(), cell(d.type).c_str(), cell(d.value).c_str(), cell(what(d)).c_str());
   std::printf("\n## Reports\n");
   for_each_report([]<class Report>(std::string_view key, std::string_view heading, std::string_view what) {
     std::printf("\n### %s\n%s Its keys in Python: `report_fields(\"%s\")`.\n\n| key | what it is |\n|---|---|\n",
@@ -289,7 +292,7 @@ void print_options_markdown() {
 
 int main(int argc, char** argv) {
   meshmotion::tune_process_memory(argc, argv);  // may restart the program once (core/process_memory.hpp)
-  CLI::App app{"Curve a linear mesh into a certified P2 (P3, P4) mesh (spline or CAD boundary, RBF or blending interior)"};
+  CLI::App app{"Curve a linear mesh into a certified P2 (to P8) mesh (spline or CAD boundary, RBF or blending interior)"};
   Arguments args;
   auto* input = app.add_option("input", args.input, "linear mesh (.msh, .su2, .cgns, .vtu); none: the built-in demo");
   app.add_option("-o,--output", args.output, "curved mesh to write (.msh, .cgns; .su2 for linear); a .vtu is written beside it");

@@ -620,7 +620,7 @@ if(TARGET move_mesh_mpi)
   set_tests_properties(examples.move_mesh_mpi.budget_equals_move_mesh PROPERTIES LABELS examples
                        FIXTURES_REQUIRED "examples_mpi_budget_moved;examples_mpi_budget_serial")
   smoke_test(NAME move_mesh_mpi.sle.json REQUIRES examples_demo_mesh RANKS 2
-             KEYS solver VALUES method=sle,after/invalid=0
+             KEYS petsc_solver VALUES method=sle,petsc_solver=cg_hypre,after/invalid=0
              COMMAND move_mesh_mpi "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved_mpi_sle.vtu" --group wall --rotate 2
                      --fixed farfield --method sle --petsc-solver cg_hypre --rank-files --json)
   smoke_test(NAME move_mesh_mpi.p2_to_openfoam.json REQUIRES examples_demo_mesh RANKS 2 EXPECT_RC 1 KEYS error

@@ -76,3 +76,15 @@ if(MESHMOTION_BUILD_COMPILED AND CMAKE_NM)
   set_tests_properties("cmake: each mover is compiled in one object" PROPERTIES LABELS cmake
                        PASS_REGULAR_EXPRESSION "each mover's setup defined in one at most")
 endif()
+
+# The option schema's rules: each key is its field's name, each option's description its only
+# doc (tests/schema/check_option_schema.py).
+find_program(MESHMOTION_PYTHON3 NAMES python3)
+if(MESHMOTION_PYTHON3)
+  add_test(NAME "schema: keys are field names, one doc per option"
+           COMMAND ${MESHMOTION_PYTHON3} "${CMAKE_CURRENT_SOURCE_DIR}/schema/check_option_schema.py" "${PROJECT_SOURCE_DIR}/include")
+  set_tests_properties("schema: keys are field names, one doc per option" PROPERTIES LABELS cmake
+                       PASS_REGULAR_EXPRESSION "options, 0 problems")
+else()
+  message(STATUS "meshmotion: no python3: the option schema's check is skipped")
+endif()

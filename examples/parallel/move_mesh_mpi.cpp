@@ -84,7 +84,6 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
     if (method == nullptr)
       throw InputError("move_mesh_mpi: --method '" + config.method + "' has no distributed mover (expected " +
                        known_distributed_methods<Dim>() + ")");
-    method->prepare(config.options);
     if (!root) return;
     // As move_mesh: an output that cannot hold the mesh's order is refused before any work.
     int order = 1;
@@ -130,16 +129,13 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
     MoverStats step = stats;
     step.setup_seconds = seconds[0];
     step.move_seconds = seconds[1];
+    const DistributedChoices chose = mover->choices();
     const MoveReport report{config.method, 1, whole->num_nodes(), seconds[0], seconds[1], before, after, {step}};
     if (a.json) {
       JsonWriter w(std::cout);
       w.begin_object().key("input").value(a.input).key("output").value(a.output);
       w.key("ranks").value(ranks).key("threads_per_rank").value(num_threads());
-      if (mover->support_radius() > 0.0) w.key("support_radius").value(mover->support_radius());
-      if (mover->boundary_solve() != "none")
-        w.key("boundary_solve").value(std::string(mover->boundary_solve()));
-      else
-        w.key("solver").value(name(parallel.elasticity.solver));
+      write_json_fields(w, chose);
       write_json_fields(w, report);
       if (verdict.foam) {
         w.key("checkmesh_after");
@@ -150,8 +146,8 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
     } else {
       std::cout << "moved " << whole->num_nodes() << " nodes with " << config.method << " on " << ranks << " rank(s) of "
                 << num_threads() << " thread(s)"
-                << (mover->boundary_solve() != "none" ? ", boundary solve " + std::string(mover->boundary_solve()) : std::string())
                 << " (times: the slowest rank)\n";
+      write_text(std::cout, chose, 2);
       write_text(std::cout, report, 2);
       if (verdict.foam) {
         std::cout << "  the case's own cells (checkMesh's measures; the validity verdict):\n";

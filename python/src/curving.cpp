@@ -126,10 +126,11 @@ void bind_curving(py::module_& m) {
       [](const std::string& method) {
         py::list out;
         for (const OptionDoc& d : curve_option_docs<3>(method))
-          out.append(py::dict(py::arg("key") = d.key, py::arg("type") = d.type, py::arg("default") = d.value, py::arg("doc") = d.doc));
+          out.append(py::dict(py::arg("key") = d.key, py::arg("type") = d.type, py::arg("default") = d.value, py::arg("doc") = d.doc,
+                              py::arg("details") = d.details));
         return out;
       },
-      py::arg("method") = "blend", "curve_mesh's keywords with method `method`: key, type, default (as text) and doc");
+      py::arg("method") = "blend", "curve_mesh's keywords with method `method`: key, type, default (as text), doc (a line) and details (the rest of its description, or empty)");
   m.def(
       "report_fields",
       [](const std::string& report) { return report_fields(report); },

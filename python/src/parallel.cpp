@@ -98,9 +98,9 @@ class DistributedMover {
   [[nodiscard]] bool has_derivatives() const { return true; }
   [[nodiscard]] MoverStats stats() const { return mover_->stats(); }
   /// The RBF boundary system is solved through PETSc (false for elasticity, which always is).
-  [[nodiscard]] bool petsc_solve() const { return mover_->boundary_solve() == "petsc"; }
+  [[nodiscard]] bool petsc_solve() const { return mover_->choices().boundary_solve == "petsc"; }
   /// Where the RBF boundary system is solved (BoundarySolve's name; elasticity: none).
-  [[nodiscard]] std::string boundary_solve() const { return std::string(mover_->boundary_solve()); }
+  [[nodiscard]] std::string boundary_solve() const { return mover_->choices().boundary_solve; }
 
  private:
   std::unique_ptr<parallel::DistributedMover<Dim>> mover_;

@@ -631,7 +631,10 @@ def test_curve_mesh_keywords_and_report_come_from_one_description():
     keys = [o["key"] for o in options]
     assert len(keys) == len(set(keys)) and {"order", "raise_rounds", "kernel", "sliding"} <= set(keys)
     for o in options:
-        assert set(o) == {"key", "type", "default", "doc"} and o["doc"]
+        assert set(o) == {"key", "type", "default", "doc", "details"} and o["doc"]
+    # The one description of an option holds its whole doc: a line, then the details.
+    radius = next(o for o in options if o["key"] == "support_radii")
+    assert "nonsymmetric" in radius["details"] and "nonsymmetric" not in radius["doc"]
     assert "blending_factor" in [o["key"] for o in mm.curve_options()]
     circle = {"wall": "circle:0,0,0.5"}
     _, report = mm.curve_mesh(annulus(), geometry=circle, method="rbf", raise_rounds=1, midpoint="parameter",

@@ -61,7 +61,7 @@ TEST_CASE("curve options: every key reads back from its text, and typed values a
   CHECK(o.order == 3);
   CHECK(o.sliding == std::vector<std::string>{"symmetry", "farfield"});
   CHECK(o.snap.midpoint == SplineMidpoint::parameter);
-  CHECK(!o.untangle.enabled);
+  CHECK(!o.untangle.untangle);
   CHECK(o.untangle.raise_rounds == 2);
   CHECK(o.report.quality.jacobian.max_leaves == 100);
   CHECK(o.layer.aspect_ratio_threshold == 5.0);

@@ -457,7 +457,7 @@ TEST_CASE("pipeline: under the RBF a farfield snapped outward moves only its own
   options.method = "rbf";
   options.geometry.emplace("wall", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 0.5)));
   options.geometry.emplace("farfield", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 20.0)));
-  options.untangle.enabled = false;  // its rounds raise the worst cells anywhere
+  options.untangle.untangle = false;  // its rounds raise the worst cells anywhere
   const CurveResult<2> curved = curve_mesh(linear, options);
   REQUIRE(curved.layers.size() == 2);
   REQUIRE(curved.layers[1].thickness == 0.0);

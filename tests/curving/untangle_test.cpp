@@ -56,7 +56,7 @@ TEST_CASE("untangling turns a tangled curved mesh valid, keeping its boundary", 
   const Mesh<2> before = m;
   std::vector<double> quality = cell_quality(m, Metric::scaled_jacobian);
   UntangleOptions options;
-  options.max_sweeps = 100;
+  options.untangle_sweeps = 100;
   const UntangleReport report = untangle(m, fixed, quality, options);
   INFO("invalid " << report.invalid_before << " -> " << report.invalid_after << ", min " << report.min_before << " -> "
                   << report.min_after << ", " << report.free_nodes << " free nodes, " << report.sweeps << " sweeps");
@@ -94,11 +94,11 @@ TEST_CASE("untangling: nothing below the threshold, nothing moves, switched off,
   const Mesh<2> before = m;
   std::vector<double> quality = cell_quality(m, Metric::scaled_jacobian);
   UntangleOptions off;
-  off.enabled = false;
+  off.untangle = false;
   CHECK(untangle(m, fixed, quality, off).sweeps == 0);
   CHECK(m.points == before.points);
   UntangleOptions low;
-  low.threshold = -1e9;
+  low.untangle_threshold = -1e9;
   low.raise_rounds = 0;
   CHECK(untangle(m, fixed, quality, low).cells_below == 0);
   CHECK(m.points == before.points);
@@ -118,11 +118,11 @@ TEST_CASE("the pipeline untangles after the regularization and reports it", "[cu
   options.geometry.emplace("wall", BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 0.5)));
   options.method = "rbf";
   options.support_radius = 0.003;  // a support inside the first layers: the regularization alone leaves tangles
-  options.untangle.enabled = false;
+  options.untangle.untangle = false;
   const CurveResult<2> plain = curve_mesh(linear, options);
   REQUIRE(plain.invalid() > 0);
   CHECK(plain.untangle.sweeps == 0);
-  options.untangle.enabled = true;
+  options.untangle.untangle = true;
   const CurveResult<2> untangled = curve_mesh(linear, options);
   CHECK(untangled.untangle.cells_below > 0);
   CHECK(untangled.untangle.invalid_before == plain.invalid());
@@ -133,7 +133,7 @@ TEST_CASE("the pipeline untangles after the regularization and reports it", "[cu
   // The wall's nodes slid on their circle, none off it; switched off, they stay.
   CHECK(untangled.untangle.slid_nodes > 0);
   for (const Index v : untangled.curved.group_nodes("wall")) CHECK(untangled.curved.points.col(v).norm() == Approx(0.5).margin(1e-12));
-  options.untangle.slide = false;
+  options.untangle.untangle_slide = false;
   const CurveResult<2> held = curve_mesh(linear, options);
   CHECK(held.untangle.slid_nodes == 0);
   for (const Index v : held.curved.group_nodes("wall")) CHECK(held.curved.points.col(v) == plain.curved.points.col(v));
@@ -170,7 +170,7 @@ TEST_CASE("a wall node slides along its geometry to untangle a cell the nodes in
   options.order = 2;
   const BoundaryGeometry<2> circle = BoundaryGeometry<2>::project(SphereProjection<2>(Vec<2>::Zero(), 0.5));
   options.geometry.emplace("wall", circle);
-  options.untangle.enabled = false;
+  options.untangle.untangle = false;
   const CurveResult<2> curved = curve_mesh(o_mesh({.n_around = 24, .n_radial = 6, .first_height = 0.05, .farfield_radius = 4.0}), options);
   REQUIRE(curved.invalid() == 0);
   Mesh<2> m = curved.curved;

@@ -361,7 +361,7 @@ TEST_CASE("Delaunay-graph movers: bad input", "[movers]") {
   CHECK_THAT(test::message_of<InputError>([&] { (void)mover.move(nan); }), Catch::Matchers::Contains("not finite"));
 
   DgrbfOptions negative;
-  negative.rbf.relative_support = -1.0;
+  negative.rbf.simplex_support = -1.0;
   DgrbfMover<2> dgrbf(negative);
   CHECK_THAT(test::message_of<InputError>([&] { (void)dgrbf.setup(mesh, b); }), Catch::Matchers::Contains("support"));
   Dgrbf2Options<3> zero_axis;

@@ -418,7 +418,7 @@ TEST_CASE("iterative solvers agree with the direct solve and report iterations",
   const Points<2> direct = run(ElasticityMover<2>(), mesh, b);
   for (const auto kind : {SolverKind::cg_jacobi, SolverKind::cg_incomplete_cholesky, SolverKind::simplicial_llt}) {
     ElasticityOptions o;
-    o.solver.kind = kind;
+    o.solver.solver = kind;
     ElasticityMover<2> mover(o);
     mover.setup(mesh, b);
     const Points<2> u = mover.move(b.displacements);

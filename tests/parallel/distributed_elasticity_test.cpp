@@ -48,14 +48,14 @@ TEST_CASE("distributed elasticity equals serial within the solver tolerance (2D,
   spec.moving("bottom", Rotation2D{{0.5, 0.0}, radians(6.0)}).fixed("top").sliding("left").sliding("right");
   DistributedElasticityOptions options;
   options.elasticity.poisson_ratio = 0.4;
-  options.tolerance = 1e-12;
+  options.petsc_tolerance = 1e-12;
   SECTION("CG + GAMG") { CHECK(relative_error(mesh, spec, options) <= 1e-9); }
   SECTION("CG + BoomerAMG") {
-    options.solver = PetscSolverKind::cg_hypre;
+    options.petsc_solver = PetscSolverKind::cg_hypre;
     CHECK(relative_error(mesh, spec, options) <= 1e-9);
   }
   SECTION("MUMPS") {
-    options.solver = PetscSolverKind::direct_mumps;
+    options.petsc_solver = PetscSolverKind::direct_mumps;
     CHECK(relative_error(mesh, spec, options) <= 1e-11);
   }
 }
@@ -66,7 +66,7 @@ TEST_CASE("distributed stiffened elasticity equals serial in 3D", "[parallel][el
   spec.moving("bottom", Rotation3D{{0.5, 0.5, 0.0}, {1.0, 0.0, 0.0}, radians(4.0)}).fixed("top").sliding("front").sliding("left");
   DistributedElasticityOptions options;
   options.elasticity.stiffening_exponent = 2.0;
-  options.tolerance = 1e-12;
+  options.petsc_tolerance = 1e-12;
   MoverStats stats;
   CHECK(relative_error(mesh, spec, options, {}, &stats) <= 1e-9);
   CHECK(stats.moves == 1);
@@ -79,7 +79,7 @@ TEST_CASE("distributed elasticity: an empty rank and a rank without boundary nod
   BoundarySpec<2> spec;
   spec.moving("bottom", Translation<2>{{0.02, 0.05}}).fixed("top");
   DistributedElasticityOptions options;
-  options.tolerance = 1e-12;
+  options.petsc_tolerance = 1e-12;
   CHECK(relative_error(mesh, spec, options, ranks) <= 1e-9);
 }
 
@@ -91,7 +91,7 @@ TEST_CASE("distributed elasticity derivatives: the ranks' reverse gradients add 
   const ResolvedBoundary<2> b = spec.resolve(whole);
   DistributedElasticityOptions options;
   options.elasticity.stiffening_exponent = 1.0;
-  options.tolerance = 1e-13;
+  options.petsc_tolerance = 1e-13;
   ElasticityMover<2> serial(options.elasticity);
   serial.setup(whole, b);
   // One seed per node of the whole mesh, the same on every rank.
@@ -140,11 +140,11 @@ TEST_CASE("distributed elasticity: a solver failure raises on every rank, or fal
   BoundarySpec<2> spec;
   spec.moving("bottom", Translation<2>{{0.0, 0.05}}).fixed("top");
   DistributedElasticityOptions options;
-  options.tolerance = 1e-14;
-  options.max_iterations = 1;
-  options.solver = PetscSolverKind::cg_hypre;
+  options.petsc_tolerance = 1e-14;
+  options.petsc_max_iterations = 1;
+  options.petsc_solver = PetscSolverKind::cg_hypre;
   CHECK_THROWS_AS(relative_error(mesh, spec, options), SolverError);
-  options.fallback_to_direct = true;
+  options.petsc_fallback_to_direct = true;
   MoverStats stats;
   CHECK(relative_error(mesh, spec, options, {}, &stats) <= 1e-11);
   CHECK(stats.fell_back);

@@ -65,7 +65,7 @@ Outcome compare_with_serial(const Mesh<Dim>& whole, const ResolvedBoundary<Dim>&
     for (const Index v : local_b.nodes) local_options.support_radii.push_back(radius_at(part.local.points.col(v)));
   DistributedRbfMover<Dim> mover(local_options, solve);
   mover.setup(part.view(), local_b);
-  REQUIRE(mover.petsc_solve() == (solve.kind == BoundarySolve::petsc));
+  REQUIRE(mover.petsc_solve() == (solve.boundary_solve == BoundarySolve::petsc));
   const Points<Dim> got = mover.move(local_b.displacements);
 
   Outcome out;
@@ -372,13 +372,13 @@ TEST_CASE("distributed partition of unity: patches on their ranks, the serial PU
 TEST_CASE("parallel options: described once, set from text, bad values refused naming the key", "[parallel][options]") {
   BoundarySolveOptions solve;
   CHECK(set_option(solve, "boundary_solve", "petsc"));
-  CHECK(solve.kind == BoundarySolve::petsc);
+  CHECK(solve.boundary_solve == BoundarySolve::petsc);
   CHECK(set_option(solve, "petsc_min_node_centres", "12"));
   CHECK(solve.petsc_min_node_centres == 12);
   CHECK_THROWS_WITH(set_option(solve, "boundary_solve", "mumps"), Catch::Contains("boundary_solve") && Catch::Contains("replicated"));
   DistributedElasticityOptions elasticity;
   CHECK(set_option(elasticity, "petsc_solver", "mumps"));
-  CHECK(elasticity.solver == PetscSolverKind::direct_mumps);
+  CHECK(elasticity.petsc_solver == PetscSolverKind::direct_mumps);
   CHECK_FALSE(set_option(elasticity, "boundary_solve", "petsc"));
   // The defaults the docs show are the structs' own.
   for (const OptionDoc& d : option_docs(BoundarySolveOptions{}))

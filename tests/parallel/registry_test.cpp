@@ -43,8 +43,11 @@ TEST_CASE("distributed registry: rbf, le and sle through one type, set up once a
     const std::unique_ptr<DistributedMover<2>> mover = make_distributed_mover(config);
     mover->setup(part, local);
     CHECK(find_distributed_method<2>(method)->needs_cells == (method != "rbf"));
-    CHECK((mover->support_radius() > 0.0) == (method == "rbf"));
-    CHECK((mover->boundary_solve() == "none") == (method != "rbf"));
+    const DistributedChoices chose = mover->choices();
+    CHECK((chose.support_radius > 0.0) == (method == "rbf"));
+    CHECK((chose.boundary_solve == "none") == (method != "rbf"));
+    CHECK((chose.petsc_solver == "none") == (method == "rbf"));
+    if (method != "rbf") CHECK(chose.petsc_solver == "mumps");  // automatic, resolved in 2D
     for (const double scale : {0.5, 1.0, -2.0}) {
       const Points<2> expected = serial.move(scale * motion.displacements);
       const Points<2> got = mover->move(scale * local_motion.displacements);
@@ -64,13 +67,15 @@ TEST_CASE("distributed registry: methods without a distributed mover, and movers
   // Every distributed method is a serial one, with the serial registry's needs for cells.
   for (const DistributedMethod<3>& m : distributed_methods<3>())
     CHECK(mover_method<3>(m.name).needs_cells == m.needs_cells);
-  // The RBF interpolates the whole motion: its automatic rigid part is none.
-  MoverOptions<3> options = RbfOptions{};
-  find_distributed_method<3>("rbf")->prepare(options);
-  CHECK(std::get<RbfOptions>(options).rigid_part == RigidPart::none);
   // Elasticity without cells is refused with what to do instead.
   const Mesh<3> box = box_mesh({.nx = 2, .ny = 2, .nz = 2});
   const DistributedMesh<3> part = partition_mesh(world(), box);
+  // The rigid part is the distributed RBF's own to decide (it interpolates the whole motion):
+  // blend is refused by the mover, naming why.
+  MoverConfig<3> blend = mover_config<3>("rbf");
+  blend.set("rigid_part", "blend");
+  CHECK_THROWS_WITH(make_distributed_mover(blend)->setup(part.view(), ResolvedBoundary<3>{}),
+                    Catch::Contains("rigid_part=blend is not distributed"));
   const std::unique_ptr<DistributedMover<3>> le = make_distributed_mover(mover_config<3>("le"));
   CHECK_THROWS_WITH(le->setup(part.view(), ResolvedBoundary<3>{}), Catch::Contains("needs the cells"));
 }
@@ -80,8 +85,8 @@ TEST_CASE("parallel options: split off a method's keys in order, the rest left t
   const KeyValues rest = take_parallel_options(
       {{"support_radius", "2"}, {"boundary_solve", "petsc"}, {"petsc_solver", "cg_gamg"}, {"kernel", "wendland4"}}, parallel);
   CHECK(rest == KeyValues{{"support_radius", "2"}, {"kernel", "wendland4"}});
-  CHECK(parallel.boundary.kind == BoundarySolve::petsc);
-  CHECK(parallel.elasticity.solver == PetscSolverKind::cg_gamg);
+  CHECK(parallel.boundary.boundary_solve == BoundarySolve::petsc);
+  CHECK(parallel.elasticity.petsc_solver == PetscSolverKind::cg_gamg);
   CHECK_THROWS_WITH(take_parallel_options({{"boundary_solve", "mumps"}}, parallel), Catch::Contains("boundary_solve"));
   // Every key once, in the docs the programs and Python show.
   const std::vector<std::string> keys = option_keys(ParallelOptions{});

@@ -68,12 +68,17 @@ inline constexpr OptionRange non_negative{0.0};
 }
 }  // namespace range
 
-/// An option's line of help and its range: what visit_options() hands each visitor as its
-/// third argument (visitors that want the text alone take it as a std::string_view).
+/// An option's description, the one doc of its field: what visit_options() hands each visitor
+/// as its third argument (visitors that want the line alone take it as a std::string_view).
+/// `text` is the line listings and flags show; `details`, where a line is not enough, the whole
+/// description (defaults that depend on the case, costs, what the library measured), which the
+/// API docs (docs/options.md) show in place of the line. Option structs carry no doc comment of their own
+/// on a described field, so there is one text to keep true.
 struct OptionHelp {
   std::string_view text;
   OptionRange range{};
-  constexpr OptionHelp(const char* t, OptionRange r = {}) : text(t), range(r) {}
+  std::string_view details{};
+  constexpr OptionHelp(const char* t, OptionRange r = {}, const char* d = "") : text(t), range(r), details(d) {}
   OptionHelp(const std::string& t, OptionRange r = {}) : text(t), range(r) {}
   constexpr operator std::string_view() const noexcept { return text; }
 };
@@ -386,6 +391,7 @@ struct OptionDoc {
   std::string type;   ///< option_type_name()
   std::string value;  ///< its value (the default, for a default-made struct) as text
   std::string doc;    ///< one line
+  std::string details;  ///< the whole description where one line is not enough (OptionHelp::details), else empty
 };
 
 /// Every key of an options struct with a visit_options description, in its order.
@@ -395,7 +401,7 @@ template <class Options>
   visit_options(o, [&](const std::string& key, auto& field, const OptionHelp& help) {
     std::string type = option_type_name(field);
     if (const std::string r = help.range.text(); !r.empty()) type += " " + r;
-    out.push_back({key, std::move(type), format_option_value(field), std::string(help.text)});
+    out.push_back({key, std::move(type), format_option_value(field), std::string(help.text), std::string(help.details)});
   });
   return out;
 }

@@ -90,15 +90,9 @@ struct BoundaryGeometry {
 
 /// Options of snap_boundary().
 struct SnapOptions {
-  double corner_angle = 30.0;       ///< spline corners: facet directions differing by more (degrees)
-  std::vector<Index> corner_nodes;  ///< spline corners whatever their angle
-  /// Where a spline facet's nodes go: at fractions of its arc length (default), or of its
-  /// parameter (the thesis). The parameter need not be arc length, and the tangential offset
-  /// it gives a wall node is carried into a thin layer (the measurements: docs/curving.md,
-  /// "Spline midpoints").
+  double corner_angle = 30.0;
+  std::vector<Index> corner_nodes;
   SplineMidpoint midpoint = SplineMidpoint::arc_length;
-  /// A vertex whose projection is closer than this (relative to the mesh's bounding-box
-  /// diagonal) is already on the geometry and stays.
   double on_geometry_tolerance = 1e-12;
 };
 
@@ -106,7 +100,10 @@ template <class F>
 void visit_options(SnapOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "corner_angle", o.corner_angle, OptionHelp{"spline corners: facet directions differing by more (degrees)", range::between(0, 180)});
   f(prefix + "corner_nodes", o.corner_nodes, "spline corners whatever their angle (node indices, comma-separated)");
-  f(prefix + "midpoint", o.midpoint, "spline facet nodes at fractions of its arc_length, or of its parameter (the thesis)");
+  f(prefix + "midpoint", o.midpoint, OptionHelp{"spline facet nodes at fractions of its arc_length, or of its parameter (the thesis)", {},
+      "Where a spline facet's nodes go: at fractions of its arc length (default), or of its parameter (the "
+      "thesis). The parameter need not be arc length, and the tangential offset it gives a wall node is "
+      "carried into a thin layer (the measurements: docs/curving.md, \"Spline midpoints\")."});
   f(prefix + "on_geometry_tolerance", o.on_geometry_tolerance,
     OptionHelp{"a vertex closer than this x the mesh diagonal to its projection is on the geometry and stays", range::non_negative});
 }

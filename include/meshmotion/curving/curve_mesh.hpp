@@ -139,16 +139,16 @@ void regularize_and_certify(Mover& mover, const ResolvedBoundary<Dim>& boundary,
   result.cell_quality.reserve(cells.size());
   for (const CellQuality& c : cells) result.cell_quality.push_back(c.value);
   result.seconds.certify = certify_clock.seconds();
-  if (options.untangle.enabled) {
+  if (options.untangle.untangle) {
     const detail::Stopwatch untangle_clock;
     // Boundary nodes are on the geometry: they stay, or slide on it (`wall_sliding`, and the
     // entries sliding in a plane), asked for only when there is something to untangle.
     std::vector<char> fixed(static_cast<std::size_t>(mesh.num_nodes()), 0);
     for (const Index v : boundary.nodes) fixed[static_cast<std::size_t>(v)] = 1;
     SlidingNodes<Dim> sliding;
-    if (std::any_of(result.cell_quality.begin(), result.cell_quality.end(), [&](double q) { return q < options.untangle.threshold; })) {
-      detail::report_progress(options.progress, "untangling the cells below " + format_option_value(options.untangle.threshold));
-      if (options.untangle.slide) {
+    if (std::any_of(result.cell_quality.begin(), result.cell_quality.end(), [&](double q) { return q < options.untangle.untangle_threshold; })) {
+      detail::report_progress(options.progress, "untangling the cells below " + format_option_value(options.untangle.untangle_threshold));
+      if (options.untangle.untangle_slide) {
         if (wall_sliding) sliding = wall_sliding();
         detail::add_sliding_entries(mesh, boundary, sliding);
       }
@@ -307,7 +307,7 @@ template <int Dim>
   // Strict mode refuses below, the geometry first: a wall in the wrong place explains invalid cells.
   CurveOptions<Dim> stage = options;
   stage.strict = false;
-  if (!moves_interior) stage.untangle.enabled = false;
+  if (!moves_interior) stage.untangle.untangle = false;
   regularize_and_certify(mover, boundary, given, stage, result,
                          [&] { return detail::wall_sliding_nodes(result.curved, geometry, options.snap.corner_angle); });
   result.reversed_cells = detail::count_reversed(result.curved, at_moved_vertices);

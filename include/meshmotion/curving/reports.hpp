@@ -15,6 +15,7 @@
 #include "meshmotion/movers/boundary_layer.hpp"
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/movers/step_driver.hpp"
+#include "meshmotion/parallel/parallel_options.hpp"
 #include "meshmotion/quality/quality_report.hpp"
 
 #include <string>
@@ -42,6 +43,8 @@ void for_each_report(F&& f) {
   f.template operator()<MoverStats>("mover_stats", "mover_steps", "A mover's stats (Python's Mover.stats).");
   f.template operator()<MoveReport>("move", "move_mesh's report",
                                     "`move_mesh --json` (beside input, output, support_radius, options).");
+  f.template operator()<parallel::DistributedChoices>("distributed", "move_mesh_mpi's choices",
+                                                     "`move_mesh_mpi --json` (beside ranks, threads_per_rank and move_mesh's report).");
   f.template operator()<MeshSummary>("summary", "summary", "What a mesh holds (`mesh_info --json`, Python's Mesh.summary).");
   f.template operator()<FoamCaseSummary>("openfoam_case", "openfoam",
                                          "An OpenFOAM case as checkMesh counts it (`mesh_info --json` of a case).");

@@ -56,23 +56,15 @@ namespace meshmotion {
 
 /// Options of untangle().
 struct UntangleOptions {
-  bool enabled = true;      ///< false: leave the regularized mesh as it is
-  double threshold = 0.1;   ///< cells whose certified scaled Jacobian is below this are optimized
-  int layers = 3;           ///< rings of neighbouring cells that move with them
-  int max_sweeps = 20;      ///< node sweeps at most per pass
-  /// Boundary nodes the caller lets slide (untangle()'s `sliding`; in the curving pipeline the
-  /// wall nodes off sharp edges and the symmetry planes' nodes) move along their geometry.
-  bool slide = true;
-  /// After the cells below the threshold, rounds that raise the certified minimum: each
-  /// optimizes the `raise_cells` worst cells (those within `raise_margin` of the minimum) and
-  /// `raise_layers` rings around them towards the minimum plus the margin; the rounds stop when
-  /// the minimum no longer rises.
+  bool untangle = true;
+  double untangle_threshold = 0.1;
+  int untangle_layers = 3;
+  int untangle_sweeps = 20;
+  bool untangle_slide = true;
   int raise_rounds = 4;
   int raise_cells = 16;
   int raise_layers = 0;
   double raise_margin = 0.05;
-  /// The rounds' work at most: this many cell evaluations per cell of the mesh (one evaluation
-  /// costs about what the certification spends on a cell).
   double raise_budget = 4.0;
 };
 
@@ -109,16 +101,23 @@ struct UntangleReport {
 /// pipeline's own keys.
 template <class F>
 void visit_options(UntangleOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "untangle", o.enabled, "optimize the cells below untangle_threshold after the regularization");
-  f(prefix + "untangle_threshold", o.threshold, OptionHelp{"optimize the high-order nodes around cells whose certified scaled Jacobian is below this", range::at_most(1)});
-  f(prefix + "untangle_layers", o.layers, OptionHelp{"rings of neighbouring cells that move with a cell below the threshold", range::non_negative});
-  f(prefix + "untangle_sweeps", o.max_sweeps, OptionHelp{"node sweeps at most per pass", range::at_least(1)});
-  f(prefix + "untangle_slide", o.slide, "wall nodes off sharp edges, and sliding planes' nodes, move along their geometry while untangling");
-  f(prefix + "raise_rounds", o.raise_rounds, OptionHelp{"then rounds raising the worst cells while the minimum rises (0: none)", range::non_negative});
+  f(prefix + "untangle", o.untangle, "optimize the cells below untangle_threshold after the regularization (false: leave the mesh as it is)");
+  f(prefix + "untangle_threshold", o.untangle_threshold, OptionHelp{"optimize the high-order nodes around cells whose certified scaled Jacobian is below this", range::at_most(1)});
+  f(prefix + "untangle_layers", o.untangle_layers, OptionHelp{"rings of neighbouring cells that move with a cell below the threshold", range::non_negative});
+  f(prefix + "untangle_sweeps", o.untangle_sweeps, OptionHelp{"node sweeps at most per pass", range::at_least(1)});
+  f(prefix + "untangle_slide", o.untangle_slide, OptionHelp{"wall nodes off sharp edges, and sliding planes' nodes, move along their geometry while untangling", {},
+      "Boundary nodes the caller lets slide (untangle()'s `sliding`; in the curving pipeline the wall nodes "
+      "off sharp edges and the symmetry planes' nodes) move along their geometry."});
+  f(prefix + "raise_rounds", o.raise_rounds, OptionHelp{"then rounds raising the worst cells while the minimum rises (0: none)", range::non_negative,
+      "After the cells below the threshold, rounds that raise the certified minimum: each optimizes the "
+      "`raise_cells` worst cells (those within `raise_margin` of the minimum) and `raise_layers` rings around "
+      "them towards the minimum plus the margin; the rounds stop when the minimum no longer rises."});
   f(prefix + "raise_cells", o.raise_cells, OptionHelp{"worst cells optimized per round", range::at_least(1)});
   f(prefix + "raise_layers", o.raise_layers, OptionHelp{"rings of cells around them that move too", range::non_negative});
   f(prefix + "raise_margin", o.raise_margin, OptionHelp{"cells within this of the minimum are the worst; the round aims at minimum + margin", range::non_negative});
-  f(prefix + "raise_budget", o.raise_budget, OptionHelp{"the rounds' cell evaluations at most, per cell of the mesh", range::non_negative});
+  f(prefix + "raise_budget", o.raise_budget, OptionHelp{"the rounds' cell evaluations at most, per cell of the mesh", range::non_negative,
+      "The rounds' work at most: this many cell evaluations per cell of the mesh (one evaluation costs about "
+      "what the certification spends on a cell)."});
 }
 
 template <class F>
@@ -545,7 +544,7 @@ class PatchOptimizer {
 }  // namespace detail
 
 /// Optimizes the nodes around the cells of `mesh` whose value in `quality` (the certified
-/// scaled Jacobian of each cell, in cell order) is below options.threshold, then raises the
+/// scaled Jacobian of each cell, in cell order) is below options.untangle_threshold, then raises the
 /// worst cells (options.raise_rounds); nodes with fixed[node] set do not move, except the
 /// `sliding` ones, which move along their geometry while the cells below the threshold are
 /// optimized. `quality` is updated for every cell that was certified again. Throws InputError
@@ -565,13 +564,13 @@ UntangleReport untangle(Mesh<Dim>& mesh, std::span<const char> fixed, std::vecto
   report.min_after = report.min_before;
   std::vector<Index> below;
   for (std::size_t c = 0; c < quality.size(); ++c) {
-    if (quality[c] < options.threshold) below.push_back(static_cast<Index>(c));
+    if (quality[c] < options.untangle_threshold) below.push_back(static_cast<Index>(c));
     report.invalid_before += quality[c] <= 0.0 ? 1 : 0;
   }
   report.cells_below = static_cast<Index>(below.size());
   report.invalid_after = report.invalid_before;
   const bool raise = options.raise_rounds > 0 && options.raise_cells > 0;
-  if (!options.enabled || (below.empty() && !raise)) return report;
+  if (!options.untangle || (below.empty() && !raise)) return report;
 
   detail::PatchOptimizer<Dim> optimizer(mesh, fixed, sliding);
   const auto add = [&](const typename detail::PatchOptimizer<Dim>::Pass& pass) {
@@ -581,8 +580,8 @@ UntangleReport untangle(Mesh<Dim>& mesh, std::span<const char> fixed, std::vecto
     report.sweeps += pass.sweeps;
   };
   if (!below.empty()) {
-    const auto pass = optimizer.run(below, options.threshold, options.layers, options.max_sweeps,
-                                    std::numeric_limits<long long>::max(), false, options.slide, quality);
+    const auto pass = optimizer.run(below, options.untangle_threshold, options.untangle_layers, options.untangle_sweeps,
+                                    std::numeric_limits<long long>::max(), false, options.untangle_slide, quality);
     add(pass);
     report.reverted = pass.reverted;
   }
@@ -594,7 +593,7 @@ UntangleReport untangle(Mesh<Dim>& mesh, std::span<const char> fixed, std::vecto
                            static_cast<long long>(std::max(0.0, options.raise_budget) * static_cast<double>(quality.size()));
   for (int round = 0; raise && round < options.raise_rounds && optimizer.evaluations() < budget; ++round) {
     const double low = minimum();
-    if (low < options.threshold) break;  // the untangling could not lift these; a round would not either
+    if (low < options.untangle_threshold) break;  // the untangling could not lift these; a round would not either
     std::iota(order.begin(), order.end(), Index{0});
     const auto count = std::min<std::size_t>(static_cast<std::size_t>(options.raise_cells), order.size());
     std::nth_element(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(count - 1), order.end(),
@@ -610,7 +609,7 @@ UntangleReport untangle(Mesh<Dim>& mesh, std::span<const char> fixed, std::vecto
     for (Index c = 0; c < static_cast<Index>(quality.size()); ++c)
       if (level(c) <= last && quality[static_cast<std::size_t>(c)] < target) seeds.push_back(c);
     std::stable_sort(seeds.begin(), seeds.end(), [&](Index a, Index b) { return level(a) < level(b); });
-    add(optimizer.run(seeds, target, options.raise_layers, options.max_sweeps, budget, true, false, quality));
+    add(optimizer.run(seeds, target, options.raise_layers, options.untangle_sweeps, budget, true, false, quality));
     if (!(minimum() > low + 1e-4)) break;
     ++report.raise_rounds;
   }

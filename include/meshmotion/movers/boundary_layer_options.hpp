@@ -11,8 +11,6 @@ namespace meshmotion {
 
 /// Options of estimate_boundary_layer().
 struct BoundaryLayerOptions {
-  /// Cells with longest/shortest vertex edge at least this belong to the layer; 2–4 separates
-  /// the stretched layer from the isotropic core of usual meshes.
   double aspect_ratio_threshold = 3.0;
 };
 
@@ -20,7 +18,9 @@ struct BoundaryLayerOptions {
 template <class F>
 void visit_options(BoundaryLayerOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "aspect_ratio_threshold", o.aspect_ratio_threshold,
-    OptionHelp{"cells at least this anisotropic (longest/shortest edge) form a wall's boundary layer", range::at_least(1)});
+    OptionHelp{"cells at least this anisotropic (longest/shortest edge) form a wall's boundary layer", range::at_least(1),
+      "Cells with longest/shortest vertex edge at least this belong to the layer; 2–4 separates the stretched "
+      "layer from the isotropic core of usual meshes."});
 }
 
 }  // namespace meshmotion

@@ -38,15 +38,8 @@ enum class OutsideGraph {
 /// A a = s_T, A_ij = φ(|x_ti − x_tj|). The (Dim+1)² systems are factorized once per simplex.
 struct SimplexRbfOptions {
   RbfKernel kernel = RbfKernel::wendland2;
-  /// Absolute support radius (shape scale of global kernels) when > 0; when 0 each simplex
-  /// uses relative_support × its longest edge, so every point of the simplex lies inside the
-  /// support of every vertex whatever the simplex size (graph simplices range from wall
-  /// spacing to farfield size).
-  double support_radius = 0.0;
-  double relative_support = 2.0;  ///< used when support_radius == 0; must be > 0
-  /// Divide the cardinal weights A⁻¹φ(x) by their sum (rescaled RBF): the interpolant then
-  /// reproduces constants exactly (rigid translations, and in DGRBF2 rigid rotations),
-  /// which plain RBF with Dim+1 centres does not. false gives the thesis's eq. 2.15 as is.
+  double simplex_support_radius = 0.0;
+  double simplex_support = 2.0;
   bool normalize = true;
 };
 
@@ -54,9 +47,15 @@ struct SimplexRbfOptions {
 template <class F>
 void visit_options(SimplexRbfOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "kernel", o.kernel, "radial function of the per-simplex interpolation");
-  f(prefix + "simplex_support_radius", o.support_radius, OptionHelp{"absolute per-simplex support radius (0: relative)", range::non_negative});
-  f(prefix + "simplex_support", o.relative_support, OptionHelp{"per-simplex support, × the simplex's longest edge", range::positive});
-  f(prefix + "normalize", o.normalize, "divide the cardinal weights by their sum");
+  f(prefix + "simplex_support_radius", o.simplex_support_radius, OptionHelp{"absolute per-simplex support radius (0: relative)", range::non_negative,
+      "Absolute support radius (shape scale of global kernels) when > 0; when 0 each simplex uses "
+      "simplex_support × its longest edge, so every point of the simplex lies inside the support of every "
+      "vertex whatever the simplex size (graph simplices range from wall spacing to farfield size)."});
+  f(prefix + "simplex_support", o.simplex_support, OptionHelp{"per-simplex support, × the simplex's longest edge (when simplex_support_radius is 0)", range::positive});
+  f(prefix + "normalize", o.normalize, OptionHelp{"divide the cardinal weights by their sum", {},
+      "Divide the cardinal weights A⁻¹φ(x) by their sum (rescaled RBF): the interpolant then reproduces "
+      "constants exactly (rigid translations, and in DGRBF2 rigid rotations), which plain RBF with Dim+1 "
+      "centres does not. false gives the thesis's eq. 2.15 as is."});
 }
 
 }  // namespace meshmotion

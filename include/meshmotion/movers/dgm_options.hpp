@@ -12,7 +12,6 @@ namespace meshmotion {
 /// Options of DgmMover.
 struct DgmOptions {
   OutsideGraph outside = OutsideGraph::clamp;
-  /// Refuse (InvalidMeshError) when the moved graph inverts; false maps anyway.
   bool check_inversion = true;
 };
 

@@ -16,10 +16,7 @@ template <int Dim>
 struct Dgrbf2Options {
   SimplexRbfOptions rbf = {};
   OutsideGraph outside = OutsideGraph::clamp;
-  /// Centre of rotation (the centre of the rigid Rotation2D/Rotation3D given to the moving
-  /// group; for a Composition, the rotation's centre). Empty: the centroid of the moving nodes.
   std::optional<Vec<Dim>> center;
-  /// Rotation axis in 3D (any non-zero length; ignored in 2D).
   Vec<3> axis = Vec<3>::UnitZ();
 };
 
@@ -28,7 +25,9 @@ template <int Dim, class F>
 void visit_options(Dgrbf2Options<Dim>& o, F&& f, const std::string& prefix = {}) {
   visit_options(o.rbf, f, prefix);
   f(prefix + "outside", o.outside, "nodes outside the graph's hull");
-  f(prefix + "center", o.center, "centre of the rigid rotation (none: centroid of the moving nodes)");
+  f(prefix + "center", o.center, OptionHelp{"centre of the rigid rotation (none: centroid of the moving nodes)", {},
+      "Centre of rotation (the centre of the rigid Rotation2D/Rotation3D given to the moving group; for a "
+      "Composition, the rotation's centre). Empty: the centroid of the moving nodes."});
   if constexpr (Dim == 3) f(prefix + "axis", o.axis, "rotation axis");
 }
 

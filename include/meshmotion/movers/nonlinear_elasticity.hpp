@@ -56,7 +56,7 @@ class NonlinearElasticityMover : public detail::MoveFromMoveInto<NonlinearElasti
   [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
 
   /// Copies `mesh` (any MeshLike of dimension Dim) and numbers the unknowns for `boundary`.
-  /// Throws InputError for E ≤ 0, ν outside (−1, 0.5), load_steps or max_newton_iterations
+  /// Throws InputError for E ≤ 0, ν outside (−1, 0.5), load_steps or newton_iterations
   /// < 1, a non-positive tolerance, or bad mesh/boundary data.
   template <MeshLike M>
     requires(mesh_dim<M> == Dim)
@@ -64,10 +64,10 @@ class NonlinearElasticityMover : public detail::MoveFromMoveInto<NonlinearElasti
     const detail::Stopwatch watch;
     ready_ = false;
     lame_ = detail::lame_parameters(options_.youngs_modulus, options_.poisson_ratio, "NonlinearElasticityMover::setup");
-    if (options_.load_steps < 1 || options_.max_newton_iterations < 1)
-      throw InputError("NonlinearElasticityMover::setup: load_steps and max_newton_iterations must be >= 1 (got " +
-                       std::to_string(options_.load_steps) + " and " + std::to_string(options_.max_newton_iterations) + ")");
-    if (!(options_.tolerance > 0.0) || !(options_.min_step > 0.0 && options_.min_step < 1.0))
+    if (options_.load_steps < 1 || options_.newton_iterations < 1)
+      throw InputError("NonlinearElasticityMover::setup: load_steps and newton_iterations must be >= 1 (got " +
+                       std::to_string(options_.load_steps) + " and " + std::to_string(options_.newton_iterations) + ")");
+    if (!(options_.newton_tolerance > 0.0) || !(options_.min_step > 0.0 && options_.min_step < 1.0))
       throw InputError("NonlinearElasticityMover::setup: tolerance must be > 0 and min_step in (0, 1)");
     mesh_ = detail::checked_copy(mesh, boundary, "NonlinearElasticityMover");
     boundary_nodes_ = boundary.nodes;
@@ -116,7 +116,7 @@ class NonlinearElasticityMover : public detail::MoveFromMoveInto<NonlinearElasti
     for (int s = 1; s <= options_.load_steps; ++s) {
       const Points<Dim> target = d * (static_cast<double>(s) / options_.load_steps);
       bool converged = false;
-      for (int it = 0; it < options_.max_newton_iterations && !converged; ++it, ++iterations) {
+      for (int it = 0; it < options_.newton_iterations && !converged; ++it, ++iterations) {
         Points<Dim> increment = target - applied;
         for (Index k = 0; k < increment.cols(); ++k)
           if (kinds_[static_cast<std::size_t>(k)] == BoundaryKind::sliding) increment.col(k).setZero();
@@ -141,11 +141,11 @@ class NonlinearElasticityMover : public detail::MoveFromMoveInto<NonlinearElasti
         applied += alpha * increment;
         if (alpha == 1.0) applied = target;  // exact boundary values once the increment is complete
         const double update = alpha * step.cwiseAbs().maxCoeff();
-        converged = boundary_done && update <= options_.tolerance * diameter_;
+        converged = boundary_done && update <= options_.newton_tolerance * diameter_;
       }
       if (!converged)
         throw SolverError("NonlinearElasticityMover::move: Newton did not converge in " +
-                          std::to_string(options_.max_newton_iterations) + " iterations (load step " + std::to_string(s) + ")");
+                          std::to_string(options_.newton_iterations) + " iterations (load step " + std::to_string(s) + ")");
     }
     // Boundary nodes get their targets exactly (sliding ones keep their computed position).
     for (Index k = 0; k < d.cols(); ++k)

@@ -44,69 +44,20 @@ enum class RigidPart {
 /// Options of RbfMover.
 struct RbfOptions {
   RbfKernel kernel = RbfKernel::wendland2;
-  /// Support radius of compact kernels (shape scale of global ones), in mesh units; 0
-  /// (default): suggest_support_radius() of the boundary each setup is given (its nodes and
-  /// displacements), so that the same mesh in millimetres and in metres moves alike;
-  /// RbfMover::support_radius() says what setup took.
   double support_radius = 0.0;
-  /// A radius per boundary entry (in the order of the boundary given to setup), replacing
-  /// support_radius; empty: support_radius everywhere. Coincident nodes share the radius of
-  /// the one that gives their value. Lets each wall's support follow its own boundary layer.
-  /// Radii that differ between centres within each other's support make the interpolation
-  /// matrix nonsymmetric: it is then factorized by sparse LU whatever `solver` says (BiCGSTAB
-  /// is kept). Walls whose supports do not meet keep it symmetric, and `solver` applies.
   std::vector<double> support_radii{};
-  /// Add a linear polynomial (reproduces affine motions exactly). Always on for the kernels
-  /// that need it (needs_polynomial(): tps, multiquadric; without it a rotation moved by tps
-  /// gave a scaled Jacobian of -230): see effective_options().
   bool polynomial = false;
   /// Solver of the sparse system of compact kernels.
   SolverOptions solver = {};
-  /// Factorization of the dense system of global kernels.
   DenseSolverKind dense_solver = DenseSolverKind::partial_piv_lu;
-  /// Largest boundary-node count accepted for a global kernel (dense m × m system).
   Index max_dense_centres = 4000;
-  /// Boundary nodes closer than this fraction of the boundary's bounding-box diagonal are one node.
   double coincidence_tolerance = 1e-10;
-  /// Global kernels: setup stores the dense evaluation matrix (evaluated nodes × centres, 8
-  /// bytes an entry) when it takes at most this many bytes, so a move is one dense matrix
-  /// product instead of n × m kernel evaluations; larger matrices are recomputed every move.
-  /// 0 never caches. Compact kernels keep a sparse operator unless their support reaches most
-  /// centres from most nodes and the dense matrix fits here.
   std::size_t max_evaluation_cache_bytes = std::size_t{256} << 20;
-  /// Interpolate with local systems on overlapping patches of the boundary, blended by a
-  /// partition of unity, instead of one system over every centre: for boundaries too large to
-  /// factorize at once (from ~100k nodes). Needs a compact kernel, one support_radius and no
-  /// polynomial. Interpolating and linear like the global system, not equal to it: the
-  /// difference is what data beyond a patch contributes inside it (docs/interpolation.md).
   bool partition_of_unity = false;
-  /// Partition of unity: most centres per patch before the overlap is added.
   Index patch_centres = 4000;
-  /// Partition of unity: each patch's ball reaches this fraction of its radius, and at least
-  /// the support radius, beyond its own centres.
   double patch_overlap = 0.25;
-  /// Compact kernels with one radius, without partition of unity: the most memory (bytes) the
-  /// system, its factor and the evaluation operator may take, estimated before assembly from
-  /// a sample of nodes and centres; 0 (default): half the machine's memory. A radius given
-  /// beyond it is refused. The default radius is reduced until the estimate fits
-  /// max(1 KiB per mesh node, an eighth of the machine's memory) and this limit: a large
-  /// rotation's default radius (5 × the largest displacement) can reach the whole domain,
-  /// which made the system and the operator dense (22 GB on a 28k-node case).
-  /// support_radius_reduced() says when it was.
   double max_memory_bytes = 0.0;
-  /// Take the rigid part of the setup boundary's motion out before interpolating
-  /// (rigid_part.hpp): every node follows the prescribed nodes' rigid motion, its angle and
-  /// translation blended to nothing at the nearest held node, and the interpolation carries
-  /// the rest. The default (automatic) does it for a rigid motion the default radius cannot
-  /// spread within the memory budget (a body turned 90° in a box), or when nothing is held.
   RigidPart rigid_part = RigidPart::automatic;
-  /// Compact kernels without partition of unity: a system whose estimated condition number
-  /// (MoverStats::condition) exceeds this is thinned: centres closer together than its radius
-  /// can resolve (a blunt trailing edge's two sides 1e-6 apart under a radius of 2) keep their
-  /// value through a bump no wider than the gap to their neighbour, and the system is that of
-  /// the centres kept (detail::RbfSystem::setup). Rounding in a move or a derivative grows by
-  /// up to the condition: 1e10 keeps derivatives to about 1e-6 relative. 0 never thins.
-  /// MoverStats::thinned_centres says how many were.
   double condition_limit = 1e10;
 };
 
@@ -114,22 +65,63 @@ struct RbfOptions {
 template <class F>
 void visit_options(RbfOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "kernel", o.kernel, "radial function");
-  f(prefix + "support_radius", o.support_radius, OptionHelp{"support radius (scale of global kernels), mesh units; 0: from the boundary", range::non_negative});
-  f(prefix + "support_radii", o.support_radii, OptionHelp{"a radius per boundary entry (comma-separated), replacing support_radius", range::positive});
-  f(prefix + "polynomial", o.polynomial, "add a linear polynomial (affine motions exact)");
+  f(prefix + "support_radius", o.support_radius, OptionHelp{"support radius (scale of global kernels), mesh units; 0: from the boundary", range::non_negative,
+      "Support radius of compact kernels (shape scale of global ones), in mesh units; 0 (default): "
+      "suggest_support_radius() of the boundary each setup is given (its nodes and displacements), so that "
+      "the same mesh in millimetres and in metres moves alike; RbfMover::support_radius() says what setup "
+      "took."});
+  f(prefix + "support_radii", o.support_radii, OptionHelp{"a radius per boundary entry (comma-separated), replacing support_radius", range::positive,
+      "A radius per boundary entry (in the order of the boundary given to setup), replacing support_radius; "
+      "empty: support_radius everywhere. Coincident nodes share the radius of the one that gives their value. "
+      "Lets each wall's support follow its own boundary layer. Radii that differ between centres within each "
+      "other's support make the interpolation matrix nonsymmetric: it is then factorized by sparse LU "
+      "whatever `solver` says (BiCGSTAB is kept). Walls whose supports do not meet keep it symmetric, and "
+      "`solver` applies."});
+  f(prefix + "polynomial", o.polynomial, OptionHelp{"add a linear polynomial (affine motions exact)", {},
+      "Add a linear polynomial (reproduces affine motions exactly). Always on for the kernels that need it "
+      "(needs_polynomial(): tps, multiquadric; without it a rotation moved by tps gave a scaled Jacobian of "
+      "-230): see effective_options()."});
   visit_options(o.solver, f, prefix);
   f(prefix + "dense_solver", o.dense_solver, "factorization of the dense system of global kernels");
   f(prefix + "max_dense_centres", o.max_dense_centres, OptionHelp{"largest centre count of a global kernel", range::at_least(1)});
   f(prefix + "coincidence_tolerance", o.coincidence_tolerance, OptionHelp{"boundary nodes closer than this × the diagonal are one", range::non_negative});
-  f(prefix + "max_evaluation_cache_bytes", o.max_evaluation_cache_bytes, OptionHelp{"largest dense evaluation matrix kept", range::between(0, 0x1p50)});
-  f(prefix + "partition_of_unity", o.partition_of_unity, "local systems on overlapping patches (boundaries of ~100k+ nodes)");
+  f(prefix + "max_evaluation_cache_bytes", o.max_evaluation_cache_bytes, OptionHelp{"largest dense evaluation matrix kept", range::between(0, 0x1p50),
+      "Global kernels: setup stores the dense evaluation matrix (evaluated nodes × centres, 8 bytes an entry) "
+      "when it takes at most this many bytes, so a move is one dense matrix product instead of n × m kernel "
+      "evaluations; larger matrices are recomputed every move. 0 never caches. Compact kernels keep a sparse "
+      "operator unless their support reaches most centres from most nodes and the dense matrix fits here."});
+  f(prefix + "partition_of_unity", o.partition_of_unity, OptionHelp{"local systems on overlapping patches (boundaries of ~100k+ nodes)", {},
+      "Interpolate with local systems on overlapping patches of the boundary, blended by a partition of "
+      "unity, instead of one system over every centre: for boundaries too large to factorize at once (from "
+      "~100k nodes). Needs a compact kernel, one support_radius and no polynomial. Interpolating and linear "
+      "like the global system, not equal to it: the difference is what data beyond a patch contributes inside "
+      "it (docs/interpolation.md)."});
   f(prefix + "patch_centres", o.patch_centres, OptionHelp{"partition of unity: most centres per patch before the overlap", range::at_least(1)});
   f(prefix + "patch_overlap", o.patch_overlap, OptionHelp{"partition of unity: overlap, x each patch's radius (at least the support radius)", range::non_negative});
   f(prefix + "max_memory_bytes", o.max_memory_bytes,
-    OptionHelp{"compact kernels: estimated memory allowed, bytes (0: half the machine's); a default radius is reduced to fit", range::non_negative});
-  f(prefix + "rigid_part", o.rigid_part, "blend a large rigid motion into the volume before interpolating the rest");
+    OptionHelp{"compact kernels: estimated memory allowed, bytes (0: half the machine's); a default radius is reduced to fit", range::non_negative,
+      "Compact kernels with one radius, without partition of unity: the most memory (bytes) the system, its "
+      "factor and the evaluation operator may take, estimated before assembly from a sample of nodes and "
+      "centres; 0 (default): half the machine's memory. A radius given beyond it is refused. The default "
+      "radius is reduced until the estimate fits max(1 KiB per mesh node, an eighth of the machine's memory) "
+      "and this limit: a large rotation's default radius (5 × the largest displacement) can reach the whole "
+      "domain, which made the system and the operator dense (22 GB on a 28k-node case). "
+      "support_radius_reduced() says when it was."});
+  f(prefix + "rigid_part", o.rigid_part, OptionHelp{"blend a large rigid motion into the volume before interpolating the rest", {},
+      "Take the rigid part of the setup boundary's motion out before interpolating (rigid_part.hpp): every "
+      "node follows the prescribed nodes' rigid motion, its angle and translation blended to nothing at the "
+      "nearest held node, and the interpolation carries the rest. The default (automatic) does it for a rigid "
+      "motion the default radius cannot spread within the memory budget (a body turned 90° in a box), or when "
+      "nothing is held."});
   f(prefix + "condition_limit", o.condition_limit,
-    OptionHelp{"compact kernels: thin centres closer than the radius resolves when the condition exceeds this (0: never)", range::or_zero(range::at_least(1))});
+    OptionHelp{"compact kernels: thin centres closer than the radius resolves when the condition exceeds this (0: never)", range::or_zero(range::at_least(1)),
+      "Compact kernels without partition of unity: a system whose estimated condition number "
+      "(MoverStats::condition) exceeds this is thinned: centres closer together than its radius can resolve "
+      "(a blunt trailing edge's two sides 1e-6 apart under a radius of 2) keep their value through a bump no "
+      "wider than the gap to their neighbour, and the system is that of the centres kept "
+      "(detail::RbfSystem::setup). Rounding in a move or a derivative grows by up to the condition: 1e10 "
+      "keeps derivatives to about 1e-6 relative. 0 never thins. MoverStats::thinned_centres says how many "
+      "were."});
 }
 
 }  // namespace meshmotion

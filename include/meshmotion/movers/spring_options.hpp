@@ -12,7 +12,6 @@ namespace meshmotion {
 
 /// Options of SpringMover.
 struct SpringOptions {
-  /// p in k_ij = ‖r_i − r_j‖^−p; Batina's choice (eq. 2.2) is 1. Must be finite.
   double length_exponent = 1.0;
   /// Solver of the (SPD) spring system.
   SolverOptions solver = {};
@@ -21,7 +20,7 @@ struct SpringOptions {
 // visit_options(o, f) calls f(key, field, help) for every field of `o` that text may set.
 template <class F>
 void visit_options(SpringOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "length_exponent", o.length_exponent, OptionHelp{"p in k = length^-p", range::non_negative});
+  f(prefix + "length_exponent", o.length_exponent, OptionHelp{"p in the spring stiffness k_ij = |r_i - r_j|^-p (Batina's, eq. 2.2: 1)", range::non_negative});
   visit_options(o.solver, f, prefix);
 }
 

@@ -12,11 +12,8 @@ namespace meshmotion {
 
 /// Options of TorsionSpringMover.
 struct TorsionSpringOptions {
-  /// Multiplies every torsional stiffness (0 gives plain coupled lineal springs); ≥ 0.
   double torsion_weight = 1.0;
-  /// Lineal springs in Farhat et al.'s coupled truss form (true) or Batina's uncoupled form.
   bool coupled_lineal = true;
-  /// 3D: add Degand & Farhat's vertex–facet (dihedral-angle) springs to the face-corner ones.
   bool vertex_facet_springs = true;
   /// Solver of the (SPD) coupled system.
   SolverOptions solver = {};

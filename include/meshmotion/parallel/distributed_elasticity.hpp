@@ -63,6 +63,8 @@ class DistributedElasticityMover {
 
   [[nodiscard]] const DistributedElasticityOptions& options() const noexcept { return options_; }
   [[nodiscard]] const MoverStats& stats() const noexcept { return stats_; }
+  /// The solver the last setup built (PetscSolverKind::automatic resolved).
+  [[nodiscard]] PetscSolverKind solver_kind() const noexcept { return solver_kind_; }
 
   /// Collective. `part`: this rank's nodes; `local_mesh`: its cells over the local node
   /// indices (any MeshLike, whose nodes are part's); `boundary`: entries of local nodes (owned
@@ -159,6 +161,7 @@ class DistributedElasticityMover {
   OwnedVec scale_, b_, x_, values_, ghosts_;
   detail::OwnedScatter scatter_;
   OwnedKsp ksp_, direct_;
+  PetscSolverKind solver_kind_ = PetscSolverKind::automatic;
 };
 
 template <int Dim>
@@ -178,7 +181,7 @@ void DistributedElasticityMover<Dim>::build_solver(OwnedKsp& ksp, PetscSolverKin
     } else {
       petsc_check(PCSetType(pc, PCGAMG), where, "PCSetType");
     }
-    petsc_check(KSPSetTolerances(ksp.get(), options_.tolerance, 0.0, PETSC_DEFAULT, static_cast<PetscInt>(options_.max_iterations)), where, "KSPSetTolerances");
+    petsc_check(KSPSetTolerances(ksp.get(), options_.petsc_tolerance, 0.0, PETSC_DEFAULT, static_cast<PetscInt>(options_.petsc_max_iterations)), where, "KSPSetTolerances");
     petsc_check(KSPSetNormType(ksp.get(), KSP_NORM_UNPRECONDITIONED), where, "KSPSetNormType");
   }
   petsc_check(KSPSetOptionsPrefix(ksp.get(), options_.petsc_prefix.c_str()), where, "KSPSetOptionsPrefix");
@@ -212,7 +215,7 @@ void DistributedElasticityMover<Dim>::setup_mesh(const PartitionView<Dim>& part,
     if (!(eo.stiffening_exponent >= 0.0) || !std::isfinite(eo.stiffening_exponent))
       throw InputError("DistributedElasticityMover::setup: stiffening_exponent must be finite and >= 0 (got " +
                        std::to_string(eo.stiffening_exponent) + ")");
-    if (!(options_.tolerance > 0.0)) throw InputError("DistributedElasticityMover::setup: tolerance must be positive");
+    if (!(options_.petsc_tolerance > 0.0)) throw InputError("DistributedElasticityMover::setup: petsc_tolerance must be positive");
     static_cast<void>(meshmotion::detail::lame_parameters(eo.youngs_modulus, eo.poisson_ratio, "DistributedElasticityMover::setup"));
     for (const auto& block : mesh.cells)
       for (const Index v : block.connectivity)
@@ -382,7 +385,7 @@ void DistributedElasticityMover<Dim>::setup_mesh(const PartitionView<Dim>& part,
   petsc_check(MatDiagonalScale(a_.get(), scale_.get(), scale_.get()), where, "MatDiagonalScale");
   petsc_check(MatSetOption(a_.get(), MAT_SYMMETRIC, PETSC_TRUE), where, "MatSetOption");
   petsc_check(MatSetOption(a_.get(), MAT_SPD, PETSC_TRUE), where, "MatSetOption");
-  if (options_.solver == PetscSolverKind::cg_gamg || (options_.solver == PetscSolverKind::automatic && Dim == 3)) {
+  if (options_.petsc_solver == PetscSolverKind::cg_gamg || (options_.petsc_solver == PetscSolverKind::automatic && Dim == 3)) {
     // Rigid-body modes of the owned nodes (in the unrotated frame: near enough for the AMG).
     OwnedVec coordinates;
     petsc_check(VecCreateMPI(comm_, local_rows, PETSC_DETERMINE, coordinates.out()), where, "VecCreateMPI");
@@ -396,10 +399,10 @@ void DistributedElasticityMover<Dim>::setup_mesh(const PartitionView<Dim>& part,
     petsc_check(MatNullSpaceCreateRigidBody(coordinates.get(), modes.out()), where, "MatNullSpaceCreateRigidBody");
     petsc_check(MatSetNearNullSpace(a_.get(), modes.get()), where, "MatSetNearNullSpace");
   }
-  const PetscSolverKind kind = options_.solver != PetscSolverKind::automatic ? options_.solver
-                               : Dim == 2                                   ? PetscSolverKind::direct_mumps
-                                                                            : PetscSolverKind::cg_gamg;
-  build_solver(ksp_, kind, where);
+  solver_kind_ = options_.petsc_solver != PetscSolverKind::automatic ? options_.petsc_solver
+                 : Dim == 2                                   ? PetscSolverKind::direct_mumps
+                                                              : PetscSolverKind::cg_gamg;
+  build_solver(ksp_, solver_kind_, where);
 
   // Ghost values come from their owners' rows.
   std::vector<PetscInt> from;
@@ -541,9 +544,9 @@ void DistributedElasticityMover<Dim>::solve_scaled(const char* where) {
   stats_.fell_back = false;
   // The reason is the same on every rank, so every rank raises or falls back alike.
   if (reason < 0) {
-    if (!options_.fallback_to_direct) {
+    if (!options_.petsc_fallback_to_direct) {
       throw SolverError(std::string(where) + ": CG did not converge (PETSc reason " + std::to_string(static_cast<int>(reason)) +
-                        " after " + std::to_string(iterations) + " iterations; tolerance " + std::to_string(options_.tolerance) +
+                        " after " + std::to_string(iterations) + " iterations; tolerance " + std::to_string(options_.petsc_tolerance) +
                         "); set fallback_to_direct or another solver");
     }
     if (!direct_) build_solver(direct_, PetscSolverKind::direct_mumps, where);

@@ -253,7 +253,7 @@ void DistributedRbfMover<Dim>::set_up(const ResolvedBoundary<Dim>& boundary) {
     if (!radii.empty() && static_cast<Index>(radii.size()) != boundary.size())
       throw InputError("DistributedRbfMover::setup: " + std::to_string(radii.size()) + " support radii for " +
                        std::to_string(boundary.size()) + " local boundary entries (expected one per entry, or none)");
-    if (solve_.kind == BoundarySolve::patches && !options_.partition_of_unity)
+    if (solve_.boundary_solve == BoundarySolve::patches && !options_.partition_of_unity)
       throw InputError("DistributedRbfMover::setup: BoundarySolve::patches needs RbfOptions::partition_of_unity");
     if (options_.rigid_part == RigidPart::blend)
       throw InputError("DistributedRbfMover::setup: rigid_part=blend is not distributed (the ranks interpolate the whole "
@@ -265,7 +265,7 @@ void DistributedRbfMover<Dim>::set_up(const ResolvedBoundary<Dim>& boundary) {
   for (Index i = 0; i < n; ++i) owned_[static_cast<std::size_t>(i)] = part.owns(i) ? 1 : 0;
   patches_.reset();
   radius_reduced_ = false;
-  if (options_.partition_of_unity && (solve_.kind == BoundarySolve::automatic || solve_.kind == BoundarySolve::patches)) {
+  if (options_.partition_of_unity && (solve_.boundary_solve == BoundarySolve::automatic || solve_.boundary_solve == BoundarySolve::patches)) {
     // No rank gathers the boundary: patches own it.
     auto patches = std::make_unique<detail::DistributedPartitionOfUnity<Dim>>();
     const std::string obstacle = patches->setup(part, boundary, options_);
@@ -283,7 +283,7 @@ void DistributedRbfMover<Dim>::set_up(const ResolvedBoundary<Dim>& boundary) {
       stats_.setup_seconds = watch.seconds();
       return;
     }
-    if (solve_.kind == BoundarySolve::patches)
+    if (solve_.boundary_solve == BoundarySolve::patches)
       throw InputError("DistributedRbfMover::setup: the partition of unity cannot be spread over the ranks: " + obstacle +
                        " (use BoundarySolve::replicated)");
   }
@@ -457,10 +457,10 @@ bool DistributedRbfMover<Dim>::choose_petsc(const GatheredBoundary& gathered, co
   const int sharing = ranks_on_node(comm_);
   const int rounds = (sharing + cores_of_node() - 1) / cores_of_node();
   const bool crowded = size_of(comm_) > 1 && m * sharing * rounds >= solve_.petsc_min_node_centres;
-  const bool wanted = solve_.kind == BoundarySolve::petsc ||
-                      (solve_.kind == BoundarySolve::automatic && (m >= solve_.petsc_min_centres || crowded));
+  const bool wanted = solve_.boundary_solve == BoundarySolve::petsc ||
+                      (solve_.boundary_solve == BoundarySolve::automatic && (m >= solve_.petsc_min_centres || crowded));
   const std::string obstacle = wanted ? petsc_obstacle(gathered.kinds, gathered.radius_per_entry, centres) : std::string();
-  if (solve_.kind == BoundarySolve::petsc && !obstacle.empty())
+  if (solve_.boundary_solve == BoundarySolve::petsc && !obstacle.empty())
     throw InputError("DistributedRbfMover::setup: the boundary system cannot go through PETSc: " + obstacle +
                      " (use BoundarySolve::replicated)");
   return wanted && obstacle.empty();

@@ -43,22 +43,20 @@ enum class BoundarySolve {
 /// 5× slower at 8 ranks and 25× at 16 than at one (16,129 centres), while MUMPS's setup fell
 /// with the ranks and its moves were faster from 2 ranks on.
 struct BoundarySolveOptions {
-  BoundarySolve kind = BoundarySolve::automatic;
-  /// Fewest centres for which automatic takes PETSc at any rank count: above, the factor on
-  /// every rank costs too much memory.
+  BoundarySolve boundary_solve = BoundarySolve::automatic;
   Index petsc_min_centres = 50000;
-  /// Fewest centres × ranks sharing a node for which automatic takes PETSc on 2 ranks or more:
-  /// the replicated factorizations a node runs at once, counted once more for each further
-  /// round when the node has more ranks than cores (they then run one after another).
   Index petsc_min_node_centres = 30000;
 };
 
 template <class F>
 void visit_options(BoundarySolveOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "boundary_solve", o.kind, "where the RBF boundary system is solved");
+  f(prefix + "boundary_solve", o.boundary_solve, "where the RBF boundary system is solved");
   f(prefix + "petsc_min_centres", o.petsc_min_centres, OptionHelp{"automatic: fewest centres for PETSc at any rank count", range::non_negative});
   f(prefix + "petsc_min_node_centres", o.petsc_min_node_centres,
-    OptionHelp{"automatic: fewest centres x ranks per node for PETSc on several ranks", range::non_negative});
+    OptionHelp{"automatic: fewest centres x ranks per node for PETSc on several ranks", range::non_negative,
+      "Fewest centres × ranks sharing a node for which automatic takes PETSc on 2 ranks or more: the "
+      "replicated factorizations a node runs at once, counted once more for each further round when the node "
+      "has more ranks than cores (they then run one after another)."});
 }
 
 /// PETSc solver of the distributed elasticity system.
@@ -89,14 +87,10 @@ struct DistributedElasticityOptions {
   /// Material and Jacobian stiffening as in serial; `solver` there is not used (see below),
   /// distance_exponent and active_radius must be 0.
   ElasticityOptions elasticity = {};
-  PetscSolverKind solver = PetscSolverKind::automatic;
-  /// Relative residual of the diagonally scaled system (displacement units) for CG.
-  double tolerance = 1e-10;
-  Index max_iterations = 10000;
-  /// A CG solve that does not converge is solved again by MUMPS instead of raising.
-  bool fallback_to_direct = false;
-  /// Prefix of the PETSc options that refine the solver from the command line or
-  /// PETSC_OPTIONS (e.g. -meshmotion_ksp_monitor).
+  PetscSolverKind petsc_solver = PetscSolverKind::automatic;
+  double petsc_tolerance = 1e-10;
+  Index petsc_max_iterations = 10000;
+  bool petsc_fallback_to_direct = false;
   std::string petsc_prefix = "meshmotion_";
 };
 
@@ -104,10 +98,10 @@ struct DistributedElasticityOptions {
 /// mover's, ElasticityOptions).
 template <class F>
 void visit_options(DistributedElasticityOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "petsc_solver", o.solver, "PETSc solver (automatic: mumps in 2D, cg_gamg in 3D)");
-  f(prefix + "petsc_tolerance", o.tolerance, OptionHelp{"relative residual of CG on the scaled system (displacement units)", range::positive});
-  f(prefix + "petsc_max_iterations", o.max_iterations, OptionHelp{"iteration cap of CG", range::at_least(1)});
-  f(prefix + "petsc_fallback_to_direct", o.fallback_to_direct, "solve again with MUMPS when CG does not converge");
+  f(prefix + "petsc_solver", o.petsc_solver, "PETSc solver (automatic: mumps in 2D, cg_gamg in 3D)");
+  f(prefix + "petsc_tolerance", o.petsc_tolerance, OptionHelp{"relative residual of CG on the scaled system (displacement units)", range::positive});
+  f(prefix + "petsc_max_iterations", o.petsc_max_iterations, OptionHelp{"iteration cap of CG", range::at_least(1)});
+  f(prefix + "petsc_fallback_to_direct", o.petsc_fallback_to_direct, "solve again with MUMPS when CG does not converge");
   f(prefix + "petsc_prefix", o.petsc_prefix, "prefix of the PETSc options that refine the solver");
 }
 
@@ -122,6 +116,21 @@ template <class F>
 void visit_options(ParallelOptions& o, F&& f, const std::string& prefix = {}) {
   visit_options(o.boundary, f, prefix);
   visit_options(o.elasticity, f, prefix);
+}
+
+/// What a distributed mover chose at its last setup (DistributedMover::choices()), reported by
+/// move_mesh_mpi beside its move report and by Python's Warp(comm=...).
+struct DistributedChoices {
+  double support_radius = 0.0;
+  std::string boundary_solve = "none";
+  std::string petsc_solver = "none";
+};
+
+template <class F>
+void visit_fields(const DistributedChoices& c, F&& f) {
+  f("support_radius", c.support_radius, "the RBF's support radius (the default one when none was given); 0 for elasticity");
+  f("boundary_solve", c.boundary_solve, "where the RBF's boundary system was solved: replicated, petsc or patches (none for elasticity)");
+  f("petsc_solver", c.petsc_solver, "the elasticity's PETSc solver, automatic resolved: mumps, cg_gamg or cg_hypre (none for the RBF)");
 }
 
 /// Sets the keys of `given` that ParallelOptions takes on `o` and returns the others, in order,

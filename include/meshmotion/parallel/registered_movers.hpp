@@ -32,8 +32,9 @@ class DistributedRbf final : public DistributedMover<Dim> {
   [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) override { return mover_.derivative_reverse(v); }
   [[nodiscard]] Points<Dim> velocity(PointsView<Dim> v) override { return mover_.velocity(v); }
   [[nodiscard]] MoverStats stats() const override { return mover_.stats(); }
-  [[nodiscard]] double support_radius() const override { return mover_.support_radius(); }
-  [[nodiscard]] std::string_view boundary_solve() const override { return name(mover_.solved_by()); }
+  [[nodiscard]] DistributedChoices choices() const override {
+    return {mover_.support_radius(), std::string(name(mover_.solved_by())), "none"};
+  }
 
  private:
   DistributedRbfMover<Dim> mover_;
@@ -56,8 +57,7 @@ class DistributedElasticity final : public DistributedMover<Dim> {
   [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) override { return mover_.derivative_reverse(v); }
   [[nodiscard]] Points<Dim> velocity(PointsView<Dim> v) override { return mover_.derivative_forward(v); }
   [[nodiscard]] MoverStats stats() const override { return mover_.stats(); }
-  [[nodiscard]] double support_radius() const override { return 0.0; }
-  [[nodiscard]] std::string_view boundary_solve() const override { return "none"; }
+  [[nodiscard]] DistributedChoices choices() const override { return {0.0, "none", name(mover_.solver_kind())}; }
 
  private:
   static DistributedElasticityOptions with_material(DistributedElasticityOptions o, const ElasticityOptions& material) {
@@ -67,22 +67,9 @@ class DistributedElasticity final : public DistributedMover<Dim> {
   DistributedElasticityMover<Dim> mover_;
 };
 
-// The distributed RBF interpolates the whole motion: automatic means none; blend is refused
-// by the mover.
-template <int Dim>
-void prepare_distributed_rbf(MoverOptions<Dim>& options) {
-  RbfOptions& o = std::get<RbfOptions>(options);
-  if (o.rigid_part == RigidPart::automatic) o.rigid_part = RigidPart::none;
-}
-
-template <int Dim>
-void prepare_nothing(MoverOptions<Dim>&) {}
-
 template <int Dim>
 std::unique_ptr<DistributedMover<Dim>> make_distributed_rbf(const MoverOptions<Dim>& options, const ParallelOptions& parallel) {
-  MoverOptions<Dim> prepared = options;
-  prepare_distributed_rbf<Dim>(prepared);
-  return std::make_unique<DistributedRbf<Dim>>(std::get<RbfOptions>(prepared), parallel.boundary);
+  return std::make_unique<DistributedRbf<Dim>>(std::get<RbfOptions>(options), parallel.boundary);
 }
 
 template <int Dim>
@@ -95,9 +82,9 @@ std::unique_ptr<DistributedMover<Dim>> make_distributed_elasticity(const MoverOp
 template <int Dim>
 std::span<const DistributedMethod<Dim>> distributed_methods() {
   static const std::array<DistributedMethod<Dim>, 3> methods{{
-      {"rbf", false, &detail::prepare_distributed_rbf<Dim>, &detail::make_distributed_rbf<Dim>},
-      {"le", true, &detail::prepare_nothing<Dim>, &detail::make_distributed_elasticity<Dim>},
-      {"sle", true, &detail::prepare_nothing<Dim>, &detail::make_distributed_elasticity<Dim>},
+      {"rbf", false, &detail::make_distributed_rbf<Dim>},
+      {"le", true, &detail::make_distributed_elasticity<Dim>},
+      {"sle", true, &detail::make_distributed_elasticity<Dim>},
   }};
   return methods;
 }

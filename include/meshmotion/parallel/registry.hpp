@@ -59,12 +59,9 @@ class DistributedMover {
   /// (AnyMover::velocity(): J v through the map of the current move).
   [[nodiscard]] virtual Points<Dim> velocity(PointsView<Dim> boundary_velocities) = 0;
   [[nodiscard]] virtual MoverStats stats() const = 0;
-  /// The support radius the last setup took (the default one when none was given); 0 for a
-  /// method without one.
-  [[nodiscard]] virtual double support_radius() const = 0;
-  /// Where the last setup solved the boundary system (BoundarySolve's name); "none" for a
-  /// method without one.
-  [[nodiscard]] virtual std::string_view boundary_solve() const = 0;
+  /// What the last setup chose: the RBF's radius and where it solved its boundary system, the
+  /// elasticity's PETSc solver.
+  [[nodiscard]] virtual DistributedChoices choices() const = 0;
 };
 
 /// A method with a distributed mover.
@@ -73,11 +70,6 @@ struct DistributedMethod {
   std::string_view name;
   /// false: setup(PartitionView) serves, a rank's points alone.
   bool needs_cells = true;
-  /// Sets in the method's options what its distributed mover runs with (the RBF: the whole
-  /// motion interpolated, rigid_part none, as its PETSc and patch solves have no rigid part to
-  /// take out); make() does it too. A front end that derives a default from the options (a
-  /// radius) calls it first.
-  void (*prepare)(MoverOptions<Dim>&);
   /// The mover for the method's options (its MoverConfig's) and the parallel options.
   std::unique_ptr<DistributedMover<Dim>> (*make)(const MoverOptions<Dim>&, const ParallelOptions&);
 };

@@ -50,8 +50,9 @@ inline constexpr std::array<Metric, 6> all_metrics{Metric::relative_size, Metric
 }
 
 /// Options of cell_quality() and evaluate_cells().
+/// Options of the cell metrics; described once, in visit_options(ReportOptions&)
+/// (quality/quality_report.hpp), whose keys they are.
 struct QualityOptions {
-  /// Area/volume that has relative size 1; 0 means the mesh's mean cell measure.
   double reference_measure = 0.0;
   ScaledJacobianOptions jacobian{};
 };

@@ -90,24 +90,24 @@ void visit_fields(const QualityReport& r, F&& f) {
 
 /// Options of quality_report().
 struct ReportOptions {
-  int bins = 10;
+  int histogram_bins = 10;
   int num_worst = 10;
   QualityOptions quality{};
 };
 
 template <class F>
 void visit_options(ScaledJacobianOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "certify", o.certify, "certified Bezier bounds (false: sampled extremes only)");
+  f(prefix + "certify", o.certify, "certified Bezier bounds (false: sampled extremes only, a fast screening)");
   f(prefix + "sharp", o.sharp, "refine both bounds to the tolerance (false: stop once validity is decided)");
-  f(prefix + "sharp_max", o.sharp_max, "with sharp: refine the upper bound too");
-  f(prefix + "tolerance", o.tolerance, OptionHelp{"gap between a Bezier bound and the sampled extreme", range::positive});
+  f(prefix + "sharp_max", o.sharp_max, "with sharp: refine the upper bound too (false when only the minimum is used)");
+  f(prefix + "tolerance", o.tolerance, OptionHelp{"wanted gap between a Bezier bound and the sampled extreme (scaled units)", range::positive});
   f(prefix + "max_depth", o.max_depth, OptionHelp{"deepest subdivision level", range::non_negative});
-  f(prefix + "max_leaves", o.max_leaves, OptionHelp{"subdomains per cell at most", range::at_least(1)});
+  f(prefix + "max_leaves", o.max_leaves, OptionHelp{"subdomains per cell at most (the bound stays a bound when hit)", range::at_least(1)});
 }
 
 template <class F>
 void visit_options(ReportOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "histogram_bins", o.bins, OptionHelp{"bins of the quality histogram", range::at_least(1)});
+  f(prefix + "histogram_bins", o.histogram_bins, OptionHelp{"bins of the quality histogram", range::at_least(1)});
   f(prefix + "num_worst", o.num_worst, OptionHelp{"worst cells listed", range::non_negative});
   f(prefix + "reference_measure", o.quality.reference_measure, OptionHelp{"size metrics: the measure of relative size 1 (0: the mean)", range::non_negative});
   visit_options(o.quality.jacobian, f, prefix + "jacobian_");
@@ -120,7 +120,7 @@ template <int Dim>
   QualityReport r;
   r.metric = metric;
   r.num_elements = static_cast<Index>(cells.size());
-  r.histogram.assign(static_cast<std::size_t>(std::max(1, options.bins)), 0);
+  r.histogram.assign(static_cast<std::size_t>(std::max(1, options.histogram_bins)), 0);
   const auto finite = [](double v) { return std::isfinite(v) ? v : 0.0; };
   double sum = 0.0;
   r.min = cells.empty() ? 0.0 : std::numeric_limits<double>::infinity();

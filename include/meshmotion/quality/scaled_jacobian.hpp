@@ -35,14 +35,15 @@
 
 namespace meshmotion {
 
-/// Options of the scaled-Jacobian check.
+/// Options of the scaled-Jacobian check; each field is described once, in its visit_options()
+/// (quality/quality_report.hpp).
 struct ScaledJacobianOptions {
-  bool certify = true;        ///< false: sampled extremes only (fast screening)
-  bool sharp = true;          ///< refine both bounds to `tolerance`; false: stop once validity is decided
-  bool sharp_max = true;      ///< with `sharp`: refine the upper bound too (false when only the minimum is used)
-  double tolerance = 1e-4;    ///< wanted gap between Bézier bound and sampled extreme (scaled units)
-  int max_depth = 10;         ///< deepest subdivision level
-  int max_leaves = 4096;      ///< subdomains per element at most (the bound stays a bound when hit)
+  bool certify = true;
+  bool sharp = true;
+  bool sharp_max = true;
+  double tolerance = 1e-4;
+  int max_depth = 10;
+  int max_leaves = 4096;
 };
 
 /// Scaled Jacobian of one element. All values are det J / |det J_lin|: an inverted

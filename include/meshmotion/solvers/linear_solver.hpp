@@ -88,8 +88,8 @@ class IterativeBackend final : public SparseBackend {
 /// True when a matrix of `rows` rows goes to CHOLMOD under options `o` (see
 /// SolverOptions::supernodal_min_rows).
 [[nodiscard]] inline bool use_supernodal(const SolverOptions& o, Index rows) {
-  if (o.kind == SolverKind::cholmod_supernodal) return true;
-  return have_cholmod() && (o.kind == SolverKind::simplicial_ldlt || o.kind == SolverKind::simplicial_llt) &&
+  if (o.solver == SolverKind::cholmod_supernodal) return true;
+  return have_cholmod() && (o.solver == SolverKind::simplicial_ldlt || o.solver == SolverKind::simplicial_llt) &&
          o.supernodal_min_rows > 0 && rows >= o.supernodal_min_rows;
 }
 
@@ -98,7 +98,7 @@ template <int = 0>
 std::unique_ptr<SparseBackend> make_backend(const SolverOptions& o) {
   constexpr int Lower = Eigen::Lower;
   constexpr int LowerUpper = Eigen::Lower | Eigen::Upper;
-  switch (o.kind) {
+  switch (o.solver) {
     case SolverKind::cholmod_supernodal:
 #ifdef MESHMOTION_HAVE_CHOLMOD
       return std::make_unique<DirectBackend<CholmodSupernodalLLT>>();
@@ -174,7 +174,7 @@ class BasicLinearSolver {
     ++report_.factorizations;
     // Chosen for its size, CHOLMOD may meet a matrix that is not positive definite (a
     // quasi-definite one LDLᵀ takes): the simplicial factorization asked for answers.
-    if (!ok && supernodal_ && options_.kind != SolverKind::cholmod_supernodal) {
+    if (!ok && supernodal_ && options_.solver != SolverKind::cholmod_supernodal) {
       supernodal_ = false;
       backend_ = detail::make_backend(options_);
       backend_->analyze(matrix_);
@@ -186,7 +186,7 @@ class BasicLinearSolver {
     if (fallback_) fallback_factorize();
     report_.seconds += watch.seconds();
     if (!ok)
-      throw SolverError(std::string(name(supernodal_ ? SolverKind::cholmod_supernodal : options_.kind)) + ": factorization of a " + std::to_string(a.rows()) +
+      throw SolverError(std::string(name(supernodal_ ? SolverKind::cholmod_supernodal : options_.solver)) + ": factorization of a " + std::to_string(a.rows()) +
                         " × " + std::to_string(a.rows()) +
                         " matrix failed (matrix singular or not positive definite)");
   }
@@ -217,13 +217,13 @@ class BasicLinearSolver {
       }
       Index iterations = 0;
       bool ok = backend_->solve(rhs_, column_, iterations);
-      if (ok && scaled && is_iterative(options_.kind)) ok = tighten_scaled_solve(iterations);
+      if (ok && scaled && is_iterative(options_.solver)) ok = tighten_scaled_solve(iterations);
       double residual = relative_residual();
       report_.iterations = std::max(report_.iterations, iterations);
-      const double limit = is_iterative(options_.kind) ? 10.0 * options_.tolerance : 1e-6;
+      const double limit = is_iterative(options_.solver) ? 10.0 * options_.tolerance : 1e-6;
       if (check == ResidualCheck::enforced && (!ok || !(residual <= std::max(limit, 1e-13)))) {
-        if (!options_.fallback_to_direct || !is_iterative(options_.kind))
-          throw SolverError(std::string(name(options_.kind)) + ": solve did not converge (iterations " +
+        if (!options_.fallback_to_direct || !is_iterative(options_.solver))
+          throw SolverError(std::string(name(options_.solver)) + ": solve did not converge (iterations " +
                             std::to_string(iterations) + ", relative residual " + std::to_string(residual) +
                             ", expected <= " + std::to_string(limit) + ")");
         if (!fallback_) fallback_factorize();
@@ -231,7 +231,7 @@ class BasicLinearSolver {
         residual = relative_residual();
         report_.fell_back = true;
         if (!ok || !(residual <= 1e-6))
-          throw SolverError(std::string(name(options_.kind)) + " and its sparse_lu fallback failed (relative residual " +
+          throw SolverError(std::string(name(options_.solver)) + " and its sparse_lu fallback failed (relative residual " +
                             std::to_string(residual) + ")");
       }
       report_.residual = std::max(report_.residual, residual);
@@ -251,7 +251,7 @@ class BasicLinearSolver {
  private:
   [[nodiscard]] SolverOptions with_kind(SolverKind kind) const {
     SolverOptions o = options_;
-    o.kind = kind;
+    o.solver = kind;
     return o;
   }
 

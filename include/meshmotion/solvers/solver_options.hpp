@@ -63,22 +63,10 @@ enum class SolverKind {
 
 /// Options of a LinearSolver.
 struct SolverOptions {
-  SolverKind kind = SolverKind::simplicial_ldlt;
-  /// Relative residual ||A x - b|| / ||b|| an iterative solver must reach.
+  SolverKind solver = SolverKind::simplicial_ldlt;
   double tolerance = 1e-12;
-  /// Iteration cap of an iterative solver; 0 means Eigen's default (2 × matrix size).
   Index max_iterations = 0;
-  /// When an iterative solver does not converge, solve again with SparseLU instead of
-  /// throwing (the report's fell_back says so).
   bool fallback_to_direct = false;
-  /// Solve the symmetrically scaled system (D^-1/2 A D^-1/2) y = D^-1/2 b, x = D^-1/2 y,
-  /// D = diag(A) (needs a positive diagonal). The tolerance and the reported residual then
-  /// refer to the scaled system, whose rows are balanced: when the rows of A span many
-  /// orders of magnitude (stiffened elasticity), ||A x − b|| / ||b|| is dominated by the
-  /// stiffest rows and says nothing about the others. CG with the Jacobi preconditioner
-  /// makes the same iterates either way; only its stopping test changes. Iterative solvers
-  /// then also meet the tolerance in D^-1-scaled (displacement) units, ||D^-1 r|| ≤ tol
-  /// ||D^-1 b||, restarting warm with a tighter target when their own test stops short.
   bool diagonal_scaling = false;
   /// The simplicial Cholesky kinds hand matrices of at least this many rows to CHOLMOD's
   /// supernodal factorization in builds that have it (its dense kernels win on the large
@@ -128,11 +116,18 @@ enum class DenseSolverKind {
 // visit_options(o, f) calls f(key, field, help) for every field of `o` that text may set.
 template <class F>
 void visit_options(SolverOptions& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "solver", o.kind, "sparse solver of the system");
+  f(prefix + "solver", o.solver, "sparse solver of the system");
   f(prefix + "tolerance", o.tolerance, OptionHelp{"relative residual an iterative solver must reach", range::positive});
   f(prefix + "max_iterations", o.max_iterations, OptionHelp{"iteration cap of an iterative solver (0: twice the size)", range::non_negative});
   f(prefix + "fallback_to_direct", o.fallback_to_direct, "solve with sparse LU when an iterative solver fails");
-  f(prefix + "diagonal_scaling", o.diagonal_scaling, "solve the diagonally scaled system");
+  f(prefix + "diagonal_scaling", o.diagonal_scaling, OptionHelp{"solve the diagonally scaled system", {},
+      "Solve the symmetrically scaled system (D^-1/2 A D^-1/2) y = D^-1/2 b, x = D^-1/2 y, D = diag(A) (needs "
+      "a positive diagonal). The tolerance and the reported residual then refer to the scaled system, whose "
+      "rows are balanced: when the rows of A span many orders of magnitude (stiffened elasticity), ||A x − "
+      "b|| / ||b|| is dominated by the stiffest rows and says nothing about the others. CG with the Jacobi "
+      "preconditioner makes the same iterates either way; only its stopping test changes. Iterative solvers "
+      "then also meet the tolerance in D^-1-scaled (displacement) units, ||D^-1 r|| ≤ tol ||D^-1 b||, "
+      "restarting warm with a tighter target when their own test stops short."});
 }
 
 }  // namespace meshmotion

@@ -37,9 +37,9 @@ class GraphInterpolation {
   /// simplex (fewer than Dim+1, collinear, coplanar) or a coordinate is not finite.
   void build(const Points<Dim>& graph_points, const Points<Dim>& queries, const std::optional<SimplexRbfOptions>& rbf,
              OutsideGraph outside, const std::string& who) {
-    if (rbf && (!(rbf->support_radius >= 0.0) || (rbf->support_radius == 0.0 && !(rbf->relative_support > 0.0))))
-      throw InputError(who + ": simplex RBF support must be positive (got support_radius " +
-                       std::to_string(rbf->support_radius) + ", relative_support " + std::to_string(rbf->relative_support) + ")");
+    if (rbf && (!(rbf->simplex_support_radius >= 0.0) || (rbf->simplex_support_radius == 0.0 && !(rbf->simplex_support > 0.0))))
+      throw InputError(who + ": simplex RBF support must be positive (got simplex_support_radius " +
+                       std::to_string(rbf->simplex_support_radius) + ", simplex_support " + std::to_string(rbf->simplex_support) + ")");
     if (graph_points.cols() < corners)
       throw InputError(who + ": the Delaunay graph needs at least " + std::to_string(corners) + " boundary nodes (got " +
                        std::to_string(graph_points.cols()) + ")");
@@ -144,7 +144,7 @@ class GraphInterpolation {
                                 std::vector<double>& radius) {
     const auto n = static_cast<std::size_t>(graph.num_simplices());
     inverse.assign(n, std::nullopt);
-    radius.assign(n, rbf.support_radius);
+    radius.assign(n, rbf.simplex_support_radius);
     for (std::size_t s = 0; s < n; ++s) {
       const Eigen::Matrix<double, Dim, corners> c = graph.corner_points(static_cast<Index>(s));
       double longest = 0.0;
@@ -154,7 +154,7 @@ class GraphInterpolation {
           distance(i, j) = (c.col(i) - c.col(j)).norm();
           longest = std::max(longest, distance(i, j));
         }
-      if (rbf.support_radius == 0.0) radius[s] = rbf.relative_support * longest;
+      if (rbf.simplex_support_radius == 0.0) radius[s] = rbf.simplex_support * longest;
       Eigen::Matrix<double, corners, corners> a;
       for (int i = 0; i < corners; ++i)
         for (int j = 0; j < corners; ++j) a(i, j) = rbf_value(rbf.kernel, distance(i, j), radius[s]);

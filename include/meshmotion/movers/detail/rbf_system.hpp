@@ -332,7 +332,7 @@ class RbfSystem {
       matrix_ = SparseMatrix(compact_kernel_rows(centres_, all, within(), k, kernel_));
       nonzeros_ = matrix_.nonZeros();
       if (varying_) symmetric_ = radii_agree_on_pattern();
-      if (!symmetric_ && sparse_options.kind != SolverKind::bicgstab) sparse_options.kind = SolverKind::sparse_lu;
+      if (!symmetric_ && sparse_options.solver != SolverKind::bicgstab) sparse_options.solver = SolverKind::sparse_lu;
       sparse_options_ = sparse_options;
       sparse_ = LinearSolver(sparse_options);
       sparse_.compute(matrix_);
