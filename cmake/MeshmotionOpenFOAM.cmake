@@ -51,13 +51,17 @@ set_target_properties(meshmotion_foam_side PROPERTIES CXX_STANDARD 17 CXX_STANDA
 target_include_directories(meshmotion_foam_side SYSTEM PRIVATE ${_foam_includes})
 target_compile_definitions(meshmotion_foam_side PRIVATE WM_DP WM_LABEL_SIZE=32 NoRepository linux64 OPENFOAM=1912)
 target_compile_options(meshmotion_foam_side PRIVATE -m64 -ftemplate-depth-100)
-add_library(meshmotionFoam SHARED src/openfoam/bridge.cpp $<TARGET_OBJECTS:meshmotion_foam_side>)
+# Decomposed cases (-parallel) go through the distributed movers (Debian's OpenFOAM runs on the
+# same Open MPI): bridge_parallel.cpp serves them, bridge_serial_only.cpp refuses them.
+if(MESHMOTION_HAVE_PARALLEL)
+  set(_foam_decomposed src/openfoam/bridge_parallel.cpp)
+else()
+  set(_foam_decomposed src/openfoam/bridge_serial_only.cpp)
+endif()
+add_library(meshmotionFoam SHARED src/openfoam/bridge.cpp ${_foam_decomposed} $<TARGET_OBJECTS:meshmotion_foam_side>)
 target_link_libraries(meshmotionFoam PRIVATE ${MESHMOTION_LINK_TARGET} ${_foam_libraries})
-# Decomposed cases (-parallel) go through the distributed RBF mover: Debian's OpenFOAM runs on
-# the same Open MPI.
 if(MESHMOTION_HAVE_PARALLEL)
   target_link_libraries(meshmotionFoam PRIVATE meshmotion::parallel)
-  target_compile_definitions(meshmotionFoam PRIVATE MESHMOTION_FOAM_PARALLEL)
 else()
   message(STATUS "meshmotion: OpenFOAM plugin without the parallel layer: decomposed cases are refused")
 endif()

@@ -35,6 +35,8 @@ struct BridgeInput {
   std::vector<long> coupled_faces;
 };
 
+class Serving;
+
 /// Whether the plugin hands `method` the cells: the registry's needs_cells, and, where the
 /// plugin moves decomposed cases, every method without a distributed mover (such a case is
 /// gathered on rank 0, which moves it with the serial mover and sends each rank its points).
@@ -59,8 +61,7 @@ class Bridge {
   [[nodiscard]] int setups() const;
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<Serving> serving_;  // serving.hpp: one type per mode
 };
 
 }  // namespace meshmotion::foam
