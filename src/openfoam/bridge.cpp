@@ -8,14 +8,15 @@
 
 namespace meshmotion::foam {
 
-ResolvedBoundary<3> input_boundary(const BridgeInput& input) {
-  const auto nb = static_cast<Index>(input.boundary.size());
+ResolvedBoundary<3> resolved_boundary(const std::vector<long>& points, const std::vector<int>& roles,
+                                      const std::vector<double>& directions) {
+  const auto nb = static_cast<Index>(points.size());
   ResolvedBoundary<3> b;
-  b.nodes.assign(input.boundary.begin(), input.boundary.end());
+  b.nodes.assign(points.begin(), points.end());
   b.displacements = b.normals = b.directions = Points<3>::Zero(3, nb);
-  const Eigen::Map<const Points<3>> along(input.directions.data(), 3, nb);
+  const Eigen::Map<const Points<3>> along(directions.data(), 3, nb);
   for (Index k = 0; k < nb; ++k) {
-    const auto role = static_cast<PointRole>(input.roles[static_cast<std::size_t>(k)]);
+    const auto role = static_cast<PointRole>(roles[static_cast<std::size_t>(k)]);
     b.kinds.push_back(role == PointRole::prescribed ? BoundaryKind::prescribed : BoundaryKind::sliding);
     if (role == PointRole::sliding_plane) b.normals.col(k) = along.col(k);
     if (role == PointRole::sliding_line) b.directions.col(k) = along.col(k);

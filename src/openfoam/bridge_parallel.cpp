@@ -245,15 +245,17 @@ class GatheredServing final : public Serving {
       if (parallel::rank_of(comm) != 0) return;
       std::map<std::int64_t, std::size_t> first;  // emplace keeps the lowest rank's
       for (std::size_t f = 0; f < all_ids.size(); ++f) first.emplace(all_ids[f], f);
-      BridgeInput entries;  // the whole case's boundary, in input_boundary()'s terms
+      std::vector<long> points;  // the whole case's boundary points, their roles and directions
+      std::vector<int> roles;
+      std::vector<double> directions;
       for (const auto& [id, f] : first) {
-        entries.boundary.push_back(static_cast<long>(id));
-        entries.roles.push_back(all_roles[f]);
-        entries.directions.insert(entries.directions.end(), all_directions.begin() + static_cast<std::ptrdiff_t>(3 * f),
-                                  all_directions.begin() + static_cast<std::ptrdiff_t>(3 * f + 3));
+        points.push_back(static_cast<long>(id));
+        roles.push_back(all_roles[f]);
+        directions.insert(directions.end(), all_directions.begin() + static_cast<std::ptrdiff_t>(3 * f),
+                          all_directions.begin() + static_cast<std::ptrdiff_t>(3 * f + 3));
         picks_.push_back(f);
       }
-      ResolvedBoundary<3> b = input_boundary(entries);
+      ResolvedBoundary<3> b = resolved_boundary(points, roles, directions);
       Mesh<3> mesh = to_mesh(whole.poly);
       const FaceCentres centres(whole.poly, mesh, whole.coupled, b);
       std::size_t at = 0;

@@ -27,8 +27,14 @@ class Serving {
   [[nodiscard]] virtual MoverStats stats() const = 0;
 };
 
-/// The boundary points as the mover's boundary: their roles, zero displacements.
-[[nodiscard]] ResolvedBoundary<3> input_boundary(const BridgeInput& input);
+/// Boundary points (ascending), their PointRole and direction (3 × points) as the mover's
+/// boundary, with zero displacements.
+[[nodiscard]] ResolvedBoundary<3> resolved_boundary(const std::vector<long>& points, const std::vector<int>& roles,
+                                                    const std::vector<double>& directions);
+/// The input's boundary points as the mover's boundary.
+[[nodiscard]] inline ResolvedBoundary<3> input_boundary(const BridgeInput& input) {
+  return resolved_boundary(input.boundary, input.roles, input.directions);
+}
 /// The input's cells as a polyMesh with one boundary patch.
 [[nodiscard]] PolyMesh input_cells(const BridgeInput& input);
 /// Per face, whether it is coupled (input.coupled_faces); empty when none is.
