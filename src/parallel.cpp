@@ -1,5 +1,4 @@
-// The parallel layer of the compiled library (target meshmotion::parallel) for one dimension,
-// MESHMOTION_INSTANTIATE_DIM (CMake compiles this file once for 2 and once for 3): the
+// The parallel layer of the compiled library (target meshmotion::parallel) for 2D and 3D: the
 // distributed movers, the partitioning and the distributed registry's table
 // (parallel/registered_movers.hpp), behind the extern template declarations consumers see.
 
@@ -8,11 +7,14 @@
 
 namespace meshmotion::parallel {
 
-constexpr int D = MESHMOTION_INSTANTIATE_DIM;
+template class DistributedRbfMover<2>;
+template class DistributedElasticityMover<2>;
+template DistributedMesh<2> partition_mesh<2>(MPI_Comm, const Mesh<2>&, std::span<const int>, int);
+template std::span<const DistributedMethod<2>> distributed_methods<2>();
 
-template class DistributedRbfMover<D>;
-template class DistributedElasticityMover<D>;
-template DistributedMesh<D> partition_mesh<D>(MPI_Comm, const Mesh<D>&, std::span<const int>, int);
-template std::span<const DistributedMethod<D>> distributed_methods<D>();
+template class DistributedRbfMover<3>;
+template class DistributedElasticityMover<3>;
+template DistributedMesh<3> partition_mesh<3>(MPI_Comm, const Mesh<3>&, std::span<const int>, int);
+template std::span<const DistributedMethod<3>> distributed_methods<3>();
 
 }  // namespace meshmotion::parallel

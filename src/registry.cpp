@@ -1,17 +1,20 @@
-// The registry of serial movers (method -> factory, movers/registered_movers.hpp) and the blending and boundary-only movers of the compiled library (target meshmotion::compiled) for one dimension,
-// MESHMOTION_INSTANTIATE_DIM (CMake compiles this file once for 2 and once for 3), behind the
-// extern template declarations consumers see. Each mover is instantiated in one object file
-// of the library alone: src/movers_*.cpp and src/registry.cpp share them out so that the two
-// cores of a build compile them side by side.
+// The registry of serial movers (method -> factory, movers/registered_movers.hpp) and the blending
+// and boundary-only movers of the compiled library (target meshmotion::compiled) for 2D and 3D,
+// behind the extern template declarations consumers see. Each mover is instantiated in one object
+// file of the library alone. Both dimensions are instantiated in one translation unit: they share
+// the headers' parsing and every function that does not depend on the dimension, which two objects
+// compiled again (docs/compiled.md).
 
 #include "meshmotion/movers/registered_movers.hpp"
 
 namespace meshmotion {
 
-constexpr int D = MESHMOTION_INSTANTIATE_DIM;
+template class BlendMover<2>;
+template class BoundaryOnlyMover<2>;
+template std::span<const MoverMethod<2>> mover_methods<2>();
 
-template class BlendMover<D>;
-template class BoundaryOnlyMover<D>;
-template std::span<const MoverMethod<D>> mover_methods<D>();
+template class BlendMover<3>;
+template class BoundaryOnlyMover<3>;
+template std::span<const MoverMethod<3>> mover_methods<3>();
 
 }  // namespace meshmotion
