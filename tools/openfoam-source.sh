@@ -39,8 +39,10 @@ tar -xf "$archive" -C "$out/extract" --wildcards "${patterns[@]}"
 mv "$out/extract"/*/src "$out/src"
 rm -rf "$out/extract" "$apt"
 for l in "${libraries[@]}"; do
+  # One ln for all of a library's files (one per file took most of this script's time); a link
+  # is named by its target's base name, as wmake's are.
   (cd "$out/src/$l" && mkdir -p lnInclude &&
-   find . -path ./lnInclude -prune -o \( -name '*.H' -o -name '*.C' -o -name '*.h' \) -type f -print |
-     while read -r f; do ln -sf "../$f" "lnInclude/$(basename "$f")"; done)
+   find . -path ./lnInclude -prune -o \( -name '*.H' -o -name '*.C' -o -name '*.h' \) -type f -printf '../%P\n' |
+     xargs -r ln -sf -t lnInclude)
 done
 touch "$out/src/.complete"
