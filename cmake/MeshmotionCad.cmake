@@ -36,18 +36,24 @@ endif()
 add_library(meshmotion_cad_occt MODULE ${_exclude} src/cad/occt_shape.cpp)
 target_include_directories(meshmotion_cad_occt SYSTEM PRIVATE ${OpenCASCADE_INCLUDE_DIR})
 target_link_libraries(meshmotion_cad_occt PRIVATE meshmotion::meshmotion ${MESHMOTION_OCCT_LIBRARIES})
-add_library(meshmotion_cad STATIC ${_exclude} src/cad/cad_model.cpp)
+# The component's code compiles beside the module; the archive waits for the module, so that a
+# program linking meshmotion::cad finds it built.
+add_library(meshmotion_cad_objects OBJECT ${_exclude} src/cad/cad_model.cpp)
+set_target_properties(meshmotion_cad_objects PROPERTIES POSITION_INDEPENDENT_CODE ON)
+target_link_libraries(meshmotion_cad_objects PRIVATE meshmotion::meshmotion)
+target_compile_definitions(meshmotion_cad_objects PRIVATE MESHMOTION_HAVE_CAD
+  MESHMOTION_CAD_MODULE_BUILD="$<TARGET_FILE:meshmotion_cad_occt>"
+  MESHMOTION_CAD_MODULE_INSTALL="${CMAKE_INSTALL_FULL_LIBDIR}/$<TARGET_FILE_NAME:meshmotion_cad_occt>")
+add_library(meshmotion_cad STATIC ${_exclude} $<TARGET_OBJECTS:meshmotion_cad_objects>)
 add_library(meshmotion::cad ALIAS meshmotion_cad)
 set_target_properties(meshmotion_cad PROPERTIES EXPORT_NAME cad POSITION_INDEPENDENT_CODE ON)
 add_dependencies(meshmotion_cad meshmotion_cad_occt)
 # The header-only core, not meshmotion::compiled: linking the component must not build the
 # whole compiled library (a consumer links meshmotion::compiled beside it for fast builds).
 target_link_libraries(meshmotion_cad PUBLIC meshmotion::meshmotion ${CMAKE_DL_LIBS})
-target_compile_definitions(meshmotion_cad PUBLIC MESHMOTION_HAVE_CAD PRIVATE
-  MESHMOTION_CAD_MODULE_BUILD="$<TARGET_FILE:meshmotion_cad_occt>"
-  MESHMOTION_CAD_MODULE_INSTALL="${CMAKE_INSTALL_FULL_LIBDIR}/$<TARGET_FILE_NAME:meshmotion_cad_occt>")
+target_compile_definitions(meshmotion_cad PUBLIC MESHMOTION_HAVE_CAD)
 if(TARGET meshmotion_warnings)
-  target_link_libraries(meshmotion_cad PRIVATE $<BUILD_INTERFACE:meshmotion_warnings>)
+  target_link_libraries(meshmotion_cad_objects PRIVATE meshmotion_warnings)
   target_link_libraries(meshmotion_cad_occt PRIVATE meshmotion_warnings)
 endif()
 message(STATUS "meshmotion: CAD component on OpenCASCADE ${OpenCASCADE_VERSION}: STEP, IGES and BREP geometry for curving")
