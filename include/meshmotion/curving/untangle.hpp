@@ -308,6 +308,11 @@ class PatchOptimizer {
   void coefficients(ElementType type, const ElementCoords<Dim>& x, LatticeVector& values, double& linear) {
     ++evaluations_;
     const detail::JacobianSpace& s = detail::jacobian_space(type);
+    // The line search keeps four polynomials of det J per cell around a node on the stack.
+    if (s.num_points > detail::max_lattice_points)
+      throw InputError("untangle: a " + std::string(name(type)) + "'s det J has " + std::to_string(s.num_points) +
+                       " lattice points, more than the " + std::to_string(detail::max_lattice_points) +
+                       " the untangling holds (hexahedra are untangled up to order 3)");
     detail::lattice_dets<Dim>(s, x, 1.0, values);
     if (s.bezier) detail::to_bezier(s, values);
     linear = detail::linear_det<Dim>(s, x);

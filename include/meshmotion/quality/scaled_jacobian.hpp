@@ -10,8 +10,9 @@
 /// The certified bound follows Johnen, Remacle & Geuzaine (J. Comput. Phys. 233, 2013):
 /// det J is sampled on the lattice of its polynomial space, converted to Bézier coefficients,
 /// whose minimum (maximum) bounds det J from below (above); the domain is subdivided where
-/// the bound is further than `tolerance` from the sampled values. Types: tri3/6, quad4/8/9,
-/// tet4/10, hex8/20/27, prism6/15/18. Pyramids (rational maps) are sampled only: there
+/// the bound is further than `tolerance` from the sampled values. Types: every triangle,
+/// quadrilateral, tetrahedron, hexahedron and prism of the catalogue (core/element.hpp: to
+/// order 8, tetrahedra to 6, prisms to 3). Pyramids (rational maps) are sampled only: there
 /// `certified` is false and the "certified" bounds are the sampled extremes.
 
 #include "meshmotion/core/element.hpp"
@@ -71,7 +72,11 @@ namespace detail {
 
 template <int D>
 using ElementCoords = Eigen::Matrix<double, D, Eigen::Dynamic, 0, D, max_element_nodes>;
+// The lattice values of det J: on the stack up to a tet84's 816 points (every type but the
+// hexahedra past order 3), on the heap beyond (a hex729's 13,824). Sized for the largest, the
+// stack frames of a P2 cell's certificate grew to 110 KiB and it ran 6 times slower.
 using LatticeVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_lattice_points, 1>;
+using LargeLatticeVector = Eigen::VectorXd;
 
 // One pass of apply_factors: to[o, r, i] = Σ_b f(r, b) from[o, b, i], as whole rows over i (the
 // compiler vectorizes them) or, on the last axis (inner = 1), as sums kept in a register. The
@@ -148,8 +153,9 @@ inline void factor_pass(const Eigen::MatrixXd& f, Index outer, Index inner, cons
 // coordinates, the last fastest): one pass of a small matrix per factor. A factor may be
 // rectangular (rows × cols maps an axis of cols entries to rows entries). The last axis goes
 // first, while the data is smallest: its pass is the one that cannot be vectorized.
-inline void apply_factors(std::span<const Eigen::MatrixXd* const> factors, LatticeVector& values) {
-  thread_local LatticeVector out;
+template <class Lattice>
+void apply_factors(std::span<const Eigen::MatrixXd* const> factors, Lattice& values) {
+  thread_local Lattice out;
   std::array<Index, 4> sizes{};
   for (std::size_t a = 0; a < factors.size(); ++a) sizes[a] = factors[a]->cols();
   for (std::size_t a = factors.size(); a-- > 0;) {
@@ -167,13 +173,13 @@ inline void apply_factors(std::span<const Eigen::MatrixXd* const> factors, Latti
 // det J at every lattice point, divided by `scale`. The transposed Jacobians (row point · D +
 // reference direction, column physical coordinate) come by sum factorization for quad9 and
 // hex27, otherwise as the product of the shape-gradient table with the coordinates.
-template <int D>
-void lattice_dets(const JacobianSpace& s, const ElementCoords<D>& x, double scale, LatticeVector& values) {
+template <int D, class Lattice>
+void lattice_dets(const JacobianSpace& s, const ElementCoords<D>& x, double scale, Lattice& values) {
   thread_local Eigen::Matrix<double, Eigen::Dynamic, D> jacobians;
   jacobians.resize(static_cast<Index>(s.num_points) * D, D);
   if (!s.tensor_node.empty()) {
     std::array<const Eigen::MatrixXd*, D> f{};
-    LatticeVector v;
+    Lattice v;
     for (int c = 0; c < D; ++c)
       for (int d = 0; d < D; ++d) {
         v.resize(static_cast<Index>(s.tensor_node.size()));
@@ -193,7 +199,8 @@ void lattice_dets(const JacobianSpace& s, const ElementCoords<D>& x, double scal
 }
 
 // values ← Bézier coefficients of the lattice values.
-inline void to_bezier(const JacobianSpace& s, LatticeVector& values) {
+template <class Lattice>
+void to_bezier(const JacobianSpace& s, Lattice& values) {
   std::array<const Eigen::MatrixXd*, 4> f{};
   int count = 0;
   if (s.simplex_dim > 0) f[static_cast<std::size_t>(count++)] = &s.simplex.to_bezier;
@@ -205,14 +212,14 @@ inline void to_bezier(const JacobianSpace& s, LatticeVector& values) {
 // last factor is applied first, so children that differ only in earlier factors share the
 // passes over the later ones: a hex's 8 children take 2 + 4 + 8 passes instead of 24, and
 // only 2 of them are the unvectorized last-axis kind.
-template <class Visit>
-void for_each_child(const JacobianSpace& s, const LatticeVector& parent, Visit&& visit) {
+template <class Lattice, class Visit>
+void for_each_child(const JacobianSpace& s, const Lattice& parent, Visit&& visit) {
   const int count = (s.simplex_dim > 0 ? 1 : 0) + s.line_dims;
   std::array<Index, 4> sizes{};
   for (int a = 0; a < count; ++a)
     sizes[static_cast<std::size_t>(a)] = (a == 0 && s.simplex_dim > 0) ? s.simplex.to_bezier.cols() : s.line.to_bezier.cols();
-  thread_local std::array<LatticeVector, 4> levels;
-  const auto descend = [&](const auto& self, int a, const LatticeVector& from) -> void {
+  thread_local std::array<Lattice, 4> levels;
+  const auto descend = [&](const auto& self, int a, const Lattice& from) -> void {
     if (a < 0) {
       visit(from);
       return;
@@ -221,7 +228,7 @@ void for_each_child(const JacobianSpace& s, const LatticeVector& parent, Visit&&
     for (int b = 0; b < a; ++b) outer *= sizes[static_cast<std::size_t>(b)];
     for (int b = a + 1; b < count; ++b) inner *= sizes[static_cast<std::size_t>(b)];
     const auto& choices = (a == 0 && s.simplex_dim > 0) ? s.simplex.child_bezier : s.line.child_bezier;
-    LatticeVector& to = levels[static_cast<std::size_t>(a)];
+    Lattice& to = levels[static_cast<std::size_t>(a)];
     for (const auto& factor : choices) {
       to.resize(from.size());
       factor_pass(factor, outer, inner, from.data(), to.data());
@@ -240,15 +247,17 @@ double linear_det(const JacobianSpace& s, const ElementCoords<D>& x) {
   return jac.determinant();
 }
 
+template <class Lattice>
 struct BezierLeaf {
-  LatticeVector coefficients;
+  Lattice coefficients;
   double min = 0.0, max = 0.0;
   int depth = 0;
 };
 
-inline BezierLeaf make_leaf(const JacobianSpace& s, LatticeVector values, int depth) {
+template <class Lattice>
+BezierLeaf<Lattice> make_leaf(const JacobianSpace& s, Lattice values, int depth) {
   to_bezier(s, values);
-  BezierLeaf leaf{std::move(values), 0.0, 0.0, depth};
+  BezierLeaf<Lattice> leaf{std::move(values), 0.0, 0.0, depth};
   leaf.min = leaf.coefficients.minCoeff();
   leaf.max = leaf.coefficients.maxCoeff();
   return leaf;
@@ -256,11 +265,18 @@ inline BezierLeaf make_leaf(const JacobianSpace& s, LatticeVector values, int de
 
 // Adaptive subdivision (Johnen et al. 2013, sec. 4): refine the leaf whose bound is furthest
 // from the best sampled value until every gap is within tolerance.
-inline void certify(const JacobianSpace& s, const LatticeVector& values, const ScaledJacobianOptions& opt,
-                    ScaledJacobian& r) {
+// Leaves of one cell's subdivision held at most: a hex729's leaf is 110 KB, and max_leaves of
+// them would be 450 MB per thread. The bound stays a bound when the cap is reached.
+inline constexpr std::size_t max_leaf_bytes = std::size_t{64} << 20;
+
+template <class Lattice>
+void certify(const JacobianSpace& s, const Lattice& values, const ScaledJacobianOptions& opt, ScaledJacobian& r) {
   // Reused per thread: the common case (no subdivision) then allocates nothing.
-  thread_local std::vector<BezierLeaf> leaves;
+  thread_local std::vector<BezierLeaf<Lattice>> leaves;
   leaves.clear();
+  const int max_leaves = static_cast<int>(std::min<std::size_t>(
+      static_cast<std::size_t>(std::max(opt.max_leaves, 1)),
+      max_leaf_bytes / (sizeof(double) * static_cast<std::size_t>(std::max(s.num_points, 1)))));
   leaves.push_back(make_leaf(s, values, 0));
   double upper_min = r.sampled_min, lower_max = r.sampled_max;
   for (;;) {
@@ -278,14 +294,14 @@ inline void certify(const JacobianSpace& s, const LatticeVector& values, const S
     if (opt.sharp ? (min_sharp && max_sharp) : decided) break;
     const std::size_t pick = (opt.sharp && min_sharp) ? worst_max : worst_min;
     if (leaves[pick].depth >= opt.max_depth ||
-        static_cast<int>(leaves.size()) + s.num_children() > opt.max_leaves)
+        static_cast<int>(leaves.size()) + s.num_children() > max_leaves)
       break;
-    const BezierLeaf parent = leaves[pick];
+    const BezierLeaf<Lattice> parent = leaves[pick];
     leaves.erase(leaves.begin() + static_cast<std::ptrdiff_t>(pick));
     // Children's coefficients straight from the parent's (one pass per axis instead of two);
     // their corner coefficients are values of det J and tighten the sampled extremes.
-    for_each_child(s, parent.coefficients, [&](const LatticeVector& coefficients) {
-      BezierLeaf leaf{coefficients, 0.0, 0.0, parent.depth + 1};
+    for_each_child(s, parent.coefficients, [&](const Lattice& coefficients) {
+      BezierLeaf<Lattice> leaf{coefficients, 0.0, 0.0, parent.depth + 1};
       leaf.min = leaf.coefficients.minCoeff();
       leaf.max = leaf.coefficients.maxCoeff();
       for (const int k : s.corners) {
@@ -327,16 +343,20 @@ ScaledJacobian scaled_jacobian_fixed(ElementType type, const ElementCoords<D>& x
     if (((x - straight).cwiseAbs().array() <= tolerance).all())
       return scaled_jacobian_fixed<D>(linear_type(type), ElementCoords<D>(vertices), opt);
   }
-  const double scale = 1.0 / std::abs(lin);
-  LatticeVector values;
-  lattice_dets<D>(s, x, scale, values);
-  r.sampled_min = r.certified_min = values.minCoeff();
-  r.sampled_max = r.certified_max = values.maxCoeff();
-  r.leaves = 1;
-  if (opt.certify && s.bezier) {
-    r.certified = true;
-    certify(s, values, opt, r);
-  }
+  const auto bound = [&]<class Lattice>(Lattice values) {
+    lattice_dets<D>(s, x, 1.0 / std::abs(lin), values);
+    r.sampled_min = r.certified_min = values.minCoeff();
+    r.sampled_max = r.certified_max = values.maxCoeff();
+    r.leaves = 1;
+    if (opt.certify && s.bezier) {
+      r.certified = true;
+      certify(s, values, opt, r);
+    }
+  };
+  if (s.num_points <= max_lattice_points)
+    bound(LatticeVector{});
+  else
+    bound(LargeLatticeVector{});
   r.valid = r.certified_min > 0;
   return r;
 }

@@ -335,21 +335,14 @@ inline JacobianSpace make_jacobian_space(ElementType t) {
 // Each type's tables on its first use: those of every type at once (the P4 tetrahedron's Bézier
 // inverse and its subdivision products among them) took 25 ms of curving the 30P30N's
 // triangles, an eighth of the whole program.
-// Most lattice points of a det J the certificate holds (a tet84's, degree 15). The lattice
-// values live in fixed storage on the stack: sized for a hex729's 13,824 points, the
-// certificate of a P2 cell was 6 times slower (its 110 KiB frames), so hexahedra past order 3
-// (1,728 points at order 4) are refused by name until the storage grows with the cell.
-inline constexpr int max_lattice_points = 816;
-
 inline const JacobianSpace& jacobian_space(ElementType t) {
   static PerTypeCache<JacobianSpace> spaces;
-  const JacobianSpace& s =
-      spaces.get(t, [](ElementType type) { return dimension(type) >= 2 ? make_jacobian_space(type) : JacobianSpace{}; });
-  if (s.num_points > max_lattice_points)
-    throw InputError("the certified scaled Jacobian takes hexahedra up to order 3 (a " + std::string(name(t)) +
-                     "'s det J has " + std::to_string(s.num_points) + " lattice points, more than the " +
-                     std::to_string(max_lattice_points) + " it holds)");
-  return s;
+  return spaces.get(t, [](ElementType type) { return dimension(type) >= 2 ? make_jacobian_space(type) : JacobianSpace{}; });
 }
+
+// Most lattice points of a det J held on the stack (a tet84's, degree 15): every type but the
+// hexahedra past order 3, whose lattices (1,728 points at order 4, 13,824 at order 8) the
+// certificate keeps on the heap (quality/scaled_jacobian.hpp).
+inline constexpr int max_lattice_points = 816;
 
 }  // namespace meshmotion::detail
