@@ -666,6 +666,10 @@ TEST_CASE("CGNS: each kind of bad file gets a clear error naming the node path",
                           f.section(z, "q", CGNS_ENUMV(QUAD_4), 1, 1, {1, 2, 99, 3});
                         })); },
                       {"/Base/dom/q", "element 1 has node 99", "4 nodes"});
+  require_input_error([&] { (void)read_mesh(one_quad("repeated_node", [](CgnsBuilder& f, int z) {
+                          f.section(z, "q", CGNS_ENUMV(QUAD_4), 1, 1, {1, 2, 2, 3});
+                        })); },
+                      {"/Base/dom/q", "element 1 lists node 2 twice"});
   require_input_error([&] { (void)read_mesh(one_quad("tri10", [](CgnsBuilder& f, int z) {
                           f.section(z, "p3", CGNS_ENUMV(TRI_10), 1, 1, {1, 2, 3, 1, 2, 3, 1, 2, 3, 4});
                         })); },

@@ -263,12 +263,12 @@ BezierLeaf<Lattice> make_leaf(const JacobianSpace& s, Lattice values, int depth)
   return leaf;
 }
 
-// Adaptive subdivision (Johnen et al. 2013, sec. 4): refine the leaf whose bound is furthest
-// from the best sampled value until every gap is within tolerance.
 // Leaves of one cell's subdivision held at most: a hex729's leaf is 110 KB, and max_leaves of
 // them would be 450 MB per thread. The bound stays a bound when the cap is reached.
 inline constexpr std::size_t max_leaf_bytes = std::size_t{64} << 20;
 
+// Adaptive subdivision (Johnen et al. 2013, sec. 4): refine the leaf whose bound is furthest
+// from the best sampled value until every gap is within tolerance.
 template <class Lattice>
 void certify(const JacobianSpace& s, const Lattice& values, const ScaledJacobianOptions& opt, ScaledJacobian& r) {
   // Reused per thread: the common case (no subdivision) then allocates nothing.
