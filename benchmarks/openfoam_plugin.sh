@@ -9,7 +9,11 @@
 # counts; `sle` stands beside it. One table, and one JSON line per case and solver:
 # {"bench": "openfoam_plugin", "case", "solver", "largest_valid_deg", "seconds_per_step",
 #  "max_rss_mb", "non_orthogonality", "time_ratio"} (time_ratio: per step, over
-# displacementLaplacian's).
+# displacementLaplacian's). Then the cost at a solver's size (issue 69): the 3D block meshed
+# with 79,080 hexahedra, turned to 30 degrees over 20 steps once per motion solver: the whole
+# run's wall time (setups included), its peak memory, the last step's non-orthogonality and
+# whether every step passed the check, with both ratios over displacementLaplacian's
+# ({"bench": "openfoam_plugin_large", ..., "wall_seconds", "wall_ratio", "memory_ratio"}).
 #
 #   benchmarks/openfoam_plugin.sh [BUILD_DIR=build] [WORK_DIR=/tmp/meshmotion_openfoam_plugin]
 #
@@ -47,6 +51,9 @@ CASES = {
     "block3d": dict(breaks=[(-3, -1, 1, 3), (-3, -0.3, 0.3, 3), (-3, -0.5, 0.5, 3)],
                     cells=[(8, 12, 8), (8, 4, 8), (8, 6, 8)]),
 }
+# The cost case: block3d's blocks, 79,080 cells.
+LARGE = {"block3d_79k": dict(breaks=CASES["block3d"]["breaks"], cells=[(15, 22, 15), (15, 8, 15), (15, 11, 15)])}
+LARGE_STEPS = 20
 SOLVERS = [
     ("meshmotion", "(defaults)", "motionSolverLibs (\"libfvMotionSolvers.so\" \"%s\");\nmotionSolver meshmotion;\nmeshmotionCoeffs { }\n" % lib),
     ("meshmotion", "method sle", "motionSolverLibs (\"libfvMotionSolvers.so\" \"%s\");\nmotionSolver meshmotion;\nmeshmotionCoeffs { method sle; }\n" % lib),
@@ -99,15 +106,15 @@ def block_mesh(case, spec):
     return two_d
 
 
-def write_case(case, spec, angle, solver):
-    """A fresh case turning the body to `angle` degrees over STEPS steps with `solver`."""
+def write_case(case, spec, angle, solver, steps=STEPS):
+    """A fresh case turning the body to `angle` degrees over `steps` steps with `solver`."""
     shutil.rmtree(case, ignore_errors=True)
     two_d = block_mesh(case, spec)
     os.makedirs(f"{case}/constant", exist_ok=True)
     os.makedirs(f"{case}/0", exist_ok=True)
     with open(f"{case}/system/controlDict", "w") as out:
         out.write(HEADER % "controlDict" + f"application moveDynamicMesh; startFrom startTime; startTime 0; stopAt endTime;"
-                  f" endTime {STEPS}; deltaT 1; writeControl timeStep; writeInterval {STEPS}; writeFormat binary;"
+                  f" endTime {steps}; deltaT 1; writeControl timeStep; writeInterval {steps}; writeFormat binary;"
                   " writePrecision 17; writeCompression off; timeFormat general; timePrecision 6; runTimeModifiable false;\n")
     with open(f"{case}/system/fvSchemes", "w") as out:
         out.write(HEADER % "fvSchemes" + "ddtSchemes { default Euler; } gradSchemes { default Gauss linear; }"
@@ -118,7 +125,7 @@ def write_case(case, spec, angle, solver):
                   " tolerance 1e-8; relTol 0; minIter 3; } }\n")
     with open(f"{case}/constant/dynamicMeshDict", "w") as out:
         out.write(HEADER % "dynamicMeshDict" + "dynamicFvMesh dynamicMotionSolverFvMesh;\n" + solver)
-    omega = math.pi / 2 / STEPS  # the angle reaches its amplitude at the last step
+    omega = math.pi / 2 / steps  # the angle reaches its amplitude at the last step
     empty = "frontAndBack { type empty; }" if two_d else ""
     with open(f"{case}/0/pointDisplacement", "w") as out:
         out.write("FoamFile { version 2.0; format ascii; class pointVectorField; object pointDisplacement; }\n"
@@ -131,20 +138,22 @@ def write_case(case, spec, angle, solver):
         sys.exit(f"openfoam_plugin: blockMesh failed in {case}:\n{log.stdout[-2000:]}{log.stderr[-2000:]}")
 
 
-def run(case):
-    """moveDynamicMesh: every step valid, seconds per step, peak memory (MB), last non-orthogonality."""
+def run(case, steps=STEPS):
+    """moveDynamicMesh: every step valid, seconds per step, peak memory (MB), last
+    non-orthogonality, and the whole run's wall seconds."""
     start = time.perf_counter()
     done = subprocess.run(["/usr/bin/time", "-f", "%M", "moveDynamicMesh"], cwd=case, capture_output=True, text=True)
     wall = time.perf_counter() - start
     log = done.stdout
     with open(f"{case}/log.moveDynamicMesh", "w") as out:
         out.write(log + done.stderr)
-    ok = done.returncode == 0 and log.count("Mesh OK") >= STEPS and "Failed" not in log
+    ok = done.returncode == 0 and log.count("Mesh OK") >= steps and "Failed" not in log
     times = [float(t) for t in re.findall(r"ExecutionTime = ([0-9.eE+-]+) s", log)]
-    per_step = (times[-1] - times[0]) / (len(times) - 1) if len(times) > 1 else wall / STEPS
+    per_step = (times[-1] - times[0]) / (len(times) - 1) if len(times) > 1 else wall / steps
     rss = [int(x) for x in re.findall(r"^(\d+)$", done.stderr, re.M)]
     orthogonality = re.findall(r"Mesh non-orthogonality Max: ([0-9.eE+-]+)", log)
-    return ok, per_step, (rss[-1] / 1024 if rss else float("nan")), (float(orthogonality[-1]) if orthogonality else float("nan"))
+    return (ok, per_step, (rss[-1] / 1024 if rss else float("nan")), (float(orthogonality[-1]) if orthogonality else float("nan")),
+            wall)
 
 
 print(f"openfoam_plugin: OpenFOAM {subprocess.run(['dpkg-query', '-W', '-f=${Version}', 'openfoam'], capture_output=True, text=True).stdout},"
@@ -164,7 +173,7 @@ for name, spec in CASES.items():
                 break
             largest = angle
         write_case(case, spec, REFERENCE, dictionary)
-        ok, per_step, rss, orthogonality = run(case)
+        ok, per_step, rss, orthogonality, _ = run(case)
         rows.append(dict(bench="openfoam_plugin", case=name, solver=solver, options=options, largest_valid_deg=largest,
                          seconds_per_step=per_step, max_rss_mb=rss, non_orthogonality=orthogonality,
                          valid_at_reference=ok))
@@ -174,6 +183,25 @@ for name, spec in CASES.items():
         print(f"{name:9} {r['solver']:24} {r['options']:24} {r['largest_valid_deg']:>11} deg {r['seconds_per_step']:10.4f}"
               f" {r['max_rss_mb']:7.0f} {r['non_orthogonality']:12.1f} {r['time_ratio']:10.2f}"
               + ("" if r["valid_at_reference"] else "  (invalid at 30 deg)"))
+        lines.append(r)
+
+print(f"\n{'case':12} {'motion solver':24} {'options':24} {'valid':>5} {'wall s':>8} {'wall x':>7} {'MB':>7} {'MB x':>6}"
+      f" {'non-orth':>8}   ({LARGE_STEPS} steps to {REFERENCE} deg, setups included)")
+for name, spec in LARGE.items():
+    rows = []
+    for solver, options, dictionary in SOLVERS:
+        case = os.path.join(work, name, solver + ("_" + options.split()[-1] if options.startswith("method") else ""))
+        write_case(case, spec, REFERENCE, dictionary, LARGE_STEPS)
+        ok, per_step, rss, orthogonality, wall = run(case, LARGE_STEPS)
+        rows.append(dict(bench="openfoam_plugin_large", case=name, solver=solver, options=options, steps=LARGE_STEPS,
+                         angle_deg=REFERENCE, valid=ok, wall_seconds=wall, seconds_per_step=per_step, max_rss_mb=rss,
+                         non_orthogonality=orthogonality))
+    peer = next(r for r in rows if r["solver"] == "displacementLaplacian")
+    for r in rows:
+        r["wall_ratio"] = r["wall_seconds"] / peer["wall_seconds"]
+        r["memory_ratio"] = r["max_rss_mb"] / peer["max_rss_mb"]
+        print(f"{name:12} {r['solver']:24} {r['options']:24} {'yes' if r['valid'] else 'NO':>5} {r['wall_seconds']:8.1f}"
+              f" {r['wall_ratio']:7.2f} {r['max_rss_mb']:7.0f} {r['memory_ratio']:6.2f} {r['non_orthogonality']:8.1f}")
         lines.append(r)
 for line in lines:
     print(json.dumps(line))

@@ -1,3 +1,4 @@
+#include "meshmotion/core/threads.hpp"
 #include "meshmotion/solvers.hpp"
 
 #include <catch2/catch.hpp>
@@ -146,3 +147,23 @@ TEST_CASE("CHOLMOD's supernodal Cholesky: asked for, chosen for large matrices, 
   LinearSolver refused(SolverOptions{SolverKind::cholmod_supernodal});
   CHECK_THROWS_WITH(refused.compute(indefinite), Catch::Contains("cholmod_supernodal"));
 }
+
+#ifdef MESHMOTION_HAVE_CHOLMOD
+TEST_CASE("CHOLMOD's BLAS works with the library's threads when it is OpenBLAS", "[solvers]") {
+  // OpenBLAS's pthreads build sizes its pool by the machine: ranks sharing a node would each
+  // take every core in a factorization.
+  using Count = int (*)();
+  const auto count = reinterpret_cast<Count>(dlsym(detail::cholmod_api().handle, "openblas_get_num_threads"));
+  if (count == nullptr) {
+    WARN("skipped: CHOLMOD's BLAS is not OpenBLAS (libopenblas0-pthread)");
+    return;
+  }
+  for (const int n : {1, 2}) {
+    set_num_threads(n);
+    LinearSolver solver(SolverOptions{SolverKind::cholmod_supernodal});
+    solver.compute(poisson(20));
+    CHECK(count() == n);
+  }
+  set_num_threads(0);
+}
+#endif

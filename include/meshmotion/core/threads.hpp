@@ -25,6 +25,8 @@
 
 #include <Eigen/Core>
 
+#include <dlfcn.h>
+
 namespace meshmotion {
 
 /// Most threads set_num_threads takes: the OpenMP runtime fails outright on tens of
@@ -77,7 +79,16 @@ class RegionErrors {
   std::atomic<bool> failed_{false};
   std::exception_ptr first_;
 };
+/// OpenBLAS's thread count, where `scope` (a dlopen handle, or RTLD_DEFAULT: what the process
+/// linked) holds OpenBLAS: its pthreads build (Debian's libopenblas0-pthread) keeps a pool of
+/// its own, sized by the machine rather than by OpenMP. Nothing where there is no OpenBLAS.
+inline void set_blas_threads(void* scope, int n) noexcept {
+  using SetThreads = void (*)(int);
+  if (const auto set = reinterpret_cast<SetThreads>(dlsym(scope, "openblas_set_num_threads"))) set(n);
+}
 }  // namespace detail
+
+[[nodiscard]] inline int num_threads();
 
 /// Threads of the library's parallel loops, of Eigen's dense products and of the libraries
 /// it calls that use OpenMP (CHOLMOD's supernodal factorization) from now on; 0 gives back
@@ -86,7 +97,8 @@ class RegionErrors {
 ///
 /// OpenMP's default is set too, on the calling thread: CHOLMOD opens its parallel regions
 /// with it, and 16 MPI ranks each opening 16 threads there made the replicated RBF setup 17×
-/// slower on a 16-core node (docs/parallel.md).
+/// slower on a 16-core node (docs/parallel.md). So is OpenBLAS's pool where the process has
+/// linked it (PETSc's MUMPS); CHOLMOD's, loaded later, is set at each factorization.
 inline void set_num_threads(int n) {
   if (n < 0 || n > max_threads)
     throw InputError("set_num_threads: expected 0 (OpenMP's default) to " + std::to_string(max_threads) + " threads (got " +
@@ -98,6 +110,7 @@ inline void set_num_threads(int n) {
 #endif
   detail::thread_setting().store(n);
   Eigen::setNbThreads(n);
+  detail::set_blas_threads(RTLD_DEFAULT, num_threads());
 }
 
 /// Threads the library's parallel loops use now (1 without OpenMP; at most max_threads).

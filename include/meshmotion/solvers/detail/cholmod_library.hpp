@@ -10,6 +10,7 @@
 
 #include "meshmotion/core/detail/shared_library.hpp"
 #include "meshmotion/core/error.hpp"
+#include "meshmotion/core/threads.hpp"
 
 #include <Eigen/Core>
 #include <cholmod.h>
@@ -28,6 +29,7 @@ namespace meshmotion::detail {
 
 struct CholmodLibrary {
   MESHMOTION_CHOLMOD_FUNCTIONS(MESHMOTION_LIBRARY_MEMBER)
+  void* handle = nullptr;  ///< the library and what it loaded (its BLAS), for set_blas_threads()
 };
 
 /// The loaded library (opened once). Throws SolverError naming the library when it cannot be
@@ -35,7 +37,10 @@ struct CholmodLibrary {
 inline const CholmodLibrary& cholmod_api() {
   return loaded_api<CholmodLibrary, SolverError>(
       MESHMOTION_CHOLMOD_LIBRARY, "CHOLMOD",
-      [](const LoadedLibrary<SolverError>& library, CholmodLibrary& api) { MESHMOTION_CHOLMOD_FUNCTIONS(MESHMOTION_LIBRARY_LOAD) });
+      [](const LoadedLibrary<SolverError>& library, CholmodLibrary& api) {
+        MESHMOTION_CHOLMOD_FUNCTIONS(MESHMOTION_LIBRARY_LOAD)
+        api.handle = library.handle();
+      });
 }
 
 /// CHOLMOD's supernodal LLᵀ of a symmetric matrix's lower triangle: the calls of Eigen's
@@ -67,6 +72,8 @@ class CholmodSupernodalLLT {
   void factorize(const Matrix& a) {
     if (factor_ == nullptr) return;
     cholmod_sparse view = lower_view(a);
+    // The BLAS's threads follow the library's (set_num_threads(): one rank's share of a node).
+    set_blas_threads(api_.handle, num_threads());
     api_.cholmod_factorize(&view, factor_, &common_);
     info_ = factor_->minor == factor_->n ? Eigen::Success : Eigen::NumericalIssue;
   }
