@@ -85,13 +85,7 @@ class DistributedMover {
     mover_->setup(parallel::PartitionView<Dim>{comm, points_, global_ids_, owner_}, boundary);
   }
   void move_into(PointsView<Dim> d, Points<Dim>& out) { mover_->move_into(d, out); }
-  void move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) {
-    move_into(d, out_);
-    if (out_.cols() != out.cols())
-      throw InputError("move_into: out has " + std::to_string(out.cols()) + " rows (expected " +
-                       std::to_string(out_.cols()) + ", one per local node)");
-    out = out_;
-  }
+  void move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) { mover_->move_into(d, out); }
   [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) { return mover_->derivative_reverse(v); }
   [[nodiscard]] Points<Dim> velocity(PointsView<Dim> v) { return mover_->velocity(v); }
   /// Every distributed mover is linear in the displacements and gives its reverse derivative.
@@ -104,7 +98,6 @@ class DistributedMover {
 
  private:
   std::unique_ptr<parallel::DistributedMover<Dim>> mover_;
-  Points<Dim> out_;  ///< move_into's result before it is copied to the caller's array
   Points<Dim> points_;  ///< a solver's own partition (setup from arrays)
   std::vector<std::int64_t> global_ids_;
   std::vector<int> owner_;

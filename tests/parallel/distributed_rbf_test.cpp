@@ -369,6 +369,36 @@ TEST_CASE("distributed partition of unity: patches on their ranks, the serial PU
   }
 }
 
+TEST_CASE("distributed RBF moves straight into the caller's storage, and refuses another shape on every rank",
+          "[parallel][rbf]") {
+  // What Python's Warp(comm=) hands it: a numpy array of the part's size, written in place.
+  const Mesh<2> mesh = rectangle_mesh({.nx = 16, .ny = 12, .cells = RectangleCells::tri_quad});
+  BoundarySpec<2> spec;
+  spec.moving("bottom", Rotation2D{{0.5, 0.0}, radians(6.0)}).fixed("top").fixed("left");
+  const DistributedMesh<2> part = partition_mesh(world(), mesh);
+  const ResolvedBoundary<2> b = distribute_boundary(part, spec.resolve(mesh));
+  RbfOptions patched;
+  patched.partition_of_unity = true;
+  patched.patch_centres = 7;
+  const std::pair<RbfOptions, BoundarySolve> cases[] = {{RbfOptions{}, BoundarySolve::replicated},
+                                                        {RbfOptions{}, BoundarySolve::petsc},
+                                                        {patched, BoundarySolve::patches}};
+  for (auto [options, solve] : cases) {
+    options.support_radius = 0.4;
+    DistributedRbfMover<2> mover(options, {solve});
+    mover.setup(part.view(), b);
+    REQUIRE(mover.solved_by() == solve);
+    const Points<2> expected = mover.move(b.displacements);
+    Points<2> storage = Points<2>::Constant(2, part.local.num_nodes(), std::nan(""));
+    mover.move_into(b.displacements, Eigen::Ref<Points<2>>(storage));
+    INFO("boundary solve " << name(solve));
+    CHECK(global_max((storage - expected).cwiseAbs().maxCoeff()) == 0.0);
+    // One rank's storage of another size: every rank raises, none waits in a collective.
+    Points<2> wrong(2, part.local.num_nodes() + (rank_of(world()) == 0 ? 1 : 0));
+    CHECK_THROWS_WITH(mover.move_into(b.displacements, Eigen::Ref<Points<2>>(wrong)), Catch::Contains("columns"));
+  }
+}
+
 TEST_CASE("parallel options: described once, set from text, bad values refused naming the key", "[parallel][options]") {
   BoundarySolveOptions solve;
   CHECK(set_option(solve, "boundary_solve", "petsc"));

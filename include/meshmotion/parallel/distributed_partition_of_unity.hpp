@@ -38,6 +38,7 @@
 #include "meshmotion/spatial/kd_tree.hpp"
 
 #include <algorithm>
+#include <concepts>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -68,8 +69,10 @@ class DistributedPartitionOfUnity {
   /// Collective. Empty: set up. Otherwise why this boundary cannot be taken (the same text on
   /// every rank). Throws on every rank what any rank finds wrong.
   [[nodiscard]] std::string setup(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary, const RbfOptions& options);
-  /// Collective; `d` and `out` as DistributedRbfMover::move_into (checked there).
-  void move_into(PointsView<Dim> d, Points<Dim>& out);
+  /// Collective; `d` and `out` as DistributedRbfMover::move_into (checked there): a
+  /// Points<Dim>, resized, or the caller's storage of the part's size.
+  template <class Out>
+  void move_into(PointsView<Dim> d, Out& out);
   /// Collective; as DistributedRbfMover::derivative_reverse (checked there): `owned` per local
   /// node, `n_entries` this rank's boundary entries.
   [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v, const std::vector<char>& owned, Index n_entries);
@@ -455,7 +458,8 @@ void DistributedPartitionOfUnity<Dim>::build_evaluation(const PartitionView<Dim>
 }
 
 template <int Dim>
-void DistributedPartitionOfUnity<Dim>::move_into(PointsView<Dim> d, Points<Dim>& out) {
+template <class Out>
+void DistributedPartitionOfUnity<Dim>::move_into(PointsView<Dim> d, Out& out) {
   // The owned centres' displacements to the owners of their patches.
   std::vector<std::vector<double>> send(static_cast<std::size_t>(ranks_));
   for (int r = 0; r < ranks_; ++r)
@@ -488,7 +492,8 @@ void DistributedPartitionOfUnity<Dim>::move_into(PointsView<Dim> d, Points<Dim>&
   for (const auto& block : got)
     for (std::size_t i = 0; i < block.size(); i += Dim, ++row)
       for (int k = 0; k < Dim; ++k) stacked(row, k) = block[i + static_cast<std::size_t>(k)];
-  if (out.cols() != n_local_) out.resize(Dim, n_local_);
+  if constexpr (std::same_as<Out, Points<Dim>>)
+    if (out.cols() != n_local_) out.resize(Dim, n_local_);
   out.setZero();
   Points<Dim> columns;
   meshmotion::detail::kernel_rows_times<Dim>(operator_, stacked, columns, [&](Index r, const Vec<Dim>& value) {

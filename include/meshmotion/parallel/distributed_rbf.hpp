@@ -53,6 +53,7 @@
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 
 #include <algorithm>
+#include <concepts>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -102,7 +103,11 @@ class DistributedRbfMover {
   /// `d` (Dim × boundary.size()) of this rank's boundary entries; only owned entries are
   /// read. Throws on every rank for a wrong shape or a non-finite value on any rank, and what
   /// RbfMover::move throws.
-  void move_into(PointsView<Dim> d, Points<Dim>& out);
+  void move_into(PointsView<Dim> d, Points<Dim>& out) { move_to(d, out); }
+  /// move_into() straight into the caller's Dim × part.size() storage (an Eigen::Map over a
+  /// solver's or numpy's array), with no copy in between. Throws on every rank when any rank's
+  /// `out` has another number of columns.
+  void move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out);
   [[nodiscard]] Points<Dim> move(PointsView<Dim> d) {
     Points<Dim> out;
     move_into(d, out);
@@ -138,8 +143,18 @@ class DistributedRbfMover {
   void follow_motion(PointsView<Dim> d);
   /// Collective: refuses (on every rank) `d` of the wrong shape or with a non-finite owned entry.
   void check_entries(const char* where, PointsView<Dim> d);
+  /// A Points<Dim> `out` resized to the part; a caller's storage was checked by move_into().
+  template <class Out>
+  void size_output(Out& out) const {
+    if constexpr (std::same_as<Out, Points<Dim>>)
+      if (out.cols() != n_local_) out.resize(Dim, n_local_);
+  }
+  /// move_into() into a Points<Dim> or the caller's storage.
+  template <class Out>
+  void move_to(PointsView<Dim> d, Out& out);
   /// Collective: the map of the current setup applied to `d`.
-  void apply(PointsView<Dim> d, Points<Dim>& out) {
+  template <class Out>
+  void apply(PointsView<Dim> d, Out& out) {
     if (patches_)
       patches_->move_into(d, out);
     else
@@ -165,9 +180,11 @@ class DistributedRbfMover {
   /// Why PETSc cannot solve this boundary system (empty: it can).
   [[nodiscard]] std::string petsc_obstacle(const std::vector<int>& kinds, bool radius_per_entry, const Points<Dim>& centres) const;
   /// move_into() once the boundary was gathered (replicated or PETSc).
-  void move_gathered(PointsView<Dim> d, Points<Dim>& out);
+  template <class Out>
+  void move_gathered(PointsView<Dim> d, Out& out);
   void setup_petsc(const PartitionView<Dim>& part, Points<Dim> centres);
-  void move_petsc(Points<Dim>& out);
+  template <class Out>
+  void move_petsc(Out& out);
   [[nodiscard]] Points<Dim> reverse_petsc(const PointsView<Dim>& v);
 
   MPI_Comm comm_ = MPI_COMM_NULL;
@@ -482,7 +499,18 @@ void DistributedRbfMover<Dim>::check_entries(const char* where, PointsView<Dim> 
 }
 
 template <int Dim>
-void DistributedRbfMover<Dim>::move_into(PointsView<Dim> d, Points<Dim>& out) {
+void DistributedRbfMover<Dim>::move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) {
+  collective(comm_, [&] {
+    if (out.cols() != n_local_)
+      throw InputError("DistributedRbfMover::move_into: the output has " + std::to_string(out.cols()) + " columns (expected " +
+                       std::to_string(n_local_) + ", one per local node)");
+  });
+  move_to(d, out);
+}
+
+template <int Dim>
+template <class Out>
+void DistributedRbfMover<Dim>::move_to(PointsView<Dim> d, Out& out) {
   const meshmotion::detail::Stopwatch watch;
   check_entries("move", d);
   follow_motion(d);
@@ -500,7 +528,8 @@ Points<Dim> DistributedRbfMover<Dim>::velocity(PointsView<Dim> v) {
 }
 
 template <int Dim>
-void DistributedRbfMover<Dim>::move_gathered(PointsView<Dim> d, Points<Dim>& out) {
+template <class Out>
+void DistributedRbfMover<Dim>::move_gathered(PointsView<Dim> d, Out& out) {
   std::vector<double> mine;
   mine.reserve(owned_entries_.size() * Dim);
   for (const Index k : owned_entries_)
@@ -512,7 +541,7 @@ void DistributedRbfMover<Dim>::move_gathered(PointsView<Dim> d, Points<Dim>& out
     move_petsc(out);
   } else {
     collective(comm_, [&] { inner_.move_into(gathered_, inner_out_); });
-    if (out.cols() != n_local_) out.resize(Dim, n_local_);
+    size_output(out);
     for (Index i = 0; i < n_local_; ++i) out.col(i) = inner_out_.col(column_[static_cast<std::size_t>(i)]);
     const MoverStats& s = inner_.stats();
     stats_.iterations = s.iterations;
@@ -584,9 +613,10 @@ void DistributedRbfMover<Dim>::setup_petsc(const PartitionView<Dim>& part, Point
 }
 
 template <int Dim>
-void DistributedRbfMover<Dim>::move_petsc(Points<Dim>& out) {
+template <class Out>
+void DistributedRbfMover<Dim>::move_petsc(Out& out) {
   collective(comm_, [&] { system_->solve(gathered_.transpose(), alpha_, beta_); });
-  if (out.cols() != n_local_) out.resize(Dim, n_local_);
+  size_output(out);
   out.setZero();
   Points<Dim> columns;
   meshmotion::detail::kernel_rows_times<Dim>(operator_, alpha_, columns, [&](Index r, const Vec<Dim>& value) {

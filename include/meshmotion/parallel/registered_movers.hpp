@@ -29,6 +29,7 @@ class DistributedRbf final : public DistributedMover<Dim> {
   }
   void setup(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary) override { mover_.setup(part, boundary); }
   void move_into(PointsView<Dim> d, Points<Dim>& out) override { mover_.move_into(d, out); }
+  void move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) override { mover_.move_into(d, out); }
   [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) override { return mover_.derivative_reverse(v); }
   [[nodiscard]] Points<Dim> velocity(PointsView<Dim> v) override { return mover_.velocity(v); }
   [[nodiscard]] MoverStats stats() const override { return mover_.stats(); }
@@ -53,6 +54,7 @@ class DistributedElasticity final : public DistributedMover<Dim> {
     throw InputError("a solver's own partition (local nodes without cells) is moved by rbf only: elasticity needs the "
                      "cells (partition a mesh read on rank 0 instead)");
   }
+  using DistributedMover<Dim>::move_into;
   void move_into(PointsView<Dim> d, Points<Dim>& out) override { mover_.move_into(d, out); }
   [[nodiscard]] Points<Dim> derivative_reverse(PointsView<Dim> v) override { return mover_.derivative_reverse(v); }
   [[nodiscard]] Points<Dim> velocity(PointsView<Dim> v) override { return mover_.derivative_forward(v); }

@@ -47,6 +47,16 @@ class DistributedMover {
   virtual void setup(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary) = 0;
   /// The displacement of every local node for the local boundary entries' displacements `d`.
   virtual void move_into(PointsView<Dim> d, Points<Dim>& out) = 0;
+  /// move_into() straight into the caller's Dim × part.size() storage (numpy's array): the RBF
+  /// writes there with no copy in between (and refuses another shape on every rank); the
+  /// others move into a buffer and copy (their solve dwarfs the copy).
+  virtual void move_into(PointsView<Dim> d, Eigen::Ref<Points<Dim>> out) {
+    move_into(d, buffer_);
+    if (buffer_.cols() != out.cols())
+      throw InputError("move_into: the output has " + std::to_string(out.cols()) + " columns (expected " +
+                       std::to_string(buffer_.cols()) + ", one per local node)");
+    out = buffer_;
+  }
   [[nodiscard]] Points<Dim> move(PointsView<Dim> d) {
     Points<Dim> out;
     move_into(d, out);
@@ -62,6 +72,9 @@ class DistributedMover {
   /// What the last setup chose: the RBF's radius and where it solved its boundary system, the
   /// elasticity's PETSc solver.
   [[nodiscard]] virtual DistributedChoices choices() const = 0;
+
+ private:
+  Points<Dim> buffer_;  ///< move_into()'s result on its way to the caller's storage (not the RBF's)
 };
 
 /// A method with a distributed mover.
