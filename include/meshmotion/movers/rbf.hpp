@@ -520,12 +520,10 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   template <class Out>
   void shape_output(Out& out) const {
     const Index n = points_.cols();
-    if constexpr (std::same_as<Out, Points<Dim>>) {
-      if (out.cols() != n) out.resize(Dim, n);
-    } else if (out.cols() != n) {
+    if (!std::same_as<Out, Points<Dim>> && out.cols() != n)
       throw InputError("RbfMover::move_into: the output has " + std::to_string(out.cols()) + " columns (expected " +
                        std::to_string(n) + ", one per node)");
-    }
+    detail::size_output<Dim>(out, n);
   }
 
   template <class Out>

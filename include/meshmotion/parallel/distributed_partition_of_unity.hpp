@@ -38,7 +38,6 @@
 #include "meshmotion/spatial/kd_tree.hpp"
 
 #include <algorithm>
-#include <concepts>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -492,8 +491,7 @@ void DistributedPartitionOfUnity<Dim>::move_into(PointsView<Dim> d, Out& out) {
   for (const auto& block : got)
     for (std::size_t i = 0; i < block.size(); i += Dim, ++row)
       for (int k = 0; k < Dim; ++k) stacked(row, k) = block[i + static_cast<std::size_t>(k)];
-  if constexpr (std::same_as<Out, Points<Dim>>)
-    if (out.cols() != n_local_) out.resize(Dim, n_local_);
+  meshmotion::detail::size_output<Dim>(out, n_local_);
   out.setZero();
   Points<Dim> columns;
   meshmotion::detail::kernel_rows_times<Dim>(operator_, stacked, columns, [&](Index r, const Vec<Dim>& value) {

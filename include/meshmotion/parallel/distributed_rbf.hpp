@@ -53,7 +53,6 @@
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 
 #include <algorithm>
-#include <concepts>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -143,12 +142,6 @@ class DistributedRbfMover {
   void follow_motion(PointsView<Dim> d);
   /// Collective: refuses (on every rank) `d` of the wrong shape or with a non-finite owned entry.
   void check_entries(const char* where, PointsView<Dim> d);
-  /// A Points<Dim> `out` resized to the part; a caller's storage was checked by move_into().
-  template <class Out>
-  void size_output(Out& out) const {
-    if constexpr (std::same_as<Out, Points<Dim>>)
-      if (out.cols() != n_local_) out.resize(Dim, n_local_);
-  }
   /// move_into() into a Points<Dim> or the caller's storage.
   template <class Out>
   void move_to(PointsView<Dim> d, Out& out);
@@ -541,7 +534,7 @@ void DistributedRbfMover<Dim>::move_gathered(PointsView<Dim> d, Out& out) {
     move_petsc(out);
   } else {
     collective(comm_, [&] { inner_.move_into(gathered_, inner_out_); });
-    size_output(out);
+    meshmotion::detail::size_output<Dim>(out, n_local_);
     for (Index i = 0; i < n_local_; ++i) out.col(i) = inner_out_.col(column_[static_cast<std::size_t>(i)]);
     const MoverStats& s = inner_.stats();
     stats_.iterations = s.iterations;
@@ -616,7 +609,7 @@ template <int Dim>
 template <class Out>
 void DistributedRbfMover<Dim>::move_petsc(Out& out) {
   collective(comm_, [&] { system_->solve(gathered_.transpose(), alpha_, beta_); });
-  size_output(out);
+  meshmotion::detail::size_output<Dim>(out, n_local_);
   out.setZero();
   Points<Dim> columns;
   meshmotion::detail::kernel_rows_times<Dim>(operator_, alpha_, columns, [&](Index r, const Vec<Dim>& value) {

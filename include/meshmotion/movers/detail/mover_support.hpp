@@ -10,6 +10,7 @@
 #include "meshmotion/solvers/detail/stopwatch.hpp"
 
 #include <cmath>
+#include <concepts>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -65,6 +66,14 @@ void check_displacements(std::string_view where, PointsView<Dim> d, const std::v
     if (!d.col(b).allFinite())
       throw InputError(std::string(where) + ": displacement of node " + std::to_string(nodes[static_cast<std::size_t>(b)]) +
                        " is not finite");
+}
+
+/// A move's output sized for `n` nodes: a Points<Dim> is resized, a caller's storage (an
+/// Eigen::Ref) is written as it is, its shape checked by whoever took it.
+template <int Dim, class Out>
+void size_output(Out& out, Index n) {
+  if constexpr (std::same_as<Out, Points<Dim>>)
+    if (out.cols() != n) out.resize(Dim, n);
 }
 
 /// Throws InputError unless v (a field over the nodes, e.g. a reverse derivative's seed) is
