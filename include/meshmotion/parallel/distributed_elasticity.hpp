@@ -141,7 +141,7 @@ class DistributedElasticityMover {
     ksp_.reset();
     direct_.reset();
     scatter_.reset();
-    for (OwnedVec* v : {&scale_, &b_, &x_, &values_, &ghosts_, &last_, &before_}) v->reset();
+    for (OwnedVec* v : {&scale_, &b_, &x_, &values_, &ghosts_, &last_, &before_, &trial_, &residual_}) v->reset();
     a_.reset();
     k_.reset();
   }
@@ -178,6 +178,7 @@ class DistributedElasticityMover {
   OwnedMat k_, a_;  ///< K in the rotated frames; the same with Dirichlet rows, scaled
   OwnedVec scale_, b_, x_, values_, ghosts_;
   OwnedVec last_, before_;  ///< the last two moves' solutions of the scaled system (empty until there are)
+  OwnedVec trial_, residual_;  ///< a start being tried, a residual: work vectors of every solve
   detail::OwnedScatter scatter_;
   OwnedKsp ksp_, direct_;
   PetscSolverKind solver_kind_ = PetscSolverKind::automatic;
@@ -372,6 +373,8 @@ void DistributedElasticityMover<Dim>::setup_mesh(const PartitionView<Dim>& part,
   petsc_check(MatCreateVecs(k_.get(), x_.out(), b_.out()), where, "MatCreateVecs");
   petsc_check(VecDuplicate(x_.get(), values_.out()), where, "VecDuplicate");
   petsc_check(VecDuplicate(x_.get(), scale_.out()), where, "VecDuplicate");
+  petsc_check(VecDuplicate(x_.get(), trial_.out()), where, "VecDuplicate");
+  petsc_check(VecDuplicate(x_.get(), residual_.out()), where, "VecDuplicate");
   petsc_check(MatGetDiagonal(k_.get(), scale_.get()), where, "MatGetDiagonal");
   dirichlet_.clear();
   {
@@ -564,14 +567,11 @@ template <int Dim>
 bool DistributedElasticityMover<Dim>::choose_start(const char* where) {
   using detail::petsc_check;
   if (!last_ || solver_kind_ == PetscSolverKind::direct_mumps) return false;
-  OwnedVec trial, residual;
-  petsc_check(VecDuplicate(x_.get(), trial.out()), where, "VecDuplicate");
-  petsc_check(VecDuplicate(x_.get(), residual.out()), where, "VecDuplicate");
   const auto misfit = [&](::Vec start) {
-    petsc_check(MatMult(a_.get(), start, residual.get()), where, "MatMult");
-    petsc_check(VecAYPX(residual.get(), -1.0, b_.get()), where, "VecAYPX");
+    petsc_check(MatMult(a_.get(), start, residual_.get()), where, "MatMult");
+    petsc_check(VecAYPX(residual_.get(), -1.0, b_.get()), where, "VecAYPX");
     PetscReal norm = 0.0;
-    petsc_check(VecNorm(residual.get(), NORM_2, &norm), where, "VecNorm");
+    petsc_check(VecNorm(residual_.get(), NORM_2, &norm), where, "VecNorm");
     return norm;
   };
   PetscReal best = 0.0;
@@ -586,9 +586,9 @@ bool DistributedElasticityMover<Dim>::choose_start(const char* where) {
   };
   consider(last_.get());
   if (before_) {
-    petsc_check(VecWAXPY(trial.get(), -1.0, before_.get(), last_.get()), where, "VecWAXPY");
-    petsc_check(VecAYPX(trial.get(), 1.0, last_.get()), where, "VecAYPX");  // 2 last − before
-    consider(trial.get());
+    petsc_check(VecWAXPY(trial_.get(), -1.0, before_.get(), last_.get()), where, "VecWAXPY");
+    petsc_check(VecAYPX(trial_.get(), 1.0, last_.get()), where, "VecAYPX");  // 2 last − before
+    consider(trial_.get());
   }
   return warm;
 }
@@ -618,12 +618,10 @@ void DistributedElasticityMover<Dim>::solve_scaled(const char* where, bool warm)
     petsc_check(KSPSolve(direct_.get(), b_.get(), x_.get()), where, "KSPSolve");
     stats_.fell_back = true;
   }
-  OwnedVec residual;
-  petsc_check(VecDuplicate(b_.get(), residual.out()), where, "VecDuplicate");
-  petsc_check(MatMult(a_.get(), x_.get(), residual.get()), where, "MatMult");
-  petsc_check(VecAYPX(residual.get(), -1.0, b_.get()), where, "VecAYPX");
+  petsc_check(MatMult(a_.get(), x_.get(), residual_.get()), where, "MatMult");
+  petsc_check(VecAYPX(residual_.get(), -1.0, b_.get()), where, "VecAYPX");
   PetscReal residual_norm = 0.0;
-  petsc_check(VecNorm(residual.get(), NORM_2, &residual_norm), where, "VecNorm");
+  petsc_check(VecNorm(residual_.get(), NORM_2, &residual_norm), where, "VecNorm");
   stats_.iterations = iterations;
   stats_.residual = rhs_norm > 0.0 ? residual_norm / rhs_norm : 0.0;
 }
