@@ -14,6 +14,7 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <type_traits>
 
 using namespace meshmotion;
 
@@ -79,6 +80,56 @@ TEST_CASE("derivatives of every linear mover agree with finite differences (3D t
   spec.prescribed("bottom").fixed("top").sliding("left").fixed("right").fixed("front").fixed("back");
   const auto boundary = spec.resolve(mesh);
   for (const std::string method : {"rbf", "spring", "torsion", "le", "sle", "dgm", "idgm", "dgrbf"}) check_derivatives(mesh, boundary, method);
+}
+
+TEST_CASE("derivatives of the RBF set up at rest, which blends each move's rigid part, agree with finite differences",
+          "[movers]") {
+  // Set up with nothing moving, then moved far: a large turn (and translation) plus a small
+  // random part. The fit and the blend are not linear in the displacements; their derivatives
+  // (through the polar decomposition and SO(3)'s left Jacobian) must still be exact, at nodes
+  // that take the whole fit, a share of it, and none.
+  const auto check = [](const auto& mesh, const auto& boundary, const auto& turn) {
+    constexpr int Dim = std::remove_cvref_t<decltype(mesh)>::dim;
+    CAPTURE(Dim);
+    AnyMover<Dim> mover = make_mover<Dim>("rbf");
+    mover.setup(mesh, boundary);
+    REQUIRE(mover.stats().rigid_part);
+    Points<Dim> d = test::random_displacements<Dim>(boundary.size(), 1, 1e-3);
+    Points<Dim> w = test::random_displacements<Dim>(boundary.size(), 2, 1.0);
+    for (Index k = 0; k < boundary.size(); ++k) {
+      const Vec<Dim> x = mesh.points.col(boundary.nodes[static_cast<std::size_t>(k)]);
+      if (boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed) {
+        d.col(k) += turn(x) - x;
+      } else {
+        d.col(k).setZero();
+        w.col(k).setZero();
+      }
+    }
+    const Points<Dim> v = test::random_displacements<Dim>(mesh.num_nodes(), 3, 1.0);
+    (void)mover.move(d);  // the derivatives are those at the last move
+    const Points<Dim> jw = mover.derivative_forward(w);
+    const Points<Dim> jtv = mover.derivative_reverse(v);
+    const double h = 1e-5;
+    const Points<Dim> fd = (mover.move(d + h * w) - mover.move(d - h * w)) / (2.0 * h);
+    CHECK((fd - jw).norm() <= 1e-7 * jw.norm());
+    CHECK(dot<Dim>(jtv, w) == Approx(dot<Dim>(v, jw)).epsilon(1e-10));
+    // Nodes between the body and the held wall take part of the turn: their derivative is not
+    // the rigid one's or zero.
+    CHECK(jw.norm() > 0.0);
+  };
+  {
+    const Mesh<2> ring = annulus_mesh({.n_around = 32});
+    BoundarySpec<2> spec;
+    spec.moving("inner", Translation<2>{Vec<2>::Zero()}).fixed("outer");
+    check(ring, spec.resolve(ring), [](const Vec<2>& x) { return Vec<2>(Eigen::Rotation2Dd(2.5) * x + Vec<2>(0.05, -0.02)); });
+  }
+  {
+    const Mesh<3> box = box_mesh({.nx = 5, .ny = 5, .nz = 6, .z_max = 3.0, .cells = BoxCells::tet4});
+    BoundarySpec<3> spec;
+    spec.prescribed("bottom").fixed("top");
+    const Eigen::AngleAxisd turn(2.2, Vec<3>(1.0, 2.0, 3.0).normalized());
+    check(box, spec.resolve(box), [&](const Vec<3>& x) { return Vec<3>(turn * (x - Vec<3>(0.5, 0.5, 0.0)) + Vec<3>(0.5, 0.5, 0.1)); });
+  }
 }
 
 TEST_CASE("grid velocities: every linear mover's velocity() is the rate of change of its positions in time",

@@ -947,9 +947,10 @@ TEST_CASE("set up once on the reference, the default RBF follows a whole boundar
   // As a time loop runs it: set up before anything moves (the default radius is then ten
   // boundary spacings), moved from the reference at every step. With that radius held, the
   // ring's interior stayed behind its boundary and folded (min scaled Jacobian -36.7 at the
-  // last step); the radius now grows with the motion, at most once per doubling of it, and an
-  // oscillation within the motion seen sets nothing up again. P1 and P2 (boundary-layer cells
-  // on the inner circle).
+  // last step); the rigid part of each move (rotation and translation) is now blended in first
+  // (RigidPartAtMove: nothing is held, so every node takes it whole) and the radius grows with
+  // what is left, at most once per doubling of it, and an oscillation within the motion seen
+  // sets nothing up again. P1 and P2 (boundary-layer cells on the inner circle).
   const Mesh<2> ring = annulus_mesh();
   for (const Mesh<2>& mesh : {ring, convert_to_quadratic(ring).mesh}) {
     CAPTURE(mesh.num_nodes());
@@ -966,7 +967,8 @@ TEST_CASE("set up once on the reference, the default RBF follows a whole boundar
       }
       return d;
     };
-    std::vector<double> grown_at;  // the largest displacement of each move that set up again
+    REQUIRE(mover.rigid_part_taken_out());
+    std::vector<double> grown_at;  // the largest interpolated displacement of each move that set up again
     Index growths = 0;
     for (int step = 1; step <= 10; ++step) {
       CAPTURE(step);
@@ -975,7 +977,10 @@ TEST_CASE("set up once on the reference, the default RBF follows a whole boundar
       moved.points += mover.move(d);
       CHECK(mover.stats().moves == step);
       if (mover.stats().radius_growths > growths) {
-        grown_at.push_back(d.colwise().norm().maxCoeff());
+        double rest = 0.0;
+        for (Index k = 0; k < boundary.size(); ++k)
+          rest = std::max(rest, (d.col(k) - mover.rigid_part_displacement().col(boundary.nodes[static_cast<std::size_t>(k)])).norm());
+        grown_at.push_back(rest);
         growths = mover.stats().radius_growths;
         // Set up for twice the motion: the radius covers it with room to double.
         CHECK(mover.support_radius() == Approx(10.0 * grown_at.back()).epsilon(1e-12));
@@ -995,12 +1000,17 @@ TEST_CASE("set up once on the reference, the default RBF follows a whole boundar
     CHECK(mover.stats().radius_growths == growths);
     CHECK(mover.support_radius() == radius);
     CHECK((mover.move(displacements(0.5)) - half).norm() == 0.0);
-    // Linear between growths: the derivative is the map of the last move.
-    const Points<2> w = displacements(0.3);
-    CHECK((mover.derivative_forward(w) - mover.move(w)).norm() <= 1e-12 * w.norm());
-    // The setup's radius held folds the ring.
+    // The derivative at the last move meets a central difference of moves about it.
+    const Points<2> w = displacements(0.3), at = displacements(0.7);
+    (void)mover.move(at);
+    const Points<2> forward = mover.derivative_forward(w);
+    const double h = 1e-6;
+    const Points<2> difference = (mover.move(at + h * w) - mover.move(at - h * w)) / (2.0 * h);
+    CHECK((forward - difference).norm() <= 1e-6 * forward.norm());
+    // The setup's radius held, interpolating the whole motion, folds the ring.
     RbfOptions held;
     held.support_radius = first_radius;
+    held.rigid_part = RigidPart::none;
     RbfMover<2> folding(held);
     folding.setup(mesh, boundary);
     Mesh<2> folded = mesh;
@@ -1036,7 +1046,7 @@ TEST_CASE("set up once, the default RBF follows a whole boundary turning 90 degr
       lowest = std::min(lowest, q.min);
     }
     CHECK(lowest > 0.8);  // 0.95 at P1, 0.90 at P2 to P4 measured
-    CHECK(mover.stats().radius_growths >= 1);
+    CHECK(mover.rigid_part_taken_out());
   }
 }
 
@@ -1203,5 +1213,76 @@ TEST_CASE("rigid part: moves are affine, derivatives are the interpolation's, a 
   CHECK_THROWS_WITH(RbfMover<2>(forced).setup(ring, growing), Catch::Contains("do not move as one rigid body"));
   RbfMover<2> automatic(budget);
   automatic.setup(ring, growing);
+  CHECK_FALSE(automatic.rigid_part_taken_out());
+}
+
+TEST_CASE("set up at rest, a square turned inside a held circle from the reference to 180 degrees stays valid",
+          "[movers]") {
+  // A solver's protocol for a body turning inside held walls: one setup with nothing moving,
+  // then moves from the reference in 15 degree steps to a half turn. Each move's rigid part is
+  // fitted and blended by weights of the distance to the body's centre alone (RigidPartAtMove),
+  // a twist whose Jacobian determinant is 1 at any angle; what is left to fold is the cells'
+  // own resolution of it (64 × 40 quadrilaterals: 16 fold at 180°, min 0.16 at 150°).
+  // Interpolating the whole motion (as before, and as rigid_part=none does) folds the mesh
+  // from 105°. Sharp corners, quadrilaterals and triangles.
+  for (const bool triangles : {false, true}) {
+    CAPTURE(triangles);
+    const Mesh<2> mesh = o_mesh({.body = OMeshBody::square, .semi_axis_x = 1.0, .n_around = 96, .n_radial = 48,
+                                 .first_height = 0.01, .farfield_radius = 6.0, .triangles = triangles});
+    BoundarySpec<2> spec;
+    spec.moving("wall", Translation<2>{Vec<2>::Zero()}).fixed("farfield");
+    const ResolvedBoundary<2> boundary = spec.resolve(mesh);
+    const auto turned = [&](double degrees) {
+      Points<2> d = Points<2>::Zero(2, boundary.size());
+      for (Index k = 0; k < boundary.size(); ++k)
+        if (boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed) {
+          const Vec<2> x = mesh.points.col(boundary.nodes[static_cast<std::size_t>(k)]);
+          d.col(k) = Eigen::Rotation2Dd(degrees * std::numbers::pi / 180.0) * x - x;
+        }
+      return d;
+    };
+    RbfMover<2> mover;
+    mover.setup(mesh, boundary);
+    REQUIRE(mover.rigid_part_taken_out());
+    double lowest = 1.0;
+    for (int degrees = 15; degrees <= 180; degrees += 15) {
+      CAPTURE(degrees);
+      const Points<2> d = turned(degrees);
+      Mesh<2> moved = mesh;
+      moved.points += mover.move(d);
+      const QualityReport q = quality_report(moved, Metric::scaled_jacobian);
+      CHECK(q.num_invalid == 0);
+      lowest = std::min(lowest, q.min);
+      for (Index k = 0; k < boundary.size(); ++k)  // the body where it was put, the circle held
+        CHECK((moved.points.col(boundary.nodes[static_cast<std::size_t>(k)]) - mesh.points.col(boundary.nodes[static_cast<std::size_t>(k)]) -
+               d.col(k)).norm() <= 1e-12);
+    }
+    CHECK(lowest > 0.1);  // 0.14 measured (quadrilaterals at 180°)
+    // A rigid body leaves nothing to interpolate: the radius never grew, nothing was factorized again.
+    CHECK(mover.stats().radius_growths == 0);
+    RbfOptions whole;
+    whole.rigid_part = RigidPart::none;
+    RbfMover<2> interpolating(whole);
+    interpolating.setup(mesh, boundary);
+    Mesh<2> folded = mesh;
+    folded.points += interpolating.move(turned(120.0));
+    CHECK(quality_report(folded, Metric::scaled_jacobian).num_invalid > 0);
+  }
+}
+
+TEST_CASE("rigid_part=blend on a mover set up at rest names what stops it", "[movers]") {
+  const Mesh<2> mesh = rectangle_mesh({.nx = 6, .ny = 6});
+  RbfOptions blend;
+  blend.rigid_part = RigidPart::blend;
+  BoundarySpec<2> touching;  // the moving wall meets the held sides at its ends
+  touching.prescribed("bottom").fixed("top").fixed("left").fixed("right");
+  RbfMover<2> mover(blend);
+  CHECK_THROWS_WITH(mover.setup(mesh, touching.resolve(mesh)), Catch::Contains("rigid_part=blend: a held node lies"));
+  BoundarySpec<2> held_only;
+  held_only.fixed("top");
+  CHECK_THROWS_WITH(mover.setup(mesh, held_only.resolve(mesh)), Catch::Contains("rigid_part=blend: no prescribed node"));
+  // automatic takes nothing out there, and interpolates the whole motion as before.
+  RbfMover<2> automatic;
+  automatic.setup(mesh, touching.resolve(mesh));
   CHECK_FALSE(automatic.rigid_part_taken_out());
 }

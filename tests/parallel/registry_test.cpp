@@ -70,12 +70,11 @@ TEST_CASE("distributed registry: methods without a distributed mover, and movers
   // Elasticity without cells is refused with what to do instead.
   const Mesh<3> box = box_mesh({.nx = 2, .ny = 2, .nz = 2});
   const DistributedMesh<3> part = partition_mesh(world(), box);
-  // The rigid part is the distributed RBF's own to decide (it interpolates the whole motion):
-  // blend is refused by the mover, naming why.
+  // rigid_part=blend with nothing prescribed is refused by the mover, naming why.
   MoverConfig<3> blend = mover_config<3>("rbf");
   blend.set("rigid_part", "blend");
   CHECK_THROWS_WITH(make_distributed_mover(blend)->setup(part.view(), ResolvedBoundary<3>{}),
-                    Catch::Contains("rigid_part=blend is not distributed"));
+                    Catch::Contains("rigid_part=blend: no prescribed node"));
   const std::unique_ptr<DistributedMover<3>> le = make_distributed_mover(mover_config<3>("le"));
   CHECK_THROWS_WITH(le->setup(part.view(), ResolvedBoundary<3>{}), Catch::Contains("needs the cells"));
 }

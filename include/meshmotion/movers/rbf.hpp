@@ -306,8 +306,9 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   [[nodiscard]] bool support_radius_reduced() const noexcept { return radius_reduced_; }
   /// True when the last setup took the rigid part of the boundary's motion out
   /// (RbfOptions::rigid_part); moves then add its blend, rigid_part_displacement().
-  [[nodiscard]] bool rigid_part_taken_out() const noexcept { return rigid_.size() > 0; }
-  /// The rigid part's displacement of every node (Dim × n_nodes; empty when none was taken out).
+  [[nodiscard]] bool rigid_part_taken_out() const noexcept { return rigid_.size() > 0 || at_move_.active(); }
+  /// The rigid part's displacement of every node (Dim × n_nodes): setup's, or for a mover set
+  /// up at rest the last move's (RigidPartAtMove); empty when none was taken out or moved yet.
   [[nodiscard]] const Points<Dim>& rigid_part_displacement() const noexcept { return rigid_; }
   /// Patches of the partition of unity after setup (0: one global system).
   [[nodiscard]] Index patches() const noexcept { return patched_all_ ? patched_all_->num_patches() : 0; }
@@ -442,6 +443,10 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   template <class Out>
   void timed_apply(PointsView<Dim> d, Out& out) {
     detail::timed_move<Dim>("RbfMover::move", ready_, d, boundary_.nodes, stats_, [&] {
+      if (at_move_.active()) {
+        at_move_.blend(points_, d, rigid_);
+        rigid_scale_ = d.size() > 0 ? d.colwise().norm().maxCoeff() : 0.0;
+      }
       follow_motion(d);
       if (rigid_.size() == 0) {
         apply(d, out);
@@ -613,6 +618,8 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   bool radius_reduced_ = false;  ///< the default radius_ was reduced to fit the memory budget
   Points<Dim> rigid_;            ///< the rigid part's blend (Dim × n), empty when not taken out
   double rigid_scale_ = 0.0;     ///< the largest displacement of the motion it was fitted to
+  /// Set up at rest: the rigid part found at every move (rigid_ then holds the last move's).
+  RigidPartAtMove<Dim> at_move_;
   /// With the rigid part out, the interpolation is factorized at the first move or derivative
   /// that needs it (a move by the setup's own rigid motion does not): its centres and kernel.
   Points<Dim> pending_centres_;
@@ -626,9 +633,17 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   check_options(boundary);
   radius_reduced_ = false;
   rigid_.resize(Dim, 0);
+  at_move_ = {};
   if (!points.allFinite()) throw InputError("RbfMover::setup: mesh has a non-finite coordinate");
   detail::check_boundary<Dim>("RbfMover::setup", boundary, points.cols(), false);
-  auto [fitted, blend] = detail::radius_and_blend(points, boundary, options_, options_.support_radii.empty() && radius_ == 0.0);
+  // Set up before anything moves (a solver's time loop): the rigid part is each move's.
+  RbfOptions decided = options_;
+  if (options_.rigid_part != RigidPart::none && at_rest(boundary)) {
+    if (const auto why = at_move_.prepare(points, boundary); why && options_.rigid_part == RigidPart::blend)
+      throw InputError("rigid_part=blend: " + *why);
+    decided.rigid_part = RigidPart::none;
+  }
+  auto [fitted, blend] = detail::radius_and_blend(points, boundary, decided, options_.support_radii.empty() && radius_ == 0.0);
   if (fitted) {
     radius_ = fitted->radius;
     radius_reduced_ = fitted->reduced;
@@ -640,10 +655,10 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   boundary_ = boundary;
   stats_ = MoverStats{};
   prepare_interpolation(radius_);
+  stats_.rigid_part = blend || at_move_.active();
   if (blend) {
     rigid_ = std::move(blend->displacement);
     rigid_scale_ = boundary.displacements.colwise().norm().maxCoeff();
-    stats_.rigid_part = true;
     stats_.evaluated_nodes = points_.cols() - static_cast<Index>(boundary_.nodes.size());
   } else {
     build_interpolation();
@@ -886,7 +901,18 @@ Points<Dim> RbfMover<Dim>::derivative_forward(PointsView<Dim> w) {
   detail::check_displacements<Dim>("RbfMover::derivative_forward", w, boundary_.nodes);
   build_interpolation();
   Points<Dim> out;
-  apply(w, out);
+  if (!at_move_.active()) {
+    apply(w, out);
+    return out;
+  }
+  // move(d) = B(d) + apply(d − B_b(d)): the blend's change, and the interpolation of the rest.
+  Points<Dim> blended;
+  at_move_.derivative_forward(points_, w, blended);
+  Points<Dim> rest = w;
+  for (std::size_t b = 0; b < boundary_.nodes.size(); ++b)
+    if (boundary_.kinds[b] != BoundaryKind::sliding) rest.col(static_cast<Index>(b)) -= blended.col(boundary_.nodes[b]);
+  apply(rest, out);
+  out += blended;
   return out;
 }
 
@@ -923,6 +949,13 @@ Points<Dim> RbfMover<Dim>::derivative_reverse(PointsView<Dim> v) {
     values_bar.topRows(n_constrained_) += through_constrained;
   }
   for (Index c = 0; c < n_constrained_; ++c) grad.col(source_[static_cast<std::size_t>(c)]) += values_bar.row(c).transpose();
+  if (!at_move_.active()) return grad;
+  // The transpose of derivative_forward's: the blend's change B′ meets v less what the
+  // interpolation's transpose took at the boundary nodes (where it carried −B′_b).
+  Points<Dim> through_blend = v;
+  for (Index b = 0; b < m; ++b)
+    if (boundary_.kinds[static_cast<std::size_t>(b)] != BoundaryKind::sliding) through_blend.col(boundary_.nodes[static_cast<std::size_t>(b)]) -= grad.col(b);
+  at_move_.derivative_reverse(points_, through_blend, grad);
   return grad;
 }
 

@@ -35,13 +35,16 @@
 #include "meshmotion/movers/boundary.hpp"
 #include "meshmotion/spatial/kd_tree.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <Eigen/SVD>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -247,5 +250,298 @@ template <int Dim>
       boundary.displacements.col(k) -= blend.displacement.col(boundary.nodes[static_cast<std::size_t>(k)]);
   return boundary;
 }
+
+/// True when no prescribed entry of `boundary` moves (or it carries no displacements): a
+/// mover set up before anything moves, whose rigid part is then each move's (RigidPartAtMove).
+template <int Dim>
+[[nodiscard]] bool at_rest(const ResolvedBoundary<Dim>& boundary) {
+  if (boundary.displacements.cols() != boundary.size()) return boundary.displacements.cols() == 0;
+  for (Index k = 0; k < boundary.size(); ++k)
+    if (boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed && !boundary.displacements.col(k).isZero(0.0))
+      return false;
+  return true;
+}
+
+/// The rigid part of each move's motion, for a mover set up before anything moves (a solver's
+/// time loop, an optimizer, the OpenFOAM plugin): found at every move, blended by weights fixed
+/// at setup. The prescribed nodes' displacements are fitted by one rigid motion about their
+/// reference centroid p, x ↦ p + t + R(x − p) (least squares: t their mean displacement, R the
+/// rotation of the polar decomposition M = R S of M = Σ (y_i − q)(x_i − p)ᵀ). Every node then
+/// moves to p + v(ρ) t + R(w(ρ) φ)(x − p), φ = log R (the rotation vector, continued from the
+/// last move's so that a body turning past a half turn keeps turning the same way), ρ = |x − p|.
+///
+/// The weights depend on ρ alone, so the blend's rotation is a twist about the axis whatever
+/// the axis is: its Jacobian determinant is exactly 1 for any angle (a weight that falls with
+/// the distance to the body, as rigid_blend()'s, has ∂w/∂(angle about the axis) ≠ 0 where the
+/// body is not round about the axis, and folds past ~90°: a plate turned in a held box left
+/// 1,902 cells invalid at 180° with that profile, 82 with this one). w is 1 inside the ball of
+/// radius r0 holding every prescribed node and 0 beyond R1, the distance from p to the nearest
+/// held (fixed or sliding) node; between them it falls linearly in ln ρ (a twist's shear ρ θ w′
+/// is then the same everywhere, θ / ln(R1/r0), the least any profile can have), with quadratic
+/// ends over a tenth of that range each so that no cell straddles a kink. The translation's
+/// weight v falls as a smoothstep of ρ over the same range (a translation's strain is |t| v′,
+/// smallest when spread evenly). Nothing held: w = v = 1, every node moves rigidly.
+///
+/// The blend is not linear in the displacements; its derivatives are exact: with dR = R Ω,
+/// Ω S + S Ω = Rᵀ dM − dMᵀ R gives Ω ((tr S) I − S in 3D, tr S in 2D), and the rotation
+/// vector's change through the inverse of SO(3)'s left Jacobian.
+///
+/// Over MPI every process prepares its own nodes and counts the entries (and, for the reverse
+/// derivative, the nodes) it owns; the fit's sums go through `reduce` (a Reduction: sum, max and
+/// min over the processes in place), so every process blends the serial fit.
+struct LocalReduction {
+  void sum(double*, int) const {}
+  void max(double&) const {}
+  void min(double&) const {}
+};
+
+template <int Dim>
+class RigidPartAtMove {
+ public:
+  using Matrix = Eigen::Matrix<double, Dim, Dim>;
+  /// The rotation vector: an angle in 2D, φ in 3D.
+  using Turn = Eigen::Matrix<double, Dim == 2 ? 1 : 3, 1>;
+
+  /// Prepares the blend of `boundary`'s motion over `points` (Dim × n, the reference). Returns
+  /// why it cannot (nothing prepared): no prescribed node, prescribed nodes on one line (3D:
+  /// a turn about it is not seen) or on one point, or a held node inside their ball.
+  /// `owned` (per entry; empty: every entry): the entries this process counts.
+  template <class Reduce = LocalReduction>
+  [[nodiscard]] std::optional<std::string> prepare(const Points<Dim>& points, const ResolvedBoundary<Dim>& boundary,
+                                                   const std::vector<char>& owned = {}, const Reduce& reduce = {}) {
+    *this = RigidPartAtMove{};
+    std::vector<Index> moving, held;
+    for (Index k = 0; k < boundary.size(); ++k)
+      if (owned.empty() || owned[static_cast<std::size_t>(k)] != 0)
+        (boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed ? moving : held).push_back(k);
+    // Their count and the sum of their positions, then Σ o oᵀ: one reduction each.
+    std::array<double, Dim + 1> sums{};
+    for (const Index k : moving)
+      for (int a = 0; a < Dim; ++a) sums[static_cast<std::size_t>(a)] += points(a, boundary.nodes[static_cast<std::size_t>(k)]);
+    sums[Dim] = static_cast<double>(moving.size());
+    reduce.sum(sums.data(), Dim + 1);
+    if (sums[Dim] == 0.0) return "no prescribed node";
+    const Vec<Dim> p = Eigen::Map<const Vec<Dim>>(sums.data()) / sums[Dim];
+    Points<Dim> offsets(Dim, static_cast<Index>(moving.size()));
+    for (std::size_t i = 0; i < moving.size(); ++i)
+      offsets.col(static_cast<Index>(i)) = points.col(boundary.nodes[static_cast<std::size_t>(moving[i])]) - p;
+    Matrix spread = offsets * offsets.transpose();
+    reduce.sum(spread.data(), Dim * Dim);
+    const Eigen::SelfAdjointEigenSolver<Matrix> eigen(spread);
+    if (!(eigen.eigenvalues()(1) > 1e-12 * eigen.eigenvalues()(Dim - 1)))
+      return Dim == 2 ? "the prescribed nodes coincide" : "the prescribed nodes lie on one line";
+    double r0 = offsets.cols() > 0 ? offsets.colwise().norm().maxCoeff() : 0.0;
+    reduce.max(r0);
+    double r1 = std::numeric_limits<double>::infinity();
+    for (const Index k : held) r1 = std::min(r1, (points.col(boundary.nodes[static_cast<std::size_t>(k)]) - p).norm());
+    reduce.min(r1);
+    // A ball a fifth wider than the body at least: a narrower shell holds too few cells to twist.
+    if (r1 < 1.2 * r0)
+      return "a held node lies " + format_option_value(r1) + " from the prescribed nodes' centroid, within 1.2 x their ball's radius " +
+             format_option_value(r0);
+    const Index n = points.cols();
+    turn_weight_.resize(n);
+    shift_weight_.resize(n);
+    const double span = std::log(r1 / r0), ends = 0.1, slope = 1.0 / (1.0 - ends);
+    for (Index v = 0; v < n; ++v) {
+      const double rho = (points.col(v) - p).norm();
+      if (!std::isfinite(r1) || rho <= r0) {
+        turn_weight_(v) = shift_weight_(v) = 1.0;
+      } else if (rho >= r1) {
+        turn_weight_(v) = shift_weight_(v) = 0.0;
+      } else {
+        const double s = std::log(rho / r0) / span, u = (r1 - rho) / (r1 - r0);
+        const double fallen = s < ends         ? slope * s * s / (2.0 * ends)
+                              : s > 1.0 - ends ? 1.0 - slope * (1.0 - s) * (1.0 - s) / (2.0 * ends)
+                                               : slope * (s - ends / 2.0);
+        turn_weight_(v) = 1.0 - fallen;
+        shift_weight_(v) = u * u * (3.0 - 2.0 * u);
+      }
+    }
+    moving_ = std::move(moving);
+    offsets_ = std::move(offsets);
+    spread_ = stretch_ = spread;
+    centre_ = p;
+    count_ = sums[Dim];
+    return std::nullopt;
+  }
+
+  [[nodiscard]] bool active() const noexcept { return count_ > 0.0; }
+  /// The last fit's angle (radians, ≥ 0).
+  [[nodiscard]] double angle() const { return turn_.norm(); }
+
+  /// Fits `d`'s rigid part (Dim × boundary.size()) and writes its blend over every node of
+  /// `points` (prepare()'s) into `out` (Dim × n); the fit is kept for the derivatives.
+  template <class Reduce = LocalReduction>
+  void blend(const Points<Dim>& points, PointsView<Dim> d, Points<Dim>& out, const Reduce& reduce = {}) {
+    Matrix m;
+    first_moments(d, shift_, m, reduce);
+    m += spread_;
+    const Eigen::JacobiSVD<Matrix> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Matrix flip = Matrix::Identity();
+    flip(Dim - 1, Dim - 1) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+    rotation_ = svd.matrixU() * flip * svd.matrixV().transpose();
+    stretch_ = rotation_.transpose() * m;
+    turn_ = continued(rotation_);
+    const Index n = points.cols();
+    out.resize(Dim, n);
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
+    for (Index v = 0; v < n; ++v) {
+      const Vec<Dim> r = Vec<Dim>(points.col(v)) - centre_;
+      out.col(v) = shift_weight_(v) * shift_ + turned(turn_weight_(v), r) - r;
+    }
+  }
+
+  /// The blend's change (Dim × n) for a change `w` of the boundary displacements, at the last fit.
+  template <class Reduce = LocalReduction>
+  void derivative_forward(const Points<Dim>& points, PointsView<Dim> w, Points<Dim>& out, const Reduce& reduce = {}) const {
+    Vec<Dim> dt;
+    Matrix dm;
+    first_moments(w, dt, dm, reduce);
+    const Turn dphi = turn_change(dm);
+    const Index n = points.cols();
+    out.resize(Dim, n);
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
+    for (Index v = 0; v < n; ++v) {
+      const double wt = turn_weight_(v);
+      const Vec<Dim> r = turned(wt, Vec<Dim>(points.col(v)) - centre_);
+      out.col(v) = shift_weight_(v) * dt + turned_change(wt, dphi, r);
+    }
+  }
+
+  /// Adds to `grad` (Dim × boundary.size()) the gradient of ⟨v, the blend's change⟩ for `v`
+  /// (Dim × n): the transpose of derivative_forward(). `owned` (per node; empty: every node):
+  /// the nodes whose term this process adds.
+  template <class Reduce = LocalReduction>
+  void derivative_reverse(const Points<Dim>& points, PointsView<Dim> v, Points<Dim>& grad, const std::vector<char>& owned = {},
+                          const Reduce& reduce = {}) const {
+    Eigen::Matrix<double, Dim + Turn::RowsAtCompileTime, 1> sums = decltype(sums)::Zero();
+    for (Index x = 0; x < points.cols(); ++x) {
+      if (!owned.empty() && owned[static_cast<std::size_t>(x)] == 0) continue;
+      const double wt = turn_weight_(x);
+      sums.template head<Dim>() += shift_weight_(x) * v.col(x);
+      if (wt == 0.0) continue;
+      const Vec<Dim> r = turned(wt, Vec<Dim>(points.col(x)) - centre_);
+      sums.template tail<Turn::RowsAtCompileTime>() += turned_change_transpose(wt, r, Vec<Dim>(v.col(x)));
+    }
+    reduce.sum(sums.data(), static_cast<int>(sums.size()));
+    // ⟨gphi, dφ⟩ = ⟨q, dM⟩: dM = Σ w_i o_iᵀ gives w_i's share q o_i.
+    const Matrix q = rotation_ * generator(skew_adjoint(Turn(sums.template tail<Turn::RowsAtCompileTime>())));
+    const Vec<Dim> gt = sums.template head<Dim>() / count_;
+    for (std::size_t i = 0; i < moving_.size(); ++i) grad.col(moving_[i]) += gt + q * offsets_.col(static_cast<Index>(i));
+  }
+
+ private:
+  /// The mean of `d` over the prescribed entries and Σ d_i o_iᵀ, over every process.
+  template <class Reduce>
+  void first_moments(PointsView<Dim> d, Vec<Dim>& mean, Matrix& moment, const Reduce& reduce) const {
+    Eigen::Matrix<double, Dim + Dim * Dim, 1> sums = decltype(sums)::Zero();
+    for (std::size_t i = 0; i < moving_.size(); ++i) {
+      sums.template head<Dim>() += d.col(moving_[i]);
+      Eigen::Map<Matrix>(sums.data() + Dim) += d.col(moving_[i]) * offsets_.col(static_cast<Index>(i)).transpose();
+    }
+    reduce.sum(sums.data(), static_cast<int>(sums.size()));
+    mean = sums.template head<Dim>() / count_;
+    moment = Eigen::Map<const Matrix>(sums.data() + Dim);
+  }
+
+  /// The unit rotation's generator times g: [g]× in 3D, g J in 2D (J the quarter turn).
+  [[nodiscard]] static Matrix generator(const Turn& g) {
+    Matrix out;
+    if constexpr (Dim == 2) {
+      out << 0.0, -g(0), g(0), 0.0;
+    } else {
+      out << 0.0, -g(2), g(1), g(2), 0.0, -g(0), -g(1), g(0), 0.0;
+    }
+    return out;
+  }
+  /// The skew part of a matrix as a Turn: K(1,0) in 2D, vex(K) in 3D, for K = X − Xᵀ.
+  [[nodiscard]] static Turn skew_of(const Matrix& x) {
+    const Matrix k = x - x.transpose();
+    if constexpr (Dim == 2) {
+      return Turn(k(1, 0));
+    } else {
+      return Turn(k(2, 1), k(0, 2), k(1, 0));
+    }
+  }
+  /// SO(3)'s left Jacobian at φ: exp(φ + dφ) = exp([J_l dφ]×) exp(φ) to first order.
+  [[nodiscard]] static Eigen::Matrix3d left_jacobian(const Eigen::Vector3d& phi) {
+    const double a = phi.norm();
+    Eigen::Matrix3d k;
+    k << 0.0, -phi(2), phi(1), phi(2), 0.0, -phi(0), -phi(1), phi(0), 0.0;
+    if (a < 1e-6) return Eigen::Matrix3d::Identity() + 0.5 * k + k * k / 6.0;
+    return Eigen::Matrix3d::Identity() + (1.0 - std::cos(a)) / (a * a) * k + (a - std::sin(a)) / (a * a * a) * k * k;
+  }
+  /// log R, the branch nearest the last move's (a body past a half turn keeps its sense).
+  [[nodiscard]] Turn continued(const Matrix& r) const {
+    constexpr double two_pi = 2.0 * std::numbers::pi;
+    if constexpr (Dim == 2) {
+      const double a = std::atan2(r(1, 0), r(0, 0));
+      return Turn(a + two_pi * std::round((turn_(0) - a) / two_pi));
+    } else {
+      const Eigen::AngleAxisd aa(r);
+      if (aa.angle() == 0.0) return Turn::Zero();
+      const Turn phi = aa.angle() * aa.axis(), other = (aa.angle() - two_pi) * aa.axis();
+      return (other - turn_).norm() < (phi - turn_).norm() ? other : phi;
+    }
+  }
+  /// R(w φ) r for the last fit's φ.
+  [[nodiscard]] Vec<Dim> turned(double w, const Vec<Dim>& r) const {
+    if (w == 0.0) return r;
+    if constexpr (Dim == 2) {
+      return Eigen::Rotation2Dd(w * turn_(0)) * r;
+    } else {
+      const double a = turn_.norm();
+      return a == 0.0 ? r : Vec<Dim>(Eigen::AngleAxisd(w * a, turn_ / a) * r);
+    }
+  }
+  /// dφ for dM (the fit's rotation moves by dR = R Ω, Ω S + S Ω = Rᵀ dM − dMᵀ R).
+  [[nodiscard]] Turn turn_change(const Matrix& dm) const {
+    const Turn k = skew_of(rotation_.transpose() * dm);
+    if constexpr (Dim == 2) {
+      return Turn(k(0) / stretch_.trace());
+    } else {
+      const Eigen::Vector3d omega = (stretch_.trace() * Eigen::Matrix3d::Identity() - stretch_).partialPivLu().solve(k);
+      return left_jacobian(turn_).partialPivLu().solve(rotation_ * omega);
+    }
+  }
+  /// The transpose of turn_change: the Turn g with ⟨g, skew_of(Rᵀ dM)⟩ = ⟨gphi, turn_change(dM)⟩.
+  [[nodiscard]] Turn skew_adjoint(const Turn& gphi) const {
+    if constexpr (Dim == 2) {
+      return Turn(gphi(0) / stretch_.trace());
+    } else {
+      const Eigen::Vector3d through = rotation_.transpose() * left_jacobian(turn_).transpose().partialPivLu().solve(gphi);
+      return (stretch_.trace() * Eigen::Matrix3d::Identity() - stretch_).transpose().partialPivLu().solve(through);
+    }
+  }
+  /// d(R(w φ) r0) for dφ, with r = R(w φ) r0: w dφ × r in 2D's sense; 3D through J_l(w φ).
+  [[nodiscard]] Vec<Dim> turned_change(double w, const Turn& dphi, const Vec<Dim>& r) const {
+    if (w == 0.0) return Vec<Dim>::Zero();
+    if constexpr (Dim == 2) {
+      return w * dphi(0) * Vec<Dim>(-r.y(), r.x());
+    } else {
+      return (left_jacobian(w * turn_) * (w * dphi)).cross(r);
+    }
+  }
+  /// The transpose of turned_change in dφ: ⟨v, turned_change(w, dφ, r)⟩ = ⟨result, dφ⟩.
+  [[nodiscard]] Turn turned_change_transpose(double w, const Vec<Dim>& r, const Vec<Dim>& v) const {
+    if constexpr (Dim == 2) {
+      return Turn(w * (r.x() * v.y() - r.y() * v.x()));
+    } else {
+      return w * (left_jacobian(w * turn_).transpose() * r.cross(v));
+    }
+  }
+
+  std::vector<Index> moving_;            ///< the prescribed entries
+  Points<Dim> offsets_;                  ///< their reference positions less their centroid
+  Matrix spread_ = Matrix::Zero();       ///< Σ offsets offsetsᵀ
+  Vec<Dim> centre_ = Vec<Dim>::Zero();   ///< p
+  double count_ = 0.0;                   ///< prescribed entries over every process
+  Eigen::VectorXd turn_weight_, shift_weight_;  ///< w and v of every node
+  // The last fit.
+  Matrix rotation_ = Matrix::Identity(), stretch_ = Matrix::Identity();
+  Vec<Dim> shift_ = Vec<Dim>::Zero();
+  Turn turn_ = Turn::Zero();
+};
 
 }  // namespace meshmotion

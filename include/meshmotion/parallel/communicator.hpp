@@ -81,6 +81,15 @@ template <class T>
 }
 
 /// The cores of this node (1 when unknown).
+/// Sums, maxima and minima of doubles over the ranks of `comm`, in place (a Reduction, as
+/// RigidPartAtMove takes).
+struct RanksReduction {
+  MPI_Comm comm;
+  void sum(double* values, int n) const { MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_DOUBLE, MPI_SUM, comm); }
+  void max(double& value) const { MPI_Allreduce(MPI_IN_PLACE, &value, 1, MPI_DOUBLE, MPI_MAX, comm); }
+  void min(double& value) const { MPI_Allreduce(MPI_IN_PLACE, &value, 1, MPI_DOUBLE, MPI_MIN, comm); }
+};
+
 [[nodiscard]] inline int cores_of_node() { return std::max(1, static_cast<int>(std::thread::hardware_concurrency())); }
 
 /// This rank's even share of its node's cores among the ranks of `comm` on it, at least 1 and

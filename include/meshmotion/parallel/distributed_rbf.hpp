@@ -33,8 +33,10 @@
 ///   position, a global id and an owner per local node), so the caller's arrays need not
 ///   outlive setup().
 ///
-/// The whole motion is interpolated (RbfOptions::rigid_part as none; blend is refused): a large
-/// rigid motion, which the serial mover blends into the volume first, is not (yet) distributed.
+/// - The rigid part: set up at rest (nothing prescribed moves yet), as the serial mover, each
+///   move's rigid part is fitted (sums over the ranks) and blended in first (RigidPartAtMove);
+///   a mover set up with a motion interpolates the whole of it (rigid_part=blend is refused
+///   there: setup-time blends are the serial mover's).
 ///
 /// The owner's entry decides: a ghost's boundary entry on another rank is ignored (its kind,
 /// plane and displacement come from its owner), so parts need not agree on ghosts.
@@ -140,6 +142,10 @@ class DistributedRbfMover {
   void set_up(const ResolvedBoundary<Dim>& boundary);
   /// Collective: sets the mover up again for `d` when it outgrew the default radius.
   void follow_motion(PointsView<Dim> d);
+  /// Collective: `d` less the rigid part's blend `blend` at the non-sliding entries (rest_).
+  [[nodiscard]] const Points<Dim>& without_blend(PointsView<Dim> d, const Points<Dim>& blend);
+  /// Collective: derivative_reverse() of the interpolation alone.
+  [[nodiscard]] Points<Dim> reverse_interpolation(PointsView<Dim> v);
   /// Collective: refuses (on every rank) `d` of the wrong shape or with a non-finite owned entry.
   void check_entries(const char* where, PointsView<Dim> d);
   /// move_into() into a Points<Dim> or the caller's storage.
@@ -214,6 +220,8 @@ class DistributedRbfMover {
   std::vector<Index> entry_slot_;      ///< this rank's boundary entry → sorted position (-1: ghost)
   std::vector<int> counts_;            ///< owned entries per rank
   Points<Dim> gathered_, inner_out_;
+  RigidPartAtMove<Dim> at_move_;  ///< set up at rest: each move's rigid part
+  Points<Dim> blend_, rest_;      ///< the last move's blend (Dim × part.size()), and d less it
 };
 
 template <int Dim>
@@ -224,7 +232,30 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
   part_ids_.assign(part.global_ids.begin(), part.global_ids.end());
   part_owners_.assign(part.owner.begin(), part.owner.end());
   boundary_ = boundary;
+  at_move_ = {};
+  if (options_.rigid_part != RigidPart::none) {
+    int rest = boundary.size() == 0 || boundary.displacements.cols() != boundary.size() || at_rest(boundary) ? 1 : 0;
+    MPI_Allreduce(MPI_IN_PLACE, &rest, 1, MPI_INT, MPI_MIN, comm_);
+    if (rest != 0) {
+      std::vector<char> owned(static_cast<std::size_t>(boundary.size()), 0);
+      for (Index k = 0; k < boundary.size(); ++k) {
+        const Index v = boundary.nodes[static_cast<std::size_t>(k)];
+        owned[static_cast<std::size_t>(k)] = v >= 0 && v < part.size() && part.owns(v) ? 1 : 0;
+      }
+      std::optional<std::string> why;
+      collective(comm_, [&] { why = at_move_.prepare(part_points_, boundary, owned, RanksReduction{comm_}); });
+      if (why && options_.rigid_part == RigidPart::blend) throw InputError("DistributedRbfMover::setup: rigid_part=blend: " + *why);
+    }
+  }
   set_up(boundary);
+}
+
+template <int Dim>
+const Points<Dim>& DistributedRbfMover<Dim>::without_blend(PointsView<Dim> d, const Points<Dim>& blend) {
+  rest_ = d;
+  for (Index k = 0; k < boundary_.size(); ++k)
+    if (boundary_.kinds[static_cast<std::size_t>(k)] != BoundaryKind::sliding) rest_.col(k) -= blend.col(boundary_.nodes[static_cast<std::size_t>(k)]);
+  return rest_;
 }
 
 template <int Dim>
@@ -265,9 +296,9 @@ void DistributedRbfMover<Dim>::set_up(const ResolvedBoundary<Dim>& boundary) {
                        std::to_string(boundary.size()) + " local boundary entries (expected one per entry, or none)");
     if (solve_.boundary_solve == BoundarySolve::patches && !options_.partition_of_unity)
       throw InputError("DistributedRbfMover::setup: BoundarySolve::patches needs RbfOptions::partition_of_unity");
-    if (options_.rigid_part == RigidPart::blend)
-      throw InputError("DistributedRbfMover::setup: rigid_part=blend is not distributed (the ranks interpolate the whole "
-                       "motion; give rigid_part=automatic or none)");
+    if (options_.rigid_part == RigidPart::blend && !at_move_.active())
+      throw InputError("DistributedRbfMover::setup: rigid_part=blend on a mover set up with a motion is not distributed (the "
+                       "ranks blend each move's rigid part when set up at rest; give rigid_part=automatic or none)");
   });
   n_local_ = n;
   n_entries_ = boundary.size();
@@ -289,6 +320,7 @@ void DistributedRbfMover<Dim>::set_up(const ResolvedBoundary<Dim>& boundary) {
       stats_.support_radius = radius_;
       grows_ = options_.support_radius == 0.0;
       patches_ = std::move(patches);
+      stats_.rigid_part = at_move_.active();
       ready_ = true;
       stats_.setup_seconds = watch.seconds();
       return;
@@ -329,6 +361,7 @@ void DistributedRbfMover<Dim>::set_up(const ResolvedBoundary<Dim>& boundary) {
   stats_.support_radius = radius_;
   stats_.radius_reduced = radius_reduced_;
   grows_ = options_.support_radius == 0.0 && !gathered.radius_per_entry && !radius_reduced_;
+  stats_.rigid_part = at_move_.active();
   ready_ = true;
   stats_.setup_seconds = watch.seconds();
 }
@@ -506,8 +539,18 @@ template <class Out>
 void DistributedRbfMover<Dim>::move_to(PointsView<Dim> d, Out& out) {
   const meshmotion::detail::Stopwatch watch;
   check_entries("move", d);
-  follow_motion(d);
-  apply(d, out);
+  if (!at_move_.active()) {
+    follow_motion(d);
+    apply(d, out);
+  } else {
+    at_move_.blend(part_points_, d, blend_, RanksReduction{comm_});
+    const Points<Dim>& rest = without_blend(d, blend_);
+    follow_motion(rest);
+    apply(rest, out);
+    // A shared node's owner and its other ranks add the same two numbers (the rest, the
+    // blend): the same point on every rank, d to rounding.
+    out += blend_;
+  }
   ++stats_.moves;
   stats_.move_seconds = watch.seconds();
 }
@@ -516,7 +559,15 @@ template <int Dim>
 Points<Dim> DistributedRbfMover<Dim>::velocity(PointsView<Dim> v) {
   check_entries("velocity", v);
   Points<Dim> out;
-  apply(v, out);
+  if (!at_move_.active()) {
+    apply(v, out);
+    return out;
+  }
+  // As the serial mover's derivative_forward: the blend's change and the interpolation of the rest.
+  Points<Dim> blended;
+  at_move_.derivative_forward(part_points_, v, blended, RanksReduction{comm_});
+  apply(without_blend(v, blended), out);
+  out += blended;
   return out;
 }
 
@@ -549,6 +600,22 @@ Points<Dim> DistributedRbfMover<Dim>::derivative_reverse(PointsView<Dim> v) {
     require_ready("derivative_reverse");
     meshmotion::detail::check_node_field<Dim>("DistributedRbfMover::derivative_reverse", v, n_local_);
   });
+  Points<Dim> grad = reverse_interpolation(v);
+  if (!at_move_.active()) return grad;
+  // As the serial mover's: the blend's change meets v less what the interpolation took at the
+  // boundary (owned entries: the others' terms are their owners').
+  Points<Dim> through_blend = v;
+  for (Index k = 0; k < boundary_.size(); ++k) {
+    const Index node = boundary_.nodes[static_cast<std::size_t>(k)];
+    if (boundary_.kinds[static_cast<std::size_t>(k)] != BoundaryKind::sliding && owned_[static_cast<std::size_t>(node)] != 0)
+      through_blend.col(node) -= grad.col(k);
+  }
+  at_move_.derivative_reverse(part_points_, through_blend, grad, owned_, RanksReduction{comm_});
+  return grad;
+}
+
+template <int Dim>
+Points<Dim> DistributedRbfMover<Dim>::reverse_interpolation(PointsView<Dim> v) {
   if (patches_) return patches_->derivative_reverse(v, owned_, n_entries_);
   if (petsc_) return reverse_petsc(v);
   const Index m = global_boundary_size();
