@@ -272,6 +272,14 @@ if [[ -f "$build_dir/python/meshmotion/__init__.py" && ( -z "$only" || "$only" =
   run conditioning_bench env PYTHONPATH="$build_dir/python" /usr/bin/python3 "$here/conditioning_bench.py" \
     --data "$source_dir/../shared/data"
 fi
+# A plate turned to a half turn inside a held box from one setup (issue 68), serial and at 2
+# ranks (needs the Python module, Gmsh's and mpi4py; it says what is missing).
+if [[ -f "$build_dir/python/meshmotion/__init__.py" && ( -z "$only" || "$only" == *",plate_turn_bench,"* ) ]]; then
+  plate_flags=()
+  mpiexec --version 2>&1 | grep -qiE "open ?mpi|openrte" && plate_flags=(--oversubscribe --allow-run-as-root)
+  run plate_turn_bench env PYTHONPATH="$build_dir/python" mpiexec "${plate_flags[@]}" -n 2 /usr/bin/python3 \
+    "$here/plate_turn_bench.py"
+fi
 # The OpenFOAM plugin in OpenFOAM's time loop against displacementLaplacian (it says why when
 # the plugin or OpenFOAM is missing).
 if [[ -z "$only" || "$only" == *",openfoam_plugin,"* ]]; then

@@ -101,6 +101,15 @@ def setups_per_doubling(rows, build):
     return None
 
 
+def plate_turn(field, ranks):
+    """plate_turn_bench.py's defaults: the worst step's `field` at `ranks` ranks."""
+    def value(rows, build):
+        found = [row[field] for row in rows if row.get("build", "current") == build and row.get("bench") == "plate_turn"
+                 and row.get("options") == "(defaults)" and row.get("ranks") == ranks and field in row]
+        return max(found) if found else None
+    return value
+
+
 TARGETS = [
     ("P1->P2 30P30N quads (median)", {"bench": "conversion", "case": "30p30n-quads"}, "median_s", "<=", 0.015, "s"),
     ("P1->P2 30P30N quads (first call)", {"bench": "conversion", "case": "30p30n-quads"}, "first_s", "<=", 0.015, "s"),
@@ -126,6 +135,10 @@ TARGETS = [
     ("defaults' time / hand-set's, worst case", defaults_against_tuned("time_ratio", max), None, "<=", 1.5, "x"),
     ("OpenFOAM plugin defaults' largest valid angle / displacementLaplacian's, worst case", plugin_against_laplacian,
      None, ">=", 1.0, "x"),
+    ("plate turned to 180 deg in a held box from one setup, defaults: invalid cells, worst step", plate_turn("invalid", 1),
+     None, "<=", 0, "cells"),
+    ("plate turned to 180 deg, 2 ranks: largest distance from the serial points", plate_turn("largest_difference_from_serial", 2),
+     None, "<=", 1e-10, ""),
     ("OpenFOAM plugin, 79k cells, 20 steps, defaults: wall / displacementLaplacian's",
      {"bench": "openfoam_plugin_large", "options": "(defaults)"}, "wall_ratio", "<=", 1.0, "x"),
     ("OpenFOAM plugin, 79k cells, 20 steps, defaults: peak memory / displacementLaplacian's",
