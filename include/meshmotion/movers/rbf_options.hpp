@@ -19,14 +19,19 @@ namespace meshmotion {
 /// Whether an RBF mover takes the rigid part of the boundary's motion out first
 /// (movers/rigid_part.hpp).
 enum class RigidPart {
-  /// When the prescribed nodes move as one rigid body (within 1e-3 of the largest
-  /// displacement) and either nothing is held, or the memory budget cut the interpolation's
-  /// default radius (RbfOptions::max_memory_bytes: it cannot spread the motion) while the gap
-  /// to the held nodes is at least 4 of the body's node spacings and the blend keeps every
-  /// node's Jacobian determinant ≥ min_blend_determinant.
+  /// Set up at rest (no prescribed node moves yet: a solver's time loop): each move's rigid
+  /// part, fitted at the move and blended by weights of the distance to the prescribed nodes'
+  /// centroid (RigidPartAtMove), when their ball clears the held nodes by a fifth or nothing
+  /// is held. Set up with a motion: when the prescribed nodes move as one rigid body (within
+  /// 1e-3 of the largest displacement) and either nothing is held, or the memory budget cut the
+  /// interpolation's default radius (RbfOptions::max_memory_bytes: it cannot spread the
+  /// motion) while the gap to the held nodes is at least 4 of the body's node spacings and the
+  /// blend keeps every node's Jacobian determinant ≥ min_blend_determinant.
   automatic,
-  blend,  ///< always; InputError when the prescribed nodes do not move as one rigid body
-  none,   ///< never: the interpolation carries the whole motion
+  /// always; InputError when the prescribed nodes do not move as one rigid body (set up with a
+  /// motion) or their ball reaches a held node (set up at rest)
+  blend,
+  none,  ///< never: the interpolation carries the whole motion
 };
 
 [[nodiscard]] constexpr std::string_view name(RigidPart r) {
@@ -108,11 +113,13 @@ void visit_options(RbfOptions& o, F&& f, const std::string& prefix = {}) {
       "domain, which made the system and the operator dense (22 GB on a 28k-node case). "
       "support_radius_reduced() says when it was."});
   f(prefix + "rigid_part", o.rigid_part, OptionHelp{"blend a large rigid motion into the volume before interpolating the rest", {},
-      "Take the rigid part of the setup boundary's motion out before interpolating (rigid_part.hpp): every "
+      "Take the rigid part of the boundary's motion out before interpolating (rigid_part.hpp): every "
       "node follows the prescribed nodes' rigid motion, its angle and translation blended to nothing at the "
-      "nearest held node, and the interpolation carries the rest. The default (automatic) does it for a rigid "
-      "motion the default radius cannot spread within the memory budget (a body turned 90° in a box), or when "
-      "nothing is held."});
+      "nearest held node, and the interpolation carries the rest. A mover set up before anything moves (a "
+      "solver's time loop) fits each move's rigid part and blends it by the distance to the body's centre, a "
+      "twist valid at any angle; the default (automatic) does so whenever the body's ball clears the held "
+      "nodes. Set up with the motion, automatic blends a rigid motion the default radius cannot spread within "
+      "the memory budget (a body turned 90° in a box), or when nothing is held."});
   f(prefix + "condition_limit", o.condition_limit,
     OptionHelp{"compact kernels: thin centres closer than the radius resolves when the condition exceeds this (0: never)", range::or_zero(range::at_least(1)),
       "Compact kernels without partition of unity: a system whose estimated condition number "
