@@ -17,7 +17,9 @@ ResolvedBoundary<3> resolved_boundary(const std::vector<long>& points, const std
   const Eigen::Map<const Points<3>> along(directions.data(), 3, nb);
   for (Index k = 0; k < nb; ++k) {
     const auto role = static_cast<PointRole>(roles[static_cast<std::size_t>(k)]);
-    b.kinds.push_back(role == PointRole::prescribed ? BoundaryKind::prescribed : BoundaryKind::sliding);
+    b.kinds.push_back(role == PointRole::prescribed ? BoundaryKind::prescribed
+                      : role == PointRole::held     ? BoundaryKind::fixed
+                                                    : BoundaryKind::sliding);
     if (role == PointRole::sliding_plane) b.normals.col(k) = along.col(k);
     if (role == PointRole::sliding_line) b.directions.col(k) = along.col(k);
   }
@@ -52,6 +54,7 @@ FaceCentres::FaceCentres(const PolyMesh& poly, const Mesh<3>& mesh, const std::v
   for (std::size_t k = 0; k < b.nodes.size(); ++k) entry[static_cast<std::size_t>(b.nodes[k])] = static_cast<Index>(k);
   std::vector<Index> nodes;
   std::vector<Vec<3>> normals;
+  std::vector<BoundaryKind> kinds;
   Index centre = np;
   for (Index f = 0; f < poly.num_faces(); ++f) {
     const auto v = poly.face(f);
@@ -59,22 +62,25 @@ FaceCentres::FaceCentres(const PolyMesh& poly, const Mesh<3>& mesh, const std::v
     const Index node = centre++;
     if (f < poly.num_internal_faces() || (!coupled.empty() && coupled[static_cast<std::size_t>(f)])) continue;
     std::vector<Index> entries;
-    bool all_prescribed = true;
+    bool all_given = true, all_held = true;  // every point's value given (prescribed or held); held
     for (const Index p : v) {
       const Index e = entry[static_cast<std::size_t>(p)];
       if (e < 0) break;
       entries.push_back(e);
-      all_prescribed = all_prescribed && b.kinds[static_cast<std::size_t>(e)] == BoundaryKind::prescribed;
+      const BoundaryKind kind = b.kinds[static_cast<std::size_t>(e)];
+      all_given = all_given && kind != BoundaryKind::sliding;
+      all_held = all_held && kind == BoundaryKind::fixed;
     }
     if (entries.size() < v.size()) continue;  // a face of an unlisted patch: interior, as its points
     nodes.push_back(node);
-    normals.push_back(all_prescribed ? Vec<3>::Zero() : Vec<3>(poly.face_area(f).normalized()));
-    entries_.push_back(all_prescribed ? std::move(entries) : std::vector<Index>{});
+    normals.push_back(all_given ? Vec<3>::Zero() : Vec<3>(poly.face_area(f).normalized()));
+    kinds.push_back(!all_given ? BoundaryKind::sliding : all_held ? BoundaryKind::fixed : BoundaryKind::prescribed);
+    entries_.push_back(all_given ? std::move(entries) : std::vector<Index>{});
   }
   const Index nb = b.size(), added = size();
   for (Index k = 0; k < added; ++k) {
     b.nodes.push_back(nodes[static_cast<std::size_t>(k)]);
-    b.kinds.push_back(entries_[static_cast<std::size_t>(k)].empty() ? BoundaryKind::sliding : BoundaryKind::prescribed);
+    b.kinds.push_back(kinds[static_cast<std::size_t>(k)]);
   }
   b.displacements.conservativeResize(3, nb + added);
   b.normals.conservativeResize(3, nb + added);
@@ -154,6 +160,8 @@ Bridge::Bridge(const BridgeInput& input) {
 Bridge::~Bridge() = default;
 
 double Bridge::support_radius() const { return serving_->stats().support_radius; }
+
+bool Bridge::rigid_part() const { return serving_->stats().rigid_part; }
 
 int Bridge::setups() const { return 1 + static_cast<int>(serving_->stats().radius_growths); }
 

@@ -10,7 +10,9 @@
 namespace meshmotion::foam {
 
 /// A boundary point's part in the motion.
-enum class PointRole { prescribed = 0, sliding_plane = 1, sliding_line = 2 };
+/// held: prescribed by a patch whose value is zero at setup (a plain fixedValue wall), so not
+/// part of a moving body's rigid fit; its value still comes from the field at every move.
+enum class PointRole { prescribed = 0, sliding_plane = 1, sliding_line = 2, held = 3 };
 
 /// The mesh and its boundary as the OpenFOAM side sees them (3 × n, point after point).
 struct BridgeInput {
@@ -57,6 +59,9 @@ class Bridge {
   /// motion: a move whose largest prescribed displacement outgrew it sets the mover up again
   /// (RbfMover's radius_outgrown()).
   [[nodiscard]] double support_radius() const;
+  /// The RBF blends each move's rigid part before interpolating (RigidPartAtMove: a body
+  /// whose ball clears the held walls).
+  [[nodiscard]] bool rigid_part() const;
   /// How many times the mover was set up: once here, then once per growth of its radius.
   [[nodiscard]] int setups() const;
 

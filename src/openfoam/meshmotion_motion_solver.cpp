@@ -82,6 +82,7 @@ namespace
 enum class PatchRole
 {
     prescribed,  // the field fixes their value (the fixedValue family)
+    held,        // a plain fixedValue whose value is zero at setup: a wall, not the moving body
     sliding,     // in the plane of the patch's faces at each point (two planes: along their line)
     normal,      // fixedNormalSlip: in the plane normal to the field's n
     surface,     // surfaceSlipDisplacement: in the faces' plane, then projected by the field
@@ -181,7 +182,7 @@ void meshmotionMotionSolver::setup()
     // is the mean of its faces' normals there. On a decomposed case both are summed over the
     // ranks that hold the point, so every rank sees what the serial run sees.
     const label n = m.nPoints();
-    labelList prescribed(n, 0);
+    labelList prescribed(n, 0), held(n, 0);
     fixedHere_.assign(n, 0);
     PtrList<vectorField> normalSums;
     projected_ = false;
@@ -191,10 +192,18 @@ void meshmotionMotionSolver::setup()
         const polyPatch& patch = m.boundaryMesh()[patchi];
         if (patch.coupled()) continue;  // processor and cyclic patches: not walls
         const labelList& points = patch.meshPoints();
-        const PatchRole role = patch_role(field, patch);
-        if (role == PatchRole::prescribed)
+        PatchRole role = patch_role(field, patch);
+        // A wall held by a plain fixedValue of zero is not part of the moving body whose rigid
+        // part the mover fits at each move (over every rank: the patches are the same on all).
+        const vectorField* given = dynamic_cast<const vectorField*>(&field);
+        if (role == PatchRole::prescribed && field.type() == "fixedValue" && given && gMax(mag(*given)) <= 0)
         {
-            forAll(points, i) prescribed[points[i]] = fixedHere_[points[i]] = 1;
+            role = PatchRole::held;
+        }
+        if (role == PatchRole::prescribed || role == PatchRole::held)
+        {
+            labelList& into = role == PatchRole::held ? held : prescribed;
+            forAll(points, i) into[points[i]] = fixedHere_[points[i]] = 1;
         }
         else if (role != PatchRole::interior)
         {
@@ -214,6 +223,7 @@ void meshmotionMotionSolver::setup()
         }
     }
     syncTools::syncPointList(m, prescribed, maxEqOp<label>(), label(0));
+    syncTools::syncPointList(m, held, maxEqOp<label>(), label(0));
     forAll(normalSums, k)
     {
         syncTools::syncPointList(m, normalSums[k], plusEqOp<vector>(), vector::zero);
@@ -223,7 +233,8 @@ void meshmotionMotionSolver::setup()
     for (label v = 0; v < n; ++v)
     {
         std::vector<vector> planes;
-        if (!prescribed[v])
+        const bool given = prescribed[v] || held[v];  // a point of a moving patch and a wall moves
+        if (!given)
         {
             forAll(normalSums, k)
             {
@@ -237,7 +248,7 @@ void meshmotionMotionSolver::setup()
             if (planes.empty()) continue;
         }
         vector along = Zero;
-        int role = int(meshmotion::foam::PointRole::prescribed);
+        int role = int(prescribed[v] || !held[v] ? meshmotion::foam::PointRole::prescribed : meshmotion::foam::PointRole::held);
         if (planes.size() == 1)
         {
             role = int(meshmotion::foam::PointRole::sliding_plane);
@@ -305,6 +316,7 @@ void meshmotionMotionSolver::setup()
         << returnReduce(n, sumOp<label>());
     if (Pstream::parRun()) Info<< " on " << Pstream::nProcs() << " ranks (points on several ranks counted on each)";
     if (bridge_->support_radius() > 0) Info<< " (support radius " << bridge_->support_radius() << ")";
+    if (bridge_->rigid_part()) Info<< ", each move's rigid part blended first";
     Info<< endl;
 }
 
@@ -326,7 +338,7 @@ void meshmotionMotionSolver::solve()
     std::vector<double> d(3 * boundary_.size(), 0.0);
     for (std::size_t k = 0; k < boundary_.size(); ++k)
     {
-        if (roles_[k] != int(meshmotion::foam::PointRole::prescribed)) continue;
+        if (roles_[k] != int(meshmotion::foam::PointRole::prescribed) && roles_[k] != int(meshmotion::foam::PointRole::held)) continue;
         for (direction c = 0; c < 3; ++c) d[3 * k + c] = values[boundary_[k]][c];
     }
     std::vector<double> out;

@@ -659,10 +659,14 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   if (blend) {
     rigid_ = std::move(blend->displacement);
     rigid_scale_ = boundary.displacements.colwise().norm().maxCoeff();
-    stats_.evaluated_nodes = points_.cols() - static_cast<Index>(boundary_.nodes.size());
-  } else {
-    build_interpolation();
   }
+  // With the rigid part out, the interpolation waits for the first move (or derivative) that
+  // leaves it something to carry: a rigid body never needs it, and at rest the default radius
+  // is provisional (the first motion it cannot carry grows it).
+  if (blend || (at_move_.active() && grows_))
+    stats_.evaluated_nodes = points_.cols() - static_cast<Index>(boundary_.nodes.size());
+  else
+    build_interpolation();
   ready_ = true;
   stats_.setup_seconds = watch.seconds();
 }

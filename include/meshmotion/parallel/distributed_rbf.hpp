@@ -234,14 +234,20 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
   boundary_ = boundary;
   at_move_ = {};
   if (options_.rigid_part != RigidPart::none) {
-    int rest = boundary.size() == 0 || boundary.displacements.cols() != boundary.size() || at_rest(boundary) ? 1 : 0;
+    // At rest: no owned prescribed entry moves (a ghost's entry is its owner's to give).
+    std::vector<char> owned(static_cast<std::size_t>(boundary.size()), 0);
+    // A malformed boundary blends nothing: set_up() refuses it, naming what is wrong.
+    const bool shaped = boundary.displacements.cols() == boundary.size();
+    int rest = static_cast<Index>(boundary.kinds.size()) == boundary.size() ? 1 : 0;
+    for (Index k = 0; rest != 0 && k < boundary.size(); ++k) {
+      const Index v = boundary.nodes[static_cast<std::size_t>(k)];
+      owned[static_cast<std::size_t>(k)] = v >= 0 && v < part.size() && part.owns(v) ? 1 : 0;
+      if (owned[static_cast<std::size_t>(k)] != 0 && shaped && boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed &&
+          !boundary.displacements.col(k).isZero(0.0))
+        rest = 0;
+    }
     MPI_Allreduce(MPI_IN_PLACE, &rest, 1, MPI_INT, MPI_MIN, comm_);
     if (rest != 0) {
-      std::vector<char> owned(static_cast<std::size_t>(boundary.size()), 0);
-      for (Index k = 0; k < boundary.size(); ++k) {
-        const Index v = boundary.nodes[static_cast<std::size_t>(k)];
-        owned[static_cast<std::size_t>(k)] = v >= 0 && v < part.size() && part.owns(v) ? 1 : 0;
-      }
       std::optional<std::string> why;
       collective(comm_, [&] { why = at_move_.prepare(part_points_, boundary, owned, RanksReduction{comm_}); });
       if (why && options_.rigid_part == RigidPart::blend) throw InputError("DistributedRbfMover::setup: rigid_part=blend: " + *why);
