@@ -233,7 +233,9 @@ class Warp:
     @property
     def condition(self):
         """A lower bound of the interpolation system's condition number (RBF; 0 for methods
-        without one): rounding in warp_derivative grows by up to this factor."""
+        without one, or before the system is factorized: with the default radius and each
+        move's rigid part blended, at the first warp that needs it): rounding in
+        warp_derivative grows by up to this factor."""
         return float(self._mover.stats["condition"])
 
     @property
