@@ -262,6 +262,14 @@ template <int Dim>
   return true;
 }
 
+/// RigidPartAtMove's sums and extremes over the processes sharing a mesh, for one process:
+/// nothing to add (RanksReduction, parallel/communicator.hpp, is the MPI one).
+struct LocalReduction {
+  void sum(double*, int) const {}
+  void max(double&) const {}
+  void min(double&) const {}
+};
+
 /// The rigid part of each move's motion, for a mover set up before anything moves (a solver's
 /// time loop, an optimizer, the OpenFOAM plugin): found at every move, blended by weights fixed
 /// at setup. The prescribed nodes' displacements are fitted by one rigid motion about their
@@ -274,11 +282,12 @@ template <int Dim>
 /// the axis is: its Jacobian determinant is exactly 1 for any angle (a weight that falls with
 /// the distance to the body, as rigid_blend()'s, has ∂w/∂(angle about the axis) ≠ 0 where the
 /// body is not round about the axis, and folds past ~90°: a plate turned in a held box left
-/// 1,902 cells invalid at 180° with that profile, 82 with this one). w is 1 inside the ball of
-/// radius r0 holding every prescribed node and 0 beyond R1, the distance from p to the nearest
-/// held (fixed or sliding) node; between them it falls linearly in ln ρ (a twist's shear ρ θ w′
-/// is then the same everywhere, θ / ln(R1/r0), the least any profile can have), with quadratic
-/// ends over a tenth of that range each so that no cell straddles a kink. The translation's
+/// 1,902 cells invalid at 180° with that profile, 102 with this one: cells too coarse for the
+/// twist, docs/interpolation.md). w is 1 inside the ball of radius r0 holding every prescribed
+/// node and 0 beyond R1, the distance from p to the nearest held (fixed or sliding) node;
+/// between them it falls linearly in ln ρ (a twist's shear ρ θ w′ is then the same everywhere,
+/// θ / ln(R1/r0), the least any profile can have), with quadratic ends over a tenth of that
+/// range each so that no cell straddles a kink. The translation's
 /// weight v falls as a smoothstep of ρ over the same range (a translation's strain is |t| v′,
 /// smallest when spread evenly). Nothing held: w = v = 1, every node moves rigidly.
 ///
@@ -288,13 +297,8 @@ template <int Dim>
 ///
 /// Over MPI every process prepares its own nodes and counts the entries (and, for the reverse
 /// derivative, the nodes) it owns; the fit's sums go through `reduce` (a Reduction: sum, max and
-/// min over the processes in place), so every process blends the serial fit.
-struct LocalReduction {
-  void sum(double*, int) const {}
-  void max(double&) const {}
-  void min(double&) const {}
-};
-
+/// min over the processes in place; LocalReduction for one process), so every process blends
+/// the serial fit.
 template <int Dim>
 class RigidPartAtMove {
  public:
