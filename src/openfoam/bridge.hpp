@@ -10,8 +10,8 @@
 namespace meshmotion::foam {
 
 /// A boundary point's part in the motion.
-/// held: prescribed by a patch whose value is zero at setup (a plain fixedValue wall), so not
-/// part of a moving body's rigid fit; its value still comes from the field at every move.
+/// held (rbf): prescribed by a patch whose value is zero at setup (a plain fixedValue wall), so
+/// not part of a moving body's rigid fit; its value still comes from the field at every move.
 enum class PointRole { prescribed = 0, sliding_plane = 1, sliding_line = 2, held = 3 };
 
 /// The mesh and its boundary as the OpenFOAM side sees them (3 × n, point after point).

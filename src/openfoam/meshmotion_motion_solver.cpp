@@ -194,9 +194,12 @@ void meshmotionMotionSolver::setup()
         const labelList& points = patch.meshPoints();
         PatchRole role = patch_role(field, patch);
         // A wall held by a plain fixedValue of zero is not part of the moving body whose rigid
-        // part the mover fits at each move (over every rank: the patches are the same on all).
+        // part the RBF fits at each move (over every rank: the patches are the same on all).
+        // The RBF still takes its value at every step (a coupling that writes into it moves it);
+        // the other methods read a fixed point as still, so for them it stays prescribed.
         const vectorField* given = dynamic_cast<const vectorField*>(&field);
-        if (role == PatchRole::prescribed && field.type() == "fixedValue" && given && gMax(mag(*given)) <= 0)
+        if (input.method == "rbf" && role == PatchRole::prescribed && field.type() == "fixedValue" && given &&
+            gMax(mag(*given)) <= 0)
         {
             role = PatchRole::held;
         }
