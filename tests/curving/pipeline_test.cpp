@@ -181,6 +181,33 @@ TEST_CASE("blend mover: one wall's field vanishes on the other wall", "[curving]
   CHECK(u(1, 9 + 4) > 0.98e-3);
 }
 
+TEST_CASE("blend mover: a moving node on no wall facet is refused at setup, and at the move when set up at rest", "[curving]") {
+  const Mesh<2> mesh = rectangle_mesh({4, 4, 0.0, 1.0, 0.0, 1.0, RectangleCells::tri3});
+  // The bottom row's nodes prescribed and an interior node (2,2) prescribed with them: it
+  // lies on no facet, so no wall carries its motion into the volume.
+  const Index lone = 2 * 5 + 2;
+  const auto boundary = [&](double dy) {
+    BoundaryCollector<2> c(mesh.num_nodes());
+    BoundaryEntry<2> e;
+    e.kind = BoundaryKind::prescribed;
+    e.displacement = Vec<2>(0.0, dy);
+    for (Index i = 0; i < 5; ++i) c.add(i, e);
+    c.add(lone, e);
+    return c.resolve();
+  };
+  BlendMover<2> moving(BlendOptions{0.5, {}, 3.0});
+  CHECK_THROWS_WITH(moving.setup(mesh, boundary(0.01)), Catch::Contains("moving boundary node 12 lies on no facet"));
+  BlendMover<2> at_rest(BlendOptions{0.5, {}, 3.0});
+  const ResolvedBoundary<2> rest = boundary(0.0);
+  at_rest.setup(mesh, rest);
+  Points<2> d = boundary(0.01).displacements;
+  CHECK_THROWS_WITH(at_rest.move(d), Catch::Contains("BlendMover::move: moving boundary node 12 lies on no facet"));
+  d.col(rest.column(lone)).setZero();  // the lone node held: the wall's motion alone is blended
+  const Points<2> u = at_rest.move(d);
+  CHECK(u(1, 2) == Approx(0.01));
+  CHECK(u.col(lone).norm() == 0.0);
+}
+
 TEST_CASE("blend mover: the default length is blending_factor wall layers, and longer is better on a thin layer", "[curving]") {
   // The O-mesh triangles of docs/curving.md "Blending length" at 64 wall facets: a bow of
   // h^2/(8 rho) that a blend over one layer bends most inside the layer's thin cells.

@@ -197,6 +197,7 @@ class BlendMover {
       throw InputError("BlendMover::move: " + std::to_string(d.cols()) + " displacements (expected " +
                        std::to_string(operator_.rows()) + ", one per boundary node, after setup)");
     if (!d.allFinite()) throw InputError("BlendMover::move: non-finite displacement");
+    check_covered("move", d);
     Points<Dim> given = d;
     for (Index k = 0; k < boundary_.size(); ++k)
       if (boundary_.kinds[static_cast<std::size_t>(k)] != BoundaryKind::prescribed) given.col(k).setZero();
@@ -215,8 +216,9 @@ class BlendMover {
   [[nodiscard]] const std::vector<double>& blending_lengths() const noexcept { return lengths_; }
 
  private:
-  // Facets (of mesh.facets) whose nodes are all prescribed, grouped into connected walls.
-  [[nodiscard]] std::vector<std::vector<detail::WallFacet>> split_walls(const Mesh<Dim>& mesh) const {
+  // Facets (of mesh.facets) whose nodes are all prescribed, grouped into connected walls; the
+  // prescribed nodes on none kept in uncovered_.
+  [[nodiscard]] std::vector<std::vector<detail::WallFacet>> split_walls(const Mesh<Dim>& mesh) {
     std::vector<detail::WallFacet> facets;
     for (const auto& block : mesh.facets)
       for (Index e = 0; e < block.size(); ++e) {
@@ -253,12 +255,22 @@ class BlendMover {
     std::vector<char> covered(parent.size(), 0);
     for (const auto& f : facets)
       for (int j = 0; j < num_nodes(f.type); ++j) covered[static_cast<std::size_t>(slot(f, j))] = 1;
+    uncovered_.clear();
     for (Index k = 0; k < boundary_.size(); ++k)
-      if (boundary_.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed && !covered[static_cast<std::size_t>(k)] &&
-          boundary_.displacements.col(k).squaredNorm() > 0.0)
-        throw InputError("BlendMover::setup: moving boundary node " + std::to_string(boundary_.nodes[static_cast<std::size_t>(k)]) +
-                         " lies on no facet whose nodes all move (expected walls made of mesh.facets)");
+      if (boundary_.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed && !covered[static_cast<std::size_t>(k)])
+        uncovered_.push_back(k);
+    check_covered("setup", boundary_.displacements);
     return walls;
+  }
+
+  // A prescribed node on no wall facet carries nothing into the volume: refused when it moves,
+  // at setup or (for a mover set up at rest) at the move that first moves it.
+  void check_covered(const char* where, PointsView<Dim> d) const {
+    for (const Index k : uncovered_)
+      if (d.col(k).squaredNorm() > 0.0)
+        throw InputError(std::string("BlendMover::") + where + ": moving boundary node " +
+                         std::to_string(boundary_.nodes[static_cast<std::size_t>(k)]) +
+                         " lies on no facet whose nodes all move (expected walls made of mesh.facets)");
   }
 
   // The operator's columns (nodes) straight from the threads' entries, each column sorted by
@@ -364,6 +376,7 @@ class BlendMover {
   BlendOptions options_;
   ResolvedBoundary<Dim> boundary_;
   std::vector<Index> slot_;  // node -> boundary index, -1 inside
+  std::vector<Index> uncovered_;  // prescribed boundary indices on no wall facet
   std::vector<double> lengths_;
   std::vector<std::vector<double>> facet_lengths_;  // per facet of each wall without a layer
   Eigen::SparseMatrix<double, Eigen::ColMajor, Index> operator_;  // boundary × nodes
