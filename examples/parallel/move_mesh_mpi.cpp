@@ -100,7 +100,11 @@ int run(const Arguments& a, std::unique_ptr<Mesh<Dim>> whole) {
   const DistributedMesh<Dim> part = partition_mesh(comm, root ? *whole : empty);
   const ResolvedBoundary<Dim> local = distribute_boundary(part, boundary);
   const std::unique_ptr<DistributedMover<Dim>> mover = make_distributed_mover(config, parallel);
-  mover->setup(part, local);
+  // Set up before anything moves, as move_mesh and a solver's time loop do (run_steps): the RBF
+  // then takes the motion's rigid part at the move, and gives move_mesh's displacements.
+  ResolvedBoundary<Dim> rest = local;
+  rest.displacements.setZero();
+  mover->setup(part, rest);
   const Points<Dim> displacement = mover->move(local.displacements);
   const MoverStats stats = mover->stats();
   double seconds[2] = {stats.setup_seconds, stats.move_seconds};

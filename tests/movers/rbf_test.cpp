@@ -688,14 +688,23 @@ TEST_CASE("support radius heuristic grows with displacement and spacing", "[move
 
 #include "meshmotion/core/generators.hpp"
 
-TEST_CASE("step driver: a rotated ellipse O-mesh, wall rotated rigidly, quality reported per step", "[movers]") {
+namespace {
+
+// An O-mesh of 48 × 16 quadrilaterals around an ellipse of semi-axes 0.5 and `semi_axis_y`.
+Mesh<2> ellipse_ring(double semi_axis_y) {
   OMeshOptions o;
   o.semi_axis_x = 0.5;
-  o.semi_axis_y = 0.2;
+  o.semi_axis_y = semi_axis_y;
   o.n_around = 48;
   o.n_radial = 16;
   o.first_height = 1e-3;
-  const Mesh<2> mesh = o_mesh(o);
+  return o_mesh(o);
+}
+
+}  // namespace
+
+TEST_CASE("step driver: a rotated ellipse O-mesh, wall rotated rigidly, quality reported per step", "[movers]") {
+  const Mesh<2> mesh = ellipse_ring(0.2);
   BoundarySpec<2> spec;
   spec.moving("wall", Rotation2D{Vec<2>::Zero(), radians(60.0)}).fixed("farfield");
   for (const int steps : {1, 3}) {
@@ -712,6 +721,39 @@ TEST_CASE("step driver: a rotated ellipse O-mesh, wall rotated rigidly, quality 
     CHECK(r.steps.back().stats.factorizations == 1);
   }
   CHECK_THROWS_AS(make_mover<2>("no_such_method"), InputError);
+}
+
+TEST_CASE("step driver: the RBF moves from one setup at rest as a time loop does, other movers are set up each step",
+          "[movers]") {
+  const Mesh<2> mesh = ellipse_ring(0.1);
+  BoundarySpec<2> spec;
+  spec.moving("wall", Rotation2D{Vec<2>(0.1, 0.0), radians(150.0)}).fixed("farfield");
+  const int steps = 5;
+  auto stepped = make_mover<2>("rbf");
+  const StepResult<2> r = run_steps(stepped, mesh, spec, StepOptions{steps, Metric::skew});
+  // The time loop: set up on the reference with nothing moved, then each step's whole target.
+  auto looped = make_mover<2>("rbf");
+  ResolvedBoundary<2> rest = spec.resolve(mesh);
+  rest.displacements.setZero();
+  looped.setup(mesh, rest);
+  for (int s = 1; s <= steps; ++s) {
+    const Points<2> u = looped.move(spec.resolve(mesh, double(s) / steps).displacements);
+    const StepInfo& info = r.steps[static_cast<std::size_t>(s - 1)];
+    CHECK(info.stats.moves == s);
+    CHECK(info.stats.rigid_part);
+    REQUIRE(info.quality);
+    CHECK(info.quality->num_invalid == 0);
+    if (s == steps) CHECK((r.displacements - u).cwiseAbs().maxCoeff() < 1e-13);
+  }
+  // A spring's operator is the reference's: set up again on the moved mesh for every step.
+  auto spring = make_mover<2>("spring");
+  const StepResult<2> springs = run_steps(spring, mesh, spec, StepOptions{steps, Metric::skew});
+  for (const StepInfo& info : springs.steps) CHECK(info.stats.moves == 1);
+  const MoveReport report = move_report("spring", quality_report(mesh, Metric::skew), springs);
+  double summed = 0.0;
+  for (const StepInfo& info : springs.steps) summed += info.stats.setup_seconds;
+  CHECK(report.setup_seconds == summed);
+  CHECK(move_report("rbf", quality_report(mesh, Metric::skew), r).setup_seconds == r.steps.front().stats.setup_seconds);
 }
 
 TEST_CASE("sliding groups: two planes meet in a line (3D), a point (2D), parallel planes stay a plane", "[movers]") {
