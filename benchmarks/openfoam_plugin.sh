@@ -14,6 +14,11 @@
 # run's wall time (setups included), its peak memory, the last step's non-orthogonality and
 # whether every step passed the check, with both ratios over displacementLaplacian's
 # ({"bench": "openfoam_plugin_large", ..., "wall_seconds", "wall_ratio", "memory_ratio"}).
+# The defaults then run the same case decomposed in two (decomposePar, simple 2 1 1) under
+# mpirun with -parallel: the whole run's wall time against the serial run's, the largest rank's
+# memory, and the largest distance of the reconstructed points from the serial ones
+# (mesh_info --compare; {"bench": "openfoam_plugin_large", "ranks": 2, ...,
+# "largest_difference_from_serial", "wall_ratio_to_serial"}).
 #
 #   benchmarks/openfoam_plugin.sh [BUILD_DIR=build] [WORK_DIR=/tmp/meshmotion_openfoam_plugin]
 #
@@ -35,10 +40,10 @@ fi
 command -v moveDynamicMesh >/dev/null || { echo "openfoam_plugin: moveDynamicMesh not found (Debian's openfoam): skipped"; exit 0; }
 # OpenFOAM runs serial; the plugin's threads would otherwise compete with nothing but noise.
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
-exec /usr/bin/python3 - "$lib" "$work" <<'EOF'
+exec /usr/bin/python3 - "$lib" "$work" "$build" <<'EOF'
 import json, math, os, re, shutil, subprocess, sys, time
 
-lib, work = sys.argv[1], sys.argv[2]
+lib, work, build = sys.argv[1], sys.argv[2], sys.argv[3]
 HEADER = "FoamFile { version 2.0; format ascii; class dictionary; object %s; }\n"
 STEPS = 8
 ANGLES = [10, 20, 30, 45, 60, 75, 90]
@@ -138,11 +143,21 @@ def write_case(case, spec, angle, solver, steps=STEPS):
         sys.exit(f"openfoam_plugin: blockMesh failed in {case}:\n{log.stdout[-2000:]}{log.stderr[-2000:]}")
 
 
-def run(case, steps=STEPS):
-    """moveDynamicMesh: every step valid, seconds per step, peak memory (MB), last
-    non-orthogonality, and the whole run's wall seconds."""
+def run(case, steps=STEPS, ranks=1):
+    """moveDynamicMesh (on `ranks` ranks of a decomposed case): every step valid, seconds per
+    step, peak memory (MB; the largest process's), last non-orthogonality, and the whole run's
+    wall seconds."""
+    command = ["moveDynamicMesh"]
+    if ranks > 1:
+        with open(f"{case}/system/decomposeParDict", "w") as out:
+            out.write(HEADER % "decomposeParDict" + f"numberOfSubdomains {ranks}; method simple;"
+                      f" simpleCoeffs {{ n ({ranks} 1 1); delta 0.001; }}\n")
+        log = subprocess.run(["decomposePar", "-force"], cwd=case, capture_output=True, text=True)
+        if log.returncode != 0:
+            sys.exit(f"openfoam_plugin: decomposePar failed in {case}:\n{log.stdout[-2000:]}{log.stderr[-2000:]}")
+        command = ["mpirun", "--oversubscribe", "--allow-run-as-root", "-np", str(ranks), "moveDynamicMesh", "-parallel"]
     start = time.perf_counter()
-    done = subprocess.run(["/usr/bin/time", "-f", "%M", "moveDynamicMesh"], cwd=case, capture_output=True, text=True)
+    done = subprocess.run(["/usr/bin/time", "-f", "%M", *command], cwd=case, capture_output=True, text=True)
     wall = time.perf_counter() - start
     log = done.stdout
     with open(f"{case}/log.moveDynamicMesh", "w") as out:
@@ -195,7 +210,7 @@ for name, spec in LARGE.items():
         ok, per_step, rss, orthogonality, wall = run(case, LARGE_STEPS)
         rows.append(dict(bench="openfoam_plugin_large", case=name, solver=solver, options=options, steps=LARGE_STEPS,
                          angle_deg=REFERENCE, valid=ok, wall_seconds=wall, seconds_per_step=per_step, max_rss_mb=rss,
-                         non_orthogonality=orthogonality))
+                         non_orthogonality=orthogonality, ranks=1))
     peer = next(r for r in rows if r["solver"] == "displacementLaplacian")
     for r in rows:
         r["wall_ratio"] = r["wall_seconds"] / peer["wall_seconds"]
@@ -203,6 +218,28 @@ for name, spec in LARGE.items():
         print(f"{name:12} {r['solver']:24} {r['options']:24} {'yes' if r['valid'] else 'NO':>5} {r['wall_seconds']:8.1f}"
               f" {r['wall_ratio']:7.2f} {r['max_rss_mb']:7.0f} {r['memory_ratio']:6.2f} {r['non_orthogonality']:8.1f}")
         lines.append(r)
+    # The defaults decomposed in two, against their serial run.
+    serial = rows[0]
+    solver, options, dictionary = SOLVERS[0]
+    serial_case = os.path.join(work, name, solver)
+    case = serial_case + "_2ranks"
+    write_case(case, spec, REFERENCE, dictionary, LARGE_STEPS)
+    ok, per_step, rss, orthogonality, wall = run(case, LARGE_STEPS, 2)
+    rebuilt = subprocess.run(["reconstructPar", "-latestTime"], cwd=case, capture_output=True, text=True)
+    compared = subprocess.run([os.path.join(build, "examples", "mesh_info"), serial_case, "--latest-time", "--compare", case,
+                               "--json"], capture_output=True, text=True)
+    try:
+        difference = json.loads(compared.stdout)["compared"]["max_difference"] if rebuilt.returncode == 0 else None
+    except (ValueError, KeyError):
+        difference = None
+    r = dict(bench="openfoam_plugin_large", case=name, solver=solver, options=options, steps=LARGE_STEPS,
+             angle_deg=REFERENCE, valid=ok, wall_seconds=wall, seconds_per_step=per_step, max_rss_mb=rss,
+             non_orthogonality=orthogonality, ranks=2, wall_ratio_to_serial=wall / serial["wall_seconds"],
+             largest_difference_from_serial=difference)
+    print(f"{name:12} {solver:24} {options + ', 2 ranks':24} {'yes' if ok else 'NO':>5} {wall:8.1f}"
+          f" {r['wall_ratio_to_serial']:7.2f} {rss:7.0f} {'':6} {orthogonality:8.1f}"
+          f"   (x: over the serial run; points {difference if difference is not None else 'not compared'} from serial)")
+    lines.append(r)
 for line in lines:
     print(json.dumps(line))
 EOF

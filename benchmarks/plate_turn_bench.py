@@ -7,16 +7,22 @@ minimum shape quality (a linear tetrahedron's scaled Jacobian is only its sign) 
 time, for the defaults (each move's rigid part blended, RigidPartAtMove) beside
 rigid_part=none (the whole motion interpolated, as before), through Python's Warp; run
 under mpiexec it also moves on the ranks (Warp(comm=)) and gives the largest distance from the
-serial points. One JSON line per row.
+serial points. With --programs (the build's examples folder) the programs run the same case
+as users run them: move_mesh --steps 12 to the half turn and move_mesh_mpi on 2 ranks to a
+quarter turn (one move), each with its invalid cells and its largest distance from Warp's
+points at that angle (the policy is one: set up at rest, each move's rigid part blended);
+those rows alone, run without mpiexec. One JSON line per row.
 
     PYTHONPATH=build/python /usr/bin/python3 benchmarks/plate_turn_bench.py [--size 0.1]
     mpiexec -n 2 ... (the same, adding the distributed row on rank 0)
+    PYTHONPATH=build/python /usr/bin/python3 benchmarks/plate_turn_bench.py --programs build/examples
 """
 
 import argparse
 import json
 import math
 import os
+import subprocess
 import sys
 import tempfile
 import time
@@ -78,9 +84,36 @@ def run(mesh, options, comm=None):
     return warp, steps
 
 
+def programs_rows(programs, path, tmp, cells, serial):
+    """move_mesh and move_mesh_mpi on the plate, against Warp's serial points `serial` (by angle)."""
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    flags = ["--oversubscribe", "--allow-run-as-root"] if "open" in subprocess.run(
+        ["mpiexec", "--version"], capture_output=True, text=True).stdout.lower() else []
+    motion = ["--group", "plate", "--fixed", "walls", "--center", "0,0,0", "--axis", "0,0,1", "--json"]
+    runs = (("move_mesh --steps 12", 180, [os.path.join(programs, "move_mesh"), path, "--rotate", "180", "--steps", "12"]),
+            ("move_mesh_mpi -n 2", 90, ["mpiexec", *flags, "-n", "2", os.path.join(programs, "move_mesh_mpi"), path,
+                                        "--rotate", "90"]))
+    for name, degrees, command in runs:
+        out = os.path.join(tmp, "moved.msh")
+        start = time.perf_counter()
+        done = subprocess.run([*command, "-o", out, *motion], capture_output=True, text=True, env=env)
+        seconds = time.perf_counter() - start
+        if done.returncode not in (0, 2):
+            print(f"plate_turn_bench: {name} failed ({done.returncode}): {done.stderr.strip()}", file=sys.stderr)
+            continue
+        points = mm.read_mesh(out).points
+        moved = mm.from_arrays(points, cells, {})
+        print(json.dumps({"bench": "plate_turn", "options": f"{name} (defaults)", "ranks": 2 if "mpi" in name else 1,
+                          "degrees": degrees, "invalid": int(mm.quality_report(moved, "scaled_jacobian")["invalid"]),
+                          "min_shape": round(float(mm.quality_report(moved, "shape")["min"]), 4),
+                          "program_seconds": round(seconds, 3),
+                          "largest_difference_from_warp": float(np.abs(points - serial[degrees]).max())}), flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--size", type=float, default=0.1, help="cell size at the plate (0.5 at the walls)")
+    parser.add_argument("--programs", help="folder of move_mesh and move_mesh_mpi: add their rows")
     args = parser.parse_args()
     comm = MPI.COMM_WORLD if MPI is not None and MPI.COMM_WORLD.Get_size() > 1 else None
     rank = comm.Get_rank() if comm is not None else 0
@@ -98,6 +131,9 @@ def main():
             return
         mesh = mm.read_mesh(path)
         cells = {"tet4": mesh.cells[0][1]}
+        if args.programs:
+            programs_rows(args.programs, path, tmp, cells, {d: p for d, _, p in run(mesh, {})[1]})
+            return
         rows = {}
         for name, options in (("(defaults)", {}), ("rigid_part=none", {"rigid_part": "none"})):
             if rank == 0:

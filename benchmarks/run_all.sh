@@ -279,6 +279,8 @@ if [[ -f "$build_dir/python/meshmotion/__init__.py" && ( -z "$only" || "$only" =
   mpiexec --version 2>&1 | grep -qiE "open ?mpi|openrte" && plate_flags=(--oversubscribe --allow-run-as-root)
   run plate_turn_bench env PYTHONPATH="$build_dir/python" mpiexec "${plate_flags[@]}" -n 2 /usr/bin/python3 \
     "$here/plate_turn_bench.py"
+  run plate_turn_programs env PYTHONPATH="$build_dir/python" /usr/bin/python3 "$here/plate_turn_bench.py" \
+    --programs "$build_dir/examples"
 fi
 # The OpenFOAM plugin in OpenFOAM's time loop against displacementLaplacian (it says why when
 # the plugin or OpenFOAM is missing).
