@@ -56,10 +56,15 @@ TEST_CASE("a 2D case stored in 3D moves as its section with every method: front 
     const Index n = c.flat.num_nodes();
     for (const auto& method : mover_methods<2>()) {
       INFO(c.name << " " << method.name);
+      // In three steps with the extrusion given, as move_mesh --steps 3 moves it: a mover set
+      // up again each step is set up on the moved section.
+      const int steps = 3;
       AnyMover<2> flat_mover = make_mover(mover_config<2>(std::string(method.name)));
-      const StepResult<2> expected = run_steps(flat_mover, c.flat, c.spec2);
-      SectionMover mover(make_mover(mover_config<2>(std::string(method.name))));
-      const StepResult<3> moved = run_steps(mover, slab, c.spec3);
+      const StepResult<2> expected = run_steps(flat_mover, c.flat, c.spec2, StepOptions{steps});
+      const auto extrusion = find_extrusion(slab);
+      REQUIRE(extrusion);
+      SectionMover mover(make_mover(mover_config<2>(std::string(method.name))), *extrusion);
+      const StepResult<3> moved = run_steps(mover, slab, c.spec3, StepOptions{steps});
       CHECK(mover.extrusion().axis == 2);
       double in_plane = 0.0, along = 0.0, apart = 0.0;
       for (Index v = 0; v < n; ++v) {

@@ -139,7 +139,8 @@ class SectionMover {
 
   explicit SectionMover(AnyMover<2> mover) : mover_(std::move(mover)) {}
   /// With the extrusion of the mesh that setup will be given, as find_extrusion() gave it to
-  /// the caller: setup does not look for it again (a case moved step after step keeps it).
+  /// the caller: setup does not look for it again (a case moved step after step keeps it, its
+  /// section following the moved mesh).
   SectionMover(AnyMover<2> mover, Extrusion ext) : mover_(std::move(mover)), ext_(std::move(ext)), known_(true) {}
 
   void setup(const Mesh<3>& mesh, const ResolvedBoundary<3>& boundary) {
@@ -155,6 +156,9 @@ class SectionMover {
                        " (expected the mesh it was found on)");
     }
     SectionBoundary b = section_boundary(ext_, mesh, boundary);
+    // The section of the mesh given: run_steps sets movers up again on the moved mesh.
+    for (std::size_t s = 0; s < ext_.front_nodes.size(); ++s)
+      ext_.section.points.col(static_cast<Index>(s)) = ext_.project(mesh.points.col(ext_.front_nodes[s]));
     mover_.setup(ext_.section, b.boundary);
     section_ = std::move(b);
     num_nodes_ = mesh.num_nodes();
