@@ -632,6 +632,13 @@ TEST_CASE("distributed RBF set up at rest blends each move's rigid part as the s
     DistributedRbfMover<2> mover({}, {solve});
     mover.setup(part.view(), local_b);
     REQUIRE(mover.stats().rigid_part);
+    // As the serial mover: nothing factorized while each move's rigid part carries it all.
+    CHECK(mover.stats().factorizations == 0);
+    const Points<2> turned = motion(30.0, 0.0);
+    const Points<2> rigid = serial.move(turned);
+    CHECK(largest_gap(part, mover.move(local_values(part, b, local_b, turned)), rigid) <= 1e-12 * rigid.colwise().norm().maxCoeff());
+    CHECK(mover.stats().factorizations == 0);
+    CHECK(mover.stats().moves == 1);
     Points<2> local_seed(2, part.local.num_nodes());
     for (Index i = 0; i < part.local.num_nodes(); ++i) local_seed.col(i) = seed.col(part.global_ids[static_cast<std::size_t>(i)]);
     for (const double degrees : {45.0, 135.0, 180.0, 60.0}) {
@@ -640,6 +647,7 @@ TEST_CASE("distributed RBF set up at rest blends each move's rigid part as the s
       const Points<2> expected = serial.move(d);
       const Points<2> got = mover.move(local_values(part, b, local_b, d));
       CHECK(largest_gap(part, got, expected) <= 1e-10 * expected.colwise().norm().maxCoeff());
+      CHECK(mover.stats().factorizations >= 1);
       const Points<2> v = motion(10.0, 0.05);
       const Points<2> expected_velocity = serial.derivative_forward(v);
       CHECK(largest_gap(part, mover.velocity(local_values(part, b, local_b, v)), expected_velocity) <=

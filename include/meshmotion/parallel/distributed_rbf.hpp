@@ -138,8 +138,14 @@ class DistributedRbfMover {
     std::vector<double> geometry;  ///< per entry: position, normal, direction, radius
     bool radius_per_entry = false;  ///< some rank was given support_radii
   };
-  /// setup() on the mover's own copy of the part (part_).
-  void set_up(const ResolvedBoundary<Dim>& boundary);
+  /// setup() on the mover's own copy of the part (part_); with `defer`, everything but the
+  /// boundary system's factorization and the evaluation operator (build_interpolation()).
+  void set_up(const ResolvedBoundary<Dim>& boundary, bool defer = false);
+  /// Collective: what set_up() deferred, built (nothing when nothing was).
+  void build_interpolation();
+  /// Collective: the rest `rest` of `d` after the blend is more than the fit's round-off on
+  /// some rank (the serial mover's test: 1e-10 of the largest prescribed displacement).
+  [[nodiscard]] bool leaves_something(PointsView<Dim> d, PointsView<Dim> rest) const;
   /// Collective: sets the mover up again for `d` when it outgrew the default radius.
   void follow_motion(PointsView<Dim> d);
   /// Collective: `d` less the rigid part's blend `blend` at the non-sliding entries (rest_).
@@ -222,6 +228,9 @@ class DistributedRbfMover {
   Points<Dim> gathered_, inner_out_;
   RigidPartAtMove<Dim> at_move_;  ///< set up at rest: each move's rigid part
   Points<Dim> blend_, rest_;      ///< the last move's blend (Dim × part.size()), and d less it
+  bool pending_ = false;          ///< set_up() deferred the build (build_interpolation())
+  Points<Dim> pending_points_;    ///< replicated: the inner mover's points; PETSc: the centres
+  ResolvedBoundary<Dim> pending_centres_;  ///< replicated: the inner mover's boundary
 };
 
 template <int Dim>
@@ -253,7 +262,46 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
       if (why && options_.rigid_part == RigidPart::blend) throw InputError("DistributedRbfMover::setup: rigid_part=blend: " + *why);
     }
   }
-  set_up(boundary);
+  // As the serial mover's: with each move's rigid part taken and the default radius (which the
+  // first motion it cannot carry grows), the interpolation waits for the first move that
+  // leaves it something. A body moving rigidly never factorizes; the choices (radius, where
+  // the system is solved) are made now all the same.
+  set_up(boundary, at_move_.active() && options_.support_radius == 0.0 && options_.support_radii.empty());
+}
+
+template <int Dim>
+bool DistributedRbfMover<Dim>::leaves_something(PointsView<Dim> d, PointsView<Dim> rest) const {
+  double figures[2] = {0.0, 0.0};  // off, scale
+  for (Index k = 0; k < boundary_.size(); ++k) {
+    if (owned_[static_cast<std::size_t>(boundary_.nodes[static_cast<std::size_t>(k)])] == 0) continue;
+    figures[1] = std::max(figures[1], d.col(k).norm());
+    if (boundary_.kinds[static_cast<std::size_t>(k)] != BoundaryKind::sliding) figures[0] = std::max(figures[0], rest.col(k).norm());
+  }
+  MPI_Allreduce(MPI_IN_PLACE, figures, 2, MPI_DOUBLE, MPI_MAX, comm_);
+  return figures[0] > 1e-10 * figures[1];
+}
+
+template <int Dim>
+void DistributedRbfMover<Dim>::build_interpolation() {
+  if (!pending_) return;
+  const meshmotion::detail::Stopwatch watch;
+  pending_ = false;
+  const MoverStats before = stats_;
+  if (petsc_) {
+    setup_petsc(PartitionView<Dim>{comm_, part_points_, part_ids_, part_owners_}, std::move(pending_points_));
+  } else {
+    collective(comm_, [&] { inner_.setup_reference(std::move(pending_points_), pending_centres_); });
+    stats_ = inner_.stats();
+    stats_.evaluated_nodes = std::min(stats_.evaluated_nodes, n_local_);
+  }
+  pending_points_.resize(Dim, 0);
+  pending_centres_ = {};
+  stats_.support_radius = before.support_radius;
+  stats_.radius_reduced = before.radius_reduced;
+  stats_.rigid_part = before.rigid_part;
+  stats_.moves = before.moves;
+  stats_.radius_growths = before.radius_growths;
+  stats_.setup_seconds = before.setup_seconds + watch.seconds();
 }
 
 template <int Dim>
@@ -288,9 +336,10 @@ void DistributedRbfMover<Dim>::follow_motion(PointsView<Dim> d) {
 }
 
 template <int Dim>
-void DistributedRbfMover<Dim>::set_up(const ResolvedBoundary<Dim>& boundary) {
+void DistributedRbfMover<Dim>::set_up(const ResolvedBoundary<Dim>& boundary, bool defer) {
   const meshmotion::detail::Stopwatch watch;
   ready_ = false;
+  pending_ = false;
   const PartitionView<Dim> part{comm_, part_points_, part_ids_, part_owners_};
   const Index n = part.size();
   collective(comm_, [&] {
@@ -313,6 +362,7 @@ void DistributedRbfMover<Dim>::set_up(const ResolvedBoundary<Dim>& boundary) {
   patches_.reset();
   radius_reduced_ = false;
   if (options_.partition_of_unity && (solve_.boundary_solve == BoundarySolve::automatic || solve_.boundary_solve == BoundarySolve::patches)) {
+    // Built whole: the patches decide at their setup whether they can be spread.
     // No rank gathers the boundary: patches own it.
     auto patches = std::make_unique<detail::DistributedPartitionOfUnity<Dim>>();
     const std::string obstacle = patches->setup(part, boundary, options_);
@@ -351,19 +401,21 @@ void DistributedRbfMover<Dim>::set_up(const ResolvedBoundary<Dim>& boundary) {
   }
   gathered_.resize(Dim, m);
   petsc_ = choose_petsc(gathered, points.leftCols(m));
-  if (petsc_) {
-    setup_petsc(part, Points<Dim>(points.leftCols(m)));
-  } else {
+  if (!petsc_) {
     system_.reset();
     RbfOptions options = options_;
     options.support_radius = radius_;
     options.support_radii = std::move(radii);
     options.rigid_part = RigidPart::none;  // as the PETSc and patches solves: the whole motion interpolated
     inner_ = RbfMover<Dim>(std::move(options));
-    collective(comm_, [&] { inner_.setup_reference(std::move(points), centres); });
-    stats_ = inner_.stats();
-    stats_.evaluated_nodes = std::min(stats_.evaluated_nodes, n);
+    pending_centres_ = centres;
   }
+  pending_points_ = petsc_ ? Points<Dim>(points.leftCols(m)) : std::move(points);
+  pending_ = true;
+  stats_ = MoverStats{};
+  stats_.boundary_nodes = m;
+  stats_.evaluated_nodes = n - boundary.size();  // until built: every node but the boundary's is blended
+  if (!defer) build_interpolation();
   stats_.support_radius = radius_;
   stats_.radius_reduced = radius_reduced_;
   grows_ = options_.support_radius == 0.0 && !gathered.radius_per_entry && !radius_reduced_;
@@ -551,11 +603,18 @@ void DistributedRbfMover<Dim>::move_to(PointsView<Dim> d, Out& out) {
   } else {
     at_move_.blend(part_points_, d, blend_, RanksReduction{comm_});
     const Points<Dim>& rest = without_blend(d, blend_);
-    follow_motion(rest);
-    apply(rest, out);
-    // A shared node's owner and its other ranks add the same two numbers (the rest, the
-    // blend): the same point on every rank, d to rounding.
-    out += blend_;
+    if (pending_ && !leaves_something(d, rest)) {
+      // Nothing but the fit's round-off to interpolate, and nothing built to do it with.
+      meshmotion::detail::size_output<Dim>(out, n_local_);
+      out = blend_;
+    } else {
+      follow_motion(rest);  // a radius outgrown is set up (and built) for the motion at once
+      build_interpolation();
+      apply(rest, out);
+      // A shared node's owner and its other ranks add the same two numbers (the rest, the
+      // blend): the same point on every rank, d to rounding.
+      out += blend_;
+    }
   }
   ++stats_.moves;
   stats_.move_seconds = watch.seconds();
@@ -564,6 +623,7 @@ void DistributedRbfMover<Dim>::move_to(PointsView<Dim> d, Out& out) {
 template <int Dim>
 Points<Dim> DistributedRbfMover<Dim>::velocity(PointsView<Dim> v) {
   check_entries("velocity", v);
+  build_interpolation();
   Points<Dim> out;
   if (!at_move_.active()) {
     apply(v, out);
@@ -606,6 +666,7 @@ Points<Dim> DistributedRbfMover<Dim>::derivative_reverse(PointsView<Dim> v) {
     require_ready("derivative_reverse");
     meshmotion::detail::check_node_field<Dim>("DistributedRbfMover::derivative_reverse", v, n_local_);
   });
+  build_interpolation();
   Points<Dim> grad = reverse_interpolation(v);
   if (!at_move_.active()) return grad;
   // As the serial mover's: the blend's change meets v less what the interpolation took at the
