@@ -662,8 +662,9 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   }
   // With the rigid part out, the interpolation waits for the first move (or derivative) that
   // leaves it something to carry: a rigid body never needs it, and at rest the default radius
-  // is provisional (the first motion it cannot carry grows it).
-  if (blend || (at_move_.active() && grows_))
+  // is provisional (the first motion it cannot carry grows it; one the memory budget cut,
+  // a sphere's nearly dense operator in a large box, would cost seconds for nothing).
+  if (blend || (at_move_.active() && fitted))
     stats_.evaluated_nodes = points_.cols() - static_cast<Index>(boundary_.nodes.size());
   else
     build_interpolation();
