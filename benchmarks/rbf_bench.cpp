@@ -52,6 +52,9 @@ StepResult<2> rotate(const Mesh<2>& mesh, double degrees, int steps, double radi
   spec.moving("wall", Rotation2D{Vec<2>::Zero(), radians(degrees)}).fixed("farfield");
   RbfOptions options;
   options.support_radius = radius;
+  // The thesis's RBF: the whole rotation interpolated. The defaults blend a rigid body's turn
+  // from one setup at rest (run_steps), valid at any angle: plate_turn_bench.py measures them.
+  options.rigid_part = RigidPart::none;
   RbfMover<2> mover(options);
   return run_steps(mover, mesh, spec, StepOptions{steps, Metric::skew});
 }
