@@ -458,7 +458,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
           if (boundary_.kinds[b] != BoundaryKind::sliding) off = std::max(off, rest.col(static_cast<Index>(b)).norm());
         }
         // What the rigid fit leaves of its own motion is round-off: nothing to interpolate.
-        if (off > 1e-10 * rigid_scale_) {
+        if (off > rigid_fit_round_off * rigid_scale_) {
           build_interpolation();
           apply(rest, out);
           out += rigid_;

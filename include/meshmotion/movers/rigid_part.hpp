@@ -262,6 +262,10 @@ template <int Dim>
   return true;
 }
 
+/// What a rigid fit leaves of its own motion, relative to the largest prescribed displacement,
+/// and is round-off: below it the rest is not interpolated (serial and distributed alike).
+inline constexpr double rigid_fit_round_off = 1e-10;
+
 /// RigidPartAtMove's sums and extremes over the processes sharing a mesh, for one process:
 /// nothing to add (RanksReduction, parallel/communicator.hpp, is the MPI one).
 struct LocalReduction {

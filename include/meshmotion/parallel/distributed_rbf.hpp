@@ -143,8 +143,8 @@ class DistributedRbfMover {
   void set_up(const ResolvedBoundary<Dim>& boundary, bool defer = false);
   /// Collective: what set_up() deferred, built (nothing when nothing was).
   void build_interpolation();
-  /// Collective: the rest `rest` of `d` after the blend is more than the fit's round-off on
-  /// some rank (the serial mover's test: 1e-10 of the largest prescribed displacement).
+  /// Collective: the rest `rest` of `d` after the blend is more than the fit's round-off
+  /// (rigid_fit_round_off, as the serial mover's test) on some rank.
   [[nodiscard]] bool leaves_something(PointsView<Dim> d, PointsView<Dim> rest) const;
   /// Collective: sets the mover up again for `d` when it outgrew the default radius.
   void follow_motion(PointsView<Dim> d);
@@ -278,7 +278,7 @@ bool DistributedRbfMover<Dim>::leaves_something(PointsView<Dim> d, PointsView<Di
     if (boundary_.kinds[static_cast<std::size_t>(k)] != BoundaryKind::sliding) figures[0] = std::max(figures[0], rest.col(k).norm());
   }
   MPI_Allreduce(MPI_IN_PLACE, figures, 2, MPI_DOUBLE, MPI_MAX, comm_);
-  return figures[0] > 1e-10 * figures[1];
+  return figures[0] > rigid_fit_round_off * figures[1];
 }
 
 template <int Dim>
@@ -362,8 +362,8 @@ void DistributedRbfMover<Dim>::set_up(const ResolvedBoundary<Dim>& boundary, boo
   patches_.reset();
   radius_reduced_ = false;
   if (options_.partition_of_unity && (solve_.boundary_solve == BoundarySolve::automatic || solve_.boundary_solve == BoundarySolve::patches)) {
-    // Built whole: the patches decide at their setup whether they can be spread.
-    // No rank gathers the boundary: patches own it.
+    // No rank gathers the boundary: patches own it, and are built whole (they decide at their
+    // setup whether they can be spread, so nothing waits for a move).
     auto patches = std::make_unique<detail::DistributedPartitionOfUnity<Dim>>();
     const std::string obstacle = patches->setup(part, boundary, options_);
     if (obstacle.empty()) {
@@ -391,7 +391,7 @@ void DistributedRbfMover<Dim>::set_up(const ResolvedBoundary<Dim>& boundary, boo
   number_columns(part, boundary);
   Points<Dim> points;
   std::vector<double> radii;
-  const ResolvedBoundary<Dim> centres = inner_boundary(part, gathered, points, radii);
+  ResolvedBoundary<Dim> centres = inner_boundary(part, gathered, points, radii);
 
   radius_ = options_.support_radius;
   if (radius_ == 0.0 && !gathered.radius_per_entry) {
@@ -408,7 +408,7 @@ void DistributedRbfMover<Dim>::set_up(const ResolvedBoundary<Dim>& boundary, boo
     options.support_radii = std::move(radii);
     options.rigid_part = RigidPart::none;  // as the PETSc and patches solves: the whole motion interpolated
     inner_ = RbfMover<Dim>(std::move(options));
-    pending_centres_ = centres;
+    pending_centres_ = std::move(centres);
   }
   pending_points_ = petsc_ ? Points<Dim>(points.leftCols(m)) : std::move(points);
   pending_ = true;
