@@ -195,11 +195,6 @@ SparseMatrix ElasticityMover<Dim>::assemble_stiffness(const Mesh<Dim>& mesh, con
     const detail::QuadratureTable& table = detail::quadrature_table(block.type);
     const double measure = detail::reference_measure(block.type);
     const double factor = cell_factor.empty() ? 1.0 : cell_factor[static_cast<std::size_t>(block_start[static_cast<std::size_t>(b)] + e)];
-    if (!unknown.empty()) {
-      bool touches_free = false;
-      for (const Index v : block.element(e)) touches_free = touches_free || unknown[static_cast<std::size_t>(v)];
-      if (!touches_free) return;
-    }
     detail::FemCoords<Dim> x;
     detail::gather_coords(mesh.points, block, e, x);
     const int n = table.num_nodes;
@@ -219,7 +214,7 @@ SparseMatrix ElasticityMover<Dim>::assemble_stiffness(const Mesh<Dim>& mesh, con
       detail::add_elastic_stiffness<Dim>(g, lame.lambda, lame.mu, scale, k);
     }
     detail::scatter_element_matrix<Dim>(block.element(e), k, out);
-  });
+  }, unknown);
   if (degenerate)
     throw InputError("ElasticityMover::setup: a cell has a zero Jacobian determinant (degenerate cell), so its "
                      "stiffening factor (J0/J)^chi is infinite");

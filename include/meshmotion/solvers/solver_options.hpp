@@ -73,6 +73,19 @@ struct SolverOptions {
   /// systems; the simplicial factorization answers if CHOLMOD finds the matrix not positive
   /// definite). 0 never does.
   Index supernodal_min_rows = 10000;
+  /// The simplicial Cholesky kinds solve a coupled 3D mechanics system (three unknowns per
+  /// node: elasticity) of at least this many rows by conjugate gradients preconditioned with
+  /// one factorization of the nodes' scalar matrix, started from the earlier solutions
+  /// (solvers/detail/component_cg.hpp): its factor holds a ninth of the coupled one's entries
+  /// and costs about a twentieth of its time, and a time loop's moves take a few iterations
+  /// each. 0 never does. Coupled 2D systems, whose factorization is cheap, stay direct.
+  Index coupled_cg_min_rows = 60000;
+  /// That CG factorizes the coupled system after all once its iterations since setup add up
+  /// to this many, and solves directly from then on (a long run of motions that keep changing
+  /// shape then pays at most about twice the cheaper of the two). −1: the factorization's
+  /// estimated cost in iterations (ComponentCg::direct_after: 270 at 222k unknowns); 0: never
+  /// (the memory stays the nodal factor's).
+  Index coupled_direct_after_iterations = -1;
 };
 
 /// What a solver did, accumulated since it was created (seconds, factorizations) or for the
@@ -90,6 +103,7 @@ struct SolverReport {
   Index factorizations = 0;  ///< numeric factorizations (or preconditioner builds) performed
   bool fell_back = false;    ///< an iterative solve failed and the direct fallback answered
   bool supernodal = false;   ///< the last factorization was CHOLMOD's supernodal one
+  bool component_cg = false; ///< solved by CG preconditioned with the nodes' scalar factorization (coupled_cg_min_rows)
 };
 
 /// Dense factorizations.

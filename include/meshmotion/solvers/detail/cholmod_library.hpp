@@ -78,13 +78,16 @@ class CholmodSupernodalLLT {
     info_ = factor_->minor == factor_->n ? Eigen::Success : Eigen::NumericalIssue;
   }
   [[nodiscard]] Eigen::ComputationInfo info() const noexcept { return info_; }
-  /// A⁻¹ b (one column); info() is NumericalIssue when CHOLMOD fails.
-  [[nodiscard]] Eigen::VectorXd solve(const Eigen::VectorXd& b) {
-    Eigen::VectorXd x;
+  /// A⁻¹ B (every column in one pass over the factor); info() is NumericalIssue when CHOLMOD
+  /// fails.
+  [[nodiscard]] Eigen::MatrixXd solve(const Eigen::Ref<const Eigen::MatrixXd>& b) {
+    Eigen::MatrixXd x;
     if (factor_ == nullptr || info_ != Eigen::Success) return x;
     cholmod_dense rhs{};
-    rhs.nrow = rhs.nzmax = rhs.d = static_cast<std::size_t>(b.size());
-    rhs.ncol = 1;
+    rhs.nrow = static_cast<std::size_t>(b.rows());
+    rhs.ncol = static_cast<std::size_t>(b.cols());
+    rhs.d = static_cast<std::size_t>(b.outerStride());
+    rhs.nzmax = rhs.d * rhs.ncol;
     rhs.x = const_cast<double*>(b.data());  // read only: CHOLMOD's API is not const-correct
     rhs.xtype = CHOLMOD_REAL;
     rhs.dtype = CHOLMOD_DOUBLE;
@@ -93,7 +96,7 @@ class CholmodSupernodalLLT {
       info_ = Eigen::NumericalIssue;
       return x;
     }
-    x = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(solution->x), b.size());
+    x = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(solution->x), b.rows(), b.cols());
     api_.cholmod_free_dense(&solution, &common_);
     return x;
   }
