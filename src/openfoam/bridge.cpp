@@ -165,6 +165,8 @@ bool Bridge::rigid_part() const { return serving_->stats().rigid_part; }
 
 int Bridge::setups() const { return 1 + static_cast<int>(serving_->stats().radius_growths); }
 
+long Bridge::solver_iterations() const { return static_cast<long>(serving_->stats().iterations); }
+
 void Bridge::move(const std::vector<double>& boundary_displacements, std::vector<double>& out) {
   try {
     serving_->move(boundary_displacements, out);

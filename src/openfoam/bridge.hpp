@@ -64,6 +64,8 @@ class Bridge {
   [[nodiscard]] bool rigid_part() const;
   /// How many times the mover was set up: once here, then once per growth of its radius.
   [[nodiscard]] int setups() const;
+  /// The iterations of the last move's linear solve (0 for direct solves and interpolation).
+  [[nodiscard]] long solver_iterations() const;
 
  private:
   std::unique_ptr<Serving> serving_;  // serving.hpp: one type per mode

@@ -362,8 +362,9 @@ void meshmotionMotionSolver::solve()
             << endl;
     }
     // Where the time goes, as OpenFOAM's solvers log their residuals: this rank's.
-    Info<< "meshmotion: moved in " << seconds << " s (set-ups again included), resident memory "
-        << memInfo().update().rss() / 1024 << " MB" << endl;
+    Info<< "meshmotion: moved in " << seconds << " s (set-ups again included), ";
+    if (bridge_->solver_iterations() > 0) Info<< bridge_->solver_iterations() << " solver iterations, ";
+    Info<< "resident memory " << memInfo().update().rss() / 1024 << " MB" << endl;
     vectorField& displacement = pointDisplacement_.primitiveFieldRef();
     forAll(displacement, i)
     {
