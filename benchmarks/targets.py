@@ -155,11 +155,13 @@ TARGETS = [
     ("OpenFOAM plugin, 79k cells, 20 steps, sle: wall / displacementLaplacian's",
      {"bench": "openfoam_plugin_large", "options": "method sle"}, "wall_ratio", "<=", 2.0, "x"),
     # A time loop's 3D elasticity: the defaults (CG on the nodes' factorization) against the
-    # coupled factorization they replaced, setup and 20 moves.
+    # coupled factorization they replaced, setup and 20 moves. A body's motion (two fields)
+    # must cost less; a motion that keeps changing shape at most twice (the iterations add up
+    # to the factorization's estimated cost, then it is factorized: the rental's bound).
     ("sle time loop, 3D graded box, turning wall: defaults' time / the coupled factorization's",
      {"case": "sle time loop", "motion": "turning wall", "solver": "defaults"}, "ratio", "<=", 1.0, "x"),
     ("sle time loop, 3D graded box, travelling bump: defaults' time / the coupled factorization's",
-     {"case": "sle time loop", "motion": "travelling bump", "solver": "defaults"}, "ratio", "<=", 1.0, "x"),
+     {"case": "sle time loop", "motion": "travelling bump", "solver": "defaults"}, "ratio", "<=", 2.0, "x"),
     ("Python over MPI / the C++ distributed mover, per call, worst rank count", python_mpi_overhead, None, "<=", 1.05,
      "x"),
     ("RBF gradient on a RANS grid, default limit, worst radius: error", rbf_gradient_error, None, "<=", 1e-6, ""),
