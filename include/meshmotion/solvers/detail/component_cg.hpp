@@ -71,7 +71,8 @@ class ComponentCg {
   /// per node, node-major) of the nodes that hold unknowns (a sliding node's tangent unknowns
   /// through its basis); `nodes`: those nodes' scalar matrix; `direct_after`: the iterations
   /// after which the coupled system is factorized (SolverOptions::coupled_direct_after_iterations).
-  /// Throws SolverError when the scalar matrix is not positive definite.
+  /// A scalar matrix that is not positive definite factorizes the coupled system instead
+  /// (SolverError when that fails too).
   void compute(SparseMatrix a, SparseMatrix lift, const SparseMatrix& nodes, int components, Index direct_after) {
     const Stopwatch watch;
     a_ = std::move(a);
@@ -84,13 +85,16 @@ class ComponentCg {
     factor_ = std::make_unique<NodeFactor>();
     factor_->analyzePattern(nodes);
     factor_->factorize(nodes);
-    if (factor_->info() != Eigen::Success)
-      throw SolverError("component CG: factorization of the " + std::to_string(nodes.rows()) + " × " +
-                        std::to_string(nodes.rows()) + " nodal matrix failed (not positive definite)");
     report_ = SolverReport{};
     report_.analyses = report_.factorizations = 1;
     report_.supernodal = have_cholmod();
     report_.component_cg = true;
+    // A nodal matrix that is not positive definite (a tangent stiffness past a fold, which the
+    // direct LDLᵀ still takes): the coupled system is factorized as before.
+    if (factor_->info() != Eigen::Success) {
+      fall_back();
+      report_.fell_back = true;
+    }
     report_.seconds = watch.seconds();
   }
 
