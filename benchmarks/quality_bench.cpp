@@ -4,9 +4,9 @@
 // count; the target is certified ≤ 5× sampled on valid meshes. The thesis gives no timing for
 // this step (it ran Gmsh's plugin).
 //
-// Then the cost per element by order: triangles, quadrilaterals and hexahedra at P2 to P8,
-// tetrahedra at P2 to P6, curved by moving every node past the vertices; each row's ratio is to
-// the same shape's P2 row of the same run.
+// Then the cost per element by order: triangles, quadrilaterals, tetrahedra and hexahedra at P2
+// to P8, curved by moving every node past the vertices; each row's ratio is to the same shape's
+// P2 row of the same run.
 //
 //   quality_bench [--quick]     (--quick: ~100k elements)
 

@@ -15,7 +15,7 @@ GMSH_IDS = {
     "tri3": 2, "tri6": 9, "tri10": 21, "tri15": 23, "tri21": 25, "tri28": 42, "tri36": 43, "tri45": 44,
     "quad4": 3, "quad8": 16, "quad9": 10, "quad16": 36, "quad25": 37, "quad36": 38, "quad49": 47, "quad64": 48,
     "quad81": 49,
-    "tet4": 4, "tet10": 11, "tet20": 29, "tet35": 30, "tet56": 31, "tet84": 71,
+    "tet4": 4, "tet10": 11, "tet20": 29, "tet35": 30, "tet56": 31, "tet84": 71, "tet120": 72, "tet165": 73,
     "hex8": 5, "hex20": 17, "hex27": 12, "hex64": 92, "hex125": 93, "hex216": 94, "hex343": 95, "hex512": 96,
     "hex729": 97,
     "prism6": 6, "prism15": 18, "prism18": 13, "prism40": 90,
@@ -93,7 +93,7 @@ LAGRANGE = {"line": "vtkLagrangeCurve", "tri": "vtkLagrangeTriangle", "quad": "v
             "tet": "vtkLagrangeTetra", "hex": "vtkLagrangeHexahedron", "prism": "vtkLagrangeWedge"}
 VTK_TYPES = ["line3", "line4", "line5", "line6", "line9", "tri6", "tri10", "tri15", "tri21", "tri28", "tri36", "tri45",
              "quad9", "quad16", "quad25", "quad36", "quad49", "quad64", "quad81", "tet10", "tet20", "tet35", "tet56",
-             "tet84", "hex27", "hex64", "hex125", "hex216", "hex729", "prism18", "prism40"]
+             "tet84", "tet120", "tet165", "hex27", "hex64", "hex125", "hex216", "hex729", "prism18", "prism40"]
 
 
 def to_vtk_parametric(type_name, x):

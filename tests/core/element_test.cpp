@@ -81,8 +81,12 @@ TEST_CASE("orders the catalogue does not hold are refused by name", "[core]") {
   CHECK(element_type(Shape::triangle, 8) == ElementType::tri45);
   CHECK(element_type(Shape::quadrilateral, 8) == ElementType::quad81);
   CHECK(element_type(Shape::tetrahedron, 6) == ElementType::tet84);
+  CHECK(element_type(Shape::tetrahedron, 7) == ElementType::tet120);
+  CHECK(element_type(Shape::tetrahedron, 8) == ElementType::tet165);
+  CHECK(element_type_from_gmsh(72) == ElementType::tet120);
+  CHECK(element_type_from_gmsh(73) == ElementType::tet165);
   CHECK_THROWS_WITH(element_type(Shape::triangle, 9), Catch::Contains("no triangle of order 9"));
-  CHECK_THROWS_WITH(element_type(Shape::tetrahedron, 7), Catch::Contains("no tetrahedron of order 7 (orders 1 to 6"));
+  CHECK_THROWS_WITH(element_type(Shape::tetrahedron, 9), Catch::Contains("no tetrahedron of order 9 (orders 1 to 8"));
   CHECK_THROWS_WITH(element_type(Shape::quadrilateral, 3, false), Catch::Contains("serendipity"));
   CHECK(element_type(Shape::hexahedron, 8) == ElementType::hex729);
   CHECK_THROWS_WITH(element_type(Shape::prism, 4), Catch::Contains("no prism of order 4"));
@@ -91,7 +95,7 @@ TEST_CASE("orders the catalogue does not hold are refused by name", "[core]") {
 
 TEST_CASE("unknown type numbers and names are errors", "[core]") {
   CHECK_THROWS_AS(element_type_from_gmsh(45), InputError);  // tri55, order 9
-  CHECK_THROWS_WITH(element_type_from_gmsh(72), Catch::Contains("a tetrahedron of order 1 to 6"));  // tet120
+  CHECK_THROWS_WITH(element_type_from_gmsh(74), Catch::Contains("tetrahedron or hexahedron of order 1 to 8"));  // tet220
   CHECK_THROWS_AS(element_type_from_vtk(99), InputError);
   CHECK_THROWS_WITH(element_type_from_name("tri7"), Catch::Contains("tri7"));
 }

@@ -107,7 +107,7 @@ TEST_CASE("P1 -> Pk conversion of every element type and mixed meshes is conform
       INFO("box cells " << static_cast<int>(cells));
       const bool held = std::all_of(m.cells.begin(), m.cells.end(), [k](const ElementBlock& b) { return max_order(shape(b.type)) >= k; });
       if (!held) {
-        CHECK_THROWS_AS(convert_to_order(m, k), InputError);  // prisms and pyramids stop at 3, tetrahedra at 6
+        CHECK_THROWS_AS(convert_to_order(m, k), InputError);  // prisms and pyramids stop at 3
         continue;
       }
       check_straight_conversion(m, k);

@@ -614,6 +614,48 @@ TEST_CASE("pipeline: every element type and mixed meshes curve onto a graph", "[
   }
 }
 
+TEST_CASE("pipeline: tetrahedra curve onto a graph at orders 7 and 8, hexahedra at order 4, certified", "[curving]") {
+  // The orders whose det J the certificate subdivides without tables (tetrahedra) and the
+  // untangling holds past the stack's lattice (a tet165's 2,024 points, a hex125's 1,728).
+  const auto bump = [](double x, double y) {
+    const double p = std::numbers::pi;
+    GraphSample2 g;
+    g.value = 0.03 * std::sin(p * x) * std::sin(p * y);
+    g.gradient << 0.03 * p * std::cos(p * x) * std::sin(p * y), 0.03 * p * std::sin(p * x) * std::cos(p * y);
+    g.hessian << -p * p * g.value, 0.03 * p * p * std::cos(p * x) * std::cos(p * y),
+        0.03 * p * p * std::cos(p * x) * std::cos(p * y), -p * p * g.value;
+    return g;
+  };
+  // One cube of tetrahedra (a second of cells at order 8, with 3 s for the tables' first use),
+  // eight hexahedra.
+  struct Case {
+    BoxCells cells;
+    Index n;
+    int order;
+    ElementType type;
+  };
+  for (const Case c : {Case{BoxCells::tet4, 1, 7, ElementType::tet120}, Case{BoxCells::tet4, 1, 8, ElementType::tet165},
+                       Case{BoxCells::hex8, 2, 4, ElementType::hex125}}) {
+    INFO(name(c.type));
+    const Mesh<3> linear = box_mesh({c.n, c.n, c.n, 0.0, 1.0, 0.0, 1.0, 0.0, 1.0, c.cells});
+    CurveOptions<3> options;
+    options.order = c.order;
+    options.geometry.emplace("bottom", BoundaryGeometry<3>::project(GraphProjection3(bump)));
+    const CurveResult<3> curved = curve_mesh(linear, options);
+    REQUIRE(curved.curved.cells.front().type == c.type);
+    INFO("min " << curved.quality.min);
+    CHECK(curved.invalid() == 0);
+    CHECK(curved.quality.min > 0.5);
+    for (const Index v : curved.curved.group_nodes("bottom")) {
+      const Vec<3> x = curved.curved.points.col(v);
+      CHECK(std::abs(x.z() - bump(x.x(), x.y()).value) < 1e-10);
+    }
+    // The report's verdicts are the certificate's, cell by cell.
+    const auto certified = scaled_jacobians(curved.curved);
+    for (std::size_t e = 0; e < certified.size(); ++e) CHECK(certified[e].valid);
+  }
+}
+
 TEST_CASE("pipeline: bad options", "[curving]") {
   const Mesh<2> linear = o_mesh(circle_mesh(12));
   CurveOptions<2> options;

@@ -253,11 +253,12 @@ TEST_CASE("certified bound is below the sampled minimum and sharp on curved elem
   }
 }
 
-TEST_CASE("hexahedra of orders 4 to 8: certified below their det J and sharp, valid and folded", "[quality]") {
-  // Their det J (1,728 to 13,824 lattice points) is held on the heap; the nodes of the
-  // reference cube bent by x -> x + a sin(2 y) e_x + a sin(2 z) e_y + a x y e_z: valid for a
-  // small bend, folded for a large one, a polynomial of the full degree either way.
-  for (const ElementType t : {ElementType::hex125, ElementType::hex343, ElementType::hex729}) {
+TEST_CASE("hexahedra of orders 4 to 8 and tetrahedra of orders 7 and 8: certified below their det J and sharp, valid and folded", "[quality]") {
+  // Their det J (1,330 to 13,824 lattice points) is held on the heap, and the tetrahedra's
+  // children come by de Casteljau's algorithm (no tables); the nodes of the reference cell bent
+  // by x -> x + a sin(2 y) e_x + a sin(2 z) e_y + a x y e_z: valid for a small bend, folded for a
+  // large one, a polynomial of the full degree either way.
+  for (const ElementType t : {ElementType::hex125, ElementType::hex343, ElementType::hex729, ElementType::tet120, ElementType::tet165}) {
     for (const double a : {0.15, 0.9}) {
       INFO(name(t) << ", bend " << a);
       auto x = affine_element<3>(t, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
@@ -275,6 +276,51 @@ TEST_CASE("hexahedra of orders 4 to 8: certified below their det J and sharp, va
       CHECK(s.certified_min == Approx(std::min(s.sampled_min, dense)).margin(5e-3));
       CHECK(s.valid == (a < 0.5));
       CHECK(s.valid == (dense > 0));
+    }
+  }
+}
+
+TEST_CASE("a tetrahedron's children by de Casteljau's algorithm are its children's Bezier coefficients", "[quality]") {
+  // Against the subdivision tables where they are kept (tet35: degree 9, the tables' rounding
+  // 2e-12; at a tet84's degree 15 the tables themselves carry 1e-7 of the Bernstein inversion's
+  // rounding) and, at the degree of a tet165's det J, against the definition: a child's
+  // coefficients, evaluated as a Bernstein polynomial at its own points, give the parent's at
+  // the same places.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<std::array<std::array<double, 4>, 4>> children;
+  for (const auto& vertices : detail::simplex_children(3)) {
+    auto& bary = children.emplace_back();
+    for (std::size_t i = 0; i < 4; ++i)
+      bary[i] = {1.0 - vertices[i][0] - vertices[i][1] - vertices[i][2], vertices[i][0], vertices[i][1], vertices[i][2]};
+  }
+  const detail::JacobianSpace& tables = detail::jacobian_space(ElementType::tet35);
+  REQUIRE(tables.simplex.child_bezier.size() == 8);
+  Eigen::VectorXd parent(tables.num_points), child(tables.num_points);
+  for (Index k = 0; k < parent.size(); ++k) parent(k) = u(rng);
+  for (std::size_t c = 0; c < 8; ++c) {
+    detail::tet_child_coefficients(tables.simplex_degree, children[c], parent.data(), child.data());
+    CHECK((child - tables.simplex.child_bezier[c] * parent).cwiseAbs().maxCoeff() < 1e-10);
+  }
+  const detail::JacobianSpace& s = detail::jacobian_space(ElementType::tet165);
+  CHECK(s.simplex.child_bezier.empty());
+  REQUIRE(s.num_children() == 8);
+  const auto at = [&](const Eigen::VectorXd& coefficients, const RefPoint& x) {
+    double sum = 0.0;
+    for (std::size_t k = 0; k < s.points.size(); ++k) sum += coefficients(static_cast<Index>(k)) * detail::bernstein(s, k, x);
+    return sum;
+  };
+  parent.resize(s.num_points);
+  child.resize(s.num_points);
+  for (Index k = 0; k < parent.size(); ++k) parent(k) = u(rng);
+  for (const std::size_t c : {std::size_t{1}, std::size_t{6}}) {  // a corner child and one of the octahedron's
+    detail::tet_child_coefficients(s.simplex_degree, children[c], parent.data(), child.data());
+    for (const RefPoint& x : {RefPoint{0.2, 0.3, 0.1}, RefPoint{0.0, 0.0, 1.0}, RefPoint{0.25, 0.25, 0.25}}) {
+      RefPoint y{0, 0, 0};  // x mapped into the child, in the parent's reference coordinates
+      const std::array<double, 4> lambda{1.0 - x[0] - x[1] - x[2], x[0], x[1], x[2]};
+      for (std::size_t i = 0; i < 4; ++i)
+        for (std::size_t d = 0; d < 3; ++d) y[d] += lambda[i] * children[c][i][d + 1];
+      CHECK(at(child, x) == Approx(at(parent, y)).margin(1e-9));
     }
   }
 }

@@ -31,15 +31,16 @@ enum class ElementType : std::uint8_t {
   line4, tri10, quad16, tet20, hex64, prism40, pyramid30,
   line5, tri15, quad25, tet35,
   // Orders 5 to 8 (lines, triangles and quadrilaterals; tetrahedra to 6), then hexahedra of
-  // orders 4 to 8.
+  // orders 4 to 8, then tetrahedra of orders 7 and 8 (appended when the certificate could hold them).
   line6, tri21, quad36, tet56,
   line7, tri28, quad49, tet84,
   line8, tri36, quad64,
   line9, tri45, quad81,
   hex125, hex216, hex343, hex512, hex729,
+  tet120, tet165,
 };
 
-inline constexpr int num_element_types = 49;
+inline constexpr int num_element_types = 51;
 
 /// Most nodes of any element type (hex729).
 inline constexpr int max_element_nodes = 729;
@@ -109,7 +110,8 @@ inline constexpr std::array<ElementInfo, num_element_types> element_table{{
     {ElementType::line5, "line5", Shape::line, 1, 4, 5, 2, true, 27, -1, 68},
     {ElementType::tri15, "tri15", Shape::triangle, 2, 4, 15, 3, true, 23, -1, 69},
     {ElementType::quad25, "quad25", Shape::quadrilateral, 2, 4, 25, 4, true, 37, -1, 70},
-    {ElementType::tet35, "tet35", Shape::tetrahedron, 3, 4, 35, 4, true, 30, -1, 71},    {ElementType::line6, "line6", Shape::line, 1, 5, 6, 2, true, 28, -1, 68},
+    {ElementType::tet35, "tet35", Shape::tetrahedron, 3, 4, 35, 4, true, 30, -1, 71},
+    {ElementType::line6, "line6", Shape::line, 1, 5, 6, 2, true, 28, -1, 68},
     {ElementType::tri21, "tri21", Shape::triangle, 2, 5, 21, 3, true, 25, -1, 69},
     {ElementType::quad36, "quad36", Shape::quadrilateral, 2, 5, 36, 4, true, 38, -1, 70},
     {ElementType::tet56, "tet56", Shape::tetrahedron, 3, 5, 56, 4, true, 31, -1, 71},
@@ -128,6 +130,8 @@ inline constexpr std::array<ElementInfo, num_element_types> element_table{{
     {ElementType::hex343, "hex343", Shape::hexahedron, 3, 6, 343, 8, true, 95, -1, 72},
     {ElementType::hex512, "hex512", Shape::hexahedron, 3, 7, 512, 8, true, 96, -1, 72},
     {ElementType::hex729, "hex729", Shape::hexahedron, 3, 8, 729, 8, true, 97, -1, 72},
+    {ElementType::tet120, "tet120", Shape::tetrahedron, 3, 7, 120, 4, true, 72, -1, 71},
+    {ElementType::tet165, "tet165", Shape::tetrahedron, 3, 8, 165, 4, true, 73, -1, 71},
 }};
 
 using Edge = std::array<int, 2>;
@@ -210,6 +214,8 @@ inline constexpr std::array<int, 84> tet84_vtk{
     0,  1,  2,  3,  4,  5,  6,  7,  8,  9,  10, 11, 12, 13, 14, 15, 16, 17, 18, 23, 22, 21, 20, 19, 33, 32, 31, 30,
     29, 28, 27, 26, 25, 24, 44, 45, 46, 47, 48, 49, 50, 51, 52, 53, 66, 64, 65, 71, 72, 67, 68, 69, 70, 73, 54, 55,
     56, 57, 58, 59, 60, 61, 62, 63, 34, 35, 36, 37, 38, 39, 40, 41, 42, 43, 74, 75, 76, 77, 78, 79, 80, 81, 83, 82};
+inline constexpr std::array<int, 120> tet120_vtk{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 27, 26, 25, 24, 23, 22, 39, 38, 37, 36, 35, 34, 33, 32, 31, 30, 29, 28, 55, 56, 57, 58, 59, 60, 61, 62, 63, 64, 65, 66, 67, 68, 69, 87, 85, 86, 94, 95, 96, 88, 89, 90, 91, 92, 93, 99, 97, 98, 70, 71, 72, 73, 74, 75, 76, 77, 78, 79, 80, 81, 82, 83, 84, 40, 41, 42, 43, 44, 45, 46, 47, 48, 49, 50, 51, 52, 53, 54, 100, 101, 102, 103, 104, 105, 106, 107, 108, 109, 111, 110, 115, 114, 113, 112, 117, 119, 118, 116};
+inline constexpr std::array<int, 165> tet165_vtk{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22, 23, 24, 31, 30, 29, 28, 27, 26, 25, 45, 44, 43, 42, 41, 40, 39, 38, 37, 36, 35, 34, 33, 32, 67, 68, 69, 70, 71, 72, 73, 74, 75, 76, 77, 78, 79, 80, 81, 82, 83, 84, 85, 86, 87, 111, 109, 110, 120, 121, 122, 123, 112, 113, 114, 115, 116, 117, 118, 119, 126, 124, 125, 129, 127, 128, 88, 89, 90, 91, 92, 93, 94, 95, 96, 97, 98, 99, 100, 101, 102, 103, 104, 105, 106, 107, 108, 46, 47, 48, 49, 50, 51, 52, 53, 54, 55, 56, 57, 58, 59, 60, 61, 62, 63, 64, 65, 66, 130, 131, 132, 133, 134, 135, 136, 137, 138, 139, 140, 141, 142, 145, 144, 143, 151, 150, 149, 148, 147, 146, 155, 156, 157, 163, 161, 162, 158, 159, 160, 152, 153, 154, 164};
 inline constexpr std::array<int, 13> pyramid13_vtk{0, 1, 2, 3, 4, 5, 8, 10, 6, 7, 9, 11, 12};
 
 template <class T, std::size_t N>
@@ -278,15 +284,12 @@ constexpr std::span<const T> as_span(const std::array<T, N>& a) {
 }
 
 /// Highest order of the catalogue's elements of a shape: 8 for lines, triangles,
-/// quadrilaterals and hexahedra, 6 for tetrahedra, 3 for prisms and pyramids. (The
-/// certificate's Bézier tables of a tetrahedron grow as the cube of its order: at order 8,
-/// 2,024 coefficients and a quarter of a gigabyte of subdivision tables. Gmsh lays out the
+/// quadrilaterals, tetrahedra and hexahedra, 3 for prisms and pyramids. (Gmsh lays out the
 /// inside of prisms past order 3, and of pyramids past order 3, in ways the catalogue's
 /// lattice does not reproduce yet.)
 [[nodiscard]] constexpr int max_order(Shape s) {
   switch (s) {
     case Shape::point: return 0;
-    case Shape::tetrahedron: return 6;
     case Shape::prism:
     case Shape::pyramid: return 3;
     default: return max_element_order;
@@ -306,7 +309,7 @@ constexpr std::span<const T> as_span(const std::array<T, N>& a) {
     if (e.shape == s && e.order == element_order && (e.complete || !complete)) return e.type;
   throw InputError("element_type: no " + std::string(shape_name(s)) + " of order " + std::to_string(element_order) +
                    " (orders 1 to " + std::to_string(max_order(s)) + " for " + std::string(shape_name(s)) +
-                   "s; 1 to 8 for lines, triangles, quadrilaterals and hexahedra, 1 to 6 for tetrahedra, 1 to 3 for prisms and pyramids)");
+                   "s; 1 to 8 for lines, triangles, quadrilaterals, tetrahedra and hexahedra, 1 to 3 for prisms and pyramids)");
 }
 
 /// The linear element of the same shape.
@@ -453,6 +456,8 @@ namespace detail {
     case ElementType::prism40: return detail::as_span(detail::prism40_vtk);
     case ElementType::tet56: return detail::as_span(detail::tet56_vtk);
     case ElementType::tet84: return detail::as_span(detail::tet84_vtk);
+    case ElementType::tet120: return detail::as_span(detail::tet120_vtk);
+    case ElementType::tet165: return detail::as_span(detail::tet165_vtk);
     default: return {};
   }
 }
@@ -475,8 +480,8 @@ namespace detail {
   for (const auto& e : detail::element_table)
     if (e.gmsh_id == gmsh_id) return e.type;
   throw InputError("element_type_from_gmsh: unsupported Gmsh element type " + std::to_string(gmsh_id) +
-                   " (expected a point, a line, triangle, quadrilateral or hexahedron of order 1 to 8, a tetrahedron of order " +
-                   "1 to 6, or a prism or pyramid of order 1 to 3; the serendipity elements stop at order 2)");
+                   " (expected a point, a line, triangle, quadrilateral, tetrahedron or hexahedron of order 1 to 8, " +
+                   "or a prism or pyramid of order 1 to 3; the serendipity elements stop at order 2)");
 }
 
 /// The linear type with the given VTK/SU2 number; throws InputError for unknown numbers.

@@ -161,6 +161,12 @@ void node_cells(const Mesh<Dim>& mesh, std::vector<Index>& offsets, std::vector<
 
 namespace detail {
 
+// Most lattice points of a det J the untangling holds (a tet165's, degree 21; a hex125's 1,728),
+// in place in each of the four polynomials per cell around a node: on the heap they would be
+// allocated afresh whenever the cells around a node change type.
+inline constexpr int max_untangle_lattice_points = 2024;
+using UntangleLattice = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_untangle_lattice_points, 1>;
+
 // The optimization of a patch of cells and its undoing, over the node-to-cell adjacency of one
 // mesh (built once for every pass).
 template <int Dim>
@@ -284,7 +290,7 @@ class PatchOptimizer {
   // most all Dim, so det J's Bézier coefficients and the straight measure are polynomials in t
   // of degree 1 along an axis, Dim otherwise. The cell's value is min_k c_k(t) / |l(t)|.
   struct CellLine {
-    std::array<LatticeVector, 4> c;  // c[0] + t c[1] + t² c[2] + t³ c[3]
+    std::array<UntangleLattice, 4> c;  // c[0] + t c[1] + t² c[2] + t³ c[3]
     std::array<double, 4> l{};
     int degree = 1;
     double degenerate_below = 0.0, at_zero = 0.0;
@@ -305,14 +311,13 @@ class PatchOptimizer {
 
   // det J's coefficients (Bézier, or lattice values for a pyramid) at the cell's nodes `x`,
   // unscaled, and its straight measure.
-  void coefficients(ElementType type, const ElementCoords<Dim>& x, LatticeVector& values, double& linear) {
+  void coefficients(ElementType type, const ElementCoords<Dim>& x, UntangleLattice& values, double& linear) {
     ++evaluations_;
     const detail::JacobianSpace& s = detail::jacobian_space(type);
-    // The line search keeps four polynomials of det J per cell around a node on the stack.
-    if (s.num_points > detail::max_lattice_points)
+    if (s.num_points > max_untangle_lattice_points)
       throw InputError("untangle: a " + std::string(name(type)) + "'s det J has " + std::to_string(s.num_points) +
-                       " lattice points, more than the " + std::to_string(detail::max_lattice_points) +
-                       " the untangling holds (hexahedra are untangled up to order 3)");
+                       " lattice points, more than the " + std::to_string(max_untangle_lattice_points) +
+                       " the untangling holds (hexahedra are untangled up to order 4)");
     detail::lattice_dets<Dim>(s, x, 1.0, values);
     if (s.bezier) detail::to_bezier(s, values);
     linear = detail::linear_det<Dim>(s, x);
@@ -334,7 +339,7 @@ class PatchOptimizer {
     line.degenerate_below = degenerate_below(type_of(c), x);
     line.degree = axis ? 1 : Dim;
     const Vec<Dim> at = x.col(local);
-    std::array<LatticeVector, 4>& f = samples_;
+    std::array<UntangleLattice, 4>& f = samples_;
     std::array<double, 4> g{};
     constexpr std::array<double, 4> taus{0.0, 1.0, -1.0, 2.0};
     for (int j = 0; j <= line.degree; ++j) {
@@ -542,7 +547,7 @@ class PatchOptimizer {
   std::vector<Index> offsets_, cells_;
   std::vector<std::pair<std::size_t, Index>> where_;
   std::vector<CellLine> lines_;
-  std::array<LatticeVector, 4> samples_;
+  std::array<UntangleLattice, 4> samples_;
   long long evaluations_ = 0;
 };
 

@@ -12,7 +12,7 @@
 /// whose minimum (maximum) bounds det J from below (above); the domain is subdivided where
 /// the bound is further than `tolerance` from the sampled values. Types: every triangle,
 /// quadrilateral, tetrahedron, hexahedron and prism of the catalogue (core/element.hpp: to
-/// order 8, tetrahedra to 6, prisms to 3). Pyramids (rational maps) are sampled only: there
+/// order 8, prisms to 3). Pyramids (rational maps) are sampled only: there
 /// `certified` is false and the "certified" bounds are the sampled extremes.
 
 #include "meshmotion/core/element.hpp"
@@ -73,7 +73,7 @@ namespace detail {
 template <int D>
 using ElementCoords = Eigen::Matrix<double, D, Eigen::Dynamic, 0, D, max_element_nodes>;
 // The lattice values of det J: on the stack up to a tet84's 816 points (every type but the
-// hexahedra past order 3), on the heap beyond (a hex729's 13,824). Sized for the largest, the
+// hexahedra past order 3 and the tetrahedra past order 6), on the heap beyond (a hex729's 13,824). Sized for the largest, the
 // stack frames of a P2 cell's certificate grew to 110 KiB and it ran 6 times slower.
 using LatticeVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_lattice_points, 1>;
 using LargeLatticeVector = Eigen::VectorXd;
@@ -227,8 +227,17 @@ void for_each_child(const JacobianSpace& s, const Lattice& parent, Visit&& visit
     Index outer = 1, inner = 1;
     for (int b = 0; b < a; ++b) outer *= sizes[static_cast<std::size_t>(b)];
     for (int b = a + 1; b < count; ++b) inner *= sizes[static_cast<std::size_t>(b)];
-    const auto& choices = (a == 0 && s.simplex_dim > 0) ? s.simplex.child_bezier : s.line.child_bezier;
     Lattice& to = levels[static_cast<std::size_t>(a)];
+    if (a == 0 && s.simplex_dim > 0 && s.simplex.child_bezier.empty()) {
+      // A tetrahedron past order 6 (no line factor: outer = inner = 1).
+      for (const auto& vertices : s.simplex.child_vertices) {
+        to.resize(from.size());
+        tet_child_coefficients(s.simplex_degree, vertices, from.data(), to.data());
+        self(self, a - 1, to);
+      }
+      return;
+    }
+    const auto& choices = (a == 0 && s.simplex_dim > 0) ? s.simplex.child_bezier : s.line.child_bezier;
     for (const auto& factor : choices) {
       to.resize(from.size());
       factor_pass(factor, outer, inner, from.data(), to.data());

@@ -38,6 +38,15 @@ namespace meshmotion::detail {
 struct BezierFactor {
   Eigen::MatrixXd to_bezier;              // Bézier coefficients = to_bezier × lattice values
   std::vector<Eigen::MatrixXd> child_bezier;  // Bézier coefficients of child c = child_bezier[c] × coefficients
+  // Tetrahedra past a tet84's det J (degree 15, 816 coefficients) keep no child tables: they
+  // would grow as the square of the coefficients (8 × 2,024² doubles at order 8, a quarter of a
+  // gigabyte, and minutes of products to form), where de Casteljau's algorithm gives a child
+  // from its parent in about the table's multiply-adds (tet_child_coefficients). The children's
+  // vertices instead, in the parent's barycentric coordinates.
+  std::vector<std::array<std::array<double, 4>, 4>> child_vertices;
+  [[nodiscard]] int num_children() const {
+    return static_cast<int>(child_bezier.empty() ? child_vertices.size() : child_bezier.size());
+  }
 };
 
 struct JacobianSpace {
@@ -68,7 +77,7 @@ struct JacobianSpace {
   BezierFactor line;                           // when line_dims > 0
   // Children of a subdivision: simplex child outermost, then one bit per line coordinate.
   [[nodiscard]] int num_children() const {
-    return (simplex_dim > 0 ? static_cast<int>(simplex.child_bezier.size()) : 1) << line_dims;
+    return (simplex_dim > 0 ? simplex.num_children() : 1) << line_dims;
   }
 };
 
@@ -204,6 +213,63 @@ inline void add_lattice(JacobianSpace& s) {
     }
 }
 
+// Most lattice points of a det J held on the stack (a tet84's, degree 15): every type but the
+// hexahedra past order 3 and the tetrahedra past order 6, whose lattices (1,728 points at a
+// hex125, 13,824 at a hex729, 2,024 at a tet165) the certificate keeps on the heap (quality/scaled_jacobian.hpp).
+inline constexpr int max_lattice_points = 816;
+
+// Points of a tetrahedral lattice of degree m.
+[[nodiscard]] constexpr Index tet_lattice_size(int m) { return m < 0 ? 0 : Index{m + 1} * (m + 2) * (m + 3) / 6; }
+
+// Position of the multi-index (m − a1 − a2 − a3, a1, a2, a3) in a tetrahedral lattice of degree m
+// (add_lattice's order: a1 outermost, a3 fastest).
+[[nodiscard]] constexpr Index tet_lattice_offset(int m, int a1, int a2, int a3) {
+  const auto tri = [](int k) { return k < 0 ? Index{0} : Index{k + 1} * (k + 2) / 2; };
+  return tet_lattice_size(m) - tet_lattice_size(m - a1) + tri(m - a1) - tri(m - a1 - a2) + a3;
+}
+
+// One step of de Casteljau's algorithm in place: the net of degree m (tet_lattice_offset's
+// order) becomes the net of degree m − 1 of the blossom with one argument w (barycentric). Each
+// entry is written before any entry after it is read, so one buffer serves.
+inline void tet_casteljau_step(int m, const std::array<double, 4>& w, double* net) {
+  Index out = 0;
+  for (int a1 = 0; a1 < m; ++a1)
+    for (int a2 = 0; a1 + a2 < m; ++a2) {
+      const double* same = net + tet_lattice_offset(m, a1, a2, 0);
+      const double* up1 = net + tet_lattice_offset(m, a1 + 1, a2, 0);
+      const double* up2 = net + tet_lattice_offset(m, a1, a2 + 1, 0);
+      for (int a3 = 0; a1 + a2 + a3 < m; ++a3, ++out)
+        net[out] = w[0] * same[a3] + w[1] * up1[a3] + w[2] * up2[a3] + w[3] * same[a3 + 1];
+    }
+}
+
+// The Bézier coefficients of a child tetrahedron (vertices v, barycentric in the parent) of a
+// degree-n polynomial with coefficients `parent`: coefficient α of the child is the blossom
+// at v0 (α0 times), v1 (α1 times), v2, v3, taken argument by argument, each partial blossom
+// shared by every coefficient that starts with it (about (n + 7)! / (n! 7!) × 4 multiply-adds:
+// 4.7 million at degree 21, a 2,024² table's 4.1).
+inline void tet_child_coefficients(int n, const std::array<std::array<double, 4>, 4>& v, const double* parent, double* child) {
+  thread_local std::array<std::vector<double>, 4> nets;
+  const auto size = static_cast<std::size_t>(tet_lattice_size(n));
+  for (auto& net : nets) net.resize(size);
+  std::copy(parent, parent + size, nets[0].begin());
+  for (int a1 = 0; a1 <= n; ++a1) {
+    if (a1 > 0) tet_casteljau_step(n - a1 + 1, v[1], nets[0].data());
+    std::copy_n(nets[0].begin(), tet_lattice_size(n - a1), nets[1].begin());
+    for (int a2 = 0; a1 + a2 <= n; ++a2) {
+      if (a2 > 0) tet_casteljau_step(n - a1 - a2 + 1, v[2], nets[1].data());
+      std::copy_n(nets[1].begin(), tet_lattice_size(n - a1 - a2), nets[2].begin());
+      for (int a3 = 0; a1 + a2 + a3 <= n; ++a3) {
+        const int m = n - a1 - a2 - a3;
+        if (a3 > 0) tet_casteljau_step(m + 1, v[3], nets[2].data());
+        std::copy_n(nets[2].begin(), tet_lattice_size(m), nets[3].begin());
+        for (int k = m; k > 0; --k) tet_casteljau_step(k, v[0], nets[3].data());
+        child[tet_lattice_offset(n, a1, a2, a3)] = nets[3][0];
+      }
+    }
+  }
+}
+
 // The Bézier tables of a space with one factor (simplex only, or a single line coordinate).
 inline BezierFactor bezier_factor(JacobianSpace f) {
   add_lattice(f);
@@ -216,6 +282,13 @@ inline BezierFactor bezier_factor(JacobianSpace f) {
   };
   BezierFactor out;
   out.to_bezier = table_inverse(values_at([&](Index j) { return f.points[static_cast<std::size_t>(j)]; }));
+  if (f.simplex_dim == 3 && np > max_lattice_points) {
+    for (const auto& verts : simplex_children(3)) {
+      auto& bary = out.child_vertices.emplace_back();
+      for (std::size_t i = 0; i < 4; ++i) bary[i] = {1.0 - verts[i][0] - verts[i][1] - verts[i][2], verts[i][0], verts[i][1], verts[i][2]};
+    }
+    return out;
+  }
   for (const auto& child : make_children(f))
     out.child_bezier.push_back(
         table_product(out.to_bezier, values_at([&](Index j) { return map_child(child, f.points[static_cast<std::size_t>(j)]); })));
@@ -340,9 +413,5 @@ inline const JacobianSpace& jacobian_space(ElementType t) {
   return spaces.get(t, [](ElementType type) { return dimension(type) >= 2 ? make_jacobian_space(type) : JacobianSpace{}; });
 }
 
-// Most lattice points of a det J held on the stack (a tet84's, degree 15): every type but the
-// hexahedra past order 3, whose lattices (1,728 points at order 4, 13,824 at order 8) the
-// certificate keeps on the heap (quality/scaled_jacobian.hpp).
-inline constexpr int max_lattice_points = 816;
 
 }  // namespace meshmotion::detail
