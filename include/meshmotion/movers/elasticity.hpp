@@ -195,11 +195,12 @@ SparseMatrix ElasticityMover<Dim>::assemble_stiffness(const Mesh<Dim>& mesh, con
     const detail::QuadratureTable& table = detail::quadrature_table(block.type);
     const double measure = detail::reference_measure(block.type);
     const double factor = cell_factor.empty() ? 1.0 : cell_factor[static_cast<std::size_t>(block_start[static_cast<std::size_t>(b)] + e)];
-    detail::FemCoords<Dim> x;
+    thread_local detail::FemCoords<Dim> x;
     detail::gather_coords(mesh.points, block, e, x);
     const int n = table.num_nodes;
-    detail::ElementMatrix<Dim> k = detail::ElementMatrix<Dim>::Zero(n * Dim, n * Dim);
-    detail::ElementGradients<Dim> g;
+    thread_local detail::ElementMatrix<Dim> k;
+    k.setZero(n * Dim, n * Dim);
+    thread_local detail::ElementGradients<Dim> g;
     Eigen::Matrix<double, Dim, Dim> jacobian;
     for (int q = 0; q < table.size(); ++q) {
       const double det = std::abs(detail::element_geometry<Dim>(table, q, x, g, jacobian));

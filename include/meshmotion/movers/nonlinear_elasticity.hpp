@@ -213,12 +213,13 @@ class NonlinearElasticityMover : public detail::MoveFromMoveInto<NonlinearElasti
       const ElementBlock& block = mesh_.cells[static_cast<std::size_t>(b)];
       const detail::QuadratureTable& table = detail::quadrature_table(block.type);
       const int nn = table.num_nodes;
-      detail::FemCoords<Dim> x, ue;
-      detail::ElementGradients<Dim> g, m;
+      thread_local detail::FemCoords<Dim> x, ue;
+      thread_local detail::ElementGradients<Dim> g, m;
       Eigen::Matrix<double, Dim, Dim> jacobian;
       detail::gather_coords(mesh_.points, block, e, x);
       detail::gather_coords(u, block, e, ue);
-      detail::ElementMatrix<Dim> k = detail::ElementMatrix<Dim>::Zero(nn * Dim, nn * Dim);
+      thread_local detail::ElementMatrix<Dim> k;
+      k.setZero(nn * Dim, nn * Dim);
       for (int q = 0; q < table.size(); ++q) {
         const double c = std::abs(detail::element_geometry<Dim>(table, q, x, g, jacobian)) * table.weights[static_cast<std::size_t>(q)];
         const Eigen::Matrix<double, Dim, Dim> f = Eigen::Matrix<double, Dim, Dim>::Identity() + ue * g;

@@ -145,10 +145,6 @@ struct QuadraturePoint {
   return {};
 }
 
-/// Largest cell the finite-element movers assemble (prism40): the element matrix of 3 × 40
-/// dofs stays on the stack (Eigen's limit is 128 KiB); a hex64's would not.
-inline constexpr int max_cell_nodes = 40;
-
 /// Shape function values and reference gradients of one cell type at its default quadrature
 /// points: values[q * n + i] = N_i(ξ_q), gradients[q * n + i][d] = ∂N_i/∂ξ_d.
 struct QuadratureTable {
@@ -194,17 +190,21 @@ struct QuadratureTable {
   });
 }
 
-/// Node coordinates of one element: Dim × n (n ≤ 27), on the stack.
-template <int Dim>
-using FemCoords = Eigen::Matrix<double, Dim, Eigen::Dynamic, 0, Dim, max_cell_nodes>;
+// Per-cell storage on the heap, kept per thread by the assembly loops: cells of every order fit
+// (a hex729's element matrix is 2,187 square), where the stack held cells of up to 40 nodes
+// (Eigen's 128 KiB) and refused a hex64.
 
-/// Physical gradients of the shape functions at a quadrature point: n × Dim, on the stack.
+/// Node coordinates of one element: Dim × n.
 template <int Dim>
-using ElementGradients = Eigen::Matrix<double, Eigen::Dynamic, Dim, 0, max_cell_nodes, Dim>;
+using FemCoords = Eigen::Matrix<double, Dim, Eigen::Dynamic>;
 
-/// Element matrix with Dim dofs per node in node-major order (a * Dim + i), on the stack.
+/// Physical gradients of the shape functions at a quadrature point: n × Dim.
 template <int Dim>
-using ElementMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, Dim * max_cell_nodes, Dim * max_cell_nodes>;
+using ElementGradients = Eigen::Matrix<double, Eigen::Dynamic, Dim>;
+
+/// Element matrix with Dim dofs per node in node-major order (a * Dim + i).
+template <int Dim>
+using ElementMatrix = Eigen::MatrixXd;
 
 /// Geometry of an element at quadrature point q: the Jacobian J = ∂x/∂ξ (Dim × Dim), its
 /// determinant, and the physical gradients G = (∂N/∂ξ) J⁻¹ (n × Dim). Returns det J.
@@ -212,7 +212,8 @@ template <int Dim>
 double element_geometry(const QuadratureTable& table, int q, const FemCoords<Dim>& x, ElementGradients<Dim>& g,
                         Eigen::Matrix<double, Dim, Dim>& jacobian) {
   const int n = table.num_nodes;
-  ElementGradients<Dim> reference(n, Dim);
+  thread_local ElementGradients<Dim> reference;
+  reference.resize(n, Dim);
   for (int i = 0; i < n; ++i)
     for (int d = 0; d < Dim; ++d) reference(i, d) = table.gradients[static_cast<std::size_t>(q * n + i)][static_cast<std::size_t>(d)];
   jacobian.noalias() = x * reference;
@@ -363,10 +364,6 @@ template <int Dim, class CellFn>
 #else
   const std::size_t threads = 1;
 #endif
-  for (const auto& block : mesh.cells)
-    if (num_nodes(block.type) > max_cell_nodes)
-      throw InputError("the finite-element movers take cells of up to " + std::to_string(max_cell_nodes) + " nodes (got " +
-                       std::string(name(block.type)) + "); move the linear or P2 mesh and raise its order afterwards");
   const Index nodes = mesh.num_nodes();
   const Index c = nodes > 0 ? size / nodes : 1;
   std::vector<Index> start, neighbours;
