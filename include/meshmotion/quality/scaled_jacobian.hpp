@@ -12,8 +12,8 @@
 /// whose minimum (maximum) bounds det J from below (above); the domain is subdivided where
 /// the bound is further than `tolerance` from the sampled values. Types: every triangle,
 /// quadrilateral, tetrahedron, hexahedron and prism of the catalogue (core/element.hpp: to
-/// order 8, prisms to 3). Pyramids (rational maps) are sampled only: there
-/// `certified` is false and the "certified" bounds are the sampled extremes.
+/// order 8, prisms to 3). Pyramids (rational maps) are sampled only: there `certified` is
+/// false and the "certified" bounds are the sampled extremes.
 
 #include "meshmotion/core/element.hpp"
 #include "meshmotion/core/error.hpp"
@@ -73,8 +73,9 @@ namespace detail {
 template <int D>
 using ElementCoords = Eigen::Matrix<double, D, Eigen::Dynamic, 0, D, max_element_nodes>;
 // The lattice values of det J: on the stack up to a tet84's 816 points (every type but the
-// hexahedra past order 3 and the tetrahedra past order 6), on the heap beyond (a hex729's 13,824). Sized for the largest, the
-// stack frames of a P2 cell's certificate grew to 110 KiB and it ran 6 times slower.
+// hexahedra past order 3 and the tetrahedra past order 6), on the heap beyond (a hex729's
+// 13,824). Sized for the largest, the stack frames of a P2 cell's certificate grew to 110 KiB
+// and it ran 6 times slower.
 using LatticeVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_lattice_points, 1>;
 using LargeLatticeVector = Eigen::VectorXd;
 

@@ -40,9 +40,9 @@ struct BezierFactor {
   std::vector<Eigen::MatrixXd> child_bezier;  // Bézier coefficients of child c = child_bezier[c] × coefficients
   // Tetrahedra past a tet84's det J (degree 15, 816 coefficients) keep no child tables: they
   // would grow as the square of the coefficients (8 × 2,024² doubles at order 8, a quarter of a
-  // gigabyte, and minutes of products to form), where de Casteljau's algorithm gives a child
-  // from its parent in about the table's multiply-adds (tet_child_coefficients). The children's
-  // vertices instead, in the parent's barycentric coordinates.
+  // gigabyte, and 66 billion multiply-adds to form), where de Casteljau's algorithm gives a
+  // child from its parent in about the table's multiply-adds (tet_child_coefficients). The
+  // children's vertices instead, in the parent's barycentric coordinates.
   std::vector<std::array<std::array<double, 4>, 4>> child_vertices;
   [[nodiscard]] int num_children() const {
     return static_cast<int>(child_bezier.empty() ? child_vertices.size() : child_bezier.size());
@@ -215,7 +215,8 @@ inline void add_lattice(JacobianSpace& s) {
 
 // Most lattice points of a det J held on the stack (a tet84's, degree 15): every type but the
 // hexahedra past order 3 and the tetrahedra past order 6, whose lattices (1,728 points at a
-// hex125, 13,824 at a hex729, 2,024 at a tet165) the certificate keeps on the heap (quality/scaled_jacobian.hpp).
+// hex125, 13,824 at a hex729, 2,024 at a tet165) the certificate keeps on the heap
+// (quality/scaled_jacobian.hpp).
 inline constexpr int max_lattice_points = 816;
 
 // Points of a tetrahedral lattice of degree m.
@@ -412,6 +413,5 @@ inline const JacobianSpace& jacobian_space(ElementType t) {
   static PerTypeCache<JacobianSpace> spaces;
   return spaces.get(t, [](ElementType type) { return dimension(type) >= 2 ? make_jacobian_space(type) : JacobianSpace{}; });
 }
-
 
 }  // namespace meshmotion::detail
