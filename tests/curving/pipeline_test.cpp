@@ -50,6 +50,19 @@ double o_mesh_layer_thickness(const OMeshOptions& o, double threshold) {
 
 const std::vector<std::string> wall_group{"wall"};
 
+// The graph z = a sin(πx) sin(πy) over the unit square, with its derivatives.
+auto sine_bump(double a) {
+  return [a](double x, double y) {
+    const double p = std::numbers::pi;
+    GraphSample2 g;
+    g.value = a * std::sin(p * x) * std::sin(p * y);
+    g.gradient << a * p * std::cos(p * x) * std::sin(p * y), a * p * std::sin(p * x) * std::cos(p * y);
+    g.hessian << -p * p * g.value, a * p * p * std::cos(p * x) * std::cos(p * y), a * p * p * std::cos(p * x) * std::cos(p * y),
+        -p * p * g.value;
+    return g;
+  };
+}
+
 }  // namespace
 
 TEST_CASE("boundary layer: thickness of a generated O-mesh layer is the one built", "[curving]") {
@@ -589,15 +602,7 @@ TEST_CASE("pipeline: every element type and mixed meshes curve onto a graph", "[
     for (const Index v : curved.curved.group_nodes("bottom"))
       CHECK(std::abs(curved.curved.points(1, v) - wave(curved.curved.points(0, v)).value) < 1e-12);
   }
-  const auto bump = [](double x, double y) {
-    const double p = std::numbers::pi;
-    GraphSample2 g;
-    g.value = 0.02 * std::sin(p * x) * std::sin(p * y);
-    g.gradient << 0.02 * p * std::cos(p * x) * std::sin(p * y), 0.02 * p * std::sin(p * x) * std::cos(p * y);
-    g.hessian << -p * p * g.value, 0.02 * p * p * std::cos(p * x) * std::cos(p * y),
-        0.02 * p * p * std::cos(p * x) * std::cos(p * y), -p * p * g.value;
-    return g;
-  };
+  const auto bump = sine_bump(0.02);
   for (const auto cells : {BoxCells::hex8, BoxCells::tet4, BoxCells::prism6, BoxCells::pyramid5, BoxCells::hex_prism,
                            BoxCells::tet_pyramid_prism}) {
     const Mesh<3> linear = box_mesh({3, 3, 3, 0.0, 1.0, 0.0, 1.0, 0.0, 1.0, cells});
@@ -617,15 +622,7 @@ TEST_CASE("pipeline: every element type and mixed meshes curve onto a graph", "[
 TEST_CASE("pipeline: tetrahedra curve onto a graph at orders 7 and 8, hexahedra at order 4, certified", "[curving]") {
   // The orders whose det J the certificate subdivides without tables (tetrahedra) and the
   // untangling holds past the stack's lattice (a tet165's 2,024 points, a hex125's 1,728).
-  const auto bump = [](double x, double y) {
-    const double p = std::numbers::pi;
-    GraphSample2 g;
-    g.value = 0.03 * std::sin(p * x) * std::sin(p * y);
-    g.gradient << 0.03 * p * std::cos(p * x) * std::sin(p * y), 0.03 * p * std::sin(p * x) * std::cos(p * y);
-    g.hessian << -p * p * g.value, 0.03 * p * p * std::cos(p * x) * std::cos(p * y),
-        0.03 * p * p * std::cos(p * x) * std::cos(p * y), -p * p * g.value;
-    return g;
-  };
+  const auto bump = sine_bump(0.03);
   // One cube of tetrahedra (a second of cells at order 8, with 3 s for the tables' first use),
   // eight hexahedra.
   struct Case {
