@@ -21,7 +21,17 @@ ResolvedBoundary<3> resolved_boundary(const std::vector<long>& points, const std
                       : role == PointRole::held     ? BoundaryKind::fixed
                                                     : BoundaryKind::sliding);
     if (role == PointRole::sliding_plane) b.normals.col(k) = along.col(k);
-    if (role == PointRole::sliding_line) b.directions.col(k) = along.col(k);
+    if (role == PointRole::sliding_line) {
+      // A line's node keeps a plane's normal too (ResolvedBoundary): any unit vector across the
+      // line, from the axis least along it. Without one, every edge where two slip sides meet
+      // stopped the run at setup.
+      const Vec<3> t = along.col(k);
+      Index axis = 0;
+      t.cwiseAbs().minCoeff(&axis);
+      const Vec<3> across = Vec<3>::Unit(axis) - t(axis) * t;
+      b.directions.col(k) = t;
+      b.normals.col(k) = across.normalized();
+    }
   }
   return b;
 }

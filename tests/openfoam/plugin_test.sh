@@ -9,7 +9,8 @@
 # ranks; stiffened elasticity through the cube's hexahedra and through the polyhedra of its
 # dual mesh; a sphere cut out of a box by snappyHexMesh, translated and swung, serially and on
 # 2 ranks; stiffened elasticity through hexahedra and polyhedra on 2 ranks as serial; the
-# front as fixedNormalSlip and as surfaceSlipDisplacement kept in its plane, a point patch field
+# front as fixedNormalSlip and as surfaceSlipDisplacement kept in its plane, a box's four
+# fixedNormalSlip sides in their planes and their edges' points along the edges, a point patch field
 # type the plugin does not know refused naming the patch, the options read from
 # dynamicMeshDict's top level without meshmotionCoeffs, each step's time and memory logged; an
 # unknown option refused with its name, and a method through the cells that has no distributed
@@ -302,6 +303,43 @@ grep -q angularOscillating 0/pointDisplacement || { echo "FAIL: the swing was no
 move "method rbf;" "rbf set up on"
 sphere_check swing
 parallel_equals_serial moveDynamicMesh
+# A box whose four sides are fixedNormalSlip, each its own patch, under a rising lid: the points
+# of each side stay in its plane, and those on an edge where two sides meet move along it only
+# (such a point has two planes: it slides on their line; the bridge once gave it no normal and
+# the run stopped at setup).
+make_case "$work/sides" "(0 0 0) (1 0 0) (1 1 0) (0 1 0) (0 0 1) (1 0 1) (1 1 1) (0 1 1)" "(8 8 8)" \
+  "lid { type wall; faces ((4 5 6 7)); }
+   floor { type wall; faces ((0 3 2 1)); }
+   west { type wall; faces ((0 4 7 3)); }
+   east { type wall; faces ((1 2 6 5)); }
+   south { type wall; faces ((0 1 5 4)); }
+   north { type wall; faces ((3 7 6 2)); }" \
+  "lid { type uniformFixedValue; uniformValue table ((0 (0 0 0)) (4 (0 0 0.2))); }
+   floor { type fixedValue; value uniform (0 0 0); }
+   west { type fixedNormalSlip; n (-1 0 0); value uniform (0 0 0); }
+   east { type fixedNormalSlip; n (1 0 0); value uniform (0 0 0); }
+   south { type fixedNormalSlip; n (0 -1 0); value uniform (0 0 0); }
+   north { type fixedNormalSlip; n (0 1 0); value uniform (0 0 0); }"
+for method in rbf sle; do
+  rm -rf 1 2 3 4
+  move "method $method;" "$method set up on"
+  /usr/bin/python3 - <<'EOD'
+import re
+def points(path):
+    return [tuple(map(float, p)) for p in re.findall(r"\(([-0-9.e+]+) ([-0-9.e+]+) ([-0-9.e+]+)\)", open(path).read())]
+p0 = points("constant/polyMesh/points")
+off = moved = 0.0
+for t in (1, 2, 3, 4):
+    for a, b in zip(p0, points(f"{t}/polyMesh/points")):
+        for k in (0, 1):  # a side's points keep their x (west, east) or y (south, north)
+            if a[k] < 1e-12 or a[k] > 1 - 1e-12:
+                off = max(off, abs(b[k] - a[k]))
+        if 1e-12 < a[2] < 1 - 1e-12 and (a[0] < 1e-12 or a[0] > 1 - 1e-12) and (a[1] < 1e-12 or a[1] > 1 - 1e-12):
+            moved = max(moved, abs(b[2] - a[2]))  # an edge between two sides: along it
+print(f"sides' points off their planes: {off:.3g}; edges' points moved along them up to {moved:.3g}")
+assert off < 1e-12 and moved > 0.01, (off, moved)
+EOD
+done
 # A 2D case (one cell thick, front and back `empty`) whose bottom wall turns by
 # angularOscillatingDisplacement: the bottom's points where the rotation puts them, the mesh
 # still 2D with front and back moved alike, only the walls' points as the mover's boundary.
