@@ -649,3 +649,18 @@ def test_curve_mesh_keywords_and_report_come_from_one_description():
     assert report["layers"] and set(report["layers"][0]) >= {"group", "thickness"}
     with pytest.raises(ValueError, match="unknown report"):
         mm.report_fields("nothing")
+
+
+def test_two_level_rbf_from_python_interpolates_with_exact_gradients():
+    # levels="two": a coarse subset of the boundary carries the radius, every boundary node
+    # what it leaves (docs/interpolation.md); the default for a boundary of more than
+    # two_level_centres nodes.
+    mesh = grid(40, 30)
+    w = mm.Warp(mesh, design=["bottom"], fixed=["top"], levels="two")
+    assert w.verify_derivative(verbose=False) < 1e-6
+    assert 0 < w._mover.stats["coarse_centres"] < 82 / 2  # of the bottom's and the top's 82 nodes
+    automatic = mm.Warp(mesh, design=["bottom"], fixed=["top"], two_level_centres=50)
+    assert automatic.verify_derivative(verbose=False) < 1e-6
+    assert automatic._mover.stats["coarse_centres"] == w._mover.stats["coarse_centres"]
+    with pytest.raises(mm.InputError, match="levels=two.*polynomial"):
+        mm.Warp(mesh, design=["bottom"], fixed=["top"], levels="two", polynomial=True)

@@ -664,3 +664,52 @@ TEST_CASE("distributed RBF set up at rest blends each move's rigid part as the s
     }
   }
 }
+
+TEST_CASE("distributed RBF on two levels: the serial mover's levels, moves and gradients", "[parallel][rbf]") {
+  // A terrain under a held lid, the sides sliding: set up at rest on both, the bottom raised
+  // step by step. Above two_level_centres boundary nodes with the default radius, both take two
+  // levels (the coarse nodes chosen from the gathered boundary in the serial order).
+  const Mesh<3> mesh = box_mesh({.nx = 10, .ny = 10, .nz = 8});
+  BoundarySpec<3> spec;
+  spec.prescribed("bottom").fixed("top").sliding("left").sliding("right").sliding("front").sliding("back");
+  const ResolvedBoundary<3> b = spec.resolve(mesh);
+  const auto hills = [&](double height) {
+    Points<3> d = Points<3>::Zero(3, b.size());
+    for (Index k = 0; k < b.size(); ++k) {
+      const meshmotion::Vec<3> x = mesh.points.col(b.nodes[static_cast<std::size_t>(k)]);
+      if (b.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed)
+        d(2, k) = height * std::exp(-((x(0) - 0.4) * (x(0) - 0.4) + (x(1) - 0.5) * (x(1) - 0.5)) / 0.04);
+    }
+    return d;
+  };
+  RbfOptions options;
+  options.two_level_centres = 200;
+  RbfMover<3> serial(options);
+  serial.setup(mesh, b);
+  const DistributedMesh<3> part = partition_mesh(world(), mesh);
+  const ResolvedBoundary<3> local_b = distribute_boundary(part, b);
+  DistributedRbfMover<3> mover(options);
+  mover.setup(part.view(), local_b);
+  CHECK_FALSE(mover.petsc_solve());
+  for (const double height : {0.02, 0.1, 0.25, 0.1, 0.4}) {
+    CAPTURE(height);
+    const Points<3> d = hills(height);
+    const Points<3> expected = serial.move(d);
+    const Points<3> got = mover.move(local_values(part, b, local_b, d));
+    REQUIRE(serial.coarse_centres() > 0);
+    CHECK(mover.support_radius() == serial.support_radius());
+    CHECK(mover.stats().radius_growths == serial.stats().radius_growths);
+    CHECK(largest_gap(part, got, expected) <= 1e-10 * expected.colwise().norm().maxCoeff());
+  }
+  CHECK(serial.stats().radius_growths >= 1);
+  // levels=two asked for, a radius given: the reverse derivative too.
+  RbfOptions two;
+  two.levels = RbfLevels::two;
+  two.support_radius = 0.8;
+  ResolvedBoundary<3> raised = b;
+  raised.displacements = hills(0.2);
+  const Outcome r = compare_with_serial(mesh, raised, two);
+  INFO("move " << r.error << ", gradient " << r.gradient << ", rounding " << r.gradient_rounding);
+  CHECK(r.error <= 1e-12);
+  CHECK(r.gradient <= std::max(1e-12, 10.0 * r.gradient_rounding));
+}

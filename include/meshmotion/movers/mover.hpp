@@ -40,6 +40,8 @@ struct MoverStats {
   /// RBF: times a move outgrew the default radius and set the mover up again since the setup
   /// the caller made (radius_outgrown()); `moves` counts on through them.
   Index radius_growths = 0;
+  /// RBF: centres of the coarse level of a two-level interpolation (RbfOptions::levels; 0: one level).
+  Index coarse_centres = 0;
 };
 
 template <class F>
@@ -60,6 +62,7 @@ void visit_fields(const MoverStats& s, F&& f) {
   f("support_radius", s.support_radius, "RBF: the support radius of the last setup, given or the default (0: none)");
   f("radius_reduced", s.radius_reduced, "RBF: the default radius was reduced to fit the memory budget");
   f("radius_growths", s.radius_growths, "RBF: moves that outgrew the default radius and set the mover up again");
+  f("coarse_centres", s.coarse_centres, "RBF: centres of the coarse level of a two-level interpolation (0: one level)");
 }
 
 /// A mesh mover in Dim = M::dim dimensions.

@@ -40,6 +40,10 @@
 /// - Boundaries too large for one factorization (RbfOptions::partition_of_unity): local
 ///   systems on overlapping patches of centres, blended by a partition of unity
 ///   (detail/rbf_partition_of_unity.hpp); still interpolating, linear, with derivatives.
+/// - A radius wider than the boundary's spacing on a large boundary (RbfOptions::levels):
+///   a coarse subset of the centres carries it and every centre, at ten boundary spacings,
+///   what the coarse level leaves (detail/rbf_two_level.hpp), so that neither the memory nor
+///   a move's cost grows with the motion; still interpolating, linear, with derivatives.
 
 #include "meshmotion/movers/rbf_options.hpp"
 #include "meshmotion/core/error.hpp"
@@ -53,6 +57,7 @@
 #include "meshmotion/movers/detail/mover_support.hpp"
 #include "meshmotion/movers/detail/rbf_partition_of_unity.hpp"
 #include "meshmotion/movers/detail/rbf_system.hpp"
+#include "meshmotion/movers/detail/rbf_two_level.hpp"
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
 #include "meshmotion/movers/rigid_part.hpp"
@@ -312,6 +317,9 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   [[nodiscard]] const Points<Dim>& rigid_part_displacement() const noexcept { return rigid_; }
   /// Patches of the partition of unity after setup (0: one global system).
   [[nodiscard]] Index patches() const noexcept { return patched_all_ ? patched_all_->num_patches() : 0; }
+  /// Centres of the coarse level of a two-level interpolation (RbfOptions::levels; 0: one
+  /// level), as the last move or derivative built it.
+  [[nodiscard]] Index coarse_centres() const noexcept { return two_all_ ? two_all_->num_coarse() : 0; }
 
   /// Reference-configuration work (see the file comment). `mesh`: any MeshLike of dimension
   /// Dim; `boundary`: nodes and kinds (its displacements are not used here).
@@ -374,14 +382,23 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   /// comment); the rigid part, when setup took one out, stays.
   void follow_motion(PointsView<Dim> d);
 
-  /// f(the system over every centre), global or patched; likewise over the constrained ones.
+  /// f(the system over every centre), global, patched or two-level; likewise over the
+  /// constrained ones.
   template <class F>
   decltype(auto) with_all(F&& f) {
-    return patched_all_ ? f(*patched_all_) : f(all_);
+    return patched_all_ ? f(*patched_all_) : two_all_ ? f(*two_all_) : f(all_);
   }
   template <class F>
   decltype(auto) with_constrained(F&& f) {
-    return patched_constrained_ ? f(*patched_constrained_) : f(constrained_);
+    return patched_constrained_ ? f(*patched_constrained_) : two_constrained_ ? f(*two_constrained_) : f(constrained_);
+  }
+  /// Whether the interpolation at `kernel` over `centres` takes two levels
+  /// (RbfOptions::levels); fine_radius_ is then the fine level's, chosen at the first.
+  [[nodiscard]] bool two_levels(const Points<Dim>& centres, const detail::RbfKernelSettings& kernel) {
+    if (!two_level_interpolation(options_, default_radius_, boundary_.size()) || centres.cols() < 2) return false;
+    if (fine_radius_ == 0.0)
+      fine_radius_ = std::min(kernel.radius, suggest_support_radius(centres, 0.0, SupportRadiusOptions{0.0, options_.fine_spacings}));
+    return true;
   }
 
   void require_ready(const char* where) const {
@@ -604,6 +621,11 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   detail::RbfSystem<Dim> constrained_;      ///< over constrained centres (sliding boundaries only)
   /// Partition of unity: replace all_ and constrained_ (the coefficients are then the patches')
   std::unique_ptr<detail::PartitionOfUnityRbf<Dim>> patched_all_, patched_constrained_;
+  /// Two levels: replace all_ and constrained_ (coefficients: the coarse level's, then every
+  /// centre's); their fine levels stay through a set up again for a grown radius.
+  std::unique_ptr<detail::TwoLevelRbf<Dim>> two_all_, two_constrained_;
+  double fine_radius_ = 0.0;  ///< the fine level's radius (0: not yet chosen)
+  bool default_radius_ = false;  ///< no radius given: the last setup took the default
   std::vector<Index> sliding_rows_;         ///< sliding centres
   Operator sliding_operator_;               ///< sliding centres × constrained centres
   std::vector<Index> interior_;             ///< non-boundary nodes
@@ -634,6 +656,9 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
   radius_reduced_ = false;
   rigid_.resize(Dim, 0);
   at_move_ = {};
+  two_all_.reset();
+  two_constrained_.reset();
+  fine_radius_ = 0.0;
   if (!points.allFinite()) throw InputError("RbfMover::setup: mesh has a non-finite coordinate");
   detail::check_boundary<Dim>("RbfMover::setup", boundary, points.cols(), false);
   // Set up before anything moves (a solver's time loop): the rigid part is each move's.
@@ -651,6 +676,7 @@ void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<D
     check_support_radius_memory(points, boundary, radius_, options_);
   }
   grows_ = fitted && !fitted->reduced;
+  default_radius_ = fitted.has_value();
   points_ = std::move(points);
   boundary_ = boundary;
   stats_ = MoverStats{};
@@ -732,7 +758,11 @@ void RbfMover<Dim>::build_interpolation() {
                           (n_centres_ > n_constrained_ ? with_constrained([](auto& system) { return system.report().factorizations; }) : 0);
   stats_.condition = std::max(with_all([](auto& system) { return system.condition(); }),
                               n_centres_ > n_constrained_ ? with_constrained([](auto& system) { return system.condition(); }) : 0.0);
-  if (!patched_all_) stats_.thinned_centres = all_.thinned() + (n_centres_ > n_constrained_ ? constrained_.thinned() : 0);
+  if (two_all_)
+    stats_.thinned_centres = two_all_->thinned() + (two_constrained_ ? two_constrained_->thinned() : 0);
+  else if (!patched_all_)
+    stats_.thinned_centres = all_.thinned() + (n_centres_ > n_constrained_ ? constrained_.thinned() : 0);
+  stats_.coarse_centres = coarse_centres();
 }
 
 template <int Dim>
@@ -752,6 +782,16 @@ void RbfMover<Dim>::check_options(const ResolvedBoundary<Dim>& boundary) {
         throw InputError("RbfMover::setup: support radius of boundary entry " + std::to_string(b) + " (node " +
                          std::to_string(boundary.nodes[b]) + ") must be positive (got " +
                          std::to_string(options_.support_radii[b]) + ")");
+  }
+  if (options_.levels == RbfLevels::two) {
+    const char* why = !is_compact(options_.kernel)      ? "a global kernel"
+                      : !options_.support_radii.empty() ? "support_radii"
+                      : options_.polynomial             ? "polynomial"
+                      : options_.partition_of_unity     ? "partition_of_unity"
+                                                        : nullptr;
+    if (why != nullptr)
+      throw InputError(std::string("RbfMover::setup: levels=two needs a compact kernel with one radius, no polynomial and no "
+                                   "partition of unity (got ") + why + ")");
   }
   if (!options_.partition_of_unity) return;
   const auto refuse = [](const std::string& why) { throw InputError("RbfMover::setup: partition_of_unity " + why); };
@@ -820,9 +860,21 @@ void RbfMover<Dim>::factorize(const Points<Dim>& centres, const detail::RbfKerne
     system->setup(at, settings, options_.patch_centres, options_.patch_overlap, options_.solver);
     return system;
   };
+  const bool two = two_levels(centres, kernel);
+  // The fine level is the same system through every set up again for a grown radius.
+  const auto leveled = [&](std::unique_ptr<detail::TwoLevelRbf<Dim>>& system, const Points<Dim>& at) {
+    if (!system) {
+      system = std::make_unique<detail::TwoLevelRbf<Dim>>();
+      system->setup_fine(at, detail::RbfKernelSettings{kernel.kernel, fine_radius_, false}, options_.coarse_centres, options_.solver,
+                         options_.condition_limit);
+    }
+    system->set_coarse(kernel, options_.solver, options_.condition_limit);
+  };
   if (options_.partition_of_unity) {
     all_ = detail::RbfSystem<Dim>{};
     patched_all_ = patched(centres, kernel);
+  } else if (two) {
+    leveled(two_all_, centres);
   } else {
     all_.setup(centres, kernel, options_.solver, options_.dense_solver, options_.max_dense_centres, options_.condition_limit);
   }
@@ -834,6 +886,9 @@ void RbfMover<Dim>::factorize(const Points<Dim>& centres, const detail::RbfKerne
   if (options_.partition_of_unity) {
     patched_constrained_ = patched(constrained_centres, kernel.leading(n_constrained_));
     sliding_operator_ = patched_constrained_->evaluation_rows(centres, sliding_rows_);
+  } else if (two) {
+    leveled(two_constrained_, constrained_centres);
+    sliding_operator_ = two_constrained_->evaluation_rows(centres, sliding_rows_);
   } else {
     constrained_.setup(constrained_centres, kernel.leading(n_constrained_), options_.solver, options_.dense_solver,
                        options_.max_dense_centres, options_.condition_limit);
@@ -853,13 +908,15 @@ void RbfMover<Dim>::build_evaluation() {
   for (Index i = 0; i < n; ++i)
     if (!is_boundary[static_cast<std::size_t>(i)]) interior_.push_back(i);
   evaluated_.clear();
+  // A set up again for a grown radius builds the next operator: the last one goes first.
+  operator_ = Operator{};
   dense_operator_.resize(0, 0);
   const bool fits = !interior_.empty() && static_cast<double>(interior_.size()) * static_cast<double>(k) * sizeof(double) <=
                                               static_cast<double>(options_.max_evaluation_cache_bytes);
   // A compact support that reaches most centres from most nodes (a radius far larger than the
   // moving body, as rotations want) makes the sparse operator a full one stored with indices:
   // building it dense is several times cheaper and so is every move.
-  const bool dense = !patched_all_ && fits && (!is_compact(options_.kernel) || covered_fraction() > 0.5);
+  const bool dense = !patched_all_ && !two_all_ && fits && (!is_compact(options_.kernel) || covered_fraction() > 0.5);
   const auto keep_rows = [&](Operator rows, const std::vector<Index>& kept) {
     operator_ = std::move(rows);
     evaluated_.reserve(kept.size());
@@ -869,6 +926,8 @@ void RbfMover<Dim>::build_evaluation() {
   std::vector<Index> kept;
   if (patched_all_) {
     keep_rows(patched_all_->evaluation_rows(points_, interior_, &kept), kept);
+  } else if (two_all_) {
+    keep_rows(two_all_->evaluation_rows(points_, interior_, &kept), kept);
   } else if (is_compact(options_.kernel) && !dense) {
     // Only rows with weights are kept, so skipped nodes cost nothing per move.
     // The system's radii, which thinning may have changed from the ones asked for.

@@ -46,6 +46,31 @@ enum class RigidPart {
   return {RigidPart::automatic, RigidPart::blend, RigidPart::none};
 }
 
+/// How an RBF mover carries a support radius wider than its boundary's spacing
+/// (detail/rbf_two_level.hpp).
+enum class RbfLevels {
+  /// two levels for the default radius (none given) when the boundary has more than
+  /// RbfOptions::two_level_centres nodes, for a compact kernel with no polynomial and no
+  /// partition of unity; one otherwise
+  automatic,
+  one,  ///< one system over every centre at the radius
+  /// a coarse subset of the centres at the radius, every centre at RbfOptions::fine_spacings
+  /// boundary spacings (compact kernels with one radius, no polynomial, no partition of unity)
+  two,
+};
+
+[[nodiscard]] constexpr std::string_view name(RbfLevels l) {
+  switch (l) {
+    case RbfLevels::automatic: return "automatic";
+    case RbfLevels::one: return "one";
+    case RbfLevels::two: return "two";
+  }
+  return "unknown";
+}
+[[nodiscard]] constexpr std::array<RbfLevels, 3> option_choices(RbfLevels) {
+  return {RbfLevels::automatic, RbfLevels::one, RbfLevels::two};
+}
+
 /// Options of RbfMover.
 struct RbfOptions {
   RbfKernel kernel = RbfKernel::wendland2;
@@ -64,6 +89,10 @@ struct RbfOptions {
   double max_memory_bytes = 0.0;
   RigidPart rigid_part = RigidPart::automatic;
   double condition_limit = 1e10;
+  RbfLevels levels = RbfLevels::automatic;
+  Index two_level_centres = 2000;
+  Index coarse_centres = 1000;
+  double fine_spacings = 4.0;
 };
 
 // visit_options(o, f) calls f(key, field, help) for every field of `o` that text may set.
@@ -129,6 +158,27 @@ void visit_options(RbfOptions& o, F&& f, const std::string& prefix = {}) {
       "(detail::RbfSystem::setup). Rounding in a move or a derivative grows by up to the condition: 1e10 "
       "keeps derivatives to about 1e-6 relative. 0 never thins. MoverStats::thinned_centres says how many "
       "were."});
+  f(prefix + "levels", o.levels, OptionHelp{"carry the radius on a coarse subset of the centres, the rest on a few boundary spacings", {},
+      "How the interpolation carries its support radius (detail/rbf_two_level.hpp). one: one system "
+      "over every centre, which a large motion's radius (5 x its size) makes nearly dense: its memory "
+      "and its cost a move grow with the motion. two: centres at least half the fine radius apart (at "
+      "most coarse_centres of them) carry the radius, and every centre, at the fine radius "
+      "(fine_spacings boundary spacings, at most the radius), what they leave; still interpolating and "
+      "linear, with the same reach. automatic (default): two for the default radius on a boundary of "
+      "more than two_level_centres nodes (compact kernel, no polynomial, no partition of unity); one "
+      "otherwise, and always for a radius given."});
+  f(prefix + "two_level_centres", o.two_level_centres, OptionHelp{"levels=automatic: most boundary nodes carried by one level", range::at_least(1)});
+  f(prefix + "coarse_centres", o.coarse_centres, OptionHelp{"two levels: most centres of the coarse level", range::at_least(1)});
+  f(prefix + "fine_spacings", o.fine_spacings, OptionHelp{"two levels: the fine level's radius, x the median boundary spacing", range::positive});
+}
+
+/// Whether an RBF mover with options `o` (effective_options()) interpolates on two levels
+/// (RbfOptions::levels), for a boundary of `entries` nodes whose radius is the default one
+/// (`default_radius`: none given). The serial and the distributed movers decide by it alike.
+[[nodiscard]] inline bool two_level_interpolation(const RbfOptions& o, bool default_radius, Index entries) {
+  if (o.levels == RbfLevels::one || !is_compact(o.kernel) || !o.support_radii.empty() || o.polynomial || o.partition_of_unity)
+    return false;
+  return o.levels == RbfLevels::two || (default_radius && entries > o.two_level_centres);
 }
 
 }  // namespace meshmotion

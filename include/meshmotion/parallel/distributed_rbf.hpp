@@ -177,7 +177,8 @@ class DistributedRbfMover {
                                                      Points<Dim>& points, std::vector<double>& radii) const;
   /// Whether the boundary system goes through PETSc (BoundarySolveOptions); throws on every
   /// rank when PETSc is demanded and cannot take it.
-  [[nodiscard]] bool choose_petsc(const GatheredBoundary& gathered, const Points<Dim>& centres) const;
+  /// Two levels (`two_levels`) are replicated unless PETSc is demanded.
+  [[nodiscard]] bool choose_petsc(const GatheredBoundary& gathered, const Points<Dim>& centres, bool two_levels) const;
   /// Collective: the serial mover's default radius for the whole mesh (`centres`: the
   /// gathered boundary in global id order).
   [[nodiscard]] DefaultSupportRadius default_radius(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary,
@@ -400,10 +401,13 @@ void DistributedRbfMover<Dim>::set_up(const ResolvedBoundary<Dim>& boundary, boo
     radius_reduced_ = fitted.reduced;
   }
   gathered_.resize(Dim, m);
-  petsc_ = choose_petsc(gathered, points.leftCols(m));
+  // The serial mover's levels: the inner one is given the radius, which it would keep on one.
+  const bool two = two_level_interpolation(options_, options_.support_radius == 0.0 && !gathered.radius_per_entry, m);
+  petsc_ = choose_petsc(gathered, points.leftCols(m), two);
   if (!petsc_) {
     system_.reset();
     RbfOptions options = options_;
+    options.levels = two ? RbfLevels::two : RbfLevels::one;
     options.support_radius = radius_;
     options.support_radii = std::move(radii);
     options.rigid_part = RigidPart::none;  // as the PETSc and patches solves: the whole motion interpolated
@@ -551,7 +555,7 @@ ResolvedBoundary<Dim> DistributedRbfMover<Dim>::inner_boundary(const PartitionVi
 }
 
 template <int Dim>
-bool DistributedRbfMover<Dim>::choose_petsc(const GatheredBoundary& gathered, const Points<Dim>& centres) const {
+bool DistributedRbfMover<Dim>::choose_petsc(const GatheredBoundary& gathered, const Points<Dim>& centres, bool two_levels) const {
   // Every rank decides alike: the inputs are the gathered arrays. The obstacles (a k-d tree
   // over the centres among them) are looked for only when PETSc is wanted.
   const Index m = centres.cols();
@@ -559,7 +563,7 @@ bool DistributedRbfMover<Dim>::choose_petsc(const GatheredBoundary& gathered, co
   const int rounds = (sharing + cores_of_node() - 1) / cores_of_node();
   const bool crowded = size_of(comm_) > 1 && m * sharing * rounds >= solve_.petsc_min_node_centres;
   const bool wanted = solve_.boundary_solve == BoundarySolve::petsc ||
-                      (solve_.boundary_solve == BoundarySolve::automatic && (m >= solve_.petsc_min_centres || crowded));
+                      (solve_.boundary_solve == BoundarySolve::automatic && !two_levels && (m >= solve_.petsc_min_centres || crowded));
   const std::string obstacle = wanted ? petsc_obstacle(gathered.kinds, gathered.radius_per_entry, centres) : std::string();
   if (solve_.boundary_solve == BoundarySolve::petsc && !obstacle.empty())
     throw InputError("DistributedRbfMover::setup: the boundary system cannot go through PETSc: " + obstacle +
