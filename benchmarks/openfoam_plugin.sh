@@ -14,9 +14,13 @@
 # run's wall time (setups included), its peak memory, the last step's non-orthogonality and
 # whether every step passed the check, with both ratios over displacementLaplacian's
 # ({"bench": "openfoam_plugin_large", ..., "wall_seconds", "wall_ratio", "memory_ratio"}).
-# The defaults then run the same case decomposed in two (decomposePar, simple 2 1 1) under
-# mpirun with -parallel: the whole run's wall time against the serial run's, the largest rank's
-# memory, and the largest distance of the reconstructed points from the serial ones
+# The same for a deforming boundary (terrain_72k): a 60 x 40 x 30 box of 72,000 hexahedra (6 x 4
+# x 3 km at map coordinates of order 1e6 m) whose flat bottom is raised onto hills of up to
+# 440 m over 20 steps (timeVaryingMappedFixedValue, linear in time), its top held and its four
+# sides fixedNormalSlip; the Laplacian's diffusivity is quadratic inverseDistance from the
+# bottom. Every large case's defaults then run decomposed in two (decomposePar, simple 2 1 1)
+# under mpirun with -parallel: the whole run's wall time against the serial run's, the largest
+# rank's memory, and the largest distance of the reconstructed points from the serial ones
 # (mesh_info --compare; {"bench": "openfoam_plugin_large", "ranks": 2, ...,
 # "largest_difference_from_serial", "wall_ratio_to_serial"}).
 #
@@ -57,8 +61,12 @@ CASES = {
                     cells=[(8, 12, 8), (8, 4, 8), (8, 6, 8)]),
 }
 # The cost case: block3d's blocks, 79,080 cells.
-LARGE = {"block3d_79k": dict(breaks=CASES["block3d"]["breaks"], cells=[(15, 22, 15), (15, 8, 15), (15, 11, 15)])}
+BLOCK_79K = dict(breaks=CASES["block3d"]["breaks"], cells=[(15, 22, 15), (15, 8, 15), (15, 11, 15)])
 LARGE_STEPS = 20
+# The deforming case: a box over terrain, at map coordinates.
+TERRAIN_ORIGIN = (452000.0, 5213000.0)
+TERRAIN_CELLS = (60, 40, 30)
+TERRAIN_SIZE = (6000.0, 4000.0, 3000.0)
 SOLVERS = [
     ("meshmotion", "(defaults)", "motionSolverLibs (\"libfvMotionSolvers.so\" \"%s\");\nmotionSolver meshmotion;\nmeshmotionCoeffs { }\n" % lib),
     ("meshmotion", "method sle", "motionSolverLibs (\"libfvMotionSolvers.so\" \"%s\");\nmotionSolver meshmotion;\nmeshmotionCoeffs { method sle; }\n" % lib),
@@ -117,6 +125,20 @@ def write_case(case, spec, angle, solver, steps=STEPS):
     two_d = block_mesh(case, spec)
     os.makedirs(f"{case}/constant", exist_ok=True)
     os.makedirs(f"{case}/0", exist_ok=True)
+    write_controls(case, solver, steps)
+    omega = math.pi / 2 / steps  # the angle reaches its amplitude at the last step
+    empty = "frontAndBack { type empty; }" if two_d else ""
+    with open(f"{case}/0/pointDisplacement", "w") as out:
+        out.write("FoamFile { version 2.0; format ascii; class pointVectorField; object pointDisplacement; }\n"
+                  "dimensions [0 1 0 0 0 0 0]; internalField uniform (0 0 0);\nboundaryField {\n"
+                  f"body {{ type angularOscillatingDisplacement; axis (0 0 1); origin (0 0 0); angle0 0;"
+                  f" amplitude {math.radians(angle)}; omega {omega}; value uniform (0 0 0); }}\n"
+                  f"outer {{ type fixedValue; value uniform (0 0 0); }}\n{empty}\n}}\n")
+    block_mesh_run(case)
+
+
+def write_controls(case, solver, steps):
+    """controlDict, fvSchemes, fvSolution and dynamicMeshDict (`solver`) of a case of `steps` steps."""
     with open(f"{case}/system/controlDict", "w") as out:
         out.write(HEADER % "controlDict" + f"application moveDynamicMesh; startFrom startTime; startTime 0; stopAt endTime;"
                   f" endTime {steps}; deltaT 1; writeControl timeStep; writeInterval {steps}; writeFormat binary;"
@@ -130,17 +152,58 @@ def write_case(case, spec, angle, solver, steps=STEPS):
                   " tolerance 1e-8; relTol 0; minIter 3; } }\n")
     with open(f"{case}/constant/dynamicMeshDict", "w") as out:
         out.write(HEADER % "dynamicMeshDict" + "dynamicFvMesh dynamicMotionSolverFvMesh;\n" + solver)
-    omega = math.pi / 2 / steps  # the angle reaches its amplitude at the last step
-    empty = "frontAndBack { type empty; }" if two_d else ""
-    with open(f"{case}/0/pointDisplacement", "w") as out:
-        out.write("FoamFile { version 2.0; format ascii; class pointVectorField; object pointDisplacement; }\n"
-                  "dimensions [0 1 0 0 0 0 0]; internalField uniform (0 0 0);\nboundaryField {\n"
-                  f"body {{ type angularOscillatingDisplacement; axis (0 0 1); origin (0 0 0); angle0 0;"
-                  f" amplitude {math.radians(angle)}; omega {omega}; value uniform (0 0 0); }}\n"
-                  f"outer {{ type fixedValue; value uniform (0 0 0); }}\n{empty}\n}}\n")
+
+
+def block_mesh_run(case):
     log = subprocess.run(["blockMesh"], cwd=case, capture_output=True, text=True)
     if log.returncode != 0:
         sys.exit(f"openfoam_plugin: blockMesh failed in {case}:\n{log.stdout[-2000:]}{log.stderr[-2000:]}")
+
+
+def terrain_height(x, y):
+    """The bottom's final height at (x, y): two hills and a ripple."""
+    x, y = x - TERRAIN_ORIGIN[0], y - TERRAIN_ORIGIN[1]
+    return (380.0 * math.exp(-((x - 2000) ** 2 + (y - 2000) ** 2) / 700.0 ** 2)
+            + 250.0 * math.exp(-((x - 4300) ** 2 + (y - 1500) ** 2) / 500.0 ** 2)
+            + 60.0 * math.sin(x / 400.0) * math.cos(y / 300.0))
+
+
+def write_terrain(case, solver, steps=LARGE_STEPS):
+    """A fresh terrain case whose bottom rises onto terrain_height over `steps` steps."""
+    shutil.rmtree(case, ignore_errors=True)
+    for d in ("system", "constant", "0"):
+        os.makedirs(f"{case}/{d}", exist_ok=True)
+    (x0, y0), (nx, ny, nz), (lx, ly, lz) = TERRAIN_ORIGIN, TERRAIN_CELLS, TERRAIN_SIZE
+    corners = [(x0, y0, 0), (x0 + lx, y0, 0), (x0 + lx, y0 + ly, 0), (x0, y0 + ly, 0),
+               (x0, y0, lz), (x0 + lx, y0, lz), (x0 + lx, y0 + ly, lz), (x0, y0 + ly, lz)]
+    patches = {"bottom": "(0 3 2 1)", "top": "(4 5 6 7)", "west": "(0 4 7 3)", "east": "(1 2 6 5)",
+               "south": "(0 1 5 4)", "north": "(3 7 6 2)"}
+    with open(f"{case}/system/blockMeshDict", "w") as out:
+        out.write(HEADER % "blockMeshDict" + "convertToMeters 1;\nvertices (" + " ".join(f"({a} {b} {c})" for a, b, c in corners)
+                  + f");\nblocks (hex (0 1 2 3 4 5 6 7) ({nx} {ny} {nz}) simpleGrading (1 1 1));\nedges ();\nboundary (\n"
+                  + "".join(f"{name} {{ type wall; faces ({face}); }}\n" for name, face in patches.items()) + ");\n")
+    write_controls(case, solver, steps)
+    # The bottom's points (blockMesh's grid at z = 0) and their displacement at the first and
+    # the last time: timeVaryingMappedFixedValue interpolates linearly between them. Debian's
+    # OpenFOAM reads these two files as bare lists.
+    points = [(x0 + lx * i / nx, y0 + ly * j / ny) for j in range(ny + 1) for i in range(nx + 1)]
+    data = f"{case}/constant/boundaryData/bottom"
+    with_list = lambda rows: f"{len(points)}\n(\n" + "\n".join(rows) + "\n)\n"
+    os.makedirs(data)
+    with open(f"{data}/points", "w") as out:
+        out.write(with_list(f"({x!r} {y!r} 0)" for x, y in points))
+    for t, scale in ((0, 0.0), (steps, 1.0)):
+        os.makedirs(f"{data}/{t}")
+        with open(f"{data}/{t}/pointDisplacement", "w") as out:
+            out.write(with_list(f"(0 0 {scale * terrain_height(x, y)!r})" for x, y in points))
+    sides = "".join(f"{name} {{ type fixedNormalSlip; n ({nx_} {ny_} 0); value uniform (0 0 0); }}\n"
+                    for name, nx_, ny_ in (("west", -1, 0), ("east", 1, 0), ("south", 0, -1), ("north", 0, 1)))
+    with open(f"{case}/0/pointDisplacement", "w") as out:
+        out.write("FoamFile { version 2.0; format ascii; class pointVectorField; object pointDisplacement; }\n"
+                  "dimensions [0 1 0 0 0 0 0]; internalField uniform (0 0 0);\nboundaryField {\n"
+                  "bottom { type timeVaryingMappedFixedValue; offset (0 0 0); setAverage false; value uniform (0 0 0); }\n"
+                  "top { type fixedValue; value uniform (0 0 0); }\n" + sides + "}\n")
+    block_mesh_run(case)
 
 
 def run(case, steps=STEPS, ranks=1):
@@ -163,12 +226,13 @@ def run(case, steps=STEPS, ranks=1):
     with open(f"{case}/log.moveDynamicMesh", "w") as out:
         out.write(log + done.stderr)
     ok = done.returncode == 0 and log.count("Mesh OK") >= steps and "Failed" not in log
+    skewness = re.findall(r"Max skewness = ([0-9.eE+-]+)", log)
     times = [float(t) for t in re.findall(r"ExecutionTime = ([0-9.eE+-]+) s", log)]
     per_step = (times[-1] - times[0]) / (len(times) - 1) if len(times) > 1 else wall / steps
     rss = [int(x) for x in re.findall(r"^(\d+)$", done.stderr, re.M)]
     orthogonality = re.findall(r"Mesh non-orthogonality Max: ([0-9.eE+-]+)", log)
     return (ok, per_step, (rss[-1] / 1024 if rss else float("nan")), (float(orthogonality[-1]) if orthogonality else float("nan")),
-            wall)
+            wall, float(skewness[-1]) if skewness else float("nan"))
 
 
 print(f"openfoam_plugin: OpenFOAM {subprocess.run(['dpkg-query', '-W', '-f=${Version}', 'openfoam'], capture_output=True, text=True).stdout},"
@@ -188,7 +252,7 @@ for name, spec in CASES.items():
                 break
             largest = angle
         write_case(case, spec, REFERENCE, dictionary)
-        ok, per_step, rss, orthogonality, _ = run(case)
+        ok, per_step, rss, orthogonality, *_ = run(case)
         rows.append(dict(bench="openfoam_plugin", case=name, solver=solver, options=options, largest_valid_deg=largest,
                          seconds_per_step=per_step, max_rss_mb=rss, non_orthogonality=orthogonality,
                          valid_at_reference=ok))
@@ -200,31 +264,42 @@ for name, spec in CASES.items():
               + ("" if r["valid_at_reference"] else "  (invalid at 30 deg)"))
         lines.append(r)
 
+# The large cases: each writer makes a fresh case for a dynamicMeshDict, and the Laplacian's
+# dictionary (its diffusivity's distance from the moving patch).
+LAPLACIAN = "motionSolverLibs (\"libfvMotionSolvers.so\");\nmotionSolver displacementLaplacian;\ndisplacementLaplacianCoeffs {{ diffusivity {}; }}\n"
+LARGE = {
+    "block3d_79k": (lambda case, dictionary: write_case(case, BLOCK_79K, REFERENCE, dictionary, LARGE_STEPS),
+                    LAPLACIAN.format("inverseDistance (body)")),
+    "terrain_72k": (write_terrain, LAPLACIAN.format("quadratic inverseDistance (bottom)")),
+}
 print(f"\n{'case':12} {'motion solver':24} {'options':24} {'valid':>5} {'wall s':>8} {'wall x':>7} {'MB':>7} {'MB x':>6}"
-      f" {'non-orth':>8}   ({LARGE_STEPS} steps to {REFERENCE} deg, setups included)")
-for name, spec in LARGE.items():
+      f" {'non-orth':>8} {'skew':>6}   ({LARGE_STEPS} steps, setups included; the block to {REFERENCE} deg)")
+for name, (write, laplacian) in LARGE.items():
     rows = []
     for solver, options, dictionary in SOLVERS:
+        if solver == "displacementLaplacian":
+            options, dictionary = laplacian.split("diffusivity ")[1].split(";")[0], laplacian
         case = os.path.join(work, name, solver + ("_" + options.split()[-1] if options.startswith("method") else ""))
-        write_case(case, spec, REFERENCE, dictionary, LARGE_STEPS)
-        ok, per_step, rss, orthogonality, wall = run(case, LARGE_STEPS)
+        write(case, dictionary)
+        ok, per_step, rss, orthogonality, wall, skewness = run(case, LARGE_STEPS)
         rows.append(dict(bench="openfoam_plugin_large", case=name, solver=solver, options=options, steps=LARGE_STEPS,
-                         angle_deg=REFERENCE, valid=ok, wall_seconds=wall, seconds_per_step=per_step, max_rss_mb=rss,
-                         non_orthogonality=orthogonality, ranks=1))
+                         valid=ok, wall_seconds=wall, seconds_per_step=per_step, max_rss_mb=rss,
+                         non_orthogonality=orthogonality, skewness=skewness, ranks=1))
     peer = next(r for r in rows if r["solver"] == "displacementLaplacian")
     for r in rows:
         r["wall_ratio"] = r["wall_seconds"] / peer["wall_seconds"]
         r["memory_ratio"] = r["max_rss_mb"] / peer["max_rss_mb"]
         print(f"{name:12} {r['solver']:24} {r['options']:24} {'yes' if r['valid'] else 'NO':>5} {r['wall_seconds']:8.1f}"
-              f" {r['wall_ratio']:7.2f} {r['max_rss_mb']:7.0f} {r['memory_ratio']:6.2f} {r['non_orthogonality']:8.1f}")
+              f" {r['wall_ratio']:7.2f} {r['max_rss_mb']:7.0f} {r['memory_ratio']:6.2f} {r['non_orthogonality']:8.1f}"
+              f" {r['skewness']:6.3f}")
         lines.append(r)
     # The defaults decomposed in two, against their serial run.
     serial = rows[0]
     solver, options, dictionary = SOLVERS[0]
     serial_case = os.path.join(work, name, solver)
     case = serial_case + "_2ranks"
-    write_case(case, spec, REFERENCE, dictionary, LARGE_STEPS)
-    ok, per_step, rss, orthogonality, wall = run(case, LARGE_STEPS, 2)
+    write(case, dictionary)
+    ok, per_step, rss, orthogonality, wall, skewness = run(case, LARGE_STEPS, 2)
     rebuilt = subprocess.run(["reconstructPar", "-latestTime"], cwd=case, capture_output=True, text=True)
     compared = subprocess.run([os.path.join(build, "examples", "mesh_info"), serial_case, "--latest-time", "--compare", case,
                                "--json"], capture_output=True, text=True)
@@ -233,11 +308,11 @@ for name, spec in LARGE.items():
     except (ValueError, KeyError):
         difference = None
     r = dict(bench="openfoam_plugin_large", case=name, solver=solver, options=options, steps=LARGE_STEPS,
-             angle_deg=REFERENCE, valid=ok, wall_seconds=wall, seconds_per_step=per_step, max_rss_mb=rss,
-             non_orthogonality=orthogonality, ranks=2, wall_ratio_to_serial=wall / serial["wall_seconds"],
+             valid=ok, wall_seconds=wall, seconds_per_step=per_step, max_rss_mb=rss,
+             non_orthogonality=orthogonality, skewness=skewness, ranks=2, wall_ratio_to_serial=wall / serial["wall_seconds"],
              largest_difference_from_serial=difference)
     print(f"{name:12} {solver:24} {options + ', 2 ranks':24} {'yes' if ok else 'NO':>5} {wall:8.1f}"
-          f" {r['wall_ratio_to_serial']:7.2f} {rss:7.0f} {'':6} {orthogonality:8.1f}"
+          f" {r['wall_ratio_to_serial']:7.2f} {rss:7.0f} {'':6} {orthogonality:8.1f} {skewness:6.3f}"
           f"   (x: over the serial run; points {difference if difference is not None else 'not compared'} from serial)")
     lines.append(r)
 for line in lines:
