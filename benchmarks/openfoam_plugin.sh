@@ -185,7 +185,9 @@ def write_terrain(case, solver, steps=LARGE_STEPS):
     write_controls(case, solver, steps)
     # The bottom's points (blockMesh's grid at z = 0) and their displacement at the first and
     # the last time: timeVaryingMappedFixedValue interpolates linearly between them. Debian's
-    # OpenFOAM reads these two files as bare lists.
+    # OpenFOAM reads these two files as bare lists. The points are the patch's own, taken by
+    # `mapMethod nearest`: the default planar interpolation perturbs them by its own bounding box,
+    # which a decomposed case's ranks see differently (their values differed by 1e-3 relative).
     points = [(x0 + lx * i / nx, y0 + ly * j / ny) for j in range(ny + 1) for i in range(nx + 1)]
     data = f"{case}/constant/boundaryData/bottom"
     with_list = lambda rows: f"{len(points)}\n(\n" + "\n".join(rows) + "\n)\n"
@@ -201,7 +203,7 @@ def write_terrain(case, solver, steps=LARGE_STEPS):
     with open(f"{case}/0/pointDisplacement", "w") as out:
         out.write("FoamFile { version 2.0; format ascii; class pointVectorField; object pointDisplacement; }\n"
                   "dimensions [0 1 0 0 0 0 0]; internalField uniform (0 0 0);\nboundaryField {\n"
-                  "bottom { type timeVaryingMappedFixedValue; offset (0 0 0); setAverage false; value uniform (0 0 0); }\n"
+                  "bottom { type timeVaryingMappedFixedValue; mapMethod nearest; offset (0 0 0); setAverage false; value uniform (0 0 0); }\n"
                   "top { type fixedValue; value uniform (0 0 0); }\n" + sides + "}\n")
     block_mesh_run(case)
 
@@ -218,9 +220,13 @@ def run(case, steps=STEPS, ranks=1):
         log = subprocess.run(["decomposePar", "-force"], cwd=case, capture_output=True, text=True)
         if log.returncode != 0:
             sys.exit(f"openfoam_plugin: decomposePar failed in {case}:\n{log.stdout[-2000:]}{log.stderr[-2000:]}")
-        command = ["mpirun", "--oversubscribe", "--allow-run-as-root", "-np", str(ranks), "moveDynamicMesh", "-parallel"]
+        # From a processor folder with -case: Debian's OpenFOAM reads a decomposed case's
+        # boundaryData at ../constant from the working folder, not from the processor's.
+        command = ["mpirun", "--oversubscribe", "--allow-run-as-root", "-np", str(ranks), "moveDynamicMesh", "-parallel",
+                   "-case", case]
     start = time.perf_counter()
-    done = subprocess.run(["/usr/bin/time", "-f", "%M", *command], cwd=case, capture_output=True, text=True)
+    done = subprocess.run(["/usr/bin/time", "-f", "%M", *command], cwd=os.path.join(case, "processor0") if ranks > 1 else case,
+                          capture_output=True, text=True)
     wall = time.perf_counter() - start
     log = done.stdout
     with open(f"{case}/log.moveDynamicMesh", "w") as out:
