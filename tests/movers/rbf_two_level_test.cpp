@@ -192,3 +192,20 @@ TEST_CASE("two levels: the coarse centres cover every centre within their spacin
     CHECK(nearest < spacing);
   }
 }
+
+TEST_CASE("two levels: the coarse centres follow the positions, not the numbering", "[movers]") {
+  // A distributed mover's global ids may follow its ranks: the same points renumbered keep the
+  // same coarse centres.
+  const Mesh<3> mesh = box_mesh({.nx = 12, .ny = 12, .nz = 12});
+  const ResolvedBoundary<3> boundary = terrain_boundary(mesh);
+  const Index m = boundary.size();
+  Points<3> centres(3, m), reversed(3, m);
+  for (Index b = 0; b < m; ++b) {
+    centres.col(b) = mesh.points.col(boundary.nodes[static_cast<std::size_t>(b)]);
+    reversed.col(m - 1 - b) = centres.col(b);
+  }
+  std::vector<Index> kept = detail::spaced_subset(centres, 0.2), kept_reversed = detail::spaced_subset(reversed, 0.2);
+  for (Index& k : kept_reversed) k = m - 1 - k;
+  std::sort(kept_reversed.begin(), kept_reversed.end());
+  CHECK(kept == kept_reversed);
+}

@@ -7,8 +7,8 @@
 /// cost that grows with the motion (a terrain-following bottom of 7,442 nodes: radius 945,
 /// gigabytes, seconds a step). Here the wide radius R is carried by a coarse subset of the
 /// centres, every centre within `spacing` of one kept and the kept ones at least `spacing`
-/// apart (spaced_subset(): fixed by the geometry alone, so the map stays linear and the same
-/// for any motion), and the narrow radius r (ten boundary spacings, the at-rest default) by
+/// apart (spaced_subset(): fixed by the positions alone, so the map stays linear, the same for
+/// any motion and for any numbering of the nodes), and the narrow radius r (ten boundary spacings, the at-rest default) by
 /// every centre, on what the coarse level leaves:
 ///
 ///   s(x) = Σ_{c ∈ S} a_c φ(|x − x_c| / R) + Σ_{j} b_j φ(|x − x_j| / r),
@@ -36,26 +36,33 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <numeric>
 #include <vector>
 
 namespace meshmotion::detail {
 
-/// Centres of `centres` (Dim × k) kept in index order when no earlier kept one lies within
-/// `spacing`: every centre is then within `spacing` of a kept one and the kept ones are at
-/// least `spacing` apart. The order, not a tree's, decides: any holder of the centres in the
-/// same order keeps the same ones.
+/// Centres of `centres` (Dim × k), visited in the lexicographic order of their coordinates,
+/// kept when no earlier kept one lies within `spacing`: every centre is then within `spacing`
+/// of a kept one and the kept ones are at least `spacing` apart. Returned ascending. The
+/// positions decide, not the numbering: a distributed mover whose global ids follow its ranks
+/// (the OpenFOAM plugin's merged point numbering) keeps the serial mover's centres.
 template <int Dim>
 [[nodiscard]] std::vector<Index> spaced_subset(const Points<Dim>& centres, double spacing) {
   using Cell = std::array<std::int64_t, Dim>;
   std::map<Cell, std::vector<Index>> grid;
-  std::vector<Index> kept;
+  std::vector<Index> order(static_cast<std::size_t>(centres.cols())), kept;
+  std::iota(order.begin(), order.end(), Index{0});
+  std::sort(order.begin(), order.end(), [&](Index a, Index b) {
+    return std::lexicographical_compare(centres.col(a).data(), centres.col(a).data() + Dim, centres.col(b).data(),
+                                        centres.col(b).data() + Dim);
+  });
   const Vec<Dim> origin = centres.cols() > 0 ? Vec<Dim>(centres.rowwise().minCoeff()) : Vec<Dim>::Zero();
   const auto cell_of = [&](const Vec<Dim>& x) {
     Cell c;
     for (int a = 0; a < Dim; ++a) c[static_cast<std::size_t>(a)] = static_cast<std::int64_t>(std::floor((x(a) - origin(a)) / spacing));
     return c;
   };
-  for (Index i = 0; i < centres.cols(); ++i) {
+  for (const Index i : order) {
     const Vec<Dim> x = centres.col(i);
     const Cell home = cell_of(x);
     bool covered = false;
@@ -71,6 +78,7 @@ template <int Dim>
     kept.push_back(i);
     grid[home].push_back(i);
   }
+  std::sort(kept.begin(), kept.end());
   return kept;
 }
 
