@@ -11,6 +11,7 @@
 #include "displacementMotionSolver.H"
 #include "globalIndex.H"
 #include "globalMeshData.H"
+#include "labelIOList.H"
 #include "IStringStream.H"
 #include "mapPolyMesh.H"
 #include "memInfo.H"
@@ -304,6 +305,15 @@ void meshmotionMotionSolver::setup()
         input.global_ids.assign(pointToGlobal.begin(), pointToGlobal.end());
         input.owners.resize(n);
         forAll(pointToGlobal, i) input.owners[i] = numbering().whichProcID(pointToGlobal[i]);
+        // The serial case's numbering where decomposePar left it (pointProcAddressing) replaces
+        // mergePoints', which follows the ranks: the distributed mover then samples its memory
+        // estimate and orders its centres as the serial run does, so a default radius cut to
+        // that estimate is the serial one.
+        IOobject addressing("pointProcAddressing", m.facesInstance(), polyMesh::meshSubDir, m, IOobject::MUST_READ,
+                            IOobject::NO_WRITE, false);
+        labelList serial;
+        if (addressing.typeHeaderOk<labelIOList>(true)) serial = labelIOList(addressing);
+        if (returnReduce(serial.size() == n, andOp<bool>())) input.global_ids.assign(serial.begin(), serial.end());
     }
     bridge_.reset();
     try
