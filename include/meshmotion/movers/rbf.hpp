@@ -41,7 +41,7 @@
 ///   systems on overlapping patches of centres, blended by a partition of unity
 ///   (detail/rbf_partition_of_unity.hpp); still interpolating, linear, with derivatives.
 /// - A radius wider than the boundary's spacing on a large boundary (RbfOptions::levels):
-///   a coarse subset of the centres carries it and every centre, at ten boundary spacings,
+///   a coarse subset of the centres carries it and every centre, at a few boundary spacings,
 ///   what the coarse level leaves (detail/rbf_two_level.hpp), so that neither the memory nor
 ///   a move's cost grows with the motion; still interpolating, linear, with derivatives.
 

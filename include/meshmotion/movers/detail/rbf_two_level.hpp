@@ -89,16 +89,12 @@ class TwoLevelRbf {
 
   /// The fine level over every centre of `centres` at `fine` (compact, one radius, no
   /// polynomial), and the coarse centres: spaced_subset() at half the fine radius, widened
-  /// until at most `most_coarse` remain. `fine_system`, when it already holds the fine system
-  /// (a one-level interpolation at the fine radius), is taken over instead of factorized again.
+  /// until at most `most_coarse` remain.
   void setup_fine(const Points<Dim>& centres, const RbfKernelSettings& fine, Index most_coarse, const SolverOptions& solver,
-                  double condition_limit, RbfSystem<Dim>* fine_system = nullptr) {
+                  double condition_limit) {
     k_ = centres.cols();
     centres_ = centres;
-    if (fine_system != nullptr)
-      fine_ = std::move(*fine_system);
-    else
-      fine_.setup(centres, fine, solver, DenseSolverKind::partial_piv_lu, 0, condition_limit);
+    fine_.setup(centres, fine, solver, DenseSolverKind::partial_piv_lu, 0, condition_limit);
     double spacing = 0.5 * fine.radius;
     coarse_ids_ = spaced_subset(centres, spacing);
     // Counts on a surface of centres fall as spacing^(1 − Dim): a few widening rounds settle it.
