@@ -619,12 +619,15 @@ TEST_CASE("pipeline: every element type and mixed meshes curve onto a graph", "[
   }
 }
 
-TEST_CASE("pipeline: tetrahedra curve onto a graph at orders 7 and 8, hexahedra at order 4, certified", "[curving]") {
-  // The orders whose det J the certificate subdivides without tables (tetrahedra) and the
-  // untangling holds past the stack's lattice (a tet165's 2,024 points, a hex125's 1,728).
+TEST_CASE("pipeline: tetrahedra curve onto a graph at orders 7 and 8, hexahedra at orders 4 to 8, certified",
+          "[curving]") {
+  // The orders whose det J the certificate subdivides without tables (tetrahedra) and whose
+  // det J the untangling's rounds hold on the heap (a tet165's 2,024 points, a hex216's 3,375,
+  // a hex729's 13,824: the untangling stopped at hexahedra of order 4 when it held them in
+  // place).
   const auto bump = sine_bump(0.03);
   // One cube of tetrahedra (a second of cells at order 8, with 3 s for the tables' first use),
-  // eight hexahedra.
+  // eight hexahedra, one at order 8.
   struct Case {
     BoxCells cells;
     Index n;
@@ -632,7 +635,8 @@ TEST_CASE("pipeline: tetrahedra curve onto a graph at orders 7 and 8, hexahedra 
     ElementType type;
   };
   for (const Case c : {Case{BoxCells::tet4, 1, 7, ElementType::tet120}, Case{BoxCells::tet4, 1, 8, ElementType::tet165},
-                       Case{BoxCells::hex8, 2, 4, ElementType::hex125}}) {
+                       Case{BoxCells::hex8, 2, 4, ElementType::hex125}, Case{BoxCells::hex8, 2, 5, ElementType::hex216},
+                       Case{BoxCells::hex8, 2, 6, ElementType::hex343}, Case{BoxCells::hex8, 1, 8, ElementType::hex729}}) {
     INFO(name(c.type));
     const Mesh<3> linear = box_mesh({c.n, c.n, c.n, 0.0, 1.0, 0.0, 1.0, 0.0, 1.0, c.cells});
     CurveOptions<3> options;

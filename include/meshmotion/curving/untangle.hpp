@@ -161,11 +161,10 @@ void node_cells(const Mesh<Dim>& mesh, std::vector<Index>& offsets, std::vector<
 
 namespace detail {
 
-// Most lattice points of a det J the untangling holds (a tet165's, degree 21; a hex125's 1,728),
-// in place in each of the four polynomials per cell around a node: on the heap they would be
-// allocated afresh whenever the cells around a node change type.
-inline constexpr int max_untangle_lattice_points = 2024;
-using UntangleLattice = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_untangle_lattice_points, 1>;
+// A det J's lattice values or Bézier coefficients: a tet165's 2,024, a hex729's 13,824. On the
+// heap, kept from one line search to the next (each cell line's storage is reused): they are
+// allocated again only where the cells around a node change type.
+using UntangleLattice = Eigen::VectorXd;
 
 // The optimization of a patch of cells and its undoing, over the node-to-cell adjacency of one
 // mesh (built once for every pass).
@@ -314,10 +313,6 @@ class PatchOptimizer {
   void coefficients(ElementType type, const ElementCoords<Dim>& x, UntangleLattice& values, double& linear) {
     ++evaluations_;
     const detail::JacobianSpace& s = detail::jacobian_space(type);
-    if (s.num_points > max_untangle_lattice_points)
-      throw InputError("untangle: a " + std::string(name(type)) + "'s det J has " + std::to_string(s.num_points) +
-                       " lattice points, more than the " + std::to_string(max_untangle_lattice_points) +
-                       " the untangling holds (hexahedra are untangled up to order 4)");
     detail::lattice_dets<Dim>(s, x, 1.0, values);
     if (s.bezier) detail::to_bezier(s, values);
     linear = detail::linear_det<Dim>(s, x);
@@ -398,12 +393,13 @@ class PatchOptimizer {
   // same input read from another file, made the curved meshes differ by 4e-3.
   void optimize_node(Index v, double target) {
     const auto around = cells_of(v);
-    lines_.resize(around.size());
+    if (lines_.size() < around.size()) lines_.resize(around.size());  // never shrunk: each keeps its storage
+    const std::span<const CellLine> active(lines_.data(), around.size());
     const double span = 0.4 * reach(v);
     if (!(span > 0.0)) return;
     const auto score = [&](double t) {
       double sum = 0.0;
-      for (const CellLine& line : lines_) {
+      for (const CellLine& line : active) {
         const double j = line.value(t);
         if (j < std::min(line.at_zero, target)) return -std::numeric_limits<double>::infinity();
         sum += deficit(j, target);
