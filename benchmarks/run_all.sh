@@ -18,7 +18,7 @@
 # table shows its figures and the ratios. A benchmark that does not compile against the older
 # library is reported and skipped.
 #
-# --only runs the named benchmarks alone (e.g. --only conversion_bench,io_bench,curve_mesh_program,demo_orders,move_mesh_section,defaults_bench,conditioning_bench,openfoam_plugin).
+# --only runs the named benchmarks alone (e.g. --only conversion_bench,io_bench,curve_mesh_program,demo_orders,move_mesh_section,defaults_bench,wing_vs_gmsh,conditioning_bench,openfoam_plugin).
 #
 # Programs and benchmarks run with glibc's huge-page heap (GLIBC_TUNABLES, see
 # include/meshmotion/core/process_memory.hpp) for both builds; MESHMOTION_HUGE_PAGES=0 runs
@@ -265,6 +265,14 @@ if [[ -x "$build_dir/examples/curve_mesh" && ( -z "$only" || "$only" == *",defau
   [[ -x "$build_dir/examples/move_mesh" ]] && move_mesh=(--move-mesh "$build_dir/examples/move_mesh")
   run defaults_bench python3 "$here/defaults_bench.py" "$build_dir/examples/curve_mesh" "${move_mesh[@]}" \
     --data "$source_dir/../shared/data"
+fi
+# The swept wing curved at orders 2 to 4 by the defaults and by Gmsh's HighOrderOptimize on the
+# same linear mesh and model (issue 71; needs Gmsh's Python module, and says so without it).
+if [[ -x "$build_dir/examples/curve_mesh" && ( -z "$only" || "$only" == *",wing_vs_gmsh,"* ) ]]; then
+  wing_args=()
+  [[ $full == 1 ]] && wing_args=(--full)
+  run wing_vs_gmsh /usr/bin/python3 "$here/wing_vs_gmsh.py" "$build_dir/examples/curve_mesh" \
+    "$build_dir/examples/mesh_quality" --work "$build_dir/wing_vs_gmsh" "${wing_args[@]}"
 fi
 # The RBF's conditioning on a RANS grid: thinned by default, beside the system as it is
 # (needs the Python module, which --no-peers does not build: a build that has it runs it).

@@ -142,6 +142,18 @@ def plugin_large_targets(case, label):
     ]
 
 
+def wing_targets(order):
+    """Issue 71's swept wing at one order: the defaults' invalid cells, and their minimum and time
+    over Gmsh's HighOrderOptimize 2 on the same mesh (wing_vs_gmsh.py)."""
+    row = {"bench": "wing_vs_gmsh", "case": "target", "order": order}
+    return [
+        (f"swept wing on its STEP model, P{order}, defaults: invalid cells", row, "invalid", "<=", 0, "cells"),
+        (f"swept wing, P{order}: defaults' min / Gmsh HighOrderOptimize 2's", row, "min_over_gmsh", ">=", 1.0, "x"),
+        (f"swept wing, P{order}: curve_mesh's whole run / Gmsh HighOrderOptimize 2's", row, "time_over_gmsh", "<=", 1.0,
+         "x"),
+    ]
+
+
 TARGETS = [
     ("P1->P2 30P30N quads (median)", {"bench": "conversion", "case": "30p30n-quads"}, "median_s", "<=", 0.015, "s"),
     ("P1->P2 30P30N quads (first call)", {"bench": "conversion", "case": "30p30n-quads"}, "first_s", "<=", 0.015, "s"),
@@ -206,6 +218,9 @@ TARGETS = [
      ">=", 0.5, ""),
     ("curve_mesh demo P8: min scaled Jacobian", {"bench": "program", "case": "curve_mesh-demo-p8"}, "min_scaled_jacobian",
      ">=", 0.5, ""),
+    *wing_targets(2),
+    *wing_targets(3),
+    *wing_targets(4),
     ("curve_mesh demo P6 / P4, whole program", {"bench": "program", "case": "curve_mesh-demo-p6"}, "ratio_to_p4", "<=",
      5.0, "x"),
 ]
