@@ -43,9 +43,10 @@ class CgnsWriter {
     validate(mesh);
     for (const auto* list : {&mesh.cells, &mesh.facets, &mesh.lower})
       for (const auto& b : *list)
-        if (order(b.type) > 2)
+        if (!cgns_writes(b.type))
           throw InputError("write_cgns: " + std::string(name(b.type)) +
-                           " elements: CGNS files are written up to order 2 (expected .msh or .vtu past it)");
+                           " elements: CGNS files are written up to order 2, and to order 3 for lines, triangles,"
+                           " quadrilaterals, tetrahedra and hexahedra (expected .msh or .vtu)");
     list_elements();
     plan_sections();
   }

@@ -5,6 +5,7 @@
 /// path (io/cgns_reader.hpp, io/cgns_writer.hpp).
 
 #include "meshmotion/core/element.hpp"
+#include "meshmotion/core/shape_functions.hpp"
 #include "meshmotion/core/detail/per_type_cache.hpp"
 #include "meshmotion/core/error.hpp"
 #include "meshmotion/io/detail/cgns_library.hpp"
@@ -14,6 +15,7 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -37,25 +39,35 @@ inline constexpr bool have_cgns = false;
 namespace detail {
 
 /// CGNS's local node order of a type: CGNS node i is our (Gmsh's) local node cgns_order[i].
-/// CGNS numbers edges and quadrilateral faces differently from Gmsh for tetrahedra,
-/// pyramids, prisms and hexahedra; both put vertices first, then one node per edge, per
-/// quadrilateral face and the centre. Built from CGNS's edge and face lists (SIDS, element
-/// numbering conventions) matched against the catalogue's.
+/// Both put the vertices first, then the nodes of each edge from its first vertex, the nodes
+/// inside each face and the inside; CGNS lists and orients the edges of tetrahedra, pyramids,
+/// prisms and hexahedra and the faces of the 3D shapes differently from Gmsh (SIDS, element
+/// numbering conventions: edges below; a face's inside nodes start at its first vertex, a
+/// hexahedron's side faces at the bottom edge's first vertex, (3, 0, 4, 7) included). CGNS's
+/// nodes are built as reference points from those lists and matched against the catalogue's.
+/// Orders to 3 (cgns_types holds no type past them: the quartic simplices place their face
+/// and inside nodes off the equispaced lattice).
 [[nodiscard]] inline std::vector<int> cgns_order(ElementType type) {
   using Pair = std::array<int, 2>;
-  using Quad = std::array<int, 4>;
+  struct Face {
+    int size;
+    std::array<int, 4> vertices;
+  };
   static constexpr Pair cgns_tet_edges[] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
   static constexpr Pair cgns_pyramid_edges[] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 4}, {1, 4}, {2, 4}, {3, 4}};
   static constexpr Pair cgns_prism_edges[] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 4}, {2, 5}, {3, 4}, {4, 5}, {5, 3}};
   static constexpr Pair cgns_hex_edges[] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 4}, {1, 5},
                                        {2, 6}, {3, 7}, {4, 5}, {5, 6}, {6, 7}, {7, 4}};
-  static constexpr Quad cgns_pyramid_faces[] = {{0, 1, 2, 3}};
-  static constexpr Quad cgns_prism_faces[] = {{0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}};
-  static constexpr Quad cgns_hex_faces[] = {{0, 1, 2, 3}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {0, 3, 7, 4}, {4, 5, 6, 7}};
+  static constexpr Face cgns_tet_faces[] = {{3, {0, 1, 2}}, {3, {0, 1, 3}}, {3, {1, 2, 3}}, {3, {2, 0, 3}}};
+  // Order 2 at most: the faces with a node there (the quadrilaterals).
+  static constexpr Face cgns_pyramid_faces[] = {{4, {0, 1, 2, 3}}};
+  static constexpr Face cgns_prism_faces[] = {{4, {0, 1, 4, 3}}, {4, {1, 2, 5, 4}}, {4, {2, 0, 3, 5}}};
+  static constexpr Face cgns_hex_faces[] = {{4, {0, 1, 2, 3}}, {4, {0, 1, 5, 4}}, {4, {1, 2, 6, 5}},
+                                       {4, {2, 3, 7, 6}}, {4, {3, 0, 4, 7}}, {4, {4, 5, 6, 7}}};
   std::span<const Pair> cgns_edges;
-  std::span<const Quad> cgns_faces;
+  std::span<const Face> cgns_faces;
   switch (shape(type)) {
-    case Shape::tetrahedron: cgns_edges = cgns_tet_edges; break;
+    case Shape::tetrahedron: cgns_edges = cgns_tet_edges; cgns_faces = cgns_tet_faces; break;
     case Shape::pyramid: cgns_edges = cgns_pyramid_edges; cgns_faces = cgns_pyramid_faces; break;
     case Shape::prism: cgns_edges = cgns_prism_edges; cgns_faces = cgns_prism_faces; break;
     case Shape::hexahedron: cgns_edges = cgns_hex_edges; cgns_faces = cgns_hex_faces; break;
@@ -63,26 +75,33 @@ namespace detail {
   }
   std::vector<int> order(static_cast<std::size_t>(num_nodes(type)));
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-  if (cgns_edges.empty() || ::meshmotion::order(type) < 2) return order;
-  const int nv = num_vertices(type);
-  std::size_t next = static_cast<std::size_t>(nv);
-  for (const Pair& e : cgns_edges) order[next++] = nv + local_edge(type, e[0], e[1]);
-  if (!has_face_nodes(type)) return order;
-  const int first_face_node = nv + static_cast<int>(edges(type).size());
-  for (const Quad& face : cgns_faces) {
-    Quad key = face;
-    std::sort(key.begin(), key.end());
-    int quad_index = 0;
-    for (const LocalFacet& f : facets(type)) {
-      if (f.shape != Shape::quadrilateral) continue;
-      Quad ours{f.vertices[0], f.vertices[1], f.vertices[2], f.vertices[3]};
-      std::sort(ours.begin(), ours.end());
-      if (ours == key) break;
-      ++quad_index;
+  const int p = ::meshmotion::order(type);
+  if (cgns_edges.empty() || p < 2) return order;
+  const auto ours = reference_nodes(type);
+  const auto corners = ours.first(static_cast<std::size_t>(num_vertices(type)));
+  std::vector<RefPoint> points(corners.begin(), corners.end());
+  for (const Pair& e : cgns_edges)
+    for (int j = 1; j < p; ++j) {
+      const double r = static_cast<double>(j) / p;
+      RefPoint x{};
+      for (std::size_t d = 0; d < 3; ++d)
+        x[d] = (1 - r) * corners[static_cast<std::size_t>(e[0])][d] + r * corners[static_cast<std::size_t>(e[1])][d];
+      points.push_back(x);
     }
-    order[next++] = first_face_node + quad_index;
+  if (element_info(type).complete) {
+    for (const Face& f : cgns_faces) {
+      std::array<RefPoint, 4> face{};
+      for (int k = 0; k < f.size; ++k) face[static_cast<std::size_t>(k)] = corners[static_cast<std::size_t>(f.vertices[static_cast<std::size_t>(k)])];
+      append_inside(f.size == 3 ? Shape::triangle : Shape::quadrilateral, p, std::span<const RefPoint>(face.data(), static_cast<std::size_t>(f.size)), points);
+    }
+    append_inside(shape(type), p, corners, points);
   }
-  // The hexahedron's centre stays last.
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const auto at = std::find_if(ours.begin(), ours.end(), [&](const RefPoint& x) {
+      return std::abs(x[0] - points[i][0]) + std::abs(x[1] - points[i][1]) + std::abs(x[2] - points[i][2]) < 1e-9;
+    });
+    order[i] = static_cast<int>(at - ours.begin());
+  }
   return order;
 }
 
@@ -92,12 +111,15 @@ namespace detail {
 
 namespace detail {
 
-/// CGNS element type of each catalogue type, in ElementType order (ElementTypeNull past order 2).
+/// CGNS element type of each catalogue type, in ElementType order: ElementTypeNull for the
+/// cubic prisms and pyramids (the readers at hand disagree on the PENTA_40's faces) and past
+/// order 3 (the quartic simplices' face and inside nodes lie off the equispaced lattice).
 inline constexpr CGNS_ENUMT(ElementType_t) cgns_types[num_element_types] = {
     CGNS_ENUMV(NODE),     CGNS_ENUMV(BAR_2),    CGNS_ENUMV(BAR_3),    CGNS_ENUMV(TRI_3),    CGNS_ENUMV(TRI_6),
     CGNS_ENUMV(QUAD_4),   CGNS_ENUMV(QUAD_8),   CGNS_ENUMV(QUAD_9),   CGNS_ENUMV(TETRA_4),  CGNS_ENUMV(TETRA_10),
     CGNS_ENUMV(HEXA_8),   CGNS_ENUMV(HEXA_20),  CGNS_ENUMV(HEXA_27),  CGNS_ENUMV(PENTA_6),  CGNS_ENUMV(PENTA_15),
-    CGNS_ENUMV(PENTA_18), CGNS_ENUMV(PYRA_5),   CGNS_ENUMV(PYRA_13),  CGNS_ENUMV(PYRA_14)};
+    CGNS_ENUMV(PENTA_18), CGNS_ENUMV(PYRA_5),   CGNS_ENUMV(PYRA_13),  CGNS_ENUMV(PYRA_14),  CGNS_ENUMV(BAR_4),
+    CGNS_ENUMV(TRI_10),   CGNS_ENUMV(QUAD_16),  CGNS_ENUMV(TETRA_20), CGNS_ENUMV(HEXA_64)};
 
 [[nodiscard]] inline CGNS_ENUMT(ElementType_t) cgns_type(ElementType t) { return cgns_types[static_cast<std::size_t>(t)]; }
 
@@ -106,12 +128,17 @@ inline constexpr CGNS_ENUMT(ElementType_t) cgns_types[num_element_types] = {
   return k >= 0 && k < NofValidElementTypes ? std::string(cgns_api().cg_ElementTypeName(t)) : "element type " + std::to_string(k);
 }
 
-/// Our type of a CGNS type, or nullopt-like -1 when the catalogue has none (past order 2:
-/// CGNS orders their nodes unlike Gmsh, and the table holds no CGNS type for them).
+/// Our type of a CGNS type, or -1 when cgns_types holds none.
 [[nodiscard]] inline int element_type_of_cgns(CGNS_ENUMT(ElementType_t) t) {
+  if (t == CGNS_ENUMV(ElementTypeNull)) return -1;
   for (int k = 0; k < num_element_types; ++k)
-    if (order(static_cast<ElementType>(k)) <= 2 && cgns_types[k] == t) return k;
+    if (cgns_types[k] == t) return k;
   return -1;
+}
+
+/// Whether CGNS files hold elements of type t (cgns_types names a CGNS type for it).
+[[nodiscard]] inline bool cgns_writes(ElementType t) {
+  return cgns_types[static_cast<std::size_t>(t)] != CGNS_ENUMV(ElementTypeNull);
 }
 
 /// The permutation of a type, computed on its first use.
