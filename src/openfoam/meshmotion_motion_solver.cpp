@@ -316,6 +316,7 @@ void meshmotionMotionSolver::setup()
         if (returnReduce(serial.size() == n, andOp<bool>())) input.global_ids.assign(serial.begin(), serial.end());
     }
     bridge_.reset();
+    const auto start = std::chrono::steady_clock::now();
     try
     {
         bridge_ = std::make_unique<meshmotion::foam::Bridge>(input);
@@ -330,7 +331,9 @@ void meshmotionMotionSolver::setup()
     if (Pstream::parRun()) Info<< " on " << Pstream::nProcs() << " ranks (points on several ranks counted on each)";
     if (bridge_->support_radius() > 0) Info<< " (support radius " << bridge_->support_radius() << ")";
     if (bridge_->rigid_part()) Info<< ", each move's rigid part blended first";
-    Info<< endl;
+    // The setup's cost, as each step's line gives the move's.
+    Info<< " in " << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
+        << " s, resident memory " << memInfo().update().rss() / 1024 << " MB" << endl;
 }
 
 
