@@ -256,6 +256,27 @@ TEST_CASE("CGNS: every element type, linear, quadratic and cubic, round-trips an
   }
 }
 
+TEST_CASE("CGNS node orders: a permutation for every type CGNS holds, a refusal by name for the others", "[io][cgns]") {
+  for (int t = 0; t < num_element_types; ++t) {
+    const auto type = static_cast<ElementType>(t);
+    INFO(name(type));
+    if (!detail::cgns_writes(type)) {
+      if (order(type) > 1) CHECK_THROWS_WITH(detail::cgns_order(type), Catch::Contains(std::string(name(type))));
+      continue;
+    }
+    std::vector<int> order_of = detail::cgns_order(type);
+    std::sort(order_of.begin(), order_of.end());
+    for (std::size_t i = 0; i < order_of.size(); ++i) CHECK(order_of[i] == static_cast<int>(i));
+  }
+  // The side face on the hexahedron's bottom edge (3, 0) starts at vertex 3: its first inside
+  // node is the one nearest vertex 3 (VTK's and SU2's CGNS readers agree).
+  const auto hex64 = detail::cgns_order(ElementType::hex64);
+  const auto x = reference_nodes(ElementType::hex64)[static_cast<std::size_t>(hex64[48])];
+  CHECK(x[0] == Approx(-1.0));
+  CHECK(x[1] == Approx(1.0 / 3.0));
+  CHECK(x[2] == Approx(-1.0 / 3.0));
+}
+
 TEST_CASE("CGNS: mixed P1 and P2 boxes keep orientation, numbering and groups", "[io][cgns]") {
   for (const auto cells : {BoxCells::tet_pyramid_prism, BoxCells::hex_prism, BoxCells::pyramid5}) {
     const Mesh<3> linear = box_mesh({.nx = 4, .ny = 3, .nz = 2, .cells = cells});

@@ -36,7 +36,39 @@ inline constexpr bool have_cgns = true;
 inline constexpr bool have_cgns = false;
 #endif
 
+#ifdef MESHMOTION_HAVE_CGNS
+
 namespace detail {
+
+/// CGNS element type of each catalogue type, in ElementType order: ElementTypeNull for the
+/// cubic prisms and pyramids (the readers at hand disagree on the PENTA_40's faces) and past
+/// order 3 (the quartic simplices' face and inside nodes lie off the equispaced lattice).
+inline constexpr CGNS_ENUMT(ElementType_t) cgns_types[num_element_types] = {
+    CGNS_ENUMV(NODE),     CGNS_ENUMV(BAR_2),    CGNS_ENUMV(BAR_3),    CGNS_ENUMV(TRI_3),    CGNS_ENUMV(TRI_6),
+    CGNS_ENUMV(QUAD_4),   CGNS_ENUMV(QUAD_8),   CGNS_ENUMV(QUAD_9),   CGNS_ENUMV(TETRA_4),  CGNS_ENUMV(TETRA_10),
+    CGNS_ENUMV(HEXA_8),   CGNS_ENUMV(HEXA_20),  CGNS_ENUMV(HEXA_27),  CGNS_ENUMV(PENTA_6),  CGNS_ENUMV(PENTA_15),
+    CGNS_ENUMV(PENTA_18), CGNS_ENUMV(PYRA_5),   CGNS_ENUMV(PYRA_13),  CGNS_ENUMV(PYRA_14),  CGNS_ENUMV(BAR_4),
+    CGNS_ENUMV(TRI_10),   CGNS_ENUMV(QUAD_16),  CGNS_ENUMV(TETRA_20), CGNS_ENUMV(HEXA_64)};
+
+[[nodiscard]] inline CGNS_ENUMT(ElementType_t) cgns_type(ElementType t) { return cgns_types[static_cast<std::size_t>(t)]; }
+
+[[nodiscard]] inline std::string cgns_type_name(CGNS_ENUMT(ElementType_t) t) {
+  const int k = static_cast<int>(t);
+  return k >= 0 && k < NofValidElementTypes ? std::string(cgns_api().cg_ElementTypeName(t)) : "element type " + std::to_string(k);
+}
+
+/// Our type of a CGNS type, or -1 when cgns_types holds none.
+[[nodiscard]] inline int element_type_of_cgns(CGNS_ENUMT(ElementType_t) t) {
+  if (t == CGNS_ENUMV(ElementTypeNull)) return -1;
+  for (int k = 0; k < num_element_types; ++k)
+    if (cgns_types[k] == t) return k;
+  return -1;
+}
+
+/// Whether CGNS files hold elements of type t (cgns_types names a CGNS type for it).
+[[nodiscard]] inline bool cgns_writes(ElementType t) {
+  return cgns_types[static_cast<std::size_t>(t)] != CGNS_ENUMV(ElementTypeNull);
+}
 
 /// CGNS's local node order of a type: CGNS node i is our (Gmsh's) local node cgns_order[i].
 /// Both put the vertices first, then the nodes of each edge from its first vertex, the nodes
@@ -48,6 +80,7 @@ namespace detail {
 /// Orders to 3 (cgns_types holds no type past them: the quartic simplices place their face
 /// and inside nodes off the equispaced lattice).
 [[nodiscard]] inline std::vector<int> cgns_order(ElementType type) {
+  if (!cgns_writes(type)) throw InputError("CGNS node order: no CGNS type holds a " + std::string(name(type)));
   using Pair = std::array<int, 2>;
   struct Face {
     int size;
@@ -100,45 +133,10 @@ namespace detail {
     const auto at = std::find_if(ours.begin(), ours.end(), [&](const RefPoint& x) {
       return std::abs(x[0] - points[i][0]) + std::abs(x[1] - points[i][1]) + std::abs(x[2] - points[i][2]) < 1e-9;
     });
+    if (at == ours.end()) throw InputError("CGNS node order: no " + std::string(name(type)) + " node at CGNS node " + std::to_string(i));
     order[i] = static_cast<int>(at - ours.begin());
   }
   return order;
-}
-
-}  // namespace detail
-
-#ifdef MESHMOTION_HAVE_CGNS
-
-namespace detail {
-
-/// CGNS element type of each catalogue type, in ElementType order: ElementTypeNull for the
-/// cubic prisms and pyramids (the readers at hand disagree on the PENTA_40's faces) and past
-/// order 3 (the quartic simplices' face and inside nodes lie off the equispaced lattice).
-inline constexpr CGNS_ENUMT(ElementType_t) cgns_types[num_element_types] = {
-    CGNS_ENUMV(NODE),     CGNS_ENUMV(BAR_2),    CGNS_ENUMV(BAR_3),    CGNS_ENUMV(TRI_3),    CGNS_ENUMV(TRI_6),
-    CGNS_ENUMV(QUAD_4),   CGNS_ENUMV(QUAD_8),   CGNS_ENUMV(QUAD_9),   CGNS_ENUMV(TETRA_4),  CGNS_ENUMV(TETRA_10),
-    CGNS_ENUMV(HEXA_8),   CGNS_ENUMV(HEXA_20),  CGNS_ENUMV(HEXA_27),  CGNS_ENUMV(PENTA_6),  CGNS_ENUMV(PENTA_15),
-    CGNS_ENUMV(PENTA_18), CGNS_ENUMV(PYRA_5),   CGNS_ENUMV(PYRA_13),  CGNS_ENUMV(PYRA_14),  CGNS_ENUMV(BAR_4),
-    CGNS_ENUMV(TRI_10),   CGNS_ENUMV(QUAD_16),  CGNS_ENUMV(TETRA_20), CGNS_ENUMV(HEXA_64)};
-
-[[nodiscard]] inline CGNS_ENUMT(ElementType_t) cgns_type(ElementType t) { return cgns_types[static_cast<std::size_t>(t)]; }
-
-[[nodiscard]] inline std::string cgns_type_name(CGNS_ENUMT(ElementType_t) t) {
-  const int k = static_cast<int>(t);
-  return k >= 0 && k < NofValidElementTypes ? std::string(cgns_api().cg_ElementTypeName(t)) : "element type " + std::to_string(k);
-}
-
-/// Our type of a CGNS type, or -1 when cgns_types holds none.
-[[nodiscard]] inline int element_type_of_cgns(CGNS_ENUMT(ElementType_t) t) {
-  if (t == CGNS_ENUMV(ElementTypeNull)) return -1;
-  for (int k = 0; k < num_element_types; ++k)
-    if (cgns_types[k] == t) return k;
-  return -1;
-}
-
-/// Whether CGNS files hold elements of type t (cgns_types names a CGNS type for it).
-[[nodiscard]] inline bool cgns_writes(ElementType t) {
-  return cgns_types[static_cast<std::size_t>(t)] != CGNS_ENUMV(ElementTypeNull);
 }
 
 /// The permutation of a type, computed on its first use.
