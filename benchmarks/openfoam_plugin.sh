@@ -46,9 +46,8 @@ command -v moveDynamicMesh >/dev/null || { echo "openfoam_plugin: moveDynamicMes
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
 # OpenFOAM's applications run as their users start them: without glibc's huge-page heap, which
 # run_all.sh exports for the library's own programs (a solver does not set it, and the plugin, a
-# library inside the solver's process, cannot). With it, on a machine whose memory is
-# fragmented, every huge-page fault compacts memory first: `sle`'s setup on the terrain took
-# 9.5-14.4 s against 3.5 s without (docs/openfoam_plugin.md).
+# library inside the solver's process, cannot). With it, `sle`'s setup on the terrain took
+# 9.5-14.4 s against 3.5 s without on this machine on 2026-12-04 (docs/openfoam_plugin.md).
 if [[ -n "${GLIBC_TUNABLES:-}" ]]; then
   GLIBC_TUNABLES=$(tr ':' '\n' <<< "$GLIBC_TUNABLES" | grep -v '^glibc\.malloc\.hugetlb=' | paste -sd: - || true)
   if [[ -n "$GLIBC_TUNABLES" ]]; then export GLIBC_TUNABLES; else unset GLIBC_TUNABLES; fi
