@@ -136,6 +136,19 @@ def test_vtk_lagrange_order_is_vtk_s(type_name):
     np.testing.assert_allclose(expected, theirs, atol=1e-12)
 
 
+AFFINE = np.array([[1.3, 0.2, 0.1], [-0.1, 0.9, 0.3], [0.2, -0.2, 1.1]])
+
+
+def write_affine_cell(type_name, extension):
+    """One cell of `type_name` on the affine image (AFFINE, + 0.5) of its reference element,
+    written to a scratch file of `extension`: (file, its points)."""
+    dim = DIM[family(type_name)]
+    points = mm.reference_nodes(type_name)[:, :dim] @ AFFINE[:dim, :dim].T + 0.5
+    file = scratch(f"catalogue_{type_name}{extension}")
+    mm.write_mesh(file, mm.from_arrays(points, {type_name: np.arange(len(points))[None, :]}, {}))
+    return file, points
+
+
 @pytest.mark.parametrize("type_name", [t for t in VTK_TYPES if DIM[family(t)] >= 2])
 def test_vtu_cells_past_order_2_read_back_through_vtk(type_name):
     """One cell of each type on an affine image of its reference element, written to .vtu and
@@ -143,12 +156,7 @@ def test_vtu_cells_past_order_2_read_back_through_vtk(type_name):
     (the file's node order, the legacy hexahedron edges included, is VTK's)."""
     vtk = pytest.importorskip("vtk", reason="python3-vtk9 is not installed")
     dim = DIM[family(type_name)]
-    ref = mm.reference_nodes(type_name)[:, :dim]
-    a = np.array([[1.3, 0.2, 0.1], [-0.1, 0.9, 0.3], [0.2, -0.2, 1.1]])[:dim, :dim]
-    points = ref @ a.T + 0.5
-    mesh = mm.from_arrays(points, {type_name: np.arange(len(points))[None, :]}, {})
-    vtu = scratch(f"catalogue_{type_name}.vtu")
-    mm.write_mesh(vtu, mesh)
+    vtu, points = write_affine_cell(type_name, ".vtu")
     reader = vtk.vtkXMLUnstructuredGridReader()
     reader.SetFileName(str(vtu))
     reader.Update()
@@ -162,7 +170,7 @@ def test_vtu_cells_past_order_2_read_back_through_vtk(type_name):
         vtk_ref[:, :dim] = vtk_ref[:, :dim] * 2 - 1
     if f == "prism":
         vtk_ref[:, 2] = vtk_ref[:, 2] * 2 - 1
-    expected = vtk_ref[:, :dim] @ a.T + 0.5
+    expected = vtk_ref[:, :dim] @ AFFINE[:dim, :dim].T + 0.5
     got = np.array([cell.GetPoints().GetPoint(k)[:dim] for k in range(n)])
     np.testing.assert_allclose(got, expected, atol=1e-12)
 
@@ -179,14 +187,7 @@ def test_cgns_cells_read_by_vtk(type_name):
     if not mm.have_cgns:
         pytest.skip("meshmotion was built without the CGNS library")
     dim = DIM[family(type_name)]
-    ref = mm.reference_nodes(type_name)
-    a = np.array([[1.3, 0.2, 0.1], [-0.1, 0.9, 0.3], [0.2, -0.2, 1.1]])
-    points = ref @ a.T + 0.5
-    if dim == 2:
-        points = points[:, :2]
-    mesh = mm.from_arrays(points, {type_name: np.arange(len(points))[None, :]}, {})
-    file = scratch(f"catalogue_{type_name}.cgns")
-    mm.write_mesh(file, mesh)
+    file, points = write_affine_cell(type_name, ".cgns")
     reader = vtk.vtkCGNSReader()
     reader.SetFileName(str(file))
     reader.EnableAllBases()

@@ -116,10 +116,8 @@ inline constexpr CGNS_ENUMT(ElementType_t) cgns_types[num_element_types] = {
   for (const Pair& e : cgns_edges)
     for (int j = 1; j < p; ++j) {
       const double r = static_cast<double>(j) / p;
-      RefPoint x{};
-      for (std::size_t d = 0; d < 3; ++d)
-        x[d] = (1 - r) * corners[static_cast<std::size_t>(e[0])][d] + r * corners[static_cast<std::size_t>(e[1])][d];
-      points.push_back(x);
+      points.push_back(combine(std::array<RefPoint, 2>{corners[static_cast<std::size_t>(e[0])], corners[static_cast<std::size_t>(e[1])]},
+                               {1 - r, r}));
     }
   if (element_info(type).complete) {
     for (const Face& f : cgns_faces) {
