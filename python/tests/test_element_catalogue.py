@@ -18,9 +18,12 @@ GMSH_IDS = {
     "tet4": 4, "tet10": 11, "tet20": 29, "tet35": 30, "tet56": 31, "tet84": 71, "tet120": 72, "tet165": 73,
     "hex8": 5, "hex20": 17, "hex27": 12, "hex64": 92, "hex125": 93, "hex216": 94, "hex343": 95, "hex512": 96,
     "hex729": 97,
-    "prism6": 6, "prism15": 18, "prism18": 13, "prism40": 90,
-    "pyramid5": 7, "pyramid13": 19, "pyramid14": 14, "pyramid30": 118,
+    "prism6": 6, "prism15": 18, "prism18": 13, "prism40": 90, "prism75": 91, "prism126": 106, "prism196": 107,
+    "prism288": 108, "prism405": 109,
+    "pyramid5": 7, "pyramid13": 19, "pyramid14": 14, "pyramid30": 118, "pyramid55": 119, "pyramid91": 120,
+    "pyramid140": 121, "pyramid204": 122, "pyramid285": 123,
 }
+PRISM_ORDER = {"prism40": 3, "prism75": 4, "prism126": 5, "prism196": 6, "prism288": 7, "prism405": 8}
 DIM = {"line": 1, "tri": 2, "quad": 2, "tet": 3, "hex": 3, "prism": 3, "pyramid": 3}
 
 
@@ -48,8 +51,9 @@ def gmsh():
 
 
 def meshed_prism_nodes(gmsh, order):
-    """Gmsh 4.8 cannot list a prism40's reference nodes (getElementProperties fails on its face
-    closure): mesh the reference prism itself at that order and read its one element."""
+    """Gmsh 4.8 cannot list the reference nodes of a prism past order 2 (getElementProperties
+    fails on its face closure): mesh the reference prism itself at that order and read its one
+    element."""
     gmsh.model.add(f"prism{order}")
     geo = gmsh.model.geo
     p = [geo.addPoint(*c) for c in [(0, 0, -1), (1, 0, -1), (0, 1, -1)]]
@@ -80,11 +84,63 @@ def test_reference_nodes_are_gmsh_s(gmsh, type_name):
         _, gdim, _, count, coords, _ = gmsh.model.mesh.getElementProperties(GMSH_IDS[type_name])
         theirs = np.asarray(coords).reshape(count, gdim)
     except Exception:
-        if type_name != "prism40":
+        if type_name not in PRISM_ORDER:
             raise
-        theirs = meshed_prism_nodes(gmsh, 3)
+        theirs = meshed_prism_nodes(gmsh, PRISM_ORDER[type_name])
     assert ours.shape[0] == theirs.shape[0]
-    np.testing.assert_allclose(ours[:, :dim], theirs[:, :dim], atol=1e-12)
+    # The meshed prism's nodes come from Gmsh's geometry, to its own rounding.
+    np.testing.assert_allclose(ours[:, :dim], theirs[:, :dim], atol=1e-10 if type_name in PRISM_ORDER else 1e-12)
+
+
+def pyramid_lattice(n):
+    """Points of the reference pyramid on n levels below the apex (the apex is singular)."""
+    points = []
+    for k in range(n):
+        half, m = 1 - k / n, n - k
+        points += [(half * (2 * i / m - 1), half * (2 * j / m - 1), k / n) for i in range(m + 1) for j in range(m + 1)]
+    return np.array(points)
+
+
+@pytest.mark.parametrize("order", [3, 4, 6])
+def test_pyramid_jacobians_are_gmsh_s(gmsh, order):
+    """Pyramids past order 2 with curved sides, meshed by Gmsh (between hexahedra and tetrahedra
+    on a curved annulus): each cell's min det J over the straight cell's (the quality report's
+    scaled Jacobian, sampled on a lattice of order 2p: a pyramid's det J is rational) against
+    Gmsh's own det J on a 24-level lattice (getJacobians, its basis functions): the same
+    distribution to the two samplings' difference. (Gmsh 4.8's AnalyseMeshQuality is no judge
+    here: at order 4 it calls 16 of these pyramids invalid whose det J its own getJacobians finds
+    positive everywhere, and it stops at prisms past order 2, as getJacobians does.)"""
+    gmsh.model.add(f"pyramids{order}")
+    gmsh.option.setNumber("Mesh.MeshSizeMin", 0)  # meshed_prism_nodes() leaves them at 10
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 1e22)
+    gmsh.merge(str(pathlib.Path(__file__).parents[2] / "tests" / "quality" / "data" / "prisms_pyramids.geo"))
+    gmsh.model.mesh.generate(3)
+    gmsh.model.mesh.setOrder(order)
+    file = scratch(f"pyramids_p{order}.msh")
+    gmsh.write(str(file))
+    gmsh_type = gmsh.model.mesh.getElementType("Pyramid", order)
+    _, det, _ = gmsh.model.mesh.getJacobians(gmsh_type, pyramid_lattice(24).flatten().tolist())
+    tags, nodes = gmsh.model.mesh.getElementsByType(gmsh_type)
+    det = np.asarray(det).reshape(len(tags), -1)
+    node_tags, coords, _ = gmsh.model.mesh.getNodes()
+    where = {int(t): k for k, t in enumerate(node_tags)}
+    coords = np.asarray(coords).reshape(-1, 3)
+    straight = []
+    for vertices in np.asarray(nodes).reshape(len(tags), -1)[:, :5]:
+        x = coords[[where[int(t)] for t in vertices]]
+        # The linear pyramid's Jacobian at its centroid (0, 0, 1/5), columns d/du, d/dv, d/dw.
+        straight.append(np.linalg.det(np.column_stack([(-x[0] + x[1] + x[2] - x[3]) / 4, (-x[0] - x[1] + x[2] + x[3]) / 4,
+                                                        x[4] - x[:4].sum(axis=0) / 4])))
+    gmsh.model.remove()
+    theirs = np.sort(det.min(axis=1) / np.array(straight))
+    mesh = mm.read_mesh(file)
+    values = mm.quality_report(mesh, "jacobian")["values"]
+    counts = [len(connectivity) for _, connectivity in mesh.cells]
+    block = [name.startswith("pyramid") for name, _ in mesh.cells].index(True)
+    start = sum(counts[:block])
+    ours = np.sort(values[start:start + counts[block]])
+    assert len(ours) == len(theirs) > 0
+    np.testing.assert_allclose(ours, theirs, atol=0.02)
 
 
 # ---- VTK ----------------------------------------------------------------------------------
@@ -93,7 +149,8 @@ LAGRANGE = {"line": "vtkLagrangeCurve", "tri": "vtkLagrangeTriangle", "quad": "v
             "tet": "vtkLagrangeTetra", "hex": "vtkLagrangeHexahedron", "prism": "vtkLagrangeWedge"}
 VTK_TYPES = ["line3", "line4", "line5", "line6", "line9", "tri6", "tri10", "tri15", "tri21", "tri28", "tri36", "tri45",
              "quad9", "quad16", "quad25", "quad36", "quad49", "quad64", "quad81", "tet10", "tet20", "tet35", "tet56",
-             "tet84", "tet120", "tet165", "hex27", "hex64", "hex125", "hex216", "hex729", "prism18", "prism40"]
+             "tet84", "tet120", "tet165", "hex27", "hex64", "hex125", "hex216", "hex729", "prism18", "prism40",
+             "prism75", "prism126", "prism196", "prism405"]
 
 
 def to_vtk_parametric(type_name, x):
@@ -122,7 +179,7 @@ def test_vtk_lagrange_order_is_vtk_s(type_name):
     elif family(type_name) == "hex":
         cell.SetOrder(p, p, p)
     elif family(type_name) == "prism":
-        p = {18: 2, 40: 3}[n]
+        p = {18: 2, 40: 3, 75: 4, 126: 5, 196: 6, 288: 7, 405: 8}[n]
         cell.SetOrder(p, p, p, n)
     cell.Initialize()
     parametric = cell.GetParametricCoords()

@@ -89,13 +89,21 @@ TEST_CASE("orders the catalogue does not hold are refused by name", "[core]") {
   CHECK_THROWS_WITH(element_type(Shape::tetrahedron, 9), Catch::Contains("no tetrahedron of order 9 (orders 1 to 8"));
   CHECK_THROWS_WITH(element_type(Shape::quadrilateral, 3, false), Catch::Contains("serendipity"));
   CHECK(element_type(Shape::hexahedron, 8) == ElementType::hex729);
-  CHECK_THROWS_WITH(element_type(Shape::prism, 4), Catch::Contains("no prism of order 4"));
-  CHECK_THROWS_WITH(element_type_from_gmsh(91), Catch::Contains("91"));  // prism75
+  CHECK(element_type(Shape::prism, 4) == ElementType::prism75);
+  CHECK(element_type(Shape::prism, 8) == ElementType::prism405);
+  CHECK(element_type(Shape::pyramid, 5) == ElementType::pyramid91);
+  CHECK(element_type(Shape::pyramid, 8) == ElementType::pyramid285);
+  CHECK(element_type_from_gmsh(91) == ElementType::prism75);
+  CHECK(element_type_from_gmsh(109) == ElementType::prism405);
+  CHECK(element_type_from_gmsh(119) == ElementType::pyramid55);
+  CHECK(element_type_from_gmsh(123) == ElementType::pyramid285);
+  CHECK_THROWS_WITH(element_type(Shape::prism, 9), Catch::Contains("no prism of order 9 (orders 1 to 8"));
+  CHECK_THROWS_WITH(element_type_from_gmsh(110), Catch::Contains("110"));  // prism550, order 9
 }
 
 TEST_CASE("unknown type numbers and names are errors", "[core]") {
   CHECK_THROWS_AS(element_type_from_gmsh(45), InputError);  // tri55, order 9
-  CHECK_THROWS_WITH(element_type_from_gmsh(74), Catch::Contains("tetrahedron or hexahedron of order 1 to 8"));  // tet220
+  CHECK_THROWS_WITH(element_type_from_gmsh(74), Catch::Contains("prism or pyramid of order 1 to 8"));  // tet220
   CHECK_THROWS_AS(element_type_from_vtk(99), InputError);
   CHECK_THROWS_WITH(element_type_from_name("tri7"), Catch::Contains("tri7"));
 }

@@ -178,10 +178,10 @@ TEST_CASE("order conversion refuses what is not exact or not in the catalogue", 
   const Mesh<3> hexes = box_mesh({.nx = 1, .ny = 1, .nz = 1});
   CHECK(to_order(hexes, 8).cells.front().type == ElementType::hex729);
   const Mesh<3> prisms = box_mesh({.nx = 1, .ny = 1, .nz = 1, .cells = BoxCells::prism6});
-  CHECK_THROWS_WITH(convert_to_order(prisms, 4), Catch::Contains("no prism of order 4"));
+  CHECK(to_order(prisms, 8).cells.front().type == ElementType::prism405);
   CHECK_THROWS_WITH(convert_to_order(hexes, 9), Catch::Contains("order must be 1 to 8"));
   CHECK_THROWS_WITH(convert_to_order(to_order(hexes, 3), 2), Catch::Contains("lowering the order"));
   const Mesh<3> pyramids = box_mesh({.nx = 1, .ny = 1, .nz = 1, .cells = BoxCells::pyramid5});
   CHECK(to_order(pyramids, 3).cells.front().type == ElementType::pyramid30);
-  CHECK_THROWS_WITH(convert_to_order(pyramids, 4), Catch::Contains("no pyramid of order 4"));
+  CHECK(to_order(pyramids, 8).cells.front().type == ElementType::pyramid285);
 }

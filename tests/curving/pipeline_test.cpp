@@ -619,7 +619,7 @@ TEST_CASE("pipeline: every element type and mixed meshes curve onto a graph", "[
   }
 }
 
-TEST_CASE("pipeline: tetrahedra curve onto a graph at orders 7 and 8, hexahedra at orders 4 to 8, certified",
+TEST_CASE("pipeline: tetrahedra curve onto a graph at orders 7 and 8, hexahedra, prisms and pyramids at orders 4 to 8, certified",
           "[curving]") {
   // The orders whose det J the certificate subdivides without tables (tetrahedra) and whose
   // det J the untangling's rounds hold on the heap (a tet165's 2,024 points, a hex216's 3,375,
@@ -627,7 +627,8 @@ TEST_CASE("pipeline: tetrahedra curve onto a graph at orders 7 and 8, hexahedra 
   // place).
   const auto bump = sine_bump(0.03);
   // One cube of tetrahedra (a second of cells at order 8, with 3 s for the tables' first use),
-  // eight hexahedra, one at order 8.
+  // eight hexahedra, one at order 8; two prisms, six pyramids (sampled, not certified: their
+  // det J is rational) and the mixed box of tetrahedra, pyramids and prisms.
   struct Case {
     BoxCells cells;
     Index n;
@@ -636,14 +637,18 @@ TEST_CASE("pipeline: tetrahedra curve onto a graph at orders 7 and 8, hexahedra 
   };
   for (const Case c : {Case{BoxCells::tet4, 1, 7, ElementType::tet120}, Case{BoxCells::tet4, 1, 8, ElementType::tet165},
                        Case{BoxCells::hex8, 2, 4, ElementType::hex125}, Case{BoxCells::hex8, 2, 5, ElementType::hex216},
-                       Case{BoxCells::hex8, 2, 6, ElementType::hex343}, Case{BoxCells::hex8, 1, 8, ElementType::hex729}}) {
+                       Case{BoxCells::hex8, 2, 6, ElementType::hex343}, Case{BoxCells::hex8, 1, 8, ElementType::hex729},
+                       Case{BoxCells::prism6, 1, 4, ElementType::prism75}, Case{BoxCells::prism6, 1, 6, ElementType::prism196},
+                       Case{BoxCells::prism6, 1, 8, ElementType::prism405}, Case{BoxCells::pyramid5, 1, 5, ElementType::pyramid91},
+                       Case{BoxCells::pyramid5, 1, 8, ElementType::pyramid285},
+                       Case{BoxCells::tet_pyramid_prism, 3, 5, ElementType::pyramid91}}) {
     INFO(name(c.type));
     const Mesh<3> linear = box_mesh({c.n, c.n, c.n, 0.0, 1.0, 0.0, 1.0, 0.0, 1.0, c.cells});
     CurveOptions<3> options;
     options.order = c.order;
     options.geometry.emplace("bottom", BoundaryGeometry<3>::project(GraphProjection3(bump)));
     const CurveResult<3> curved = curve_mesh(linear, options);
-    REQUIRE(curved.curved.cells.front().type == c.type);
+    REQUIRE(curved.curved.find_block(c.type));
     INFO("min " << curved.quality.min);
     CHECK(curved.invalid() == 0);
     CHECK(curved.quality.min > 0.5);

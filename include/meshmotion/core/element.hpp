@@ -38,9 +38,12 @@ enum class ElementType : std::uint8_t {
   line9, tri45, quad81,
   hex125, hex216, hex343, hex512, hex729,
   tet120, tet165,
+  // Prisms and pyramids of orders 4 to 8 (appended when the catalogue's lattice reproduced Gmsh's).
+  prism75, prism126, prism196, prism288, prism405,
+  pyramid55, pyramid91, pyramid140, pyramid204, pyramid285,
 };
 
-inline constexpr int num_element_types = 51;
+inline constexpr int num_element_types = 61;
 
 /// Most nodes of any element type (hex729).
 inline constexpr int max_element_nodes = 729;
@@ -132,6 +135,16 @@ inline constexpr std::array<ElementInfo, num_element_types> element_table{{
     {ElementType::hex729, "hex729", Shape::hexahedron, 3, 8, 729, 8, true, 97, -1, 72},
     {ElementType::tet120, "tet120", Shape::tetrahedron, 3, 7, 120, 4, true, 72, -1, 71},
     {ElementType::tet165, "tet165", Shape::tetrahedron, 3, 8, 165, 4, true, 73, -1, 71},
+    {ElementType::prism75, "prism75", Shape::prism, 3, 4, 75, 6, true, 91, -1, 73},
+    {ElementType::prism126, "prism126", Shape::prism, 3, 5, 126, 6, true, 106, -1, 73},
+    {ElementType::prism196, "prism196", Shape::prism, 3, 6, 196, 6, true, 107, -1, 73},
+    {ElementType::prism288, "prism288", Shape::prism, 3, 7, 288, 6, true, 108, -1, 73},
+    {ElementType::prism405, "prism405", Shape::prism, 3, 8, 405, 6, true, 109, -1, 73},
+    {ElementType::pyramid55, "pyramid55", Shape::pyramid, 3, 4, 55, 5, true, 119, -1, -1},
+    {ElementType::pyramid91, "pyramid91", Shape::pyramid, 3, 5, 91, 5, true, 120, -1, -1},
+    {ElementType::pyramid140, "pyramid140", Shape::pyramid, 3, 6, 140, 5, true, 121, -1, -1},
+    {ElementType::pyramid204, "pyramid204", Shape::pyramid, 3, 7, 204, 5, true, 122, -1, -1},
+    {ElementType::pyramid285, "pyramid285", Shape::pyramid, 3, 8, 285, 5, true, 123, -1, -1},
 }};
 
 using Edge = std::array<int, 2>;
@@ -196,17 +209,13 @@ inline constexpr std::array<int, 27> hex27_vtk{0,  1,  2,  3,  4,  5,  6,  7,  8
 inline constexpr std::array<int, 6> prism6_vtk{0, 2, 1, 3, 5, 4};
 inline constexpr std::array<int, 15> prism15_vtk{0, 2, 1, 3, 5, 4, 7, 9, 6, 13, 14, 12, 8, 11, 10};
 inline constexpr std::array<int, 18> prism18_vtk{0, 2, 1, 3, 5, 4, 7, 9, 6, 13, 14, 12, 8, 11, 10, 16, 17, 15};
-inline constexpr std::array<int, 18> prism18_vtk_lagrange{0, 1, 2, 3, 4, 5, 6, 9, 7, 12, 14, 13, 8, 10, 11, 15, 17, 16};
-// VTK's Lagrange tetrahedra and wedges past order 2, tabulated from VTK 9.1's own parametric
-// coordinates (python/tests/test_element_catalogue.py checks them against VTK). Lines and
-// triangles list their nodes as Gmsh does; quadrilaterals and hexahedra follow a rule
+// VTK's Lagrange tetrahedra past order 2, tabulated from VTK 9.1's own parametric coordinates
+// (python/tests/test_element_catalogue.py checks them against VTK). Lines and triangles list
+// their nodes as Gmsh does; quadrilaterals, hexahedra and Lagrange wedges follow a rule
 // (vtk_order() in core/shape_functions.hpp).
 inline constexpr std::array<int, 20> tet20_vtk{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 10, 15, 14, 13, 12, 17, 19, 18, 16};
 inline constexpr std::array<int, 35> tet35_vtk{0,  1,  2,  3,  4,  5,  6,  7,  8,  9,  10, 11, 12, 15, 14, 13, 21, 20,
                                                19, 18, 17, 16, 25, 26, 27, 33, 31, 32, 28, 29, 30, 22, 23, 24, 34};
-inline constexpr std::array<int, 40> prism40_vtk{0,  1,  2,  3,  4,  5,  6,  7,  12, 13, 9,  8,  18, 19,
-                                                 22, 23, 21, 20, 10, 11, 14, 15, 16, 17, 24, 25, 26, 27,
-                                                 29, 28, 34, 35, 37, 36, 33, 30, 32, 31, 38, 39};
 inline constexpr std::array<int, 56> tet56_vtk{
     0,  1,  2,  3,  4,  5,  6,  7,  8,  9,  10, 11, 12, 13, 14, 15, 19, 18, 17, 16, 27, 26, 25, 24, 23, 22, 21, 20,
     34, 35, 36, 37, 38, 39, 48, 46, 47, 51, 49, 50, 40, 41, 42, 43, 44, 45, 28, 29, 30, 31, 32, 33, 52, 53, 54, 55};
@@ -297,18 +306,8 @@ constexpr std::span<const T> as_span(const std::array<T, N>& a) {
   return "?";
 }
 
-/// Highest order of the catalogue's elements of a shape: 8 for lines, triangles,
-/// quadrilaterals, tetrahedra and hexahedra, 3 for prisms and pyramids. (Gmsh lays out the
-/// inside of prisms past order 3, and of pyramids past order 3, in ways the catalogue's
-/// lattice does not reproduce yet.)
-[[nodiscard]] constexpr int max_order(Shape s) {
-  switch (s) {
-    case Shape::point: return 0;
-    case Shape::prism:
-    case Shape::pyramid: return 3;
-    default: return max_element_order;
-  }
-}
+/// Highest order of the catalogue's elements of a shape: 8 for every shape but the point.
+[[nodiscard]] constexpr int max_order(Shape s) { return s == Shape::point ? 0 : max_element_order; }
 
 /// The element type of a given shape and order; `complete` picks quad9/hex27/prism18/pyramid14
 /// over the serendipity quad8/hex20/prism15/pyramid13. Orders past 2 are complete Lagrange
@@ -323,7 +322,7 @@ constexpr std::span<const T> as_span(const std::array<T, N>& a) {
     if (e.shape == s && e.order == element_order && (e.complete || !complete)) return e.type;
   throw InputError("element_type: no " + std::string(shape_name(s)) + " of order " + std::to_string(element_order) +
                    " (orders 1 to " + std::to_string(max_order(s)) + " for " + std::string(shape_name(s)) +
-                   "s; 1 to 8 for lines, triangles, quadrilaterals, tetrahedra and hexahedra, 1 to 3 for prisms and pyramids)");
+                   "s)");
 }
 
 /// The linear element of the same shape.
@@ -454,20 +453,19 @@ constexpr int facet_nodes(ElementType t, int f, std::array<int, max_facet_nodes>
 namespace detail {
 
 // The tabulated part of vtk_order() (core/shape_functions.hpp): every classic cell, and the
-// Lagrange tetrahedra and wedges.
-[[nodiscard]] constexpr std::span<const int> tabulated_vtk_order(ElementType t, bool lagrange) {
+// Lagrange tetrahedra.
+[[nodiscard]] constexpr std::span<const int> tabulated_vtk_order(ElementType t) {
   switch (t) {
     case ElementType::tet10: return detail::as_span(detail::tet10_vtk);
     case ElementType::hex20: return detail::as_span(detail::hex20_vtk);
     case ElementType::hex27: return detail::as_span(detail::hex27_vtk);
     case ElementType::prism6: return detail::as_span(detail::prism6_vtk);
     case ElementType::prism15: return detail::as_span(detail::prism15_vtk);
-    case ElementType::prism18: return lagrange ? detail::as_span(detail::prism18_vtk_lagrange) : detail::as_span(detail::prism18_vtk);
+    case ElementType::prism18: return detail::as_span(detail::prism18_vtk);
     case ElementType::pyramid13:
     case ElementType::pyramid14: return detail::as_span(detail::pyramid13_vtk);
     case ElementType::tet20: return detail::as_span(detail::tet20_vtk);
     case ElementType::tet35: return detail::as_span(detail::tet35_vtk);
-    case ElementType::prism40: return detail::as_span(detail::prism40_vtk);
     case ElementType::tet56: return detail::as_span(detail::tet56_vtk);
     case ElementType::tet84: return detail::as_span(detail::tet84_vtk);
     case ElementType::tet120: return detail::as_span(detail::tet120_vtk);
@@ -494,8 +492,8 @@ namespace detail {
   for (const auto& e : detail::element_table)
     if (e.gmsh_id == gmsh_id) return e.type;
   throw InputError("element_type_from_gmsh: unsupported Gmsh element type " + std::to_string(gmsh_id) +
-                   " (expected a point, a line, triangle, quadrilateral, tetrahedron or hexahedron of order 1 to 8, " +
-                   "or a prism or pyramid of order 1 to 3; the serendipity elements stop at order 2)");
+                   " (expected a point, or a line, triangle, quadrilateral, tetrahedron, hexahedron, prism or pyramid " +
+                   "of order 1 to 8; the serendipity elements stop at order 2)");
 }
 
 /// The linear type with the given VTK/SU2 number; throws InputError for unknown numbers.

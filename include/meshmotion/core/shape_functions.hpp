@@ -15,7 +15,8 @@
 /// - serendipity quad8/hex20: the monomials of Q2 with at most one exponent equal to 2;
 ///   prism15: P2(u,v) ⊗ {1,w} plus P1(u,v) w^2;
 /// - pyramids: Gmsh's (Bergot's) rational space û^i v̂^j (1-w)^max(i,j) w^k with
-///   û = u/(1-w), v̂ = v/(1-w), k ≤ p - max(i,j); pyramid13 drops (i,j) = (2,2).
+///   û = u/(1-w), v̂ = v/(1-w), k ≤ p - max(i,j); pyramid13 drops (i,j) = (2,2); complete
+///   pyramids span it with Legendre polynomials of û, v̂ and 2w - 1 in place of the powers.
 /// Since the interpolant in a space is unique, these are the functions Gmsh uses.
 
 #include "meshmotion/core/detail/per_type_cache.hpp"
@@ -46,10 +47,14 @@ namespace detail {
 // systems lose digits on [-1, 1]^3: the hex729's Vandermonde matrix has a condition number of
 // 4e9 in monomials, 4e3 in Legendre products, and its shape functions summed to 1 only within
 // 1e-9 (now 3e-14). On simplices, whose coordinates lie in [0, 1], Legendre products of 2x - 1
-// gained nothing (tri45 2e-11 either way, tet84 worse), so they keep the monomials.
+// gained nothing (tri45 2e-11 either way, tet84 worse), so they keep the monomials. Complete
+// pyramids take P_a(û) P_b(v̂) (1-w)^max(a,b) P_c(2w - 1) (`pyramid`; the same space, each
+// Legendre polynomial a triangular combination of the powers it replaces): with the powers a
+// pyramid285's functions were 2e-11 off at its own nodes.
 struct Monomial {
   int a = 0, b = 0, c = 0, e = 0;
   bool legendre = false;
+  bool pyramid = false;
 };
 
 inline double int_pow(double x, int n) {
@@ -87,7 +92,7 @@ inline double legendre_derivative(int n, int k, double s) {
   return r;
 }
 
-// ∂^(du,dv,dw) of a term at x (the pyramid's terms without their (1-w)^e factor).
+// ∂^(du,dv,dw) of a term at x (not for pyramids: their terms are rational).
 inline double term_derivative(const Monomial& m, const RefPoint& x, int du, int dv, int dw) {
   const std::array<int, 3> degree{m.a, m.b, m.c}, times{du, dv, dw};
   double r = 1.0;
@@ -109,7 +114,23 @@ inline double term_derivative(const Monomial& m, const RefPoint& x, int du, int 
 // take û = v̂ = 0 there, which makes them (and their derivatives) vanish.
 inline bool at_apex_singularity(const Monomial& m, double s) { return m.e < 0 && std::abs(s) < 1e-14; }
 
+// A complete pyramid's term P_a(û) P_b(v̂) (1-w)^e P_c(2w - 1), e = max(a, b), and its
+// gradient in (u, v, w): {value, ∂u, ∂v, ∂w}. At the apex û = v̂ = 0, as for the powers.
+inline std::array<double, 4> pyramid_term(const Monomial& m, const RefPoint& x) {
+  const double s = 1.0 - x[2];
+  const bool apex = std::abs(s) < 1e-14;
+  const double uh = apex ? 0.0 : x[0] / s, vh = apex ? 0.0 : x[1] / s, t = 2.0 * x[2] - 1.0;
+  const int e = std::max(m.a, m.b);
+  const double pa = legendre_derivative(m.a, 0, uh), da = legendre_derivative(m.a, 1, uh);
+  const double pb = legendre_derivative(m.b, 0, vh), db = legendre_derivative(m.b, 1, vh);
+  const double pc = legendre_derivative(m.c, 0, t), dc = 2.0 * legendre_derivative(m.c, 1, t);
+  const double power = int_pow(s, e), lower = e == 0 ? 0.0 : int_pow(s, e - 1);  // (1-w)^e, (1-w)^(e-1)
+  return {pa * pb * power * pc, da * pb * lower * pc, pa * db * lower * pc,
+          (da * pb * uh + pa * db * vh - e * pa * pb) * lower * pc + pa * pb * power * dc};
+}
+
 inline double monomial_value(const Monomial& m, const RefPoint& x) {
+  if (m.pyramid) return pyramid_term(m, x)[0];
   if (m.legendre) return term_derivative(m, x, 0, 0, 0);
   const double s = 1.0 - x[2];
   if (at_apex_singularity(m, s)) return 0.0;
@@ -117,6 +138,10 @@ inline double monomial_value(const Monomial& m, const RefPoint& x) {
 }
 
 inline std::array<double, 3> monomial_gradient(const Monomial& m, const RefPoint& x) {
+  if (m.pyramid) {
+    const auto v = pyramid_term(m, x);
+    return {v[1], v[2], v[3]};
+  }
   if (m.legendre) return {term_derivative(m, x, 1, 0, 0), term_derivative(m, x, 0, 1, 0), term_derivative(m, x, 0, 0, 1)};
   const double s = 1.0 - x[2];
   if (at_apex_singularity(m, s)) return {0.0, 0.0, 0.0};
@@ -174,7 +199,10 @@ inline std::vector<Monomial> function_space(ElementType t) {
       break;
   }
   const bool tensor = shape(t) == Shape::line || shape(t) == Shape::quadrilateral || shape(t) == Shape::hexahedron;
-  for (Monomial& term : m) term.legendre = tensor;
+  for (Monomial& term : m) {
+    term.legendre = tensor;
+    term.pyramid = shape(t) == Shape::pyramid && complete;
+  }
   return m;
 }
 
@@ -257,18 +285,34 @@ inline void append_inside(Shape s, int p, std::span<const RefPoint> c, std::vect
         append_lattice(s, p - 2, true, inner, out);
       }
       break;
-    case Shape::prism:  // the triangle's inside nodes on each inner level, bottom to top
-      for (int level = 1; level < p; ++level) {
-        const double r = level * h;
-        const std::array<RefPoint, 3> section{combine(c, {1 - r, 0, 0, r, 0, 0}), combine(c, {0, 1 - r, 0, 0, r, 0}),
-                                              combine(c, {0, 0, 1 - r, 0, 0, r})};
-        append_inside(Shape::triangle, p, section, out);
+    case Shape::prism: {
+      // The product of the triangle's inside and a line of order p - 2 on the inner levels, the
+      // triangle's node outermost and the line in its own order (both ends first): at order 4,
+      // each inside triangle node at the levels 1/4, 3/4, then 1/2 of the way up.
+      std::vector<RefPoint> triangle;  // on the reference triangle: (u, v) are barycentric weights
+      append_inside(Shape::triangle, p, vertex_coordinates(Shape::triangle), triangle);
+      std::vector<RefPoint> levels;
+      if (p >= 2) {
+        const std::array<RefPoint, 2> ends{RefPoint{h, 0, 0}, RefPoint{1 - h, 0, 0}};
+        append_lattice(Shape::line, p - 2, true, ends, levels);
       }
+      for (const RefPoint& x : triangle)
+        for (const RefPoint& level : levels) {
+          const double r = level[0], u = x[0], v = x[1];
+          out.push_back(combine(c, {(1 - u - v) * (1 - r), u * (1 - r), v * (1 - r), (1 - u - v) * r, u * r, v * r}));
+        }
       break;
-    case Shape::pyramid:  // order 3 at most: one node, a third of the way from the base centre to the apex
-      if (p == 3) {
+    }
+    case Shape::pyramid:
+      // A pyramid of order p - 3, homothetic to this one: its base at height h, its base corners
+      // 1 - 3h of the way from the axis, its apex 2h below this apex.
+      if (p >= 3) {
         const RefPoint base = mean_point(c.first(4));
-        out.push_back(combine(std::array<RefPoint, 2>{base, c[4]}, {2.0 / 3.0, 1.0 / 3.0}));
+        std::array<RefPoint, 5> inner{};
+        for (std::size_t k = 0; k < 4; ++k)
+          inner[k] = combine(std::array<RefPoint, 3>{c[k], c[4], base}, {1 - 3 * h, h, 2 * h});
+        inner[4] = combine(std::array<RefPoint, 2>{c[4], base}, {1 - 2 * h, 2 * h});
+        append_lattice(s, p - 3, true, inner, out);
       }
       break;
     case Shape::point:
@@ -309,13 +353,15 @@ inline std::vector<RefPoint> make_reference_nodes(ElementType t) {
 }
 
 /// The nodal basis of one element type: N_i(x) = Σ_k coefficients(k, i) m_k(x).
-/// Simplices also keep each node's barycentric lattice index (α_0 .. α_d, summing to the
-/// order), which shape_functions() and shape_derivatives() evaluate in Silvester's form.
+/// Simplices and prisms also keep each node's lattice index in Silvester's coordinates
+/// (silvester_coordinates(): a simplex's barycentric α_0 .. α_d summing to the order; a prism's
+/// triangle index, then its line index (p − k, k)), which shape_functions() and
+/// shape_derivatives() evaluate in Silvester's form.
 struct ShapeBasis {
   std::vector<RefPoint> nodes;
   std::vector<Monomial> monomials;
   Eigen::MatrixXd coefficients;
-  std::vector<std::array<int, 4>> simplex_index;
+  std::vector<std::array<int, 5>> silvester_index;
 };
 
 inline ShapeBasis make_shape_basis(ElementType t) {
@@ -326,15 +372,21 @@ inline ShapeBasis make_shape_basis(ElementType t) {
     for (Index k = 0; k < n; ++k)
       vandermonde(i, k) = monomial_value(basis.monomials[static_cast<std::size_t>(k)], basis.nodes[static_cast<std::size_t>(i)]);
   basis.coefficients = table_inverse(vandermonde);
-  if (shape(t) == Shape::triangle || shape(t) == Shape::tetrahedron) {
-    const int p = order(t), d = dimension(t);
+  const int p = order(t);
+  const bool simplex = shape(t) == Shape::triangle || shape(t) == Shape::tetrahedron;
+  if (simplex || (shape(t) == Shape::prism && element_info(t).complete)) {
+    const int d = simplex ? dimension(t) : 2;
     for (const RefPoint& x : basis.nodes) {
-      std::array<int, 4> alpha{p, 0, 0, 0};
+      std::array<int, 5> alpha{p, 0, 0, 0, 0};
       for (int k = 0; k < d; ++k) {
         alpha[static_cast<std::size_t>(k + 1)] = static_cast<int>(std::lround(p * x[static_cast<std::size_t>(k)]));
         alpha[0] -= alpha[static_cast<std::size_t>(k + 1)];
       }
-      basis.simplex_index.push_back(alpha);
+      if (!simplex) {
+        alpha[4] = static_cast<int>(std::lround(p * (x[2] + 1.0) / 2.0));
+        alpha[3] = p - alpha[4];
+      }
+      basis.silvester_index.push_back(alpha);
     }
   }
   return basis;
@@ -344,7 +396,9 @@ inline ShapeBasis make_shape_basis(ElementType t) {
 // node α has N_α = Π_j ℓ(α_j, λ_j) with ℓ(a, t) = Π_{k<a} (p t − k) / (k + 1), λ the
 // barycentric coordinates (λ_0 = 1 − Σ ξ, λ_j = ξ_{j−1}). Exact and stable at every order,
 // where the monomials' Vandermonde inverse lost digits with it (a tri45's functions were 3e-11
-// off at its own nodes). `value(a, t)` and `slope(a, t)`, for every α_j, by one recurrence.
+// off at its own nodes, a prism126's 1e-11). A complete prism's functions are the products
+// of its triangle's and its line's, the line a 1D simplex in ((1 − w)/2, (1 + w)/2).
+// `value(a, t)` and `slope(a, t)`, for every α_j, by one recurrence.
 struct SilvesterFactor {
   double value = 1.0, slope = 0.0;
 };
@@ -359,13 +413,35 @@ inline SilvesterFactor silvester_factor(int a, int p, double t) {
   return f;
 }
 
-inline std::array<double, 4> barycentric(int d, const RefPoint& xi) {
-  std::array<double, 4> lambda{1.0, 0.0, 0.0, 0.0};
+// The Silvester coordinates of xi (the simplex's barycentric ones, then a prism's line's) and
+// how many there are; ∂λ_j/∂ξ_k is silvester_slope(j, k).
+struct SilvesterCoordinates {
+  std::array<double, 5> lambda{1.0, 0.0, 0.0, 0.0, 0.0};
+  int count = 0;
+  bool prism = false;
+};
+
+inline SilvesterCoordinates silvester_coordinates(ElementType t, const RefPoint& xi) {
+  SilvesterCoordinates c;
+  c.prism = shape(t) == Shape::prism;
+  const int d = c.prism ? 2 : dimension(t);
   for (int k = 0; k < d; ++k) {
-    lambda[static_cast<std::size_t>(k + 1)] = xi[static_cast<std::size_t>(k)];
-    lambda[0] -= xi[static_cast<std::size_t>(k)];
+    c.lambda[static_cast<std::size_t>(k + 1)] = xi[static_cast<std::size_t>(k)];
+    c.lambda[0] -= xi[static_cast<std::size_t>(k)];
   }
-  return lambda;
+  c.count = d + 1;
+  if (c.prism) {
+    c.lambda[3] = 0.5 * (1.0 - xi[2]);
+    c.lambda[4] = 0.5 * (1.0 + xi[2]);
+    c.count = 5;
+  }
+  return c;
+}
+
+inline double silvester_slope(const SilvesterCoordinates& c, int j, int k) {
+  if (c.prism && k == 2) return j == 3 ? -0.5 : (j == 4 ? 0.5 : 0.0);
+  if (c.prism && j >= 3) return 0.0;
+  return j == 0 ? -1.0 : (j == k + 1 ? 1.0 : 0.0);
 }
 
 inline const ShapeBasis& shape_basis(ElementType t) {
@@ -431,15 +507,52 @@ inline std::vector<std::array<int, 3>> vtk_tensor_lattice(int dim, int p) {
   return out;
 }
 
-// Our local node at each point of VTK's lattice of a complete quadrilateral or hexahedron.
-inline std::vector<int> make_vtk_tensor_order(ElementType t) {
+// The lattice (integer coordinates: i, j on the triangle, i + j ≤ p; k from 0 to p along the
+// axis) of VTK's Lagrange wedge of order p: vertices; edge nodes from the first vertex, edges
+// (0,1) (1,2) (2,0) (3,4) (4,5) (5,3) (0,3) (1,4) (2,5); the insides of the bottom and top
+// triangles; of the quadrilaterals (0,1,4,3) (1,2,5,4) (2,0,3,5), along the triangle's edge
+// fastest; then of the wedge, level by level. Every triangle inside is listed row by row, i
+// fastest: VTK 9.1's wedge does so, although its triangle cell lists its inside recursively.
+inline std::vector<std::array<int, 3>> vtk_wedge_lattice(int p) {
+  const std::array<std::array<int, 3>, 6> corner{{{0, 0, 0}, {p, 0, 0}, {0, p, 0}, {0, 0, p}, {p, 0, p}, {0, p, p}}};
+  static constexpr std::array<std::array<int, 2>, 9> edge{{{0, 1}, {1, 2}, {2, 0}, {3, 4}, {4, 5}, {5, 3}, {0, 3}, {1, 4}, {2, 5}}};
+  std::vector<std::array<int, 3>> out(corner.begin(), corner.end());
+  for (const auto& e : edge)
+    for (int j = 1; j < p; ++j) {
+      const auto& a = corner[static_cast<std::size_t>(e[0])];
+      const auto& b = corner[static_cast<std::size_t>(e[1])];
+      out.push_back({a[0] + (b[0] - a[0]) * j / p, a[1] + (b[1] - a[1]) * j / p, a[2] + (b[2] - a[2]) * j / p});
+    }
+  const auto triangle_inside = [&](int k) {
+    for (int j = 1; j < p; ++j)
+      for (int i = 1; i + j < p; ++i) out.push_back({i, j, k});
+  };
+  triangle_inside(0);
+  triangle_inside(p);
+  // The triangle's edges (0,1), (1,2), (2,0) as a point m steps along them.
+  const std::array<std::array<int, 4>, 3> side{{{0, 0, 1, 0}, {p, 0, -1, 1}, {0, p, 0, -1}}};
+  for (const auto& e : side)
+    for (int k = 1; k < p; ++k)
+      for (int m = 1; m < p; ++m) out.push_back({e[0] + e[2] * m, e[1] + e[3] * m, k});
+  for (int k = 1; k < p; ++k) triangle_inside(k);
+  return out;
+}
+
+// Our local node at each point of VTK's lattice of a complete quadrilateral, hexahedron or
+// (Lagrange) wedge.
+inline std::vector<int> make_vtk_lattice_order(ElementType t) {
   const auto ours = reference_nodes(t);
   const int p = order(t);
+  const bool wedge = shape(t) == Shape::prism;
+  // Our reference coordinates of a lattice point: [0, 1] on the wedge's triangle, [-1, 1] elsewhere.
+  const auto coordinate = [&](const std::array<int, 3>& q, std::size_t d) {
+    return wedge && d < 2 ? static_cast<double>(q[d]) / p : 2.0 * q[d] / p - 1.0;
+  };
   std::vector<int> out;
-  for (const auto& q : vtk_tensor_lattice(dimension(t), p)) {
+  for (const auto& q : wedge ? vtk_wedge_lattice(p) : vtk_tensor_lattice(dimension(t), p)) {
     const auto at = std::find_if(ours.begin(), ours.end(), [&](const RefPoint& x) {
       double gap = 0.0;
-      for (std::size_t d = 0; d < static_cast<std::size_t>(dimension(t)); ++d) gap += std::abs(x[d] - (2.0 * q[d] / p - 1.0));
+      for (std::size_t d = 0; d < static_cast<std::size_t>(dimension(t)); ++d) gap += std::abs(x[d] - coordinate(q, d));
       return gap < 1e-9;
     });
     out.push_back(static_cast<int>(at - ours.begin()));
@@ -453,11 +566,11 @@ inline std::vector<int> make_vtk_tensor_order(ElementType t) {
 /// `lagrange` selects the order of the VTK Lagrange cell where it differs from the classic one
 /// (types past order 2 exist only as Lagrange cells).
 [[nodiscard]] inline std::span<const int> vtk_order(ElementType t, bool lagrange = false) {
-  const bool tensor = shape(t) == Shape::quadrilateral || shape(t) == Shape::hexahedron;
+  const bool lattice = shape(t) == Shape::quadrilateral || shape(t) == Shape::hexahedron || shape(t) == Shape::prism;
   const bool lagrange_cell = order(t) > 2 || (lagrange && order(t) == 2);
-  if (!tensor || !element_info(t).complete || !lagrange_cell) return detail::tabulated_vtk_order(t, lagrange);
+  if (!lattice || !element_info(t).complete || !lagrange_cell) return detail::tabulated_vtk_order(t);
   static detail::PerTypeCache<std::vector<int>> orders;
-  return orders.get(t, detail::make_vtk_tensor_order);
+  return orders.get(t, detail::make_vtk_lattice_order);
 }
 
 namespace detail {
@@ -537,13 +650,13 @@ inline std::vector<int> make_su2_node_order(ElementType t) {
 inline void shape_functions(ElementType type, const RefPoint& xi, std::span<double> values) {
   const auto& basis = detail::shape_basis(type);
   const auto n = static_cast<Index>(basis.nodes.size());
-  if (!basis.simplex_index.empty()) {
-    const int p = order(type), d = dimension(type);
-    const auto lambda = detail::barycentric(d, xi);
-    for (std::size_t i = 0; i < basis.simplex_index.size(); ++i) {
+  if (!basis.silvester_index.empty()) {
+    const int p = order(type);
+    const auto c = detail::silvester_coordinates(type, xi);
+    for (std::size_t i = 0; i < basis.silvester_index.size(); ++i) {
       double v = 1.0;
-      for (int j = 0; j <= d; ++j)
-        v *= detail::silvester_factor(basis.simplex_index[i][static_cast<std::size_t>(j)], p, lambda[static_cast<std::size_t>(j)]).value;
+      for (int j = 0; j < c.count; ++j)
+        v *= detail::silvester_factor(basis.silvester_index[i][static_cast<std::size_t>(j)], p, c.lambda[static_cast<std::size_t>(j)]).value;
       values[i] = v;
     }
     return;
@@ -560,23 +673,21 @@ inline void shape_functions(ElementType type, const RefPoint& xi, std::span<doub
 inline void shape_derivatives(ElementType type, const RefPoint& xi, std::span<std::array<double, 3>> gradients) {
   const auto& basis = detail::shape_basis(type);
   const auto n = static_cast<Index>(basis.nodes.size());
-  if (!basis.simplex_index.empty()) {
-    // ∂N/∂ξ_k = ∂N/∂λ_{k+1} − ∂N/∂λ_0, each the product with one factor's slope.
+  if (!basis.silvester_index.empty()) {
+    // ∂N/∂ξ_k = Σ_j ∂λ_j/∂ξ_k ∂N/∂λ_j, each ∂N/∂λ_j the product with one factor's slope.
     const int p = order(type), d = dimension(type);
-    const auto lambda = detail::barycentric(d, xi);
-    for (std::size_t i = 0; i < basis.simplex_index.size(); ++i) {
-      std::array<detail::SilvesterFactor, 4> f{};
-      for (int j = 0; j <= d; ++j)
-        f[static_cast<std::size_t>(j)] = detail::silvester_factor(basis.simplex_index[i][static_cast<std::size_t>(j)], p, lambda[static_cast<std::size_t>(j)]);
-      std::array<double, 4> by_lambda{};
-      for (int j = 0; j <= d; ++j) {
-        double g = f[static_cast<std::size_t>(j)].slope;
-        for (int m = 0; m <= d; ++m)
-          if (m != j) g *= f[static_cast<std::size_t>(m)].value;
-        by_lambda[static_cast<std::size_t>(j)] = g;
-      }
+    const auto c = detail::silvester_coordinates(type, xi);
+    for (std::size_t i = 0; i < basis.silvester_index.size(); ++i) {
+      std::array<detail::SilvesterFactor, 5> f{};
+      for (int j = 0; j < c.count; ++j)
+        f[static_cast<std::size_t>(j)] = detail::silvester_factor(basis.silvester_index[i][static_cast<std::size_t>(j)], p, c.lambda[static_cast<std::size_t>(j)]);
       gradients[i] = {0.0, 0.0, 0.0};
-      for (int k = 0; k < d; ++k) gradients[i][static_cast<std::size_t>(k)] = by_lambda[static_cast<std::size_t>(k + 1)] - by_lambda[0];
+      for (int j = 0; j < c.count; ++j) {
+        double g = f[static_cast<std::size_t>(j)].slope;
+        for (int m = 0; m < c.count; ++m)
+          if (m != j) g *= f[static_cast<std::size_t>(m)].value;
+        for (int k = 0; k < d; ++k) gradients[i][static_cast<std::size_t>(k)] += detail::silvester_slope(c, j, k) * g;
+      }
     }
     return;
   }

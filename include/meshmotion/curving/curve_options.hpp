@@ -100,7 +100,7 @@ struct CurveOptions {
 /// geometry_from_text(); `mover_options` takes the keys of the method, MoverConfig).
 template <int Dim, class F>
 void visit_options(CurveOptions<Dim>& o, F&& f, const std::string& prefix = {}) {
-  f(prefix + "order", o.order, OptionHelp{"order of the curved mesh: 2 to 8 (prisms and pyramids to 3)", range::between(2, max_element_order)});
+  f(prefix + "order", o.order, OptionHelp{"order of the curved mesh: 2 to 8", range::between(2, max_element_order)});
   f(prefix + "method", o.method, OptionHelp{"interior regularization: a registered mover (its options are keys too)", {},
       "Interior regularization: any registered method (mover_methods(), movers/registry.hpp). \"blend\" "
       "(wall-distance blending) is the default: it reached the best minimum on every case of curving_bench; "

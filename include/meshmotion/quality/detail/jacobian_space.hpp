@@ -326,10 +326,10 @@ inline void add_tensor_tables(JacobianSpace& s, ElementType t, int p) {
   }
 }
 
-// Pyramid sampling: a lattice of order 4 on the levels w = k/4 below the apex (the apex
-// itself is a singular point of the rational map), plus the centroid.
-inline void add_pyramid_samples(JacobianSpace& s) {
-  const int n = 4;
+// Pyramid sampling: a lattice of order 2p (at least 4) on the levels w = k/2p below the apex
+// (the apex itself is a singular point of the rational map), plus the centroid.
+inline void add_pyramid_samples(JacobianSpace& s, int p) {
+  const int n = std::max(4, 2 * p);
   for (int k = 0; k < n; ++k) {
     const double w = static_cast<double>(k) / n, half = 1.0 - w;
     const int m = n - k;
@@ -357,7 +357,7 @@ inline JacobianSpace make_jacobian_space(ElementType t) {
   }
   s.bezier = s.dim >= 2 && shape(t) != Shape::pyramid;
   if (s.bezier) add_lattice(s);
-  else if (shape(t) == Shape::pyramid) add_pyramid_samples(s);
+  else if (shape(t) == Shape::pyramid) add_pyramid_samples(s, p);
   s.num_points = static_cast<int>(s.points.size());
 
   // Sum factorization pays from degree 2 on (quad9, hex27); for quad4 and hex8 its many tiny
@@ -379,7 +379,7 @@ inline JacobianSpace make_jacobian_space(ElementType t) {
   shape_derivatives(lin, reference_centroid(lin), gl);
   for (const auto& gi : gl)
     for (int d = 0; d < s.dim; ++d) s.linear_gradients.push_back(gi[static_cast<std::size_t>(d)]);
-  if (lin != t && s.bezier) {
+  if (lin != t) {  // pyramids too: a straight pyramid285's own det J carried 4e-10 of rounding
     const int nv = num_nodes(lin);
     std::vector<double> values(static_cast<std::size_t>(nv));
     s.linear_embedding.resize(nv, s.num_nodes);
