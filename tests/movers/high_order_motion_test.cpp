@@ -104,7 +104,7 @@ ResolvedBoundary<3> raised_bottom(const Mesh<3>& mesh, double height) {
 
 }  // namespace
 
-TEST_CASE("set up once, the finite-element movers and the default move P4 hexahedra and P5 and P8 tetrahedra, each move certified valid",
+TEST_CASE("set up once, the finite-element movers and the default move P4 hexahedra, P5 prisms and pyramids, P5 and P8 tetrahedra, each move certified valid",
           "[movers][high_order]") {
   // The graph methods are left to the rings above: on these lattices of one or two cells across,
   // the Delaunay graph of the high-order nodes (many on one sphere) inverts simplices at once.
@@ -116,7 +116,8 @@ TEST_CASE("set up once, the finite-element movers and the default move P4 hexahe
     std::vector<const char*> methods;
   };
   for (const Case& c : {Case{BoxCells::hex8, 2, 4, {"rbf", "le", "sle", "nle"}}, Case{BoxCells::tet4, 2, 5, {"rbf", "le", "sle", "nle"}},
-                        Case{BoxCells::tet4, 1, 8, {"sle"}}}) {
+                        Case{BoxCells::prism6, 2, 5, {"rbf", "le", "sle", "nle"}},
+                        Case{BoxCells::pyramid5, 1, 5, {"rbf", "le", "sle", "nle"}}, Case{BoxCells::tet4, 1, 8, {"sle"}}}) {
     const Mesh<3> mesh = convert_to_order(box_mesh({c.n, c.n, c.n, 0.0, 1.0, 0.0, 1.0, 0.0, 1.0, c.cells}), c.order).mesh;
     REQUIRE(meshmotion::order(mesh.cells.front().type) == c.order);
     const ResolvedBoundary<3> reference = raised_bottom(mesh, 0.0);
