@@ -194,7 +194,9 @@ void lattice_dets(const JacobianSpace& s, const ElementCoords<D>& x, double scal
     // Along the line first (Y = X L^T, per triangle node), then across the triangle.
     const Index nt = s.prism_triangle[0].cols(), nl = s.line_values.cols(), nr = s.line_values.rows();
     const Index na = s.prism_triangle[0].rows();
-    Eigen::MatrixXd nodes(nt, nl), along, across, slope;
+    // Per thread, as `jacobians`: a certificate of a mesh allocates them once, not per cell.
+    thread_local Eigen::MatrixXd nodes, along, across, slope;
+    nodes.resize(nt, nl);
     for (int c = 0; c < D; ++c) {
       for (Index k = 0; k < nt; ++k)
         for (Index l = 0; l < nl; ++l) nodes(k, l) = x(c, s.prism_node[static_cast<std::size_t>(k * nl + l)]);
