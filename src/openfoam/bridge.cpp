@@ -177,6 +177,10 @@ int Bridge::setups() const { return 1 + static_cast<int>(serving_->stats().radiu
 
 long Bridge::solver_iterations() const { return static_cast<long>(serving_->stats().iterations); }
 
+double Bridge::rebuild_seconds() const { return serving_->stats().rebuild_seconds; }
+
+double Bridge::solve_seconds() const { return serving_->stats().solve_seconds; }
+
 void Bridge::move(const std::vector<double>& boundary_displacements, std::vector<double>& out) {
   try {
     serving_->move(boundary_displacements, out);

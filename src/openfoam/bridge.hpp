@@ -66,6 +66,10 @@ class Bridge {
   [[nodiscard]] int setups() const;
   /// The iterations of the last move's linear solve (0 for direct solves and interpolation).
   [[nodiscard]] long solver_iterations() const;
+  /// Of the last move on this rank (seconds): what it set up again or built first, and its
+  /// solves (MoverStats::rebuild_seconds, solve_seconds); the rest of it is evaluation.
+  [[nodiscard]] double rebuild_seconds() const;
+  [[nodiscard]] double solve_seconds() const;
 
  private:
   std::unique_ptr<Serving> serving_;  // serving.hpp: one type per mode

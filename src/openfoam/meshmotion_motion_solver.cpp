@@ -20,7 +20,9 @@
 #include "Pstream.H"
 #include "syncTools.H"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -165,6 +167,19 @@ std::string option_text(const dictionary& coeffs, bool top)
         text += e.keyword() + "=" + value.str() + " ";
     }
     return text;
+}
+
+// A time for the log, to three significant digits: OpenFOAM's streams write every digit.
+std::string seconds_text(double seconds)
+{
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g s", seconds);
+    return text;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace
@@ -332,8 +347,7 @@ void meshmotionMotionSolver::setup()
     if (bridge_->support_radius() > 0) Info<< " (support radius " << bridge_->support_radius() << ")";
     if (bridge_->rigid_part()) Info<< ", each move's rigid part blended first";
     // The setup's cost, as each step's line gives the move's.
-    Info<< " in " << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
-        << " s, resident memory " << memInfo().update().rss() / 1024 << " MB" << endl;
+    Info<< " in " << seconds_text(seconds_since(start)).c_str() << ", resident memory " << memInfo().update().rss() / 1024 << " MB" << endl;
 }
 
 
@@ -368,14 +382,18 @@ void meshmotionMotionSolver::solve()
     {
         FatalErrorInFunction << e.what() << exit(FatalError);
     }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds = seconds_since(start);
     if (bridge_->setups() > setups)
     {
         Info<< "meshmotion: set up again for the motion's size (support radius " << bridge_->support_radius() << ")"
             << endl;
     }
-    // Where the time goes, as OpenFOAM's solvers log their residuals: this rank's.
-    Info<< "meshmotion: moved in " << seconds << " s (set-ups again included), ";
+    // Where the time goes, as OpenFOAM's solvers log their residuals: this rank's. What is
+    // neither set up again nor solved is evaluation (and the plugin's own copying).
+    const double rebuild = bridge_->rebuild_seconds(), solve = bridge_->solve_seconds();
+    Info<< "meshmotion: moved in " << seconds_text(seconds).c_str() << " (set up again " << seconds_text(rebuild).c_str()
+        << ", solve " << seconds_text(solve).c_str() << ", evaluation "
+        << seconds_text(std::max(0.0, seconds - rebuild - solve)).c_str() << "), ";
     if (bridge_->solver_iterations() > 0) Info<< bridge_->solver_iterations() << " solver iterations, ";
     Info<< "resident memory " << memInfo().update().rss() / 1024 << " MB" << endl;
     vectorField& displacement = pointDisplacement_.primitiveFieldRef();

@@ -553,6 +553,10 @@ TEST_CASE("repeated moves equal a fresh setup, superpose, and reuse the factoriz
     mover.move_into(Points<2>(b1.displacements + 2.0 * b2.displacements), into);
     CHECK(mover.stats().moves == 3);
     CHECK(mover.stats().factorizations == 1);
+    // The move is its solve: nothing set up again, the solve timed within the move.
+    CHECK(mover.stats().rebuild_seconds == 0.0);
+    CHECK(mover.stats().solve_seconds > 0.0);
+    CHECK(mover.stats().solve_seconds <= mover.stats().move_seconds);
     CHECK((into - (first + 2.0 * second)).norm() < 1e-12 * into.norm());
     decltype(mover) fresh(mover.options());
     fresh.setup(mesh, b2);

@@ -1018,6 +1018,11 @@ TEST_CASE("set up once on the reference, the default RBF follows a whole boundar
       Mesh<2> moved = mesh;
       moved.points += mover.move(d);
       CHECK(mover.stats().moves == step);
+      // The move's time split: a set up again is timed where it happened, and only there.
+      const MoverStats& s = mover.stats();
+      CHECK(s.solve_seconds > 0.0);
+      CHECK(s.solve_seconds + s.rebuild_seconds <= s.move_seconds);
+      CHECK((s.rebuild_seconds > 0.0) == (step == 1 || s.radius_growths > growths));
       if (mover.stats().radius_growths > growths) {
         double rest = 0.0;
         for (Index k = 0; k < boundary.size(); ++k)
@@ -1040,6 +1045,7 @@ TEST_CASE("set up once on the reference, the default RBF follows a whole boundar
     const Points<2> half = mover.move(displacements(0.5));
     CHECK(mover.move(displacements(1.0)).allFinite());
     CHECK(mover.stats().radius_growths == growths);
+    CHECK(mover.stats().rebuild_seconds == 0.0);
     CHECK(mover.support_radius() == radius);
     CHECK((mover.move(displacements(0.5)) - half).norm() == 0.0);
     // The derivative at the last move meets a central difference of moves about it.

@@ -245,6 +245,11 @@ TEST_CASE("distributed RBF set up before the motion grows its radius with it as 
       CHECK(mover.support_radius() == serial.support_radius());
       CHECK(mover.stats().radius_growths == serial.stats().radius_growths);
       CHECK(largest_gap(part, got, expected) <= 1e-10 * expected.colwise().norm().maxCoeff());
+      // The move's time split: set up again where the serial mover was (or built first), and solved.
+      const MoverStats& split = mover.stats();
+      CHECK((split.rebuild_seconds > 0.0) == (serial.stats().rebuild_seconds > 0.0));
+      CHECK(split.solve_seconds > 0.0);
+      CHECK(split.solve_seconds + split.rebuild_seconds <= split.move_seconds);
       // The grid velocity through the same map: the serial one, and no set-up again.
       const Points<2> v = motion(0.3 * s);
       const Points<2> expected_velocity = serial.derivative_forward(v);

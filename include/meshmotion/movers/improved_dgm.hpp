@@ -113,6 +113,8 @@ class ImprovedDgmMover : public detail::MoveFromMoveInto<ImprovedDgmMover<Dim>, 
                                       options_.dgm.check_inversion, out);
       stats_.iterations = rbf_.stats().iterations;
       stats_.residual = rbf_.stats().residual;
+      stats_.solve_seconds = rbf_.stats().solve_seconds;
+      stats_.rebuild_seconds = rbf_.stats().rebuild_seconds;
     });
   }
 

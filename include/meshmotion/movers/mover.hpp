@@ -16,6 +16,13 @@ namespace meshmotion {
 struct MoverStats {
   double setup_seconds = 0.0;  ///< the last setup
   double move_seconds = 0.0;   ///< the last move
+  /// Of move_seconds: the last move's solves (the interpolation's coefficients, the system's
+  /// displacements, a factorization deferred to them included). What is left of move_seconds
+  /// after these and rebuild_seconds is evaluation: the operators applied, the rigid part blended.
+  double solve_seconds = 0.0;
+  /// Of move_seconds: what the last move set up again or built first (RBF: a radius the motion
+  /// outgrew, the interpolation a mover set up at rest builds when it first has a rest to carry).
+  double rebuild_seconds = 0.0;
   Index moves = 0;             ///< moves since the last setup
   Index factorizations = 0;    ///< numeric factorizations since the last setup (1 for linear movers)
   Index iterations = 0;        ///< solver iterations of the last move (0 for direct solvers)
@@ -48,6 +55,8 @@ template <class F>
 void visit_fields(const MoverStats& s, F&& f) {
   f("setup_seconds", s.setup_seconds, "the last setup");
   f("move_seconds", s.move_seconds, "the last move");
+  f("solve_seconds", s.solve_seconds, "of the last move: its solves");
+  f("rebuild_seconds", s.rebuild_seconds, "of the last move: what it set up again or built first");
   f("moves", s.moves, "moves since the last setup");
   f("factorizations", s.factorizations, "numeric factorizations since the last setup");
   f("iterations", s.iterations, "solver iterations of the last move (0 for direct solvers)");

@@ -95,7 +95,9 @@ class NonlinearElasticityMover : public detail::MoveFromMoveInto<NonlinearElasti
   /// move() (inherited) returns the same; move_into writes into `out`, resized only when its
   /// shape differs.
   void move_into(PointsView<Dim> d, Points<Dim>& out) {
-    detail::timed_move<Dim>("NonlinearElasticityMover::move", ready_, d, boundary_nodes_, stats_, [&] { newton(d, out); });
+    detail::timed_move<Dim>("NonlinearElasticityMover::move", ready_, d, boundary_nodes_, stats_, [&] {
+      detail::add_time(stats_.solve_seconds, [&] { newton(d, out); });
+    });
   }
 
  private:

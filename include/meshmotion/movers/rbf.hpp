@@ -464,6 +464,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
         at_move_.blend(points_, d, rigid_);
         rigid_scale_ = d.size() > 0 ? d.colwise().norm().maxCoeff() : 0.0;
       }
+      solving_ = 0.0;
       follow_motion(d);
       if (rigid_.size() == 0) {
         apply(d, out);
@@ -476,7 +477,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
         }
         // What the rigid fit leaves of its own motion is round-off: nothing to interpolate.
         if (off > rigid_fit_round_off * rigid_scale_) {
-          build_interpolation();
+          if (pending_) detail::add_time(stats_.rebuild_seconds, [&] { build_interpolation(); });
           apply(rest, out);
           out += rigid_;
         } else {
@@ -490,6 +491,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
       stats_.iterations = r.iterations;
       stats_.residual = r.residual;
       stats_.fell_back = r.fell_back;
+      stats_.solve_seconds = solving_;
     });
   }
 
@@ -517,6 +519,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
                          format_option_value(boundary_diagonal_) + ")");
       }
     }
+    const detail::Stopwatch solving;
     if (k > n_constrained_) {
       with_constrained([&](auto& system) { system.solve(values_.topRows(n_constrained_), alpha_, beta_); });
       Eigen::MatrixXd s = sliding_operator_ * alpha_;
@@ -527,6 +530,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
       values_.bottomRows(k - n_constrained_) = s;
     }
     with_all([&](auto& system) { system.solve(values_, alpha_, beta_); });
+    solving_ += solving.seconds();
     shape_output(out);
     out.setZero();
     evaluate_interior(out);
@@ -612,6 +616,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   double boundary_diagonal_ = 0.0;          ///< of the boundary's bounding box: the coincidence tolerance's scale
   ResolvedBoundary<Dim> boundary_;          ///< as given to setup (its nodes and kinds; a set up again starts from it)
   bool grows_ = false;                      ///< the default radius follows the motion (follow_motion())
+  double solving_ = 0.0;                    ///< apply()'s solves since timed_apply() began (the move's solve_seconds)
   std::vector<Index> centre_of_;            ///< boundary entry → centre
   std::vector<Index> source_;               ///< centre → boundary entry giving its value
   Index n_constrained_ = 0;                 ///< centres 0..n_constrained_-1 are prescribed/fixed
@@ -745,6 +750,7 @@ void RbfMover<Dim>::follow_motion(PointsView<Dim> d) {
   ++stats_.radius_growths;
   if (rigid_.size() == 0) build_interpolation();
   stats_.setup_seconds += watch.seconds();
+  stats_.rebuild_seconds += watch.seconds();
 }
 
 template <int Dim>

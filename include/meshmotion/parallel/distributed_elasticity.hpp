@@ -488,7 +488,9 @@ void DistributedElasticityMover<Dim>::solve_for(PointsView<Dim> d, Points<Dim>& 
   for (std::size_t r = 0; r < held.size(); ++r) b[dirichlet_[r] - first_row_] = held[r];
   petsc_check(VecRestoreArray(b_.get(), &b), where, "VecRestoreArray");
   petsc_check(VecPointwiseMult(b_.get(), b_.get(), scale_.get()), where, "VecPointwiseMult");
+  const meshmotion::detail::Stopwatch solving;
   solve_scaled(where, step && choose_start(where));
+  const double solve_seconds = solving.seconds();
   if (step) {
     std::swap(before_, last_);
     if (!last_) petsc_check(VecDuplicate(x_.get(), last_.out()), where, "VecDuplicate");
@@ -516,6 +518,8 @@ void DistributedElasticityMover<Dim>::solve_for(PointsView<Dim> d, Points<Dim>& 
   petsc_check(VecRestoreArrayRead(ghosts_.get(), &g), where, "VecRestoreArrayRead");
   ++stats_.moves;
   stats_.move_seconds = watch.seconds();
+  stats_.solve_seconds = solve_seconds;
+  stats_.rebuild_seconds = 0.0;
 }
 
 template <int Dim>

@@ -78,6 +78,8 @@ class DistributedPartitionOfUnity {
 
   [[nodiscard]] double support_radius() const noexcept { return radius_; }
   [[nodiscard]] Index global_centres() const noexcept { return global_centres_; }
+  /// The last move_into()'s patch solves on this rank.
+  [[nodiscard]] double solve_seconds() const noexcept { return solve_seconds_; }
   /// This rank's owned boundary entries (its centres), in boundary order.
   [[nodiscard]] const std::vector<Index>& entries() const noexcept { return entries_; }
   [[nodiscard]] Index num_patches() const noexcept { return static_cast<Index>(radius_of_.size()); }
@@ -127,6 +129,7 @@ class DistributedPartitionOfUnity {
   Index n_local_ = 0;
   Index global_centres_ = 0;
   double radius_ = 0.0;
+  double solve_seconds_ = 0.0;
   meshmotion::detail::RbfKernelSettings kernel_;
   MoverStats stats_;
   // The patch table, the same on every rank.
@@ -465,6 +468,7 @@ void DistributedPartitionOfUnity<Dim>::move_into(PointsView<Dim> d, Out& out) {
     for (const std::int64_t c : wanted_[static_cast<std::size_t>(r)])
       for (int a = 0; a < Dim; ++a) send[static_cast<std::size_t>(r)].push_back(d(a, entries_[static_cast<std::size_t>(c)]));
   const auto values = parallel::exchange(comm_, send);
+  const meshmotion::detail::Stopwatch solving;
   collective(comm_, [&] {
     meshmotion::detail::for_each_in_parallel(owned_patches(), [&](Index j) {
       const auto p = static_cast<std::size_t>(j);
@@ -477,6 +481,7 @@ void DistributedPartitionOfUnity<Dim>::move_into(PointsView<Dim> d, Out& out) {
       systems_[p].solve(local, alpha_[p], beta);
     });
   });
+  solve_seconds_ = solving.seconds();
   // Each patch's coefficients to the ranks whose nodes it covers.
   std::vector<std::vector<double>> coefficients(static_cast<std::size_t>(ranks_));
   for (int r = 0; r < ranks_; ++r)

@@ -146,8 +146,9 @@ class DistributedRbfMover {
   /// Collective: the rest `rest` of `d` after the blend is more than the fit's round-off
   /// (rigid_fit_round_off, as the serial mover's test) on some rank.
   [[nodiscard]] bool leaves_something(PointsView<Dim> d, PointsView<Dim> rest) const;
-  /// Collective: sets the mover up again for `d` when it outgrew the default radius.
-  void follow_motion(PointsView<Dim> d);
+  /// Collective: sets the mover up again for `d` when it outgrew the default radius; the
+  /// seconds that took (0: nothing set up).
+  double follow_motion(PointsView<Dim> d);
   /// Collective: `d` less the rigid part's blend `blend` at the non-sliding entries (rest_).
   [[nodiscard]] const Points<Dim>& without_blend(PointsView<Dim> d, const Points<Dim>& blend);
   /// Collective: derivative_reverse() of the interpolation alone.
@@ -160,10 +161,12 @@ class DistributedRbfMover {
   /// Collective: the map of the current setup applied to `d`.
   template <class Out>
   void apply(PointsView<Dim> d, Out& out) {
-    if (patches_)
+    if (patches_) {
       patches_->move_into(d, out);
-    else
+      solving_ += patches_->solve_seconds();
+    } else {
       move_gathered(d, out);
+    }
   }
   // set_up()'s stages, in order.
   /// Gathers the owned entries (owned_entries_, counts_) and sorts them by global id
@@ -229,6 +232,7 @@ class DistributedRbfMover {
   Points<Dim> gathered_, inner_out_;
   RigidPartAtMove<Dim> at_move_;  ///< set up at rest: each move's rigid part
   Points<Dim> blend_, rest_;      ///< the last move's blend (Dim × part.size()), and d less it
+  double solving_ = 0.0;          ///< apply()'s solves since move_to() began (the move's solve_seconds)
   bool pending_ = false;          ///< set_up() deferred the build (build_interpolation())
   Points<Dim> pending_points_;    ///< replicated: the inner mover's points; PETSc: the centres
   ResolvedBoundary<Dim> pending_centres_;  ///< replicated: the inner mover's boundary
@@ -314,13 +318,14 @@ const Points<Dim>& DistributedRbfMover<Dim>::without_blend(PointsView<Dim> d, co
 }
 
 template <int Dim>
-void DistributedRbfMover<Dim>::follow_motion(PointsView<Dim> d) {
-  if (!grows_) return;
+double DistributedRbfMover<Dim>::follow_motion(PointsView<Dim> d) {
+  if (!grows_) return 0.0;
   double largest = 0.0;
   for (const Index k : owned_entries_)
     if (boundary_.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed) largest = std::max(largest, d.col(k).norm());
   MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_DOUBLE, MPI_MAX, comm_);
-  if (!radius_outgrown(largest, radius_)) return;
+  if (!radius_outgrown(largest, radius_)) return 0.0;
+  const meshmotion::detail::Stopwatch watch;
   ResolvedBoundary<Dim> grown = boundary_;
   grown.displacements.setZero(Dim, grown.size());
   for (const Index k : owned_entries_)
@@ -334,6 +339,7 @@ void DistributedRbfMover<Dim>::follow_motion(PointsView<Dim> d) {
     ++stats_.radius_growths;
   else
     grows_ = false;  // the memory budget holds the radius where it is
+  return watch.seconds();
 }
 
 template <int Dim>
@@ -601,8 +607,10 @@ template <class Out>
 void DistributedRbfMover<Dim>::move_to(PointsView<Dim> d, Out& out) {
   const meshmotion::detail::Stopwatch watch;
   check_entries("move", d);
+  solving_ = 0.0;
+  double rebuilding = 0.0;
   if (!at_move_.active()) {
-    follow_motion(d);
+    rebuilding += follow_motion(d);
     apply(d, out);
   } else {
     at_move_.blend(part_points_, d, blend_, RanksReduction{comm_});
@@ -612,8 +620,8 @@ void DistributedRbfMover<Dim>::move_to(PointsView<Dim> d, Out& out) {
       meshmotion::detail::size_output<Dim>(out, n_local_);
       out = blend_;
     } else {
-      follow_motion(rest);  // a radius outgrown is set up (and built) for the motion at once
-      build_interpolation();
+      rebuilding += follow_motion(rest);  // a radius outgrown is set up (and built) for the motion at once
+      if (pending_) meshmotion::detail::add_time(rebuilding, [&] { build_interpolation(); });
       apply(rest, out);
       // A shared node's owner and its other ranks add the same two numbers (the rest, the
       // blend): the same point on every rank, d to rounding.
@@ -622,6 +630,8 @@ void DistributedRbfMover<Dim>::move_to(PointsView<Dim> d, Out& out) {
   }
   ++stats_.moves;
   stats_.move_seconds = watch.seconds();
+  stats_.solve_seconds = solving_;
+  stats_.rebuild_seconds = rebuilding;
 }
 
 template <int Dim>
@@ -658,6 +668,7 @@ void DistributedRbfMover<Dim>::move_gathered(PointsView<Dim> d, Out& out) {
     meshmotion::detail::size_output<Dim>(out, n_local_);
     for (Index i = 0; i < n_local_; ++i) out.col(i) = inner_out_.col(column_[static_cast<std::size_t>(i)]);
     const MoverStats& s = inner_.stats();
+    solving_ += s.solve_seconds;
     stats_.iterations = s.iterations;
     stats_.residual = s.residual;
     stats_.fell_back = s.fell_back;
@@ -746,7 +757,7 @@ void DistributedRbfMover<Dim>::setup_petsc(const PartitionView<Dim>& part, Point
 template <int Dim>
 template <class Out>
 void DistributedRbfMover<Dim>::move_petsc(Out& out) {
-  collective(comm_, [&] { system_->solve(gathered_.transpose(), alpha_, beta_); });
+  meshmotion::detail::add_time(solving_, [&] { collective(comm_, [&] { system_->solve(gathered_.transpose(), alpha_, beta_); }); });
   meshmotion::detail::size_output<Dim>(out, n_local_);
   out.setZero();
   Points<Dim> columns;

@@ -87,14 +87,24 @@ void check_node_field(std::string_view where, const PointsView<Dim>& v, Index n_
     if (!v.col(i).allFinite()) throw InputError(std::string(where) + ": value of node " + std::to_string(i) + " is not finite");
 }
 
+/// Runs body() and adds its time to `seconds` (a move's phase: MoverStats::solve_seconds, ...).
+template <class Body>
+void add_time(double& seconds, Body&& body) {
+  const Stopwatch watch;
+  std::forward<Body>(body)();
+  seconds += watch.seconds();
+}
+
 /// One move: throws InputError unless `ready` (setup ran) and `d` fits `nodes`
-/// (check_displacements), runs body(), then counts the move and records its time in `stats`.
+/// (check_displacements), runs body() (which adds its phases to `stats`, from zero), then
+/// counts the move and records its time in `stats`.
 template <int Dim, class Body>
 void timed_move(std::string_view where, bool ready, PointsView<Dim> d, const std::vector<Index>& nodes,
                 MoverStats& stats, Body&& body) {
   const Stopwatch watch;
   if (!ready) throw InputError(std::string(where) + ": setup() was not called");
   check_displacements<Dim>(where, d, nodes);
+  stats.solve_seconds = stats.rebuild_seconds = 0.0;
   std::forward<Body>(body)();
   ++stats.moves;
   stats.move_seconds = watch.seconds();
