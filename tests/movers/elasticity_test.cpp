@@ -652,8 +652,9 @@ TEST_CASE("3D stiffened elasticity by component CG: set up at rest, moved many t
   }
   CHECK(direct.stats().iterations == 0);
   CHECK(iterations.front() > 3);
-  // From the third move on, the two earlier solutions span the motion: round-off is left.
-  for (std::size_t s = 2; s < iterations.size(); ++s) CHECK(iterations[s] <= 2);
+  // From the third move on, the two earlier solutions span the motion: round-off is left, a
+  // few iterations (23 and 21 from nothing; 2 with the factor in double, 3 rounded to float).
+  for (std::size_t s = 2; s < iterations.size(); ++s) CHECK(iterations[s] <= 3);
   CHECK(cg.stats().factorizations == 1);
   CHECK(!cg.stats().fell_back);
   // The reverse derivative keeps its own history and agrees with the direct one.

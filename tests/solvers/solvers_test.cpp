@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <memory>
 #include <vector>
 
 using namespace meshmotion;
@@ -165,5 +166,49 @@ TEST_CASE("CHOLMOD's BLAS works with the library's threads when it is OpenBLAS",
     CHECK(count() == n);
   }
   set_num_threads(0);
+}
+
+TEST_CASE("the supernodal factor in single precision solves as CHOLMOD does, to float's rounding", "[solvers]") {
+  // Large enough for supernodes of many columns (the BLAS's triangles and products), with
+  // right-hand sides whose columns differ by 1e40 (each is scaled before it is rounded).
+  const SparseMatrix a = poisson(120, 0.01);
+  const auto factorized = [](const SparseMatrix& m) {
+    auto llt = std::make_unique<detail::CholmodSupernodalLLT>();
+    llt->analyzePattern(m);
+    llt->factorize(m);
+    REQUIRE(llt->info() == Eigen::Success);
+    return llt;
+  };
+  Eigen::MatrixXd b = Eigen::MatrixXd::Random(a.rows(), 3);
+  b.col(1) *= 1e20;
+  b.col(2) *= 1e-20;
+  const Eigen::MatrixXd exact = factorized(a)->solve(b);
+  // Scaled beyond float's range too (the factor by 1e35, or 1e-45): the same answer.
+  for (const double s : {1.0, 1e70, 1e-90}) {
+    CAPTURE(s);
+    auto llt = factorized(SparseMatrix(s * a));
+    detail::SingleSupernodalFactor single;
+    REQUIRE(single.take(llt));
+    CHECK(llt == nullptr);  // rounded in place: CHOLMOD's factor is the single one's now
+    Eigen::MatrixXd x = b;
+    single.solve_in_place(x);
+    for (Index c = 0; c < 3; ++c) {
+      CAPTURE(c);
+      const double error = (s * x.col(c) - exact.col(c)).cwiseAbs().maxCoeff();
+      CHECK(error < 1e-5 * exact.col(c).cwiseAbs().maxCoeff());
+      CHECK(error > 0.0);  // float, not CHOLMOD's double, answered
+    }
+  }
+  // A diagonal 1e-40 of the largest entry is beyond float: not taken, the factor left whole.
+  SparseMatrix graded = a;
+  graded.coeffRef(0, 0) = 1e-80;
+  graded.coeffRef(1, 0) = graded.coeffRef(0, 1) = 0.0;
+  graded.coeffRef(120, 0) = graded.coeffRef(0, 120) = 0.0;  // node 0 on its own
+  graded.prune(0.0);
+  auto llt = factorized(graded);
+  detail::SingleSupernodalFactor single;
+  CHECK_FALSE(single.take(llt));
+  REQUIRE(llt != nullptr);
+  CHECK(llt->solve(b).allFinite());
 }
 #endif
