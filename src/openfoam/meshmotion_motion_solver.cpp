@@ -169,12 +169,17 @@ std::string option_text(const dictionary& coeffs, bool top)
     return text;
 }
 
-// A time for the log, to three significant digits: OpenFOAM's streams write every digit.
-std::string seconds_text(double seconds)
+// A figure for the log to `digits` significant digits: OpenFOAM's streams write every digit.
+std::string significant(double value, int digits)
 {
     char text[32];
-    std::snprintf(text, sizeof text, "%.3g s", seconds);
+    std::snprintf(text, sizeof text, "%.*g", digits, value);
     return text;
+}
+
+std::string seconds_text(double seconds)
+{
+    return significant(seconds, 3) + " s";
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start)
@@ -344,7 +349,7 @@ void meshmotionMotionSolver::setup()
         << returnReduce(label(boundary_.size()), sumOp<label>()) << " boundary points of "
         << returnReduce(n, sumOp<label>());
     if (Pstream::parRun()) Info<< " on " << Pstream::nProcs() << " ranks (points on several ranks counted on each)";
-    if (bridge_->support_radius() > 0) Info<< " (support radius " << bridge_->support_radius() << ")";
+    if (bridge_->support_radius() > 0) Info<< " (support radius " << significant(bridge_->support_radius(), 6).c_str() << ")";
     if (bridge_->rigid_part()) Info<< ", each move's rigid part blended first";
     // The setup's cost, as each step's line gives the move's.
     Info<< " in " << seconds_text(seconds_since(start)).c_str() << ", resident memory " << memInfo().update().rss() / 1024 << " MB" << endl;
@@ -385,7 +390,8 @@ void meshmotionMotionSolver::solve()
     const double seconds = seconds_since(start);
     if (bridge_->setups() > setups)
     {
-        Info<< "meshmotion: set up again for the motion's size (support radius " << bridge_->support_radius() << ")"
+        Info<< "meshmotion: set up again for the motion's size (support radius "
+            << significant(bridge_->support_radius(), 6).c_str() << ")"
             << endl;
     }
     // Where the time goes, as OpenFOAM's solvers log their residuals: this rank's. What is
