@@ -447,6 +447,10 @@ def test_a_mover_set_up_once_follows_a_whole_boundary_turning_56_degrees():
         moved = mm.from_arrays(mesh.points + mover.move(target - x), {"quad4": mesh.cells[0][1]}, {})
         report = mm.quality_report(moved, "scaled_jacobian")
         assert report["invalid"] == 0 and report["min"] > 0.5, (step, report["min"])
+        # The move's time split: its solves and what it set up again, within the move.
+        stats = mover.stats
+        assert stats["solve_seconds"] > 0.0 and stats["rebuild_seconds"] >= 0.0
+        assert stats["solve_seconds"] + stats["rebuild_seconds"] <= stats["move_seconds"]
     assert mover.stats["moves"] == 10
     assert mover.stats["rigid_part"]
     assert mover.stats["radius_growths"] <= 4
