@@ -205,6 +205,10 @@ class SingleSupernodalFactor {
     for (int c = 0; c < k; ++c)
       if (!(scale(c) > 0.0)) scale(c) = 1.0;
     y_.resize(n, k);
+    // One buffer for every supernode's rows below its triangle (at most maxesize of them),
+    // each viewed with its own leading dimension: resizing it per supernode allocated twice
+    // per supernode and solve.
+    below_.resize(static_cast<Eigen::Index>(factor_->maxesize) * k);
     for (int c = 0; c < k; ++c)
       for (int r = 0; r < n; ++r) y_(r, c) = static_cast<float>(b(perm[r], c) / scale(c));
     const float one = 1.0F, zero = 0.0F, minus = -1.0F;
@@ -214,18 +218,18 @@ class SingleSupernodalFactor {
       Block s = block(q);
       trsm_("L", "L", "N", "N", &s.columns, &k, &one, s.values, &s.rows, &y_(s.first, 0), &n);
       if (s.below == 0) continue;
-      below_.resize(s.below, k);
+      const Eigen::Map<Eigen::MatrixXf> below(below_.data(), s.below, k);
       gemm_("N", "N", &s.below, &k, &s.columns, &one, s.values + s.columns, &s.rows, &y_(s.first, 0), &n, &zero, below_.data(), &s.below);
       for (int c = 0; c < k; ++c)
-        for (int i = 0; i < s.below; ++i) y_(s.below_rows[i], c) -= below_(i, c);
+        for (int i = 0; i < s.below; ++i) y_(s.below_rows[i], c) -= below(i, c);
     }
     // Lᵀ x = y, from the last supernode back.
     for (int q = nsuper - 1; q >= 0; --q) {
       Block s = block(q);
       if (s.below > 0) {
-        below_.resize(s.below, k);
+        Eigen::Map<Eigen::MatrixXf> below(below_.data(), s.below, k);
         for (int c = 0; c < k; ++c)
-          for (int i = 0; i < s.below; ++i) below_(i, c) = y_(s.below_rows[i], c);
+          for (int i = 0; i < s.below; ++i) below(i, c) = y_(s.below_rows[i], c);
         gemm_("T", "N", &s.columns, &k, &s.below, &minus, s.values + s.columns, &s.rows, below_.data(), &s.below, &one, &y_(s.first, 0), &n);
       }
       trsm_("L", "L", "T", "N", &s.columns, &k, &one, s.values, &s.rows, &y_(s.first, 0), &n);
@@ -264,7 +268,8 @@ class SingleSupernodalFactor {
   double scale_ = 1.0;                           ///< the rounded factor is scale_ L
   Trsm trsm_ = nullptr;
   Gemm gemm_ = nullptr;
-  Eigen::MatrixXf y_, below_;
+  Eigen::MatrixXf y_;
+  Eigen::VectorXf below_;
 };
 
 }  // namespace meshmotion::detail
