@@ -173,7 +173,7 @@ void apply_factors(std::span<const Eigen::MatrixXd* const> factors, Lattice& val
 
 // det J at every lattice point, divided by `scale`. The transposed Jacobians (row point · D +
 // reference direction, column physical coordinate) come by sum factorization for complete
-// quadrilaterals and hexahedra of order 2 on and prisms of order 4 on, otherwise as the
+// quadrilaterals, hexahedra and prisms of order 2 on, otherwise as the
 // product of the shape-gradient table with the coordinates.
 template <int D, class Lattice>
 void lattice_dets(const JacobianSpace& s, const ElementCoords<D>& x, double scale, Lattice& values) {
