@@ -4,8 +4,9 @@ edges in a held 12^3 box (tetrahedra by Gmsh: 0.1 at the plate, 0.5 at the walls
 with nothing moving, then moved from the reference about the plate's axis in 15 degree steps to
 a half turn, as a solver's time loop does. Per step: the invalid cells (scaled Jacobian), the
 minimum shape quality (a linear tetrahedron's scaled Jacobian is only its sign) and the move's
-time, for the defaults (each move's rigid part blended, RigidPartAtMove) beside
-rigid_part=none (the whole motion interpolated, as before), through Python's Warp; run
+time, for the defaults (each move's rigid part blended, RigidPartAtMove, and the cells the move
+folded repaired, RbfOptions::repair) beside repair=False (the blend alone) and rigid_part=none
+(the whole motion interpolated), through Python's Warp; run
 under mpiexec it also moves on the ranks (Warp(comm=)) and gives the largest distance from the
 serial points. With --programs (the build's examples folder) the programs run the same case
 as users run them: move_mesh --steps 12 to the half turn and move_mesh_mpi on 2 ranks to a
@@ -80,7 +81,8 @@ def run(mesh, options, comm=None):
         warp.warp()
         seconds = time.perf_counter() - start
         points = warp.gather_volume_coordinates() if comm is not None else warp.volume_coordinates()
-        steps.append((degrees, seconds, points))
+        stats = warp._mover.stats
+        steps.append((degrees, seconds, points, (int(stats["folded_cells"]), int(stats["repaired_nodes"]))))
     return warp, steps
 
 
@@ -132,26 +134,28 @@ def main():
         mesh = mm.read_mesh(path)
         cells = {"tet4": mesh.cells[0][1]}
         if args.programs:
-            programs_rows(args.programs, path, tmp, cells, {d: p for d, _, p in run(mesh, {})[1]})
+            programs_rows(args.programs, path, tmp, cells, {d: p for d, _, p, _ in run(mesh, {})[1]})
             return
         rows = {}
-        for name, options in (("(defaults)", {}), ("rigid_part=none", {"rigid_part": "none"})):
+        for name, options in (("(defaults)", {}), ("repair=False", {"repair": False}),
+                              ("rigid_part=none", {"rigid_part": "none"})):
             if rank == 0:
                 warp, steps = run(mesh, options)
                 rows[name] = steps
-                for degrees, seconds, points in steps:
+                for degrees, seconds, points, (folded, repaired) in steps:
                     moved = mm.from_arrays(points, cells, {})
                     report = mm.quality_report(moved, "scaled_jacobian")
                     row = {"bench": "plate_turn", "options": name, "ranks": 1, "nodes": len(points),
                            "cells": len(cells["tet4"]), "degrees": degrees, "invalid": int(report["invalid"]),
                            "min_shape": round(float(mm.quality_report(moved, "shape")["min"]), 4),
                            "move_seconds": round(seconds, 4),
-                           "setups_again": int(warp._mover.stats["radius_growths"])}
+                           "setups_again": int(warp._mover.stats["radius_growths"]),
+                           "folded": folded, "repaired_nodes": repaired}
                     print(json.dumps(row), flush=True)
         if comm is not None:
             _, steps = run(mesh, {}, comm)
             if rank == 0:
-                for (degrees, seconds, points), (_, _, serial) in zip(steps, rows["(defaults)"]):
+                for (degrees, seconds, points, _), (_, _, serial, _) in zip(steps, rows["(defaults)"]):
                     print(json.dumps({"bench": "plate_turn", "options": "(defaults)", "ranks": comm.Get_size(),
                                       "degrees": degrees, "move_seconds": round(seconds, 4),
                                       "largest_difference_from_serial": float(np.abs(points - serial).max())}), flush=True)

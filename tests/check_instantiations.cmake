@@ -18,8 +18,9 @@ foreach(object ${objects})
   execute_process(COMMAND "${NM}" -C --defined-only "${BUILD_DIR}/${object}" OUTPUT_VARIABLE symbols ERROR_QUIET)
   foreach(mover ${movers})
     foreach(dim 2 3)
-      # setup(mesh, boundary), or setup<Mesh<Dim>>(...) where setup is a template over the mesh type.
-      if(symbols MATCHES "meshmotion::${mover}<${dim}>::setup[(<]")
+      # setup(mesh, boundary), or setup<Mesh<Dim>>(...) where setup is a template over the mesh type
+      # (a program's own mesh type, setup<solver::AirfoilGrid>, is that program's instantiation).
+      if(symbols MATCHES "meshmotion::${mover}<${dim}>::setup(\\(|<meshmotion::)")
         list(APPEND defined_${dim}_${mover} "${object}")
       endif()
     endforeach()

@@ -97,7 +97,9 @@ TEST_CASE("partition of unity: many patches interpolate, vanish beyond the suppo
 TEST_CASE("partition of unity: linear, with derivatives, the same on any thread count", "[movers]") {
   const Mesh<3> mesh = box(10);
   const ResolvedBoundary<3> boundary = bottom_tilt(mesh);
-  RbfMover<3> mover(patched(0.35, 50));
+  RbfOptions options = patched(0.35, 50);
+  options.repair = false;  // the map's own linearity: its random motions fold cells, which the repair would move
+  RbfMover<3> mover(options);
   mover.setup(mesh, boundary);
   const Index m = boundary.size();
   const Points<3> d1 = random_displacements<3>(m, 1), d2 = random_displacements<3>(m, 2);

@@ -77,6 +77,7 @@ void check_properties(int n) {
   const Index m = boundary.size();
   RbfOptions options;
   options.support_radius = 0.35;
+  options.repair = false;  // the map's own properties: its random motions fold cells, which the repair would move
   RbfMover<Dim> mover(options);
   mover.setup(g.mesh, boundary);
   static_assert(MeshMover<RbfMover<Dim>>);
@@ -1316,6 +1317,115 @@ TEST_CASE("set up at rest, a square turned inside a held circle from the referen
     folded.points += interpolating.move(turned(120.0));
     CHECK(quality_report(folded, Metric::scaled_jacobian).num_invalid > 0);
   }
+}
+
+/// Turns `mesh`'s prescribed nodes about the z axis from one setup at rest, in 15 degree steps to
+/// a half turn, with and without RbfOptions::repair; returns the cells folded without it.
+template <int Dim>
+Index repaired_half_turn(const Mesh<Dim>& mesh, const ResolvedBoundary<Dim>& boundary) {
+  RbfMover<Dim> mover;
+  mover.setup(mesh, boundary);
+  RbfOptions off;
+  off.repair = false;
+  RbfMover<Dim> plain(off);
+  plain.setup(mesh, boundary);
+  Index folded_somewhere = 0;
+  for (int degrees = 15; degrees <= 180; degrees += 15) {
+    CAPTURE(degrees);
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(degrees * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    Points<Dim> d = Points<Dim>::Zero(Dim, boundary.size());
+    for (Index k = 0; k < boundary.size(); ++k)
+      if (boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed) {
+        const Vec<Dim> x = mesh.points.col(boundary.nodes[static_cast<std::size_t>(k)]);
+        d.col(k) = turn.topLeftCorner<Dim, Dim>() * x - x;
+      }
+    Mesh<Dim> moved = mesh, unrepaired = mesh;
+    moved.points += mover.move(d);
+    unrepaired.points += plain.move(d);
+    const Index folded = quality_report(unrepaired, Metric::scaled_jacobian).num_invalid;
+    CHECK(quality_report(moved, Metric::scaled_jacobian).num_invalid == 0);
+    CHECK(mover.stats().folded_cells == folded);
+    CHECK(mover.stats().left_folded == 0);
+    if (folded == 0) {
+      CHECK(moved.points == unrepaired.points);
+      CHECK(mover.stats().repaired_nodes == 0);
+    } else {
+      CHECK(mover.stats().repaired_nodes > 0);
+    }
+    folded_somewhere += folded;
+    for (Index k = 0; k < boundary.size(); ++k) {  // the body where it was put, the walls held, the ends in their planes
+      const Index v = boundary.nodes[static_cast<std::size_t>(k)];
+      if (boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::sliding)
+        CHECK(std::abs(boundary.normals.col(k).dot(moved.points.col(v) - mesh.points.col(v))) <= 1e-12);
+      else
+        CHECK(moved.points.col(v) == unrepaired.points.col(v));
+    }
+    // The derivatives are the map's before the repair.
+    CHECK(mover.derivative_forward(d) == plain.derivative_forward(d));
+  }
+  return folded_somewhere;
+}
+
+/// The nodes of `box` within |x| ≤ 1.5, |y|, |z| ≤ 0.8 prescribed, those on its sides fixed.
+ResolvedBoundary<3> block_in_box(const Mesh<3>& box) {
+  ResolvedBoundary<3> b;
+  for (Index v = 0; v < box.num_nodes(); ++v) {
+    const Vec<3> x = box.points.col(v);
+    if (std::abs(x.x()) <= 1.5 + 1e-9 && std::abs(x.y()) <= 0.8 && std::abs(x.z()) <= 0.8) {
+      b.nodes.push_back(v);
+      b.kinds.push_back(BoundaryKind::prescribed);
+    } else if (x.cwiseAbs().maxCoeff() > 6.0 - 1e-9) {
+      b.nodes.push_back(v);
+      b.kinds.push_back(BoundaryKind::fixed);
+    }
+  }
+  b.displacements = b.normals = Points<3>::Zero(3, b.size());
+  return b;
+}
+
+TEST_CASE("set up at rest on a coarse mesh, the cells a half turn folds are repaired", "[movers]") {
+  // The square above in a coarser O-mesh (quadrilaterals, and hexahedra extruded from them, the
+  // ends sliding in their planes): the twist folds linear cells from 150 degrees. After each
+  // move the folded cells' free nodes and two rings around them move until they unfold
+  // (RbfOptions::repair); a move that folds nothing is the move unrepaired, bit for bit.
+  const Mesh<2> mesh = o_mesh({.body = OMeshBody::square, .semi_axis_x = 1.0, .n_around = 64, .n_radial = 40,
+                               .first_height = 0.01, .farfield_radius = 6.0});
+  BoundarySpec<2> spec;
+  spec.prescribed("wall").fixed("farfield");
+  const ResolvedBoundary<2> boundary = spec.resolve(mesh);
+  CHECK(repaired_half_turn(mesh, boundary) > 0);  // 16 quadrilaterals at 180 degrees without it
+  // A block 3 x 1.5 x 1.5 of nodes inside a held box of tetrahedra 16 cells wide: 620 fold at 180.
+  const Mesh<3> box = box_mesh({.nx = 16, .ny = 16, .nz = 16, .x_min = -6, .x_max = 6, .y_min = -6, .y_max = 6,
+                                .z_min = -6, .z_max = 6, .cells = BoxCells::tet4});
+  CHECK(repaired_half_turn(box, block_in_box(box)) > 0);
+  // Without the cells (coordinates alone) there is nothing to repair.
+  RbfMover<2> points_only;
+  points_only.setup_reference(mesh.points, boundary);
+  Points<2> half = Points<2>::Zero(2, boundary.size());
+  for (Index k = 0; k < boundary.size(); ++k)
+    if (boundary.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed)
+      half.col(k) = -2.0 * mesh.points.col(boundary.nodes[static_cast<std::size_t>(k)]);
+  Mesh<2> moved = mesh;
+  moved.points += points_only.move(half);
+  CHECK(points_only.stats().folded_cells == 0);
+  CHECK(quality_report(moved, Metric::scaled_jacobian).num_invalid > 0);
+  // Hexahedra are searched by their corners and centres, then certified: what the repair says
+  // it left is what quality_report finds, and fewer than it found.
+  const Mesh<3> hexes = box_mesh({.nx = 16, .ny = 16, .nz = 16, .x_min = -6, .x_max = 6, .y_min = -6, .y_max = 6,
+                                  .z_min = -6, .z_max = 6});
+  const ResolvedBoundary<3> block = block_in_box(hexes);
+  RbfMover<3> hex_mover;
+  hex_mover.setup(hexes, block);
+  Points<3> turned = Points<3>::Zero(3, block.size());
+  for (Index k = 0; k < block.size(); ++k)
+    if (block.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed)
+      turned.col(k) = Eigen::AngleAxisd(0.8 * std::numbers::pi, Vec<3>::UnitZ()) * hexes.points.col(block.nodes[static_cast<std::size_t>(k)]) -
+                      hexes.points.col(block.nodes[static_cast<std::size_t>(k)]);
+  Mesh<3> moved_hexes = hexes;
+  moved_hexes.points += hex_mover.move(turned);
+  CHECK(hex_mover.stats().folded_cells > 0);
+  CHECK(quality_report(moved_hexes, Metric::scaled_jacobian).num_invalid == hex_mover.stats().left_folded);
+  CHECK(hex_mover.stats().left_folded < hex_mover.stats().folded_cells / 4);
 }
 
 TEST_CASE("rigid_part=blend on a mover set up at rest names what stops it", "[movers]") {

@@ -65,7 +65,7 @@ Outcome compare_with_serial(const Mesh<Dim>& whole, const ResolvedBoundary<Dim>&
   if (radius_per_entry)
     for (const Index v : local_b.nodes) local_options.support_radii.push_back(radius_at(part.local.points.col(v)));
   DistributedRbfMover<Dim> mover(local_options, solve);
-  mover.setup(part.view(), local_b);
+  mover.setup(part.view(), part.local, local_b);  // with the cells, as the serial mover: the same repair
   REQUIRE(mover.petsc_solve() == (solve.boundary_solve == BoundarySolve::petsc));
   const Points<Dim> got = mover.move(local_b.displacements);
 
@@ -635,7 +635,7 @@ TEST_CASE("distributed RBF set up at rest blends each move's rigid part as the s
     const DistributedMesh<2> part = partition_mesh(world(), mesh);
     const ResolvedBoundary<2> local_b = distribute_boundary(part, b);
     DistributedRbfMover<2> mover({}, {solve});
-    mover.setup(part.view(), local_b);
+    mover.setup(part.view(), part.local, local_b);
     REQUIRE(mover.stats().rigid_part);
     // As the serial mover: nothing factorized while each move's rigid part carries it all.
     CHECK(mover.stats().factorizations == 0);
@@ -668,6 +668,40 @@ TEST_CASE("distributed RBF set up at rest blends each move's rigid part as the s
       CHECK(global_max(worst) <= 1e-9 * expected_gradient.colwise().norm().maxCoeff());
     }
   }
+}
+
+TEST_CASE("distributed RBF given the cells repairs what a half turn folds as the serial mover does", "[parallel][rbf]") {
+  // The coarse O-mesh whose linear cells a half turn folds (rbf_test.cpp): the ranks gather
+  // the folded cells' patch and repair it in the serial order, so the points are the serial ones.
+  const Mesh<2> mesh = o_mesh({.body = OMeshBody::square, .semi_axis_x = 1.0, .n_around = 64, .n_radial = 40,
+                               .first_height = 0.01, .farfield_radius = 6.0});
+  BoundarySpec<2> spec;
+  spec.moving("wall", Translation<2>{meshmotion::Vec<2>::Zero()}).fixed("farfield");
+  const ResolvedBoundary<2> b = spec.resolve(mesh);
+  RbfMover<2> serial;
+  serial.setup(mesh, b);
+  const DistributedMesh<2> part = partition_mesh(world(), mesh);
+  const ResolvedBoundary<2> local_b = distribute_boundary(part, b);
+  DistributedRbfMover<2> mover;
+  mover.setup(part.view(), part.local, local_b);
+  Index folded = 0;
+  for (const double degrees : {90.0, 150.0, 165.0, 180.0}) {
+    CAPTURE(degrees);
+    Points<2> d = Points<2>::Zero(2, b.size());
+    for (Index k = 0; k < b.size(); ++k)
+      if (b.kinds[static_cast<std::size_t>(k)] == BoundaryKind::prescribed) {
+        const meshmotion::Vec<2> x = mesh.points.col(b.nodes[static_cast<std::size_t>(k)]);
+        d.col(k) = Eigen::Rotation2Dd(degrees * std::numbers::pi / 180.0) * x - x;
+      }
+    const Points<2> expected = serial.move(d);
+    const Points<2> got = mover.move(local_values(part, b, local_b, d));
+    CHECK(largest_gap(part, got, expected) <= 1e-10 * expected.colwise().norm().maxCoeff());
+    CHECK(mover.stats().folded_cells == serial.stats().folded_cells);
+    CHECK(mover.stats().repaired_nodes == serial.stats().repaired_nodes);
+    CHECK(mover.stats().left_folded == 0);
+    folded += serial.stats().folded_cells;
+  }
+  CHECK(folded > 0);
 }
 
 TEST_CASE("distributed RBF on two levels: the serial mover's levels, moves and gradients", "[parallel][rbf]") {

@@ -49,6 +49,11 @@ struct MoverStats {
   Index radius_growths = 0;
   /// RBF: centres of the coarse level of a two-level interpolation (RbfOptions::levels; 0: one level).
   Index coarse_centres = 0;
+  /// RBF set up with a mesh of linear cells: cells the last move folded (RbfOptions::repair),
+  /// nodes the repair then moved, and cells it left folded.
+  Index folded_cells = 0;
+  Index repaired_nodes = 0;
+  Index left_folded = 0;
 };
 
 template <class F>
@@ -72,6 +77,9 @@ void visit_fields(const MoverStats& s, F&& f) {
   f("radius_reduced", s.radius_reduced, "RBF: the default radius was reduced to fit the memory budget");
   f("radius_growths", s.radius_growths, "RBF: moves that outgrew the default radius and set the mover up again");
   f("coarse_centres", s.coarse_centres, "RBF: centres of the coarse level of a two-level interpolation (0: one level)");
+  f("folded_cells", s.folded_cells, "RBF: linear cells the last move folded (before the repair)");
+  f("repaired_nodes", s.repaired_nodes, "RBF: nodes the repair of the folded cells moved");
+  f("left_folded", s.left_folded, "RBF: cells still folded after the repair");
 }
 
 /// A mesh mover in Dim = M::dim dimensions.

@@ -58,6 +58,7 @@
 #include "meshmotion/movers/detail/rbf_partition_of_unity.hpp"
 #include "meshmotion/movers/detail/rbf_system.hpp"
 #include "meshmotion/movers/detail/rbf_two_level.hpp"
+#include "meshmotion/movers/linear_repair.hpp"
 #include "meshmotion/movers/mover.hpp"
 #include "meshmotion/movers/rbf_kernels.hpp"
 #include "meshmotion/movers/rigid_part.hpp"
@@ -330,8 +331,10 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
     requires(mesh_dim<M> == Dim)
   void setup(const M& mesh, const ResolvedBoundary<Dim>& boundary) {
     setup_reference(copy_points(mesh), boundary);
+    if (options_.repair) repair_.prepare(mesh, boundary);
   }
-  /// setup() from the reference coordinates alone (Dim × n_nodes): all the RBF needs of a mesh.
+  /// setup() from the reference coordinates alone (Dim × n_nodes): all the RBF needs of a mesh,
+  /// but the cells the repair of folded cells needs (RbfOptions::repair: not done).
   void setup_reference(Points<Dim> points, const ResolvedBoundary<Dim>& boundary);
 
   /// Displacement of every node (Dim × n_nodes) for boundary displacements `d`
@@ -487,6 +490,10 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
         for (std::size_t b = 0; b < boundary_.nodes.size(); ++b)
           if (boundary_.kinds[b] != BoundaryKind::sliding) out.col(boundary_.nodes[b]) = d.col(static_cast<Index>(b));
       }
+      const RepairReport repaired = repair_.repair(out);
+      stats_.folded_cells = repaired.folded;
+      stats_.repaired_nodes = repaired.moved_nodes;
+      stats_.left_folded = repaired.left_folded;
       const SolverReport& r = with_all([](auto& system) -> const SolverReport& { return system.report(); });
       stats_.iterations = r.iterations;
       stats_.residual = r.residual;
@@ -647,6 +654,7 @@ class RbfMover : public detail::MoveFromMoveInto<RbfMover<Dim>, Dim> {
   double rigid_scale_ = 0.0;     ///< the largest displacement of the motion it was fitted to
   /// Set up at rest: the rigid part found at every move (rigid_ then holds the last move's).
   RigidPartAtMove<Dim> at_move_;
+  LinearRepair<Dim> repair_;  ///< the cells setup() was given, when all linear (RbfOptions::repair)
   /// With the rigid part out, the interpolation is factorized at the first move or derivative
   /// that needs it (a move by the setup's own rigid motion does not): its centres and kernel.
   Points<Dim> pending_centres_;
@@ -658,6 +666,7 @@ template <int Dim>
 void RbfMover<Dim>::setup_reference(Points<Dim> points, const ResolvedBoundary<Dim>& boundary) {
   const detail::Stopwatch watch;
   check_options(boundary);
+  repair_ = {};
   radius_reduced_ = false;
   rigid_.resize(Dim, 0);
   at_move_ = {};

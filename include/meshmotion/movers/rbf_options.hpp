@@ -93,6 +93,7 @@ struct RbfOptions {
   Index two_level_centres = 2000;
   Index coarse_centres = 1000;
   double fine_spacings = 4.0;
+  bool repair = true;
 };
 
 // visit_options(o, f) calls f(key, field, help) for every field of `o` that text may set.
@@ -170,6 +171,14 @@ void visit_options(RbfOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "two_level_centres", o.two_level_centres, OptionHelp{"levels=automatic: most boundary nodes carried by one level", range::at_least(1)});
   f(prefix + "coarse_centres", o.coarse_centres, OptionHelp{"two levels: most centres of the coarse level", range::at_least(1)});
   f(prefix + "fine_spacings", o.fine_spacings, OptionHelp{"two levels: the fine level's radius, x the median boundary spacing", range::positive});
+  f(prefix + "repair", o.repair, OptionHelp{"move the free nodes around linear cells a move folded until they unfold", {},
+      "Set up with a mesh whose cells are all linear: after each move, the cells valid at the reference that "
+      "the move folded, and two rings of neighbours around them, have their free nodes (no boundary entry) "
+      "moved until the cells unfold (linear_repair.hpp): a body turned a half turn in held walls twists "
+      "the space between more than a coarse mesh's slivers take. A move that folds nothing is unchanged "
+      "(one pass of corner determinants). MoverStats::folded_cells, repaired_nodes and left_folded say what "
+      "it found and did; derivatives are those of the move before the repair. Over MPI the same repair, "
+      "on the patch gathered: the serial result."});
 }
 
 /// Whether an RBF mover with options `o` (effective_options()) interpolates on two levels

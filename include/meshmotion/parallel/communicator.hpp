@@ -123,6 +123,15 @@ template <class T>
   return all_gather(comm, std::span<const T>(mine), counts);
 }
 
+/// all_gather() as LinearRepair's gathers (LocalGather for one process).
+struct RanksGather {
+  MPI_Comm comm;
+  template <class T>
+  [[nodiscard]] std::vector<T> all(const std::vector<T>& mine) const {
+    return all_gather(comm, mine);
+  }
+};
+
 /// Every rank's `mine` concatenated in rank order, on `root` only (empty elsewhere).
 template <class T>
 [[nodiscard]] std::vector<T> gather_to(MPI_Comm comm, int root, const std::vector<T>& mine) {

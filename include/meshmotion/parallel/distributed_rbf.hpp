@@ -99,6 +99,19 @@ class DistributedRbfMover {
   /// whose arrays disagree, a global id owned by two ranks, a bad boundary, an empty global
   /// boundary, or what RbfMover::setup throws.
   void setup(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary);
+  /// setup() with the rank's cells (`local`: the part's nodes, and the cells assigned to this
+  /// rank): a move then repairs the linear cells it folded as the serial mover does
+  /// (RbfOptions::repair), on the patch gathered from every rank. Collective.
+  void setup(const PartitionView<Dim>& part, const Mesh<Dim>& local, const ResolvedBoundary<Dim>& boundary) {
+    setup(part, boundary);
+    if (!options_.repair) return;
+    std::vector<char> owned(static_cast<std::size_t>(part.size()));
+    for (Index v = 0; v < part.size(); ++v) owned[static_cast<std::size_t>(v)] = part.owns(v) ? 1 : 0;
+    repair_.prepare(local, boundary, std::vector<std::int64_t>(part.global_ids.begin(), part.global_ids.end()), std::move(owned));
+    int linear = repair_.active() ? 1 : 0;
+    MPI_Allreduce(MPI_IN_PLACE, &linear, 1, MPI_INT, MPI_MIN, comm_);
+    if (linear == 0) repair_.disable();
+  }
 
   /// Collective. Displacement (Dim × part.size()) of every local node for the displacements
   /// `d` (Dim × boundary.size()) of this rank's boundary entries; only owned entries are
@@ -204,6 +217,7 @@ class DistributedRbfMover {
   bool grows_ = false;  ///< the default radius follows the motion (follow_motion())
   RbfMover<Dim> inner_;      ///< replicated: over the gathered centres followed by the local interior nodes
   RbfOptions options_;
+  LinearRepair<Dim> repair_;  ///< the rank's cells, when setup() was given them (all linear)
   double radius_ = 0.0;  ///< the last setup's support radius (options_'s, or the default's)
   bool radius_reduced_ = false;
   BoundarySolveOptions solve_;
@@ -247,6 +261,7 @@ void DistributedRbfMover<Dim>::setup(const PartitionView<Dim>& part, const Resol
   part_owners_.assign(part.owner.begin(), part.owner.end());
   boundary_ = boundary;
   at_move_ = {};
+  repair_ = {};
   if (options_.rigid_part != RigidPart::none) {
     // At rest: no owned prescribed entry moves (a ghost's entry is its owner's to give).
     std::vector<char> owned(static_cast<std::size_t>(boundary.size()), 0);
@@ -628,6 +643,10 @@ void DistributedRbfMover<Dim>::move_to(PointsView<Dim> d, Out& out) {
       out += blend_;
     }
   }
+  const RepairReport repaired = repair_.repair(out, RanksGather{comm_});
+  stats_.folded_cells = repaired.folded;
+  stats_.repaired_nodes = repaired.moved_nodes;
+  stats_.left_folded = repaired.left_folded;
   ++stats_.moves;
   stats_.move_seconds = watch.seconds();
   stats_.solve_seconds = solving_;

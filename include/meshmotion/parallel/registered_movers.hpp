@@ -24,8 +24,8 @@ class DistributedRbf final : public DistributedMover<Dim> {
  public:
   DistributedRbf(const RbfOptions& options, const BoundarySolveOptions& solve) : mover_(options, solve) {}
   using DistributedMover<Dim>::setup;
-  void setup(const PartitionView<Dim>& part, const Mesh<Dim>&, const ResolvedBoundary<Dim>& boundary) override {
-    mover_.setup(part, boundary);
+  void setup(const PartitionView<Dim>& part, const Mesh<Dim>& local, const ResolvedBoundary<Dim>& boundary) override {
+    mover_.setup(part, local, boundary);
   }
   void setup(const PartitionView<Dim>& part, const ResolvedBoundary<Dim>& boundary) override { mover_.setup(part, boundary); }
   void move_into(PointsView<Dim> d, Points<Dim>& out) override { mover_.move_into(d, out); }
