@@ -71,7 +71,7 @@ int run(const std::string& file, double radius, int moves) {
   RbfOptions options;
   options.support_radius = radius;
   DistributedRbfMover<3> mover(options);
-  mover.setup(part.view(), local);
+  mover.setup(part.view(), part.local, local);  // with the cells, as Python's DistributedMover3.setup(part, ...)
   const double setup = slowest(comm, setup_watch.seconds());
 
   Points<3> out;
