@@ -1428,6 +1428,69 @@ TEST_CASE("set up at rest on a coarse mesh, the cells a half turn folds are repa
   CHECK(hex_mover.stats().left_folded < hex_mover.stats().folded_cells / 4);
 }
 
+TEST_CASE("a linear cell's sign margin: no motion within it flips a corner, one a few times larger does", "[movers]") {
+  // The repair's check skips a cell whose vertices moved relative to its first by less than
+  // detail::sign_margin_squared. Each corner matrix A is perturbed by −t σ_min(A) u vᵀ (u, v its smallest singular vectors), which makes it
+  // singular at t = 1: made by moving the corner's neighbours alone, scaled so the largest
+  // relative move is the margin, no determinant changes sign; at t = 1.01 this one has.
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> jitter(-0.15, 0.15);
+  for (const ElementType type : {ElementType::quad4, ElementType::hex8, ElementType::prism6, ElementType::pyramid5}) {
+    CAPTURE(name(type));
+    const Shape s = shape(type);
+    const int nv = num_vertices(type);
+    const auto check = [&]<int D>(std::integral_constant<int, D>) {
+      const auto reference = reference_nodes(type);
+      for (int trial = 0; trial < 20; ++trial) {
+        std::array<Vec<D>, 8> p{};
+        for (int k = 0; k < nv; ++k)
+          for (int a = 0; a < D; ++a) p[static_cast<std::size_t>(k)](a) = reference[static_cast<std::size_t>(k)][static_cast<std::size_t>(a)] + jitter(random);
+        REQUIRE(detail::corners_keep_sign<D>(s, 1.0, p.data()));
+        const double margin = std::sqrt(detail::sign_margin_squared<D>(s, p.data()));
+        REQUIRE(margin > 0.01);
+        for (const detail::KnuppCorner& corner : detail::knupp_table(s).corners) {
+          Eigen::Matrix<double, D, D> a;
+          for (int d = 0; d < D; ++d) a.col(d) = p[static_cast<std::size_t>(corner.neighbours[static_cast<std::size_t>(d)])] - p[static_cast<std::size_t>(corner.vertex)];
+          const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Eigen::MatrixXd(a), Eigen::ComputeFullU | Eigen::ComputeFullV);
+          const Eigen::Matrix<double, D, D> flip =
+              -svd.singularValues()(D - 1) * svd.matrixU().col(D - 1) * svd.matrixV().col(D - 1).transpose();
+          // Column d of the change is the move of neighbour d, relative to the corner's vertex
+          // (which stays); relative to vertex 0 a move is at most twice the largest column.
+          const double largest = 2.0 * flip.colwise().norm().maxCoeff();
+          for (const double t : {margin / largest, 1.01}) {
+            std::array<Vec<D>, 8> q = p;
+            for (int d = 0; d < D; ++d) q[static_cast<std::size_t>(corner.neighbours[static_cast<std::size_t>(d)])] += t * flip.col(d);
+            double rho = 0.0;
+            for (int k = 1; k < nv; ++k) rho = std::max(rho, ((q[static_cast<std::size_t>(k)] - p[static_cast<std::size_t>(k)]) - (q[0] - p[0])).norm());
+            if (t < 1.0) {
+              CHECK(rho <= margin * (1.0 + 1e-12));
+              CHECK(detail::corners_keep_sign<D>(s, 1.0, q.data()));
+            } else {
+              Eigen::Matrix<double, D, D> b;
+              for (int d = 0; d < D; ++d) b.col(d) = q[static_cast<std::size_t>(corner.neighbours[static_cast<std::size_t>(d)])] - q[static_cast<std::size_t>(corner.vertex)];
+              CHECK(b.determinant() < 0.0);
+              CHECK_FALSE(detail::corners_keep_sign<D>(s, 1.0, q.data()));
+              CHECK(rho > margin);
+            }
+          }
+        }
+      }
+      // The unit square's and cube's corners (and the cube's centre): A = I, σ_min 1, ‖A‖_F² = D.
+      if (type == ElementType::quad4 || type == ElementType::hex8) {
+        std::array<Vec<D>, 8> p{};
+        for (int k = 0; k < nv; ++k)
+          for (int a = 0; a < D; ++a) p[static_cast<std::size_t>(k)](a) = (reference[static_cast<std::size_t>(k)][static_cast<std::size_t>(a)] + 1.0) / 2.0;
+        const double lower = D == 2 ? 1.0 / std::sqrt(2.0) : 2.0 / 3.0;
+        CHECK_THAT(detail::sign_margin_squared<D>(s, p.data()), Catch::Matchers::WithinRel(std::pow(0.99 * lower / (2.0 * std::sqrt(double(D))), 2.0), 1e-12));
+      }
+    };
+    if (dimension(type) == 2)
+      check(std::integral_constant<int, 2>{});
+    else
+      check(std::integral_constant<int, 3>{});
+  }
+}
+
 TEST_CASE("rigid_part=blend on a mover set up at rest names what stops it", "[movers]") {
   const Mesh<2> mesh = rectangle_mesh({.nx = 6, .ny = 6});
   RbfOptions blend;

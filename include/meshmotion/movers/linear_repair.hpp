@@ -22,7 +22,9 @@
 /// global id) takes, by a pattern search along the axes (or its plane's or line's directions)
 /// with a halving step, the place that lowers the squared shortfall of its cells' signed corner
 /// shapes below repair_target; sweeps repeat while a node moves (at most repair_sweeps). A move
-/// that folds nothing costs one pass of corner determinants over the cells and changes nothing.
+/// that folds nothing costs one pass of corner determinants over the cells and changes nothing;
+/// a cell of several corners skips them when its vertices moved relative to each other by less
+/// than the margin prepare() computed (detail::sign_margin_squared).
 ///
 /// Over MPI the patch is gathered: the folded cells' nodes, the rings and then the patch's
 /// cells and owned nodes go to every rank (allgathers of the patch alone), which repairs the
@@ -43,6 +45,7 @@
 #include "meshmotion/quality/scaled_jacobian.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -109,6 +112,47 @@ template <class At>
   return j;
 }
 
+/// f(A) for the corner matrices of a linear cell of shape `s` at its vertices `p` (for
+/// hexahedra and prisms also J at the centre) while f returns true; whether it always did.
+/// Each matrix's columns are differences of two vertices, or (the centre's) a quarter or
+/// half or third of sums of as many such differences: a column moves by at most 2ρ when no
+/// vertex moves more than ρ relative to the first.
+template <int Dim, class F>
+[[nodiscard]] bool all_corner_matrices(Shape s, const Vec<Dim>* p, F&& f) {
+  for (const KnuppCorner& corner : knupp_table(s).corners) {
+    Eigen::Matrix<double, Dim, Dim> a;
+    for (int d = 0; d < Dim; ++d) a.col(d) = p[corner.neighbours[static_cast<std::size_t>(d)]] - p[corner.vertex];
+    if (!f(a)) return false;
+  }
+  if constexpr (Dim == 3)
+    if (s == Shape::hexahedron || s == Shape::prism) return f(centre_jacobian(s, [&](int k) { return p[k]; }));
+  return true;
+}
+
+/// Whether every corner determinant (all_corner_matrices) is positive once multiplied by
+/// `sign`: the determinants alone, the pass a move makes over the cells it cannot skip.
+template <int Dim>
+[[nodiscard]] bool corners_keep_sign(Shape s, double sign, const Vec<Dim>* p) {
+  return all_corner_matrices<Dim>(s, p, [&](const Eigen::Matrix<double, Dim, Dim>& a) { return sign * a.determinant() > 0.0; });
+}
+
+/// The squared largest ρ such that no vertex of the cell moving by at most ρ relative to its
+/// first vertex can change a corner determinant's sign: a corner matrix A keeps its sign under
+/// any change of spectral norm below σ_min(A), the change is at most 2ρ√Dim in Frobenius norm
+/// (all_corner_matrices), and σ_min(A) ≥ |det A| / ‖A‖_F (2D), 2 |det A| / ‖A‖_F² (3D: σ1σ2 ≤
+/// (σ1² + σ2²) / 2). A hundredth off for the rounding of the determinants the check would compute.
+template <int Dim>
+[[nodiscard]] double sign_margin_squared(Shape s, const Vec<Dim>* p) {
+  double smallest = std::numeric_limits<double>::infinity();
+  (void)all_corner_matrices<Dim>(s, p, [&](const Eigen::Matrix<double, Dim, Dim>& a) {
+    const double frob2 = a.squaredNorm(), det = std::abs(a.determinant());
+    smallest = std::min(smallest, frob2 > 0.0 ? (Dim == 2 ? det / std::sqrt(frob2) : 2.0 * det / frob2) : 0.0);
+    return true;
+  });
+  const double rho = 0.99 * smallest / (2.0 * std::sqrt(double(Dim)));
+  return rho * rho;
+}
+
 }  // namespace detail
 
 /// The linear cells of a mesh (or of one process's part of it) and the repair of what a move
@@ -146,13 +190,17 @@ class LinearRepair {
     for (Index v = 0; v < n; ++v)
       for (int a = 0; a < Dim; ++a) reference_(a, v) = T::coordinate(mesh, v, a);
     signs_.assign(shapes_.size(), 0);
-    for (std::size_t c = 0; c < shapes_.size(); ++c) {
-      bool positive = true, negative = true;
-      for_corners(static_cast<Index>(c), 1.0, [&](Index v) { return Vec<Dim>(reference_.col(v)); }, [&](double det, double) {
-        positive = positive && det > 0.0;
-        negative = negative && det < 0.0;
-      });
-      signs_[c] = positive ? 1 : negative ? -1 : 0;  // a cell folded at the reference is left alone
+    margins_.assign(shapes_.size(), 0.0f);
+    const auto cells = static_cast<Index>(shapes_.size());
+#pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
+    for (Index i = 0; i < cells; ++i) {
+      const auto c = static_cast<std::size_t>(i);
+      const auto p = vertices(i, Points<Dim>::Zero(Dim, n));
+      const Shape s = shapes_[c];
+      signs_[c] = detail::corners_keep_sign<Dim>(s, 1.0, p.data()) ? 1 : detail::corners_keep_sign<Dim>(s, -1.0, p.data()) ? -1 : 0;
+      // A cell folded at the reference is left alone; a simplex's one determinant is cheaper than its margin.
+      if (signs_[c] != 0 && num_vertices(element_type(s, 1)) > Dim + 1)
+        margins_[c] = static_cast<float>(detail::sign_margin_squared<Dim>(s, p.data()) * (1.0 - 1e-6));
     }
     freedom_.assign(static_cast<std::size_t>(n), Dim);
     first_direction_.assign(static_cast<std::size_t>(n), -1);
@@ -184,13 +232,11 @@ class LinearRepair {
   RepairReport repair(Out& out, const Gather& gather = {}) const {
     RepairReport report;
     if (!active()) return report;
-    const Points<Dim> x = reference_ + out;
-    const auto at = [&](Index v) { return Vec<Dim>(x.col(v)); };
     const auto cells = static_cast<Index>(shapes_.size());
     std::vector<char> folded(shapes_.size(), 0);
 #pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
     for (Index c = 0; c < cells; ++c)
-      if (signs_[static_cast<std::size_t>(c)] != 0) folded[static_cast<std::size_t>(c)] = is_folded(c, at) ? 1 : 0;
+      if (const int sign = signs_[static_cast<std::size_t>(c)]; sign != 0) folded[static_cast<std::size_t>(c)] = is_folded(c, sign, out) ? 1 : 0;
     std::vector<std::int64_t> seeds, count{0};
     for (Index c = 0; c < cells; ++c)
       if (folded[static_cast<std::size_t>(c)] != 0) {
@@ -331,31 +377,29 @@ class LinearRepair {
   [[nodiscard]] std::int64_t id(Index v) const { return ids_.empty() ? v : ids_[static_cast<std::size_t>(v)]; }
   [[nodiscard]] bool owns(Index v) const { return owned_.empty() || owned_[static_cast<std::size_t>(v)] != 0; }
 
-  /// f(det, shape) for each corner of cell c at the vertices' positions at(node).
-  template <class At, class F>
-  void for_corners(Index c, double sign, const At& at, F&& f) const {
+  /// Cell c's vertices at the reference plus `out`, read once for all its corners.
+  template <class Out>
+  [[nodiscard]] std::array<Vec<Dim>, 8> vertices(Index c, const Out& out) const {
     const std::int32_t* vertex = nodes_.data() + offsets_[static_cast<std::size_t>(c)];
-    const auto local = [&](int k) { return at(vertex[k]); };
-    for (const detail::KnuppCorner& corner : detail::knupp_table(shapes_[static_cast<std::size_t>(c)]).corners) {
-      const auto [det, q] = detail::signed_corner<Dim>(corner, sign, local);
-      f(det, q);
-    }
+    std::array<Vec<Dim>, 8> p;
+    for (Index k = 0; k < offsets_[static_cast<std::size_t>(c) + 1] - offsets_[static_cast<std::size_t>(c)]; ++k)
+      p[static_cast<std::size_t>(k)] = reference_.col(vertex[k]) + out.col(vertex[k]);
+    return p;
   }
-  /// Whether a corner of cell c left its reference sign: determinants alone, the pass every move makes.
-  template <class At>
-  [[nodiscard]] bool is_folded(Index c, const At& at) const {
-    const std::int32_t* vertex = nodes_.data() + offsets_[static_cast<std::size_t>(c)];
-    const double sign = signs_[static_cast<std::size_t>(c)];
-    for (const detail::KnuppCorner& corner : detail::knupp_table(shapes_[static_cast<std::size_t>(c)]).corners) {
-      Eigen::Matrix<double, Dim, Dim> a;
-      const Vec<Dim> origin = at(vertex[corner.vertex]);
-      for (int d = 0; d < Dim; ++d) a.col(d) = at(vertex[corner.neighbours[static_cast<std::size_t>(d)]]) - origin;
-      if (!(sign * a.determinant() > 0.0)) return true;
+  /// Whether cell c, its vertices at the reference plus `out`, has left orientation `sign`:
+  /// not when no vertex moved relative to the first by more than the cell's margin (its
+  /// determinants then cannot have changed sign), else by its determinants.
+  template <class Out>
+  [[nodiscard]] bool is_folded(Index c, int sign, const Out& out) const {
+    if (const float margin = margins_[static_cast<std::size_t>(c)]; margin > 0.0f) {
+      const std::int32_t* vertex = nodes_.data() + offsets_[static_cast<std::size_t>(c)];
+      const Vec<Dim> first = out.col(vertex[0]);
+      double rho2 = 0.0;
+      for (Index k = 1; k < offsets_[static_cast<std::size_t>(c) + 1] - offsets_[static_cast<std::size_t>(c)]; ++k)
+        rho2 = std::max(rho2, (Vec<Dim>(out.col(vertex[k])) - first).squaredNorm());
+      if (rho2 < margin) return false;
     }
-    if constexpr (Dim == 3)
-      if (!(sign * detail::centre_jacobian(shapes_[static_cast<std::size_t>(c)], [&](int k) { return at(vertex[k]); }).determinant() > 0.0))
-        return true;
-    return false;
+    return !detail::corners_keep_sign<Dim>(shapes_[static_cast<std::size_t>(c)], sign, vertices(c, out).data());
   }
   /// f(c) for every local cell with a node whose id is in `ids` (sorted).
   template <class F>
@@ -475,6 +519,7 @@ class LinearRepair {
 
   std::vector<Shape> shapes_;
   std::vector<std::int8_t> signs_;    ///< per cell: its orientation at the reference (0: folded there)
+  std::vector<float> margins_;        ///< per cell: sign_margin_squared() (0: none, check the determinants)
   std::vector<Index> offsets_;        ///< cells' first vertex in nodes_
   std::vector<std::int32_t> nodes_;   ///< cells' vertices (a mesh of 2^31 nodes or more is not repaired)
   Points<Dim> reference_;
