@@ -627,8 +627,8 @@ TEST_CASE("pipeline: tetrahedra curve onto a graph at orders 7 and 8, hexahedra,
   // place).
   const auto bump = sine_bump(0.03);
   // One cube of tetrahedra (a second of cells at order 8, with 3 s for the tables' first use),
-  // eight hexahedra, one at order 8; two prisms, six pyramids (sampled, not certified: their
-  // det J is rational) and the mixed box of tetrahedra, pyramids and prisms.
+  // eight hexahedra, one at order 8; two prisms, six pyramids (certified on their collapsed
+  // cube) and the mixed box of tetrahedra, pyramids and prisms.
   struct Case {
     BoxCells cells;
     Index n;

@@ -308,7 +308,7 @@ class PatchOptimizer {
     }
   };
 
-  // det J's coefficients (Bézier, or lattice values for a pyramid) at the cell's nodes `x`,
+  // det J's Bézier coefficients (a pyramid's on its collapsed cube) at the cell's nodes `x`,
   // unscaled, and its straight measure.
   void coefficients(ElementType type, const ElementCoords<Dim>& x, UntangleLattice& values, double& linear) {
     ++evaluations_;

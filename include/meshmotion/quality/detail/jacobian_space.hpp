@@ -11,7 +11,15 @@
 /// coefficients (BezierFactor::to_bezier per factor), which bound it from below and above; subdividing the domain into
 /// 2^d similar children tightens the bounds (child coefficients = child_bezier[c] × parent
 /// coefficients, exactly, since children are affine images of the reference element).
-/// Pyramids are rational: they get a sampling lattice only (no Bézier bound).
+///
+/// Pyramids: the map of Gmsh's (Bergot's) space is rational in (u, v, w), but in the collapsed
+/// coordinates û = u/(1−w), v̂ = v/(1−w), w of the cube [−1,1]² × [0,1] each term is
+/// f_a(û) g_b(v̂) (1−w)^m h_c(w), m = max(a, b) ≥ a, b: a polynomial. With X(û, v̂, w) the map there,
+/// ∂x/∂u = ∂X/∂û / (1−w) and ∂x/∂v = ∂X/∂v̂ / (1−w) are polynomials (each term with a or b ≥ 1
+/// carries (1−w)^m, m ≥ 1), and ∂X/∂w = ∂x/∂w − û ∂x/∂u − v̂ ∂x/∂v differs from ∂x/∂w by those
+/// columns: det J = det[∂X/∂û / (1−w), ∂X/∂v̂ / (1−w), ∂X/∂w], a polynomial of degree 3p−1 in û
+/// and in v̂ and 3p−3 in w (Johnen & Geuzaine's result for these pyramids). It is bounded as a
+/// hexahedron's on the cube (w's degree raised to 3p−1, one line factor for all three axes).
 
 #include "meshmotion/core/detail/table_kernels.hpp"
 #include "meshmotion/core/element.hpp"
@@ -55,7 +63,7 @@ struct JacobianSpace {
   int simplex_degree = 0;
   int line_dims = 0;      // trailing coordinates in [-1, 1] with a 1D Bernstein factor each
   int line_degree = 0;
-  bool bezier = false;    // false for pyramids: sampled only
+  bool bezier = false;    // Bézier bounds (every 2D and 3D type)
   int num_points = 0;
   int num_nodes = 0;      // nodes of the element type
   std::vector<RefPoint> points;                // sampling lattice
@@ -78,6 +86,12 @@ struct JacobianSpace {
   // With a prism405's gradient table (19,872 × 405) its Jacobians took 10 ms a cell; so, 0.12 ms.
   std::array<Eigen::MatrixXd, 3> prism_triangle;
   std::vector<int> prism_node;
+  // Pyramids, on the collapsed cube (file comment): per term k of the type's space its (a, b);
+  // the nodes' functions in the terms (terms × nodes); f_a and f_a' at the line lattice
+  // ((line_degree + 1) × (p + 1), for û and v̂ alike); and at the lattice's w (terms as columns)
+  // (1−w)^(m−1) h_c(w), the factor of ∂X/∂û / (1−w) and ∂X/∂v̂ / (1−w), and ∂/∂w of (1−w)^m h_c(w).
+  std::vector<std::array<int, 2>> pyramid_ab;
+  Eigen::MatrixXd pyramid_coefficients, pyramid_f, pyramid_df, pyramid_wa, pyramid_wc;
   std::vector<int> corners;                    // lattice points at the element's vertices
   BezierFactor simplex;                        // when simplex_dim > 0
   BezierFactor line;                           // when line_dims > 0
@@ -383,17 +397,38 @@ inline void add_prism_tables(JacobianSpace& s, ElementType t, int p) {
   }
 }
 
-// Pyramid sampling: a lattice of order 2p (at least 4) on the levels w = k/2p below the apex
-// (the apex itself is a singular point of the rational map), plus the centroid.
-inline void add_pyramid_samples(JacobianSpace& s, int p) {
-  const int n = std::max(4, 2 * p);
-  for (int k = 0; k < n; ++k) {
-    const double w = static_cast<double>(k) / n, half = 1.0 - w;
-    const int m = n - k;
-    for (int i = 0; i <= m; ++i)
-      for (int j = 0; j <= m; ++j) s.points.push_back({half * (2.0 * i / m - 1.0), half * (2.0 * j / m - 1.0), w});
+// The pyramid's tables (JacobianSpace::pyramid_ab and after) on the lattice add_lattice() made,
+// whose third coordinate t ∈ [−1, 1] is w = (t + 1) / 2.
+inline void add_pyramid_tables(JacobianSpace& s, ElementType t, int p) {
+  const ShapeBasis& basis = shape_basis(t);
+  const Index terms = static_cast<Index>(basis.monomials.size()), lines = s.line_degree + 1;
+  s.pyramid_coefficients = basis.coefficients;
+  s.pyramid_f.resize(lines, p + 1);
+  s.pyramid_df.resize(lines, p + 1);
+  s.pyramid_wa.resize(lines, terms);
+  s.pyramid_wc.resize(lines, terms);
+  // Complete pyramids take Legendre polynomials of û, v̂ and 2w − 1, the others powers.
+  const bool legendre = basis.monomials.front().pyramid;
+  for (Index r = 0; r < lines; ++r) {
+    const double x = line_point(static_cast<int>(r), s.line_degree);
+    for (int a = 0; a <= p; ++a) {
+      s.pyramid_f(r, a) = legendre ? legendre_derivative(a, 0, x) : int_pow(x, a);
+      s.pyramid_df(r, a) = legendre ? legendre_derivative(a, 1, x) : (a == 0 ? 0.0 : a * int_pow(x, a - 1));
+    }
   }
-  s.points.push_back({0.0, 0.0, 0.2});
+  for (Index k = 0; k < terms; ++k) {
+    const Monomial& term = basis.monomials[static_cast<std::size_t>(k)];
+    const int m = std::max(term.a, term.b), c = term.c;
+    s.pyramid_ab.push_back({term.a, term.b});
+    for (Index r = 0; r < lines; ++r) {
+      const double w = 0.5 * (line_point(static_cast<int>(r), s.line_degree) + 1.0), rest = 1.0 - w;
+      const double h = legendre ? legendre_derivative(c, 0, 2.0 * w - 1.0) : int_pow(w, c);
+      const double dh = legendre ? 2.0 * legendre_derivative(c, 1, 2.0 * w - 1.0) : (c == 0 ? 0.0 : c * int_pow(w, c - 1));
+      const double lower = m == 0 ? 0.0 : int_pow(rest, m - 1);
+      s.pyramid_wa(r, k) = lower * h;
+      s.pyramid_wc(r, k) = -m * lower * h + int_pow(rest, m) * dh;
+    }
+  }
 }
 
 inline JacobianSpace make_jacobian_space(ElementType t) {
@@ -410,11 +445,11 @@ inline JacobianSpace make_jacobian_space(ElementType t) {
       s.simplex_dim = 2; s.simplex_degree = 3 * p - 2;
       s.line_dims = 1; s.line_degree = 3 * p - 1;
       break;
+    case Shape::pyramid: s.line_dims = 3; s.line_degree = 3 * p - 1; break;  // on the collapsed cube
     default: break;
   }
-  s.bezier = s.dim >= 2 && shape(t) != Shape::pyramid;
+  s.bezier = s.dim >= 2;
   if (s.bezier) add_lattice(s);
-  else if (shape(t) == Shape::pyramid) add_pyramid_samples(s, p);
   s.num_points = static_cast<int>(s.points.size());
 
   // Sum factorization pays from degree 2 on (quad9, hex27; prism18 2.9 → 2.5 µs a cell, prism40
@@ -425,6 +460,8 @@ inline JacobianSpace make_jacobian_space(ElementType t) {
     add_tensor_tables(s, t, p);
   } else if (shape(t) == Shape::prism && p >= 2 && s.num_nodes == (p + 1) * (p + 1) * (p + 2) / 2) {
     add_prism_tables(s, t, p);
+  } else if (shape(t) == Shape::pyramid) {
+    add_pyramid_tables(s, t, p);
   } else {
     std::vector<std::array<double, 3>> g(static_cast<std::size_t>(s.num_nodes));
     s.gradients.resize(static_cast<Index>(s.num_points) * s.dim, s.num_nodes);
