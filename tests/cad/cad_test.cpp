@@ -3,6 +3,7 @@
 #include "meshmotion/cad/cad_model.hpp"
 #include "meshmotion/core/generators.hpp"
 #include "meshmotion/curving/curve_mesh.hpp"
+#include "meshmotion/curving/order_conversion.hpp"
 #include "meshmotion/io/mesh_io.hpp"
 
 #include "test_data.hpp"
@@ -34,6 +35,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <random>
 #include <set>
@@ -233,6 +235,76 @@ TEST_CASE("CAD: a box's faces are planes and its edges lines, a cylinder's side 
   CHECK(c.num_faces() == 3);
   CHECK(flat_faces == 2);
   CHECK(flat_edges == 1);
+}
+
+TEST_CASE("CAD: high-order nodes on the model's edges slide along them to untangle what a bunched edge folds", "[cad]") {
+  // A P3 tetrahedral cube on a CAD box, every face a group: the nodes of one box edge are
+  // bunched towards a vertex, so the edge's cubic doubles back and the cells along it fold.
+  // Nodes on the border of two groups do not slide on either face; they slide along the
+  // model's common edge of their facet's vertices (detail::edge_sliding_node), which untangles
+  // the cells; held, they leave them folded.
+  const auto path = test::scratch_path("unit_box.brep");
+  REQUIRE(BRepTools::Write(BRepPrimAPI_MakeBox(1.0, 1.0, 1.0).Shape(), path.c_str()));
+  const CadModel model = CadModel::read(path);
+  Mesh<3> mesh = convert_to_order(box_mesh({.nx = 2, .ny = 2, .nz = 2, .x_min = 0, .x_max = 1, .y_min = 0, .y_max = 1, .z_min = 0,
+                                            .z_max = 1, .cells = BoxCells::tet4}),
+                                  3).mesh;
+  std::map<int, BoundaryGeometry<3>> geometry;
+  for (const CadGroupMatch& m : match_cad_groups(mesh, model)) {
+    REQUIRE(m.matched());
+    geometry.emplace(mesh.group(m.group).tag, cad_boundary<3>(model, m));
+  }
+  std::vector<Index> bunched;  // the edge nodes of x in (0, 0.5) on y = z = 0
+  for (Index v = 0; v < mesh.num_nodes(); ++v) {
+    const Vec<3> x = mesh.points.col(v);
+    if (x.y() == 0.0 && x.z() == 0.0 && x.x() > 0.01 && x.x() < 0.49) bunched.push_back(v);
+  }
+  REQUIRE(bunched.size() == 2);
+  std::sort(bunched.begin(), bunched.end(), [&](Index a, Index b) { return mesh.points(0, a) < mesh.points(0, b); });
+  mesh.points(0, bunched[0]) = 0.40;
+  mesh.points(0, bunched[1]) = 0.46;
+  std::vector<char> fixed(static_cast<std::size_t>(mesh.num_nodes()), 0);
+  for (const auto& block : mesh.facets)
+    for (const Index v : block.connectivity) fixed[static_cast<std::size_t>(v)] = 1;
+  const auto certified = [](const Mesh<3>& m) {
+    std::vector<double> q;
+    for (const ScaledJacobian& s : scaled_jacobians(m)) q.push_back(s.certified_min);
+    return q;
+  };
+  const std::vector<double> before = certified(mesh);
+  REQUIRE(std::count_if(before.begin(), before.end(), [](double q) { return q <= 0.0; }) > 0);
+
+  const SlidingNodes<3> sliding = detail::wall_sliding_nodes(mesh, geometry, 30.0);
+  for (const Index v : bunched) {
+    REQUIRE(sliding.contains(v));
+    const SlidingNode<3>& node = sliding.at(v);
+    REQUIRE(node.directions.size() == 1);
+    CHECK(std::abs(node.directions[0].x()) == Approx(1.0));
+    const Vec<3> p = node.project(mesh.points.col(v) + Vec<3>(-0.2, 0.05, 0.03));  // back onto the edge
+    CHECK(p.y() == Approx(0.0).margin(1e-12));
+    CHECK(p.z() == Approx(0.0).margin(1e-12));
+    CHECK(p.x() == Approx(mesh.points(0, v) - 0.2).margin(1e-9));
+  }
+
+  Mesh<3> held = mesh;
+  SlidingNodes<3> without = sliding;
+  for (const Index v : bunched) without.erase(v);
+  std::vector<double> held_quality = before;
+  const UntangleReport stuck = untangle(held, fixed, held_quality, {}, without);
+  CHECK(stuck.invalid_after > 0);
+
+  std::vector<double> quality = before;
+  const UntangleReport report = untangle(mesh, fixed, quality, {}, sliding);
+  CHECK(report.invalid_before > 0);
+  CHECK(report.invalid_after == 0);
+  for (const double q : certified(mesh)) CHECK(q > 0.0);
+  CHECK(mesh.points(0, bunched[0]) < mesh.points(0, bunched[1]));
+  for (const Index v : bunched) {
+    CHECK(mesh.points(1, v) == Approx(0.0).margin(1e-12));
+    CHECK(mesh.points(2, v) == Approx(0.0).margin(1e-12));
+    CHECK(mesh.points(0, v) > 0.0);
+    CHECK(mesh.points(0, v) < 0.5);
+  }
 }
 
 TEST_CASE("CAD: groups match the model's edges, and a model that does not fit is named", "[cad]") {

@@ -105,9 +105,10 @@ void visit_options(UntangleOptions& o, F&& f, const std::string& prefix = {}) {
   f(prefix + "untangle_threshold", o.untangle_threshold, OptionHelp{"optimize the high-order nodes around cells whose certified scaled Jacobian is below this", range::at_most(1)});
   f(prefix + "untangle_layers", o.untangle_layers, OptionHelp{"rings of neighbouring cells that move with a cell below the threshold", range::non_negative});
   f(prefix + "untangle_sweeps", o.untangle_sweeps, OptionHelp{"node sweeps at most per pass", range::at_least(1)});
-  f(prefix + "untangle_slide", o.untangle_slide, OptionHelp{"wall nodes off sharp edges, and sliding planes' nodes, move along their geometry while untangling", {},
+  f(prefix + "untangle_slide", o.untangle_slide, OptionHelp{"wall nodes and sliding planes' nodes move along their geometry while untangling", {},
       "Boundary nodes the caller lets slide (untangle()'s `sliding`; in the curving pipeline the wall nodes "
-      "off sharp edges and the symmetry planes' nodes) move along their geometry."});
+      "on their faces, those on a CAD model's edges along the edges, and the symmetry planes' nodes) move along "
+      "their geometry."});
   f(prefix + "raise_rounds", o.raise_rounds, OptionHelp{"then rounds raising the worst cells while the minimum rises (0: none)", range::non_negative,
       "After the cells below the threshold, rounds that raise the certified minimum: each optimizes the "
       "`raise_cells` worst cells (those within `raise_margin` of the minimum) and `raise_layers` rings around "

@@ -5,6 +5,8 @@
 
 #include "meshmotion/curving/detail/curving_groups.hpp"
 
+#include <optional>
+
 namespace meshmotion {
 
 namespace detail {
@@ -23,13 +25,45 @@ template <int Dim, class Basis>
   return out;
 }
 
+/// A high-order node on edge (a, b) of a facet (block, element; the node's local index
+/// `local`) sliding along the edge's curve on `geo`, when `geo` places edge nodes
+/// (BoundaryGeometry::placement: a CAD model's common edge of a and b, at a fraction of its arc
+/// length): a trial place x goes to the curve's point at x's fraction of the chord ab, kept
+/// within 1%–99% of it (a node at an end would collapse its edge).
+template <int Dim>
+[[nodiscard]] std::optional<SlidingNode<Dim>> edge_sliding_node(const Mesh<Dim>& mesh, std::size_t block_index, Index element,
+                                                                int local, const BoundaryGeometry<Dim>& geo) {
+  const auto& block = mesh.facets[block_index];
+  const int nv = num_vertices(block.type), p = order(block.type);
+  if (!geo.placement || p < 2 || local < nv || local >= first_inside_node(block.type)) return std::nullopt;
+  const std::array<int, 2> edge = edges(block.type)[static_cast<std::size_t>((local - nv) / (p - 1))];
+  const auto el = block.element(element);
+  std::array<Vec<Dim>, 4> vertices;
+  for (int k = 0; k < nv; ++k) vertices[static_cast<std::size_t>(k)] = mesh.points.col(el[static_cast<std::size_t>(k)]);
+  const Vec<Dim> a = vertices[static_cast<std::size_t>(edge[0])], chord = vertices[static_cast<std::size_t>(edge[1])] - a;
+  if (!(chord.squaredNorm() > 0.0)) return std::nullopt;
+  SlidingNode<Dim> node;
+  node.directions = {chord.normalized()};
+  node.project = [g = &geo, vertices, nv, a, chord, edge](const Vec<Dim>& x) {
+    const double r = std::clamp((x - a).dot(chord) / chord.squaredNorm(), 0.01, 0.99);
+    std::array<double, 4> weights{};
+    weights[static_cast<std::size_t>(edge[0])] = 1.0 - r;
+    weights[static_cast<std::size_t>(edge[1])] = r;
+    return g->placement(std::span<const Vec<Dim>>(vertices.data(), static_cast<std::size_t>(nv)),
+                        std::span<const double>(weights.data(), static_cast<std::size_t>(nv)));
+  };
+  return node;
+}
+
 /// The wall nodes the untangling may slide along their geometry (untangle.hpp): every
 /// high-order node of a facet of a group curved by projection (an analytic shape, a CAD model)
 /// that lies inside its facet, or on an edge between two facets of that group whose straight
-/// normals differ by at most `corner_angle` degrees. A node on a sharp edge (a trailing edge, a
-/// wing's tip) or on the border with another group stays: sliding would take it off the edge.
-/// Each projects through its facet (BoundaryGeometry::project_in_facet(): a CAD model's local
-/// search from the facet's vertices) and searches its facets' tangent plane (in 2D, line).
+/// normals differ by at most `corner_angle` degrees. Each projects through its facet
+/// (BoundaryGeometry::project_in_facet(): a CAD model's local search from the facet's vertices)
+/// and searches its facets' tangent plane (in 2D, line). In 3D a node on a sharp edge (a
+/// trailing edge, a wing's tip) or on the border with another group slides along the edge
+/// (edge_sliding_node()) where a group holding it places edge nodes on the model's edges (a CAD
+/// model), and otherwise stays: sliding on a surface would take it off the edge.
 /// `geometry` must outlive the result.
 template <int Dim>
 [[nodiscard]] SlidingNodes<Dim> wall_sliding_nodes(const Mesh<Dim>& mesh, const std::map<int, BoundaryGeometry<Dim>>& geometry,
@@ -68,16 +102,36 @@ template <int Dim>
   };
   const double smooth = std::cos(corner_angle * std::numbers::pi / 180.0);
   SlidingNodes<Dim> out;
+  const auto projected = [&](const Holder& h) {
+    const auto it = geometry.find(mesh.facets[h.block].tags[static_cast<std::size_t>(h.element)]);
+    return it == geometry.end() || it->second.kind != BoundaryGeometry<Dim>::Kind::projection ? nullptr : &it->second;
+  };
   for (const auto& [v, on] : holders) {
+    // On an edge the surface's slide cannot take: along it, when a group holding it can.
+    const auto along_edge = [&, v = v, &on = on] {
+      if constexpr (Dim == 3)
+        for (const Holder& g : on)
+          if (const BoundaryGeometry<Dim>* geo = projected(g))
+            if (auto node = edge_sliding_node(mesh, g.block, g.element, g.local, *geo)) {
+              out.emplace(v, std::move(*node));
+              return;
+            }
+    };
     const Holder& h = on.front();
     const auto& block = mesh.facets[h.block];
     const int tag = block.tags[static_cast<std::size_t>(h.element)];
     const auto geo = geometry.find(tag);
-    if (geo == geometry.end() || geo->second.kind != BoundaryGeometry<Dim>::Kind::projection) continue;
+    if (geo == geometry.end() || geo->second.kind != BoundaryGeometry<Dim>::Kind::projection) {
+      along_edge();
+      continue;
+    }
     Vec<Dim> n = normal(h);
     if (on.size() == 2 && Dim == 3) {
       const Holder& g = on.back();
-      if (mesh.facets[g.block].tags[static_cast<std::size_t>(g.element)] != tag) continue;
+      if (mesh.facets[g.block].tags[static_cast<std::size_t>(g.element)] != tag) {
+        along_edge();
+        continue;
+      }
       // The two facets' common vertices are the edge's ends; facets oriented alike run along it in
       // opposite directions.
       std::vector<Index> common;
@@ -89,10 +143,14 @@ template <int Dim>
       if (common.size() != 2) continue;
       Vec<Dim> m = normal(g);
       if (runs(h, common[0], common[1]) == runs(g, common[0], common[1])) m = -m;
-      if (n.dot(m) < smooth) continue;
+      if (n.dot(m) < smooth) {
+        along_edge();
+        continue;
+      }
       n = (n + m).normalized();
     } else if (on.size() != 1 || (Dim == 3 && h.local < detail::first_inside_node(block.type))) {
-      continue;  // on the border of its group (or of the tagged boundary)
+      along_edge();  // on the border of its group (or of the tagged boundary)
+      continue;
     }
     const auto el = block.element(h.element);
     const int nv = num_vertices(block.type);
