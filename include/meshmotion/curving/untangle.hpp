@@ -26,6 +26,14 @@
 /// (Bézier bounds) and the caller's per-cell values replaced; a result with more invalid cells
 /// or a lower certified minimum than the input is undone (UntangleReport::reverted).
 ///
+/// Cells the node-by-node search leaves invalid (it cannot make the coordinated moves a twisted
+/// patch needs: a shaken P3 square kept 20 of its triangles and every quadrilateral folded) get
+/// their patch's free nodes moved together (UntangleOptions::untangle_joint,
+/// PatchOptimizer::run_together(): conjugate gradients on a log barrier of the patch's det J
+/// Bézier coefficients, under a barrier that moves up with the lowest), the patch doubled
+/// while some stay invalid (three passes at most); those cells are certified again and a worse
+/// result undone, as for the search.
+///
 /// Then the worst cells are raised (UntangleOptions::raise_rounds): the same search on the
 /// nodes of the few worst cells, aiming a little above the minimum, round after round while
 /// the minimum rises, within a budget of cell evaluations proportional to the mesh (about the
@@ -61,6 +69,7 @@ struct UntangleOptions {
   int untangle_layers = 3;
   int untangle_sweeps = 20;
   bool untangle_slide = true;
+  bool untangle_joint = true;
   int raise_rounds = 4;
   int raise_cells = 16;
   int raise_layers = 0;
@@ -93,6 +102,7 @@ struct UntangleReport {
   Index slid_nodes = 0;      ///< boundary nodes that moved along their geometry
   int sweeps = 0;            ///< node sweeps of every pass
   int raise_rounds = 0;      ///< rounds that raised the minimum
+  int joint_passes = 0;      ///< passes moving a patch's nodes together (cells left invalid; the patch doubled each pass)
   long long evaluations = 0; ///< cell evaluations of the optimization (each a Bézier bound of det J)
   bool reverted = false;     ///< the untangling's result was worse than its input and was undone
 };
@@ -109,6 +119,11 @@ void visit_options(UntangleOptions& o, F&& f, const std::string& prefix = {}) {
       "Boundary nodes the caller lets slide (untangle()'s `sliding`; in the curving pipeline the wall nodes "
       "on their faces, those on a CAD model's edges along the edges, and the symmetry planes' nodes) move along "
       "their geometry."});
+  f(prefix + "untangle_joint", o.untangle_joint, OptionHelp{"then move the nodes of a patch around each cell left invalid together", {},
+      "Cells the node-by-node search leaves invalid: the free nodes of a patch around them (untangle_layers "
+      "rings, doubled while some stay invalid, three passes at most) move together, by conjugate gradients "
+      "on a log barrier of their det J's Bezier coefficients under a moving barrier (Toulorge et al. 2013); "
+      "false: the node-by-node search alone."});
   f(prefix + "raise_rounds", o.raise_rounds, OptionHelp{"then rounds raising the worst cells while the minimum rises (0: none)", range::non_negative,
       "After the cells below the threshold, rounds that raise the certified minimum: each optimizes the "
       "`raise_cells` worst cells (those within `raise_margin` of the minimum) and `raise_layers` rings around "
@@ -133,6 +148,7 @@ void visit_fields(const UntangleReport& r, F&& f) {
   f("slid_nodes", r.slid_nodes, "boundary nodes that moved along their geometry");
   f("sweeps", r.sweeps, "node sweeps of every pass");
   f("raise_rounds", r.raise_rounds, "rounds that raised the minimum");
+  f("joint_passes", r.joint_passes, "passes moving a patch's nodes together (cells the node-by-node search left invalid)");
   f("evaluations", r.evaluations, "cell evaluations of the optimization (each a Bezier bound of det J)");
   f("reverted", r.reverted, "the result was worse than the input and was undone");
 }
@@ -193,18 +209,7 @@ class PatchOptimizer {
   Pass run(const std::vector<Index>& seeds, double target, int layers, int max_sweeps, long long max_evaluations,
            bool raise, bool slide, std::vector<double>& quality) {
     Pass pass;
-    std::vector<char> in_patch(where_.size(), 0);
-    std::vector<Index> frontier = seeds, patch = seeds;
-    for (const Index c : seeds) in_patch[static_cast<std::size_t>(c)] = 1;
-    for (int layer = 0; layer < layers; ++layer) {
-      std::vector<Index> next;
-      for (const Index c : frontier)
-        for (const Index v : nodes_of(c))
-          for (const Index d : cells_of(v))
-            if (!in_patch[static_cast<std::size_t>(d)]) in_patch[static_cast<std::size_t>(d)] = 1, next.push_back(d);
-      patch.insert(patch.end(), next.begin(), next.end());
-      frontier = std::move(next);
-    }
+    const std::vector<Index> patch = patch_around(seeds, layers);
     pass.patch_cells = static_cast<Index>(patch.size());
     std::vector<Index> free_nodes;
     std::vector<const SlidingNode<Dim>*> slides;  // per free node: how it slides, or null
@@ -255,32 +260,196 @@ class PatchOptimizer {
       if (!progress || now == 0.0) break;
     }
 
-    // Certify again every cell a free node belongs to.
-    const std::vector<double> input_quality = quality;
-    const double min_before = *std::min_element(quality.begin(), quality.end());
-    const auto invalid = [](const std::vector<double>& q) { return std::count_if(q.begin(), q.end(), [](double j) { return j <= 0.0; }); };
-    std::vector<char> touched(where_.size(), 0);
-    for (const Index v : free_nodes)
-      for (const Index c : cells_of(v)) touched[static_cast<std::size_t>(c)] = 1;
-    ScaledJacobianOptions certified;
-    certified.sharp_max = false;
-    for (std::size_t c = 0; c < where_.size(); ++c)
-      if (touched[c]) quality[c] = scaled_jacobian_fixed<Dim>(type_of(static_cast<Index>(c)), coords(static_cast<Index>(c)), certified).certified_min;
-    // The sweeps raise the cells' lower bounds; the certified values (subdivided) follow them
-    // but not strictly. A result worse than the input by the certified count or minimum is undone.
-    if (invalid(quality) > invalid(input_quality) || *std::min_element(quality.begin(), quality.end()) < min_before) {
-      for (std::size_t k = 0; k < free_nodes.size(); ++k) mesh_.points.col(free_nodes[k]) = original[k];
-      quality = input_quality;
-      pass.reverted = true;
-    }
+    pass.reverted = certify_or_undo(free_nodes, original, quality);
     for (std::size_t k = 0; k < free_nodes.size(); ++k)
       if (slides[k] != nullptr && mesh_.points.col(free_nodes[k]) != original[k]) ++pass.slid_nodes;
+    return pass;
+  }
+
+  // Moves the free nodes of the patch (the `seeds` cells and `layers` rings around them; the
+  // boundary held) together, as Gmsh's HighOrderOptimize (Toulorge et al., J. Comput. Phys.
+  // 237, 2013) and NekMesh's optimiser do, for what the node-by-node search leaves folded (it
+  // cannot make the coordinated moves a twisted patch needs). A moving-barrier descent on
+  //   F = Σ over the cells holding a free node, over their det J's Bézier coefficients q (over
+  //       the cell's straight measure at the start) below `target`, of log²((q − ε)/(target − ε)),
+  // ε under the lowest q: F is infinite where a coefficient reaches ε, so no step takes a cell
+  // below it, and each of `rounds` rounds raises ε under the new lowest. A coefficient is affine
+  // in each coordinate of a node (det J is linear in each column of J), so one more evaluation
+  // of each cell per coordinate gives its exact derivative. Nonlinear conjugate gradients
+  // (Polak–Ribière, restarted along the gradient when not a descent), each step halved from a
+  // fifth of the nearest node's reach until F falls, at most `iterations` a round, within
+  // `max_evaluations`. The cells are then certified again and a worse result undone, as run().
+  Pass run_together(const std::vector<Index>& seeds, double target, int layers, int rounds, int iterations,
+                    long long max_evaluations, std::vector<double>& quality) {
+    Pass pass;
+    const std::vector<Index> patch = patch_around(seeds, layers);
+    pass.patch_cells = static_cast<Index>(patch.size());
+    std::vector<Index> free_nodes;
+    std::vector<Index> slot(static_cast<std::size_t>(mesh_.num_nodes()), -1);  // node → its column among the free
+    for (const Index c : patch)
+      for (const Index v : nodes_of(c))
+        if (!fixed_[static_cast<std::size_t>(v)] && slot[static_cast<std::size_t>(v)] < 0) {
+          slot[static_cast<std::size_t>(v)] = static_cast<Index>(free_nodes.size());
+          free_nodes.push_back(v);
+        }
+    pass.free_nodes = static_cast<Index>(free_nodes.size());
+    if (free_nodes.empty()) return pass;
+    std::vector<char> held(where_.size(), 0);
+    std::vector<Index> cells;  // every cell a free node moves
+    for (const Index v : free_nodes)
+      for (const Index c : cells_of(v))
+        if (!held[static_cast<std::size_t>(c)]) held[static_cast<std::size_t>(c)] = 1, cells.push_back(c);
+    std::vector<double> scale(cells.size());
+    double step_limit = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      double linear = 0.0;
+      const ElementCoords<Dim> x = coords(cells[i]);
+      coefficients(type_of(cells[i]), x, samples_[0], linear);
+      if (!(std::abs(linear) > degenerate_below(type_of(cells[i]), x))) return pass;  // no straight measure to scale by
+      scale[i] = 1.0 / std::abs(linear);
+    }
+    for (const Index v : free_nodes) step_limit = std::min(step_limit, 0.2 * reach(v));
+    if (!(step_limit > 0.0)) return pass;
+    std::vector<Vec<Dim>> original;
+    for (const Index v : free_nodes) original.emplace_back(mesh_.points.col(v));
+
+    using Field = Eigen::Matrix<double, Dim, Eigen::Dynamic>;
+    const auto lowest = [&] {
+      double low = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < cells.size(); ++i) {
+        double linear = 0.0;
+        coefficients(type_of(cells[i]), coords(cells[i]), samples_[0], linear);
+        low = std::min(low, samples_[0].minCoeff() * scale[i]);
+      }
+      return low;
+    };
+    // F at the nodes' places, and with `gradient` its gradient (Dim × free nodes).
+    double epsilon = 0.0;
+    const auto objective = [&](Field* gradient) {
+      if (gradient != nullptr) gradient->setZero(Dim, static_cast<Index>(free_nodes.size()));
+      double sum = 0.0;
+      UntangleLattice& q = samples_[0];
+      UntangleLattice& moved = samples_[1];
+      for (std::size_t i = 0; i < cells.size(); ++i) {
+        const Index c = cells[i];
+        ElementCoords<Dim> x = coords(c);
+        double linear = 0.0;
+        coefficients(type_of(c), x, q, linear);
+        q *= scale[i];
+        if (q.minCoeff() >= target) continue;
+        if (!(q.minCoeff() > epsilon)) return std::numeric_limits<double>::infinity();
+        UntangleLattice& slope = samples_[2];
+        slope.resize(q.size());
+        for (Index k = 0; k < q.size(); ++k) {
+          if (q(k) >= target) {
+            slope(k) = 0.0;
+            continue;
+          }
+          const double l = std::log((q(k) - epsilon) / (target - epsilon));
+          sum += l * l;
+          slope(k) = 2.0 * l / (q(k) - epsilon);
+        }
+        if (gradient == nullptr) continue;
+        const auto nodes = nodes_of(c);
+        const double h = (x.rowwise().maxCoeff() - x.rowwise().minCoeff()).maxCoeff() * 0.1;
+        for (std::size_t n = 0; n < nodes.size(); ++n) {
+          const Index column = slot[static_cast<std::size_t>(nodes[n])];
+          if (column < 0) continue;
+          for (int a = 0; a < Dim; ++a) {
+            const double keep = x(a, static_cast<Index>(n));
+            x(a, static_cast<Index>(n)) = keep + h;
+            coefficients(type_of(c), x, moved, linear);
+            x(a, static_cast<Index>(n)) = keep;
+            (*gradient)(a, column) += slope.dot(moved * scale[i] - q) / h;
+          }
+        }
+      }
+      return sum;
+    };
+    const auto place = [&](const Field& at) {
+      for (std::size_t k = 0; k < free_nodes.size(); ++k) mesh_.points.col(free_nodes[k]) = at.col(static_cast<Index>(k));
+    };
+    Field at(Dim, static_cast<Index>(free_nodes.size()));
+    for (std::size_t k = 0; k < free_nodes.size(); ++k) at.col(static_cast<Index>(k)) = mesh_.points.col(free_nodes[k]);
+    double low = lowest();
+    for (int round = 0; round < rounds && low < target && evaluations_ < max_evaluations; ++round) {
+      epsilon = low - 0.25 * (target - low);
+      Field gradient, previous, direction;
+      double f = objective(&gradient);
+      direction = -gradient;
+      for (int it = 0; it < iterations && f > 0.0 && evaluations_ < max_evaluations; ++it) {
+        if (direction.cwiseProduct(gradient).sum() >= 0.0) direction = -gradient;
+        const double longest = direction.colwise().norm().maxCoeff();
+        if (!(longest > 0.0)) break;
+        double alpha = step_limit / longest, trial = std::numeric_limits<double>::infinity();
+        for (int halvings = 0; halvings < 30; ++halvings, alpha *= 0.5) {
+          place(at + alpha * direction);
+          if ((trial = objective(nullptr)) < f) break;
+        }
+        if (!(trial < f)) {
+          place(at);
+          break;
+        }
+        at += alpha * direction;
+        const bool stalled = trial > f * (1.0 - 1e-6);
+        f = trial;
+        previous = gradient;
+        f = objective(&gradient);
+        if (stalled) break;
+        const double beta = std::max(0.0, gradient.cwiseProduct(gradient - previous).sum() / previous.squaredNorm());
+        direction = -gradient + beta * direction;
+      }
+      const double now = lowest();
+      if (!(now > low + 1e-6)) break;
+      low = now;
+    }
+    pass.reverted = certify_or_undo(free_nodes, original, quality);
     return pass;
   }
 
   [[nodiscard]] long long evaluations() const noexcept { return evaluations_; }
 
  private:
+  // The `seeds` cells and `layers` rings of their neighbours (cells sharing a node), seeds first.
+  std::vector<Index> patch_around(const std::vector<Index>& seeds, int layers) const {
+    std::vector<char> in_patch(where_.size(), 0);
+    std::vector<Index> frontier = seeds, patch = seeds;
+    for (const Index c : seeds) in_patch[static_cast<std::size_t>(c)] = 1;
+    for (int layer = 0; layer < layers; ++layer) {
+      std::vector<Index> next;
+      for (const Index c : frontier)
+        for (const Index v : nodes_of(c))
+          for (const Index d : cells_of(v))
+            if (!in_patch[static_cast<std::size_t>(d)]) in_patch[static_cast<std::size_t>(d)] = 1, next.push_back(d);
+      patch.insert(patch.end(), next.begin(), next.end());
+      frontier = std::move(next);
+    }
+    return patch;
+  }
+
+  // Certifies again every cell a node of `moved` belongs to, into `quality`. The optimizations
+  // raise the cells' lower bounds; the certified values (subdivided) follow them but not
+  // strictly: a result worse than the input by the certified count or minimum puts the nodes
+  // back at `original` and `quality` as it was. Whether it did.
+  bool certify_or_undo(const std::vector<Index>& moved, const std::vector<Vec<Dim>>& original, std::vector<double>& quality) {
+    const std::vector<double> input_quality = quality;
+    const double min_before = *std::min_element(quality.begin(), quality.end());
+    const auto invalid = [](const std::vector<double>& q) { return std::count_if(q.begin(), q.end(), [](double j) { return j <= 0.0; }); };
+    std::vector<char> touched(where_.size(), 0);
+    for (const Index v : moved)
+      for (const Index c : cells_of(v)) touched[static_cast<std::size_t>(c)] = 1;
+    ScaledJacobianOptions certified;
+    certified.sharp_max = false;
+    for (std::size_t c = 0; c < where_.size(); ++c)
+      if (touched[c]) quality[c] = scaled_jacobian_fixed<Dim>(type_of(static_cast<Index>(c)), coords(static_cast<Index>(c)), certified).certified_min;
+    if (invalid(quality) > invalid(input_quality) || *std::min_element(quality.begin(), quality.end()) < min_before) {
+      for (std::size_t k = 0; k < moved.size(); ++k) mesh_.points.col(moved[k]) = original[k];
+      quality = input_quality;
+      return true;
+    }
+    return false;
+  }
+
   // How far a cell is below the target, squared.
   static double deficit(double j, double target) { return j >= target ? 0.0 : (target - j) * (target - j); }
 
@@ -591,6 +760,19 @@ UntangleReport untangle(Mesh<Dim>& mesh, std::span<const char> fixed, std::vecto
                                     std::numeric_limits<long long>::max(), false, options.untangle_slide, quality);
     add(pass);
     report.reverted = pass.reverted;
+  }
+  // What the node-by-node search left invalid: the nodes of a patch around those cells moved
+  // together, the patch doubled while some stay invalid (three passes at most, within a budget
+  // of cell evaluations).
+  const long long joint_budget = optimizer.evaluations() + std::max<long long>(2'000'000, 50 * static_cast<long long>(quality.size()));
+  for (int layers = std::max(options.untangle_layers, 1);
+       options.untangle_joint && report.joint_passes < 3 && optimizer.evaluations() < joint_budget; layers *= 2) {
+    std::vector<Index> invalid;
+    for (std::size_t c = 0; c < quality.size(); ++c)
+      if (quality[c] <= 0.0) invalid.push_back(static_cast<Index>(c));
+    if (invalid.empty() || below.empty()) break;
+    add(optimizer.run_together(invalid, options.untangle_threshold, layers, 8, 50, joint_budget, quality));
+    ++report.joint_passes;
   }
   // The worst cells first: each round moves the nodes of the `raise_cells` worst cells towards
   // the minimum plus the margin, so it costs a small patch; the rounds stop when the minimum no
