@@ -762,9 +762,13 @@ UntangleReport untangle(Mesh<Dim>& mesh, std::span<const char> fixed, std::vecto
     report.reverted = pass.reverted;
   }
   // What the node-by-node search left invalid: the nodes of a patch around those cells moved
-  // together, the patch doubled while some stay invalid (three passes at most, within a budget
-  // of cell evaluations).
-  const long long joint_budget = optimizer.evaluations() + std::max<long long>(2'000'000, 50 * static_cast<long long>(quality.size()));
+  // together, the patch doubled while some stay invalid (three passes at most), within ten times
+  // the search's cell evaluations (at least 100,000, or 50 a cell): a cell's evaluation costs
+  // alike in both, so on a mesh of any size and order the passes take at most about ten times
+  // the search's time (the shaken P4 squares took 5.5 times) or a fixed allowance.
+  const long long joint_budget =
+      optimizer.evaluations() +
+      std::max({10 * optimizer.evaluations(), 50 * static_cast<long long>(quality.size()), 100'000LL});
   for (int layers = std::max(options.untangle_layers, 1);
        options.untangle_joint && report.joint_passes < 3 && optimizer.evaluations() < joint_budget; layers *= 2) {
     std::vector<Index> invalid;
