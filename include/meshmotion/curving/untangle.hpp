@@ -323,11 +323,12 @@ class PatchOptimizer {
       }
       return low;
     };
-    // F at the nodes' places, and with `gradient` its gradient (Dim × free nodes).
-    double epsilon = 0.0;
+    // F at the nodes' places, and with `gradient` its gradient (Dim × free nodes); a call with
+    // the gradient (always at the accepted places) also leaves their lowest q in `accepted_low`.
+    double epsilon = 0.0, accepted_low = 0.0;
     const auto objective = [&](Field* gradient) {
       if (gradient != nullptr) gradient->setZero(Dim, static_cast<Index>(free_nodes.size()));
-      double sum = 0.0;
+      double sum = 0.0, seen_low = std::numeric_limits<double>::infinity();
       UntangleLattice& q = samples_[0];
       UntangleLattice& moved = samples_[1];
       for (std::size_t i = 0; i < cells.size(); ++i) {
@@ -336,6 +337,7 @@ class PatchOptimizer {
         double linear = 0.0;
         coefficients(type_of(c), x, q, linear);
         q *= scale[i];
+        seen_low = std::min(seen_low, q.minCoeff());
         if (q.minCoeff() >= target) continue;
         if (!(q.minCoeff() > epsilon)) return std::numeric_limits<double>::infinity();
         UntangleLattice& slope = samples_[2];
@@ -364,6 +366,7 @@ class PatchOptimizer {
           }
         }
       }
+      if (gradient != nullptr) accepted_low = seen_low;
       return sum;
     };
     const auto place = [&](const Field& at) {
@@ -399,9 +402,8 @@ class PatchOptimizer {
         const double beta = std::max(0.0, gradient.cwiseProduct(gradient - previous).sum() / previous.squaredNorm());
         direction = -gradient + beta * direction;
       }
-      const double now = lowest();
-      if (!(now > low + 1e-6)) break;
-      low = now;
+      if (!(accepted_low > low + 1e-6)) break;
+      low = accepted_low;
     }
     pass.reverted = certify_or_undo(free_nodes, original, quality);
     return pass;

@@ -120,8 +120,8 @@ template <int Dim>
     const Holder& h = on.front();
     const auto& block = mesh.facets[h.block];
     const int tag = block.tags[static_cast<std::size_t>(h.element)];
-    const auto geo = geometry.find(tag);
-    if (geo == geometry.end() || geo->second.kind != BoundaryGeometry<Dim>::Kind::projection) {
+    const BoundaryGeometry<Dim>* geo = projected(h);
+    if (geo == nullptr) {
       along_edge();
       continue;
     }
@@ -160,7 +160,7 @@ template <int Dim>
     SlidingNode<Dim> node;
     if constexpr (Dim == 2) node.directions = {n};
     else node.directions = tangent_directions<3>(plane_basis<3>(n));
-    node.project = [g = &geo->second, vertices, nv, weights](const Vec<Dim>& x) {
+    node.project = [g = geo, vertices, nv, weights](const Vec<Dim>& x) {
       return g->project_in_facet(std::span<const Vec<Dim>>(vertices.data(), static_cast<std::size_t>(nv)), weights, x);
     };
     out.emplace(v, std::move(node));
