@@ -429,8 +429,8 @@ smoke_test(NAME mesh_info.input_kept.json REQUIRES examples_demo_mesh examples_n
            COMMAND mesh_info "${smoke_dir}/demo.msh" --json)
 smoke_test(NAME curve_mesh.demo_with_input.json EXPECT_RC 1 KEYS error VALUES kind=usage
            COMMAND curve_mesh "${smoke_dir}/demo.msh" --demo -o "${smoke_dir}/demo_and_input.msh" --json)
-smoke_test(NAME curve_mesh.cgns_order4_output.json EXPECT_RC 1 KEYS error
-           COMMAND curve_mesh --demo --order 4 -o "${smoke_dir}/demo_curved_p4.cgns" --json)
+smoke_test(NAME curve_mesh.cgns_order5_output.json EXPECT_RC 1 KEYS error
+           COMMAND curve_mesh --demo --order 5 -o "${smoke_dir}/demo_curved_p5.cgns" --json)
 smoke_test(NAME move_mesh.unknown_output.json REQUIRES examples_demo_mesh EXPECT_RC 1 KEYS error
            COMMAND move_mesh "${smoke_dir}/demo.msh" -o "${smoke_dir}/moved.cgnx" --group wall --rotate 1 --json)
 smoke_test(NAME move_mesh.output_is_input.json EXPECT_RC 1 KEYS error

@@ -237,9 +237,9 @@ def test_cgns_cells_read_by_vtk(type_name):
     """One cell of each type CGNS holds past order 1, on an affine image of its reference element,
     written to .cgns and read by VTK's CGNS reader (its own CGNS-to-VTK orders, which SU2's CGNS
     reader shares for these types): VTK's i-th point of the cell is the image of our node
-    vtk_order[i]. (Past order 3 VTK 9.1 reads no CGNS cell; for the PENTA_40 it starts the face
-    (3, 1, 4, 6) at vertex 1 where SU2 and the SIDS start it at vertex 3: the library writes no
-    cubic prism or pyramid to CGNS.)"""
+    vtk_order[i]. (Past order 3 VTK 9.1 reads no CGNS cell, nor a PYRA_30; for the PENTA_40 it
+    starts the face (3, 1, 4, 6) at vertex 1 where SU2, Gmsh's rules and the SIDS start it at
+    vertex 3, which the library follows: cgns_test.cpp pins those orders.)"""
     vtk = pytest.importorskip("vtk", reason="python3-vtk9 is not installed")
     if not mm.have_cgns:
         pytest.skip("meshmotion was built without the CGNS library")

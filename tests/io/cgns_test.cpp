@@ -217,8 +217,12 @@ void require_input_error(F&& f, const std::vector<std::string>& parts) {
 
 }  // namespace
 
-TEST_CASE("CGNS: every element type, linear, quadratic and cubic, round-trips and passes cgnscheck", "[io][cgns]") {
-  for (const int element_order : {1, 2, 3}) {
+TEST_CASE("CGNS: every element type to order 4 round-trips and passes cgnscheck", "[io][cgns]") {
+  // CGNS names no element past order 4: refused by name before the file exists.
+  CHECK_THROWS_WITH(write_mesh(test::scratch_path("all_types3_p5_refused.cgns"), test::all_types_mesh<3>(5)),
+                    Catch::Contains("elements: CGNS names elements to order 4"));
+  CHECK_FALSE(fs::exists(test::scratch_path("all_types3_p5_refused.cgns")));
+  for (const int element_order : {1, 2, 3, 4}) {
     INFO("order " << element_order);
     const auto check = [&](const auto& mesh, const std::string& stem) {
       using M = std::decay_t<decltype(mesh)>;
@@ -243,15 +247,7 @@ TEST_CASE("CGNS: every element type, linear, quadratic and cubic, round-trips an
       write_mesh(again, a);
       test::require_same_mesh(a, std::get<M>(read_mesh(again)));
     };
-    Mesh<3> mesh3 = test::all_types_mesh<3>(element_order);
-    if (element_order == 3) {
-      // CGNS holds no cubic prism or pyramid: refused by name, the rest written.
-      CHECK_THROWS_WITH(write_mesh(test::scratch_path("all_types3_p3_refused.cgns"), mesh3),
-                        Catch::Contains("prism40 elements") && Catch::Contains("order 3 for lines, triangles"));
-      CHECK_FALSE(fs::exists(test::scratch_path("all_types3_p3_refused.cgns")));
-      std::erase_if(mesh3.cells, [](const ElementBlock& b) { return !detail::cgns_writes(b.type); });
-    }
-    check(mesh3, "all_types3_p" + std::to_string(element_order));
+    check(test::all_types_mesh<3>(element_order), "all_types3_p" + std::to_string(element_order));
     check(test::all_types_mesh<2>(element_order), "all_types2_p" + std::to_string(element_order));
   }
 }
@@ -268,13 +264,40 @@ TEST_CASE("CGNS node orders: a permutation for every type CGNS holds, a refusal 
     std::sort(order_of.begin(), order_of.end());
     for (std::size_t i = 0; i < order_of.size(); ++i) CHECK(order_of[i] == static_cast<int>(i));
   }
-  // The side face on the hexahedron's bottom edge (3, 0) starts at vertex 3: its first inside
-  // node is the one nearest vertex 3 (VTK's and SU2's CGNS readers agree).
-  const auto hex64 = detail::cgns_order(ElementType::hex64);
-  const auto x = reference_nodes(ElementType::hex64)[static_cast<std::size_t>(hex64[48])];
-  CHECK(x[0] == Approx(-1.0));
-  CHECK(x[1] == Approx(1.0 / 3.0));
-  CHECK(x[2] == Approx(-1.0 / 3.0));
+  // Where CGNS's conventions show (SIDS and its cubic and quartic extensions; every order here
+  // agrees node by node with SU2's CGNS reader): CGNS node -> the reference point it sits at.
+  struct Placed {
+    ElementType type;
+    int node;
+    RefPoint at;
+  };
+  const double t = 1.0 / 3.0;
+  const Placed placed[] = {
+      // The side face on the hexahedron's bottom edge (3, 0) starts at vertex 3 (VTK agrees).
+      {ElementType::hex64, 48, {-1, t, -t}},
+      // A cubic prism: the bottom face, each side face's ring from its first vertex toward its
+      // second ((0, 1, 4, 3), (2, 0, 3, 5)), the top face, then the inside from the bottom up.
+      {ElementType::prism40, 24, {t, t, -1}}, {ElementType::prism40, 25, {t, 0, -t}}, {ElementType::prism40, 26, {2 * t, 0, -t}},
+      {ElementType::prism40, 28, {t, 0, t}}, {ElementType::prism40, 33, {0, 2 * t, -t}}, {ElementType::prism40, 37, {t, t, 1}},
+      {ElementType::prism40, 38, {t, t, -t}}, {ElementType::prism40, 39, {t, t, t}},
+      // A cubic pyramid: the base's ring from vertex 0 toward 1, the side faces (0, 1, 4) ..., the inside.
+      {ElementType::pyramid30, 21, {-t, -t, 0}}, {ElementType::pyramid30, 22, {t, -t, 0}},
+      {ElementType::pyramid30, 25, {0, -2 * t, t}}, {ElementType::pyramid30, 29, {0, 0, t}},
+      // Quartic: a quadrilateral's inside goes round its ring, then the centre (Gmsh's nests a P2 quad).
+      {ElementType::quad25, 16, {-0.5, -0.5, 0}}, {ElementType::quad25, 17, {0, -0.5, 0}}, {ElementType::quad25, 19, {0.5, 0, 0}},
+      {ElementType::quad25, 23, {-0.5, 0, 0}}, {ElementType::quad25, 24, {0, 0, 0}},
+      {ElementType::hex125, 44, {-0.5, -0.5, -1}}, {ElementType::hex125, 52, {0, 0, -1}},
+      {ElementType::hex125, 98, {-0.5, -0.5, -0.5}}, {ElementType::hex125, 106, {0, 0, -0.5}}, {ElementType::hex125, 107, {-0.5, -0.5, 0}},
+      {ElementType::tri15, 12, {0.25, 0.25, 0}}, {ElementType::tri15, 13, {0.5, 0.25, 0}}, {ElementType::tri15, 14, {0.25, 0.5, 0}},
+      {ElementType::tet35, 25, {0.25, 0, 0.25}}, {ElementType::tet35, 26, {0.5, 0, 0.25}}, {ElementType::tet35, 27, {0.25, 0, 0.5}},
+      {ElementType::tet35, 34, {0.25, 0.25, 0.25}},
+      {ElementType::prism75, 66, {0.25, 0.25, -0.5}}, {ElementType::prism75, 67, {0.5, 0.25, -0.5}}, {ElementType::prism75, 69, {0.25, 0.25, 0}},
+      {ElementType::pyramid55, 50, {-0.25, -0.25, 0.25}}, {ElementType::pyramid55, 54, {0, 0, 0.5}}};
+  for (const Placed& p : placed) {
+    INFO(name(p.type) << " CGNS node " << p.node);
+    const RefPoint x = reference_nodes(p.type)[static_cast<std::size_t>(detail::cgns_order_of(p.type)[static_cast<std::size_t>(p.node)])];
+    for (std::size_t d = 0; d < 3; ++d) CHECK(x[d] == Approx(p.at[d]).margin(1e-12));
+  }
 }
 
 TEST_CASE("CGNS: mixed P1 and P2 boxes keep orientation, numbering and groups", "[io][cgns]") {
@@ -699,10 +722,10 @@ TEST_CASE("CGNS: each kind of bad file gets a clear error naming the node path",
                           f.section(z, "q", CGNS_ENUMV(QUAD_4), 1, 1, {1, 2, 2, 3});
                         })); },
                       {"/Base/dom/q", "element 1 lists node 2 twice"});
-  require_input_error([&] { (void)read_mesh(one_quad("tri15", [](CgnsBuilder& f, int z) {
-                          f.section(z, "p4", CGNS_ENUMV(TRI_15), 1, 1, {1, 2, 3, 1, 2, 3, 1, 2, 3, 4, 1, 2, 3, 4, 1});
+  require_input_error([&] { (void)read_mesh(one_quad("tri12", [](CgnsBuilder& f, int z) {
+                          f.section(z, "p4", CGNS_ENUMV(TRI_12), 1, 1, {1, 2, 3, 1, 2, 3, 1, 2, 3, 4, 1, 2});
                         })); },
-                      {"/Base/dom/p4", "TRI_15", "up to order 2, and to order 3"});
+                      {"/Base/dom/p4", "TRI_12", "no serendipity ones past order 2"});
   require_input_error([&] { (void)read_mesh(one_quad("two_bcs", [](CgnsBuilder& f, int z) {
                           f.section(z, "q", CGNS_ENUMV(QUAD_4), 1, 1, {1, 2, 4, 3});
                           f.section(z, "e", CGNS_ENUMV(BAR_2), 2, 2, {1, 2});

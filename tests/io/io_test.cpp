@@ -748,7 +748,7 @@ TEST_CASE("every row of the format table is written and read back by its extensi
   }
   CHECK(mesh_format_of(test::scratch_path("mesh.obj")) == nullptr);
   CHECK_THROWS_WITH(check_mesh_output(test::scratch_path("mesh.obj")), Catch::Contains("one of .msh, .su2, .cgns, .vtu"));
-  CHECK_THROWS_WITH(check_mesh_output(test::scratch_path("p4.cgns"), 4), Catch::Contains("up to order 3 (expected one of .msh, .su2, .vtu for order 4)") ||
+  CHECK_THROWS_WITH(check_mesh_output(test::scratch_path("p5.cgns"), 5), Catch::Contains("up to order 4 (expected one of .msh, .su2, .vtu for order 5)") ||
                                                                          Catch::Contains("needs the CGNS library"));
 }
 

@@ -96,10 +96,10 @@ TEST_CASE("outputs are checked before any work", "[io]") {
   CHECK_NOTHROW(check_mesh_output(test::scratch_path("a.msh"), 2));
   CHECK_NOTHROW(check_mesh_output(test::scratch_path("a.su2"), 1));
   CHECK_NOTHROW(check_mesh_output(test::scratch_path("a.su2"), 4));  // SU2's DG-FEM format
-  CHECK_THAT(input_error_of([] { check_mesh_output(test::scratch_path("a.cgns"), 4); }),
-             Catch::Contains("up to order 3") || Catch::Contains("needs the CGNS library"));
+  CHECK_THAT(input_error_of([] { check_mesh_output(test::scratch_path("a.cgns"), 5); }),
+             Catch::Contains("up to order 4") || Catch::Contains("needs the CGNS library"));
   CHECK_THAT(input_error_of([] { check_mesh_output(test::scratch_path("a.vtk"), 1); }), Catch::Contains(".vtk"));
-  if (have_cgns) CHECK_NOTHROW(check_mesh_output(test::scratch_path("a.cgns"), 3));
+  if (have_cgns) CHECK_NOTHROW(check_mesh_output(test::scratch_path("a.cgns"), 4));
   CHECK_THAT(input_error_of([] { check_mesh_output(test::scratch_path("no/such/folder/a.msh"), 1); }),
              Catch::Contains("does not exist"));
 }

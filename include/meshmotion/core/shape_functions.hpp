@@ -248,76 +248,80 @@ inline RefPoint multilinear(std::span<const RefPoint> corners, double s, double 
 
 inline void append_lattice(Shape s, int p, bool complete, std::span<const RefPoint> corners, std::vector<RefPoint>& out);
 
+// The corners of the element inside one of shape s and order p on corners c whose outermost
+// inside nodes they are: a triangle's and a tetrahedron's 1/p in from each side, a
+// quadrilateral's and a hexahedron's 1/p in from each face, a pyramid's homothetic one (its base
+// at height 1/p, its base corners 1 - 3/p of the way from the axis, its apex 2/p below this apex).
+// The element inside is of order p - 3 (triangles, pyramids), p - 4 (tetrahedra) or p - 2.
+inline std::vector<RefPoint> inner_corners(Shape s, int p, std::span<const RefPoint> c) {
+  const double h = 1.0 / p;
+  switch (s) {
+    case Shape::triangle: return {combine(c, {1 - 2 * h, h, h}), combine(c, {h, 1 - 2 * h, h}), combine(c, {h, h, 1 - 2 * h})};
+    case Shape::quadrilateral:
+      return {multilinear(c, h, h), multilinear(c, 1 - h, h), multilinear(c, 1 - h, 1 - h), multilinear(c, h, 1 - h)};
+    case Shape::tetrahedron:
+      return {combine(c, {1 - 3 * h, h, h, h}), combine(c, {h, 1 - 3 * h, h, h}), combine(c, {h, h, 1 - 3 * h, h}),
+              combine(c, {h, h, h, 1 - 3 * h})};
+    case Shape::hexahedron: {
+      std::vector<RefPoint> inner;
+      for (const RefPoint& v : vertex_coordinates(Shape::hexahedron))
+        inner.push_back(multilinear(c, v[0] < 0 ? h : 1 - h, v[1] < 0 ? h : 1 - h, v[2] < 0 ? h : 1 - h));
+      return inner;
+    }
+    case Shape::pyramid: {
+      const RefPoint base = mean_point(c.first(4));
+      std::vector<RefPoint> inner;
+      for (std::size_t k = 0; k < 4; ++k) inner.push_back(combine(std::array<RefPoint, 3>{c[k], c[4], base}, {1 - 3 * h, h, 2 * h}));
+      inner.push_back(combine(std::array<RefPoint, 2>{c[4], base}, {1 - 2 * h, 2 * h}));
+      return inner;
+    }
+    case Shape::point:
+    case Shape::line:
+    case Shape::prism: break;
+  }
+  return {};
+}
+
+// The order of the element on inner_corners(s, p, ...); negative: there are no inside nodes
+// (and for points, lines and prisms, whose insides are not one such element).
+inline int inner_order(Shape s, int p) {
+  switch (s) {
+    case Shape::triangle:
+    case Shape::pyramid: return p - 3;
+    case Shape::tetrahedron: return p - 4;
+    case Shape::quadrilateral:
+    case Shape::hexahedron: return p - 2;
+    case Shape::point:
+    case Shape::line:
+    case Shape::prism: break;
+  }
+  return -1;
+}
+
 // The nodes strictly inside an element of shape s and order p on the given corners: a
 // smaller element of the same shape on its inner corners, laid out recursively (Gmsh's order).
 inline void append_inside(Shape s, int p, std::span<const RefPoint> c, std::vector<RefPoint>& out) {
-  const double h = 1.0 / p;
-  switch (s) {
-    case Shape::triangle:
-      if (p >= 3) {
-        const std::array<RefPoint, 3> inner{combine(c, {1 - 2 * h, h, h}), combine(c, {h, 1 - 2 * h, h}),
-                                            combine(c, {h, h, 1 - 2 * h})};
-        append_lattice(s, p - 3, true, inner, out);
-      }
-      break;
-    case Shape::quadrilateral:
-      if (p >= 2) {
-        const std::array<RefPoint, 4> inner{multilinear(c, h, h), multilinear(c, 1 - h, h), multilinear(c, 1 - h, 1 - h),
-                                            multilinear(c, h, 1 - h)};
-        append_lattice(s, p - 2, true, inner, out);
-      }
-      break;
-    case Shape::tetrahedron:
-      if (p >= 4) {
-        const std::array<RefPoint, 4> inner{combine(c, {1 - 3 * h, h, h, h}), combine(c, {h, 1 - 3 * h, h, h}),
-                                            combine(c, {h, h, 1 - 3 * h, h}), combine(c, {h, h, h, 1 - 3 * h})};
-        append_lattice(s, p - 4, true, inner, out);
-      }
-      break;
-    case Shape::hexahedron:
-      if (p >= 2) {
-        std::array<RefPoint, 8> inner{};
-        const auto unit = vertex_coordinates(Shape::hexahedron);
-        for (std::size_t k = 0; k < 8; ++k) {
-          const RefPoint& v = unit[k];
-          inner[k] = multilinear(c, v[0] < 0 ? h : 1 - h, v[1] < 0 ? h : 1 - h, v[2] < 0 ? h : 1 - h);
-        }
-        append_lattice(s, p - 2, true, inner, out);
-      }
-      break;
-    case Shape::prism: {
-      // The product of the triangle's inside and a line of order p - 2 on the inner levels, the
-      // triangle's node outermost and the line in its own order (both ends first): at order 4,
-      // each inside triangle node at the levels 1/4, 3/4, then 1/2 of the way up.
-      std::vector<RefPoint> triangle;  // on the reference triangle: (u, v) are barycentric weights
-      append_inside(Shape::triangle, p, vertex_coordinates(Shape::triangle), triangle);
-      std::vector<RefPoint> levels;
-      if (p >= 2) {
-        const std::array<RefPoint, 2> ends{RefPoint{h, 0, 0}, RefPoint{1 - h, 0, 0}};
-        append_lattice(Shape::line, p - 2, true, ends, levels);
-      }
-      for (const RefPoint& x : triangle)
-        for (const RefPoint& level : levels) {
-          const double r = level[0], u = x[0], v = x[1];
-          out.push_back(combine(c, {(1 - u - v) * (1 - r), u * (1 - r), v * (1 - r), (1 - u - v) * r, u * r, v * r}));
-        }
-      break;
-    }
-    case Shape::pyramid:
-      // A pyramid of order p - 3, homothetic to this one: its base at height h, its base corners
-      // 1 - 3h of the way from the axis, its apex 2h below this apex.
-      if (p >= 3) {
-        const RefPoint base = mean_point(c.first(4));
-        std::array<RefPoint, 5> inner{};
-        for (std::size_t k = 0; k < 4; ++k)
-          inner[k] = combine(std::array<RefPoint, 3>{c[k], c[4], base}, {1 - 3 * h, h, 2 * h});
-        inner[4] = combine(std::array<RefPoint, 2>{c[4], base}, {1 - 2 * h, 2 * h});
-        append_lattice(s, p - 3, true, inner, out);
-      }
-      break;
-    case Shape::point:
-    case Shape::line: break;
+  if (const int q = inner_order(s, p); q >= 0) {
+    append_lattice(s, q, true, inner_corners(s, p, c), out);
+    return;
   }
+  if (s != Shape::prism) return;  // points and lines, or an element too low in order for inside nodes
+  // The product of the triangle's inside and a line of order p - 2 on the inner levels, the
+  // triangle's node outermost and the line in its own order (both ends first): at order 4,
+  // each inside triangle node at the levels 1/4, 3/4, then 1/2 of the way up.
+  const double h = 1.0 / p;
+  std::vector<RefPoint> triangle;  // on the reference triangle: (u, v) are barycentric weights
+  append_inside(Shape::triangle, p, vertex_coordinates(Shape::triangle), triangle);
+  std::vector<RefPoint> levels;
+  if (p >= 2) {
+    const std::array<RefPoint, 2> ends{RefPoint{h, 0, 0}, RefPoint{1 - h, 0, 0}};
+    append_lattice(Shape::line, p - 2, true, ends, levels);
+  }
+  for (const RefPoint& x : triangle)
+    for (const RefPoint& level : levels) {
+      const double r = level[0], u = x[0], v = x[1];
+      out.push_back(combine(c, {(1 - u - v) * (1 - r), u * (1 - r), v * (1 - r), (1 - u - v) * r, u * r, v * r}));
+    }
 }
 
 // An element of shape s and order p on the given corners, in Gmsh's node order; order 0 is

@@ -450,8 +450,7 @@ class CgnsReader {
       if (ours < 0) {
         const bool high_order = static_cast<int>(t) >= static_cast<int>(CGNS_ENUMV(BAR_4));  // BAR_4 and after: order 3 and 4
         cgns_.fail(path, "element " + std::to_string(number) + " is " + cgns_type_name(t) +
-                             (high_order ? " (meshmotion reads elements up to order 2, and to order 3 for lines, triangles,"
-                                          " quadrilaterals, tetrahedra and hexahedra)"
+                             (high_order ? " (meshmotion reads the complete Lagrange elements: no serendipity ones past order 2)"
                                         : " (not supported)"));
       }
       current = static_cast<ElementType>(ours);

@@ -45,8 +45,7 @@ class CgnsWriter {
       for (const auto& b : *list)
         if (!cgns_writes(b.type))
           throw InputError("write_cgns: " + std::string(name(b.type)) +
-                           " elements: CGNS files are written up to order 2, and to order 3 for lines, triangles,"
-                           " quadrilaterals, tetrahedra and hexahedra (expected .msh or .vtu)");
+                           " elements: CGNS names elements to order 4 (expected .msh or .vtu for higher orders)");
     list_elements();
     plan_sections();
   }

@@ -47,7 +47,7 @@ struct MeshFormatEntry {
 inline constexpr std::array<MeshFormatEntry, 4> mesh_file_formats{{
     {MeshFormat::gmsh, ".msh", 0, "", true},
     {MeshFormat::su2, ".su2", 0, "", true},
-    {MeshFormat::cgns, ".cgns", 3, "CGNS", have_cgns},  // order 3 but for prisms and pyramids
+    {MeshFormat::cgns, ".cgns", 4, "CGNS", have_cgns},  // the orders CGNS names
     {MeshFormat::vtu, ".vtu", 0, "", true},
 }};
 
