@@ -230,8 +230,24 @@ class LinearRepair {
   /// in place. Collective through `gather` (LocalGather for one process).
   template <class Out, class Gather = LocalGather>
   RepairReport repair(Out& out, const Gather& gather = {}) const {
+    if (!active()) return {};
+    // The check reads every vertex of every cell each move: through contiguous columns, as a
+    // map whose stride the compiler knows (a caller's Eigen::Ref, its stride known at run time
+    // only, made the check 70% slower: Python's move_into 0.6 ms on a 40³ box).
+    if (out.outerStride() != Dim) {
+      Points<Dim> copy = out;
+      const RepairReport report = repair(copy, gather);
+      out = copy;
+      return report;
+    }
+    Eigen::Map<Points<Dim>> contiguous(out.data(), Dim, out.cols());
+    return repair_contiguous(contiguous, gather);
+  }
+
+ private:
+  template <class Gather>
+  RepairReport repair_contiguous(Eigen::Map<Points<Dim>>& out, const Gather& gather) const {
     RepairReport report;
-    if (!active()) return report;
     const auto cells = static_cast<Index>(shapes_.size());
     std::vector<char> folded(shapes_.size(), 0);
 #pragma omp parallel for num_threads(::meshmotion::num_threads()) schedule(static)
@@ -308,7 +324,6 @@ class LinearRepair {
     return report;
   }
 
- private:
   /// The gathered patch: its nodes by ascending id, its cells in a canonical order.
   struct Patch {
     std::vector<std::int64_t> ids;
@@ -389,8 +404,7 @@ class LinearRepair {
   /// Whether cell c, its vertices at the reference plus `out`, has left orientation `sign`:
   /// not when no vertex moved relative to the first by more than the cell's margin (its
   /// determinants then cannot have changed sign), else by its determinants.
-  template <class Out>
-  [[nodiscard]] bool is_folded(Index c, int sign, const Out& out) const {
+  [[nodiscard]] bool is_folded(Index c, int sign, const Eigen::Map<Points<Dim>>& out) const {
     if (const float margin = margins_[static_cast<std::size_t>(c)]; margin > 0.0f) {
       const std::int32_t* vertex = nodes_.data() + offsets_[static_cast<std::size_t>(c)];
       const Vec<Dim> first = out.col(vertex[0]);
