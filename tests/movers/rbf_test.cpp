@@ -1422,10 +1422,18 @@ TEST_CASE("set up at rest on a coarse mesh, the cells a half turn folds are repa
       turned.col(k) = Eigen::AngleAxisd(0.8 * std::numbers::pi, Vec<3>::UnitZ()) * hexes.points.col(block.nodes[static_cast<std::size_t>(k)]) -
                       hexes.points.col(block.nodes[static_cast<std::size_t>(k)]);
   Mesh<3> moved_hexes = hexes;
-  moved_hexes.points += hex_mover.move(turned);
+  const Points<3> hex_move = hex_mover.move(turned);
+  moved_hexes.points += hex_move;
   CHECK(hex_mover.stats().folded_cells > 0);
   CHECK(quality_report(moved_hexes, Metric::scaled_jacobian).num_invalid == hex_mover.stats().left_folded);
   CHECK(hex_mover.stats().left_folded < hex_mover.stats().folded_cells / 4);
+  // Into a caller's storage whose columns are not contiguous (4 rows apart): the same repair.
+  Eigen::MatrixXd storage = Eigen::MatrixXd::Constant(4, hexes.num_nodes(), 7.0);
+  Eigen::Map<Points<3>, 0, Eigen::OuterStride<>> strided(storage.data(), 3, hexes.num_nodes(), Eigen::OuterStride<>(4));
+  hex_mover.move_into(turned, strided);
+  CHECK(hex_mover.stats().folded_cells > 0);
+  CHECK(Points<3>(strided) == hex_move);
+  CHECK((storage.row(3).array() == 7.0).all());
 }
 
 TEST_CASE("a linear cell's sign margin: no motion within it flips a corner, one a few times larger does", "[movers]") {
